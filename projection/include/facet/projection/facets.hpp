@@ -1,0 +1,87 @@
+#pragma once
+// Facets: continuous piecewise perspective projections (DESIGN.md, "Facets").
+//
+// A facet is a triangle of three corner points p_i on the base's natural surface (eye frame,
+// metres at unit distance). Its projection maps an eye-frame point X onto the chord plane through
+// the p_i (unit normal n, n·p_i = h > 0) along X's ray, then by the affine map that sends each p_i
+// to its exact output pixel q_i. As one homogeneous matrix:  (q·w, w) = M_q_eye · X  with
+// w = n·X. Neighbours share corners, so shared edges map identically: no cracks, no T-junctions.
+#include <array>
+#include <cstdint>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "facet/projection/warp.hpp"
+
+namespace facet {
+
+// Facets may overlap their neighbours by this much (output pixels) so that no pixel on a seam is
+// lost to rounding; DESIGN.md allows at most 0.05 px.
+inline constexpr double kDefaultGuardPx = 0.03;
+
+struct FacetVertex {
+  glm::dvec3 p_eye;  // corner on the base's natural surface, eye frame
+  glm::dvec2 st;     // base-image coordinates
+  glm::dvec2 q;      // exact output pixel P(p_eye)
+};
+
+struct Facet {
+  std::array<std::uint32_t, 3> vertex{};  // into FacetMesh::vertices, counter-clockwise in q
+  glm::dmat3 M_q_eye{1.0};                // (q·w, w) = M_q_eye · X, w = n·X
+  glm::dvec3 n{0.0};                      // unit chord-plane normal, n·p_i = h > 0
+  double h = 0.0;
+  // Inward unit normals of the planes through the eye and edges (p0,p1), (p1,p2), (p2,p0):
+  // X lies in the facet's pyramid when edge_normal[k]·X >= 0 for every k.
+  std::array<glm::dvec3, 3> edge_normal{};
+
+  // Output pixel of an eye-frame point with n·X > 0.
+  glm::dvec2 project(glm::dvec3 X) const;
+  // Eye → clip for OpenGL with glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE) and reversed-Z:
+  // x_ndc = 2qx/W − 1, y_ndc = 1 − 2qy/H, depth = z_near / (n·X) (1 at n·X = z_near, → 0 far).
+  glm::dmat4 clip_from_eye(glm::ivec2 output_size, double z_near) const;
+};
+
+struct FacetMesh {
+  glm::ivec2 output_size{0, 0};
+  std::vector<FacetVertex> vertices;
+  std::vector<Facet> facets;
+  // The tensor-product layout the facets came from: cell (c, r) spans
+  // [s_breaks[c], s_breaks[c+1]] × [t_breaks[r], t_breaks[r+1]] and holds facets 2·(r·C + c) and
+  // 2·(r·C + c) + 1, where C = s_breaks.size() − 1. Cells outside the coverage hold none and
+  // cell_first_facet marks them with UINT32_MAX.
+  std::vector<double> s_breaks, t_breaks;
+  std::vector<std::uint32_t> cell_first_facet;
+
+  // Guarded clip planes of facet f for gl_ClipDistance: the edge planes of the facet's corners
+  // scaled about its centroid on the chord plane so that each edge moves outwards by at most
+  // guard_px output pixels. X is inside when plane[k]·X >= 0.
+  std::array<glm::dvec3, 3> clip_planes(std::uint32_t f, double guard_px = kDefaultGuardPx) const;
+  // The three corner points of facet f.
+  std::array<glm::dvec3, 3> corners(std::uint32_t f) const;
+};
+
+struct FacetStrips {  // N vertical strips over the whole base image, one row (the seed's cylinder)
+  int count = 0;
+};
+struct FacetGrid {  // a uniform Gx × Gy grid of cells, two facets per cell (the seed's textures)
+  int columns = 0, rows = 0;
+};
+struct FacetTolerance {  // as few facets as the builder can find with max error <= px
+  double px = 0.25;
+};
+using FacetLayout = std::variant<FacetStrips, FacetGrid, FacetTolerance>;
+
+struct FacetBuildOptions {
+  FacetLayout layout = FacetTolerance{};
+  // Upper bound on cells a tolerance build may use before it gives up with InputError.
+  int max_cells = 1 << 20;
+};
+
+// Builds facets over the covered part of the warp. Throws InputError for a layout that cannot
+// be met (a facet spanning 180° or more, a tolerance that needs more than max_cells).
+FacetMesh build_facets(const Warp& warp, const FacetBuildOptions& options);
+
+}  // namespace facet
