@@ -1,0 +1,40 @@
+#pragma once
+// Image files for captures and patterns, through OpenImageIO, plus writing a whole folder
+// atomically.
+#include <filesystem>
+#include <functional>
+#include <string>
+
+#include <glm/glm.hpp>
+#include <opencv2/core.hpp>
+
+namespace facet::calibration {
+
+struct ImageInfo {
+  glm::ivec2 size{0, 0};  // width, height in pixels
+  int channels = 0;
+  std::string format;  // OpenImageIO's name for the file format, e.g. "png", "openexr"
+};
+
+// Reads only the header. Throws InputError(path, "", ...) when the file is missing or unreadable.
+ImageInfo read_image_info(const std::filesystem::path& path);
+
+// Reads an 8- or 16-bit PNG or an EXR (any format OpenImageIO reads) as CV_32F luminance:
+// integer formats are scaled to [0,1] (no colour-space conversion: capture images are linear in
+// light), grey is taken as is and RGB(A) becomes Rec. 709 luminance 0.2126 R + 0.7152 G +
+// 0.0722 B; alpha is ignored and never multiplied in. Throws InputError when unreadable.
+cv::Mat read_luminance(const std::filesystem::path& path);
+
+// Writes a single-channel CV_32F image of values in [0,1] (clamped) as an 8- or 16-bit grey PNG,
+// rounding to the nearest level, or as a float EXR when the extension is .exr; bit_depth is then
+// ignored. Writes to a temporary file and renames it. Asserts on a bad Mat or bit depth; throws
+// InputError when the file cannot be written.
+void write_grey_image(const std::filesystem::path& path, const cv::Mat& image, int bit_depth = 8);
+
+// Calls write(temporary_folder) with a new folder beside `folder`, then renames it onto `folder`.
+// `folder` must not exist or be an empty folder (InputError otherwise). If write throws, the
+// temporary folder is removed and the exception propagates.
+void write_folder_atomically(const std::filesystem::path& folder,
+                             const std::function<void(const std::filesystem::path&)>& write);
+
+}  // namespace facet::calibration

@@ -1,0 +1,135 @@
+#include "facet/calibration/image_io.hpp"
+
+#include <atomic>
+#include <cmath>
+#include <memory>
+#include <system_error>
+#include <vector>
+
+#include <OpenImageIO/imageio.h>
+#include <unistd.h>
+
+#include "facet/projection/atomic_file.hpp"
+#include "facet/projection/errors.hpp"
+
+namespace facet::calibration {
+namespace {
+
+// OpenImageIO premultiplies colour by alpha on read unless told the file's alpha is unassociated;
+// capture images carry light in their colour channels, whatever the alpha says.
+OIIO::ImageSpec unassociated_config() {
+  OIIO::ImageSpec config;
+  config.attribute("oiio:UnassociatedAlpha", 1);
+  return config;
+}
+
+std::unique_ptr<OIIO::ImageInput> open_image(const std::filesystem::path& path) {
+  std::error_code error;
+  if (!std::filesystem::is_regular_file(path, error)) {
+    throw InputError(path.string(), "", "an image file, but there is no such file");
+  }
+  const OIIO::ImageSpec config = unassociated_config();
+  auto input = OIIO::ImageInput::open(path.string(), &config);
+  if (!input) {
+    throw InputError(path.string(), "",
+                     "a readable PNG or EXR image (" + OIIO::geterror() + ")");
+  }
+  return input;
+}
+
+}  // namespace
+
+ImageInfo read_image_info(const std::filesystem::path& path) {
+  auto input = open_image(path);
+  const OIIO::ImageSpec& spec = input->spec();
+  return {{spec.width, spec.height}, spec.nchannels, input->format_name()};
+}
+
+cv::Mat read_luminance(const std::filesystem::path& path) {
+  auto input = open_image(path);
+  const OIIO::ImageSpec spec = input->spec();
+  if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0 || spec.depth != 1) {
+    throw InputError(path.string(), "", "a 2D image with at least one channel");
+  }
+  const int channels = spec.nchannels;
+  std::vector<float> pixels(std::size_t(spec.width) * spec.height * channels);
+  // Integer pixels are converted to float in [0,1] by OpenImageIO (value / max of the type).
+  if (!input->read_image(0, 0, 0, channels, OIIO::TypeDesc::FLOAT, pixels.data())) {
+    throw InputError(path.string(), "", "a readable image (" + input->geterror() + ")");
+  }
+  cv::Mat luminance(spec.height, spec.width, CV_32F);
+  const bool rgb = channels >= 3;  // grey + alpha has 2 channels
+  for (int y = 0; y < spec.height; ++y) {
+    auto* row = luminance.ptr<float>(y);
+    const float* in = pixels.data() + std::size_t(y) * spec.width * channels;
+    for (int x = 0; x < spec.width; ++x, in += channels) {
+      row[x] = rgb ? 0.2126f * in[0] + 0.7152f * in[1] + 0.0722f * in[2] : in[0];
+    }
+  }
+  return luminance;
+}
+
+void write_grey_image(const std::filesystem::path& path, const cv::Mat& image, int bit_depth) {
+  FACET_ASSERT(image.type() == CV_32F && !image.empty());
+  const bool exr = path.extension() == ".exr";
+  FACET_ASSERT(exr || bit_depth == 8 || bit_depth == 16);
+  const OIIO::TypeDesc file_type =
+      exr ? OIIO::TypeDesc::FLOAT : (bit_depth == 8 ? OIIO::TypeDesc::UINT8 : OIIO::TypeDesc::UINT16);
+  OIIO::ImageSpec spec(image.cols, image.rows, 1, file_type);
+  spec.attribute("oiio:UnassociatedAlpha", 1);
+  cv::Mat clamped;
+  cv::Mat contiguous = image.isContinuous() ? image : image.clone();
+  if (exr) {
+    clamped = contiguous;
+  } else {
+    // Round to the nearest level ourselves: OpenImageIO's float to integer conversion would do
+    // the same, but an explicit rounding makes the quantisation of the file well defined.
+    const double levels = bit_depth == 8 ? 255.0 : 65535.0;
+    cv::Mat scaled = cv::min(cv::max(contiguous, 0.0), 1.0);
+    scaled.convertTo(clamped, bit_depth == 8 ? CV_8U : CV_16U, levels);  // saturate_cast rounds
+  }
+  write_atomically(path, [&](const std::filesystem::path& temporary) {
+    auto output = OIIO::ImageOutput::create(temporary.string());
+    if (!output || !output->open(temporary.string(), spec)) {
+      throw InputError(path.string(), "", "a writable image file (" + OIIO::geterror() + ")");
+    }
+    if (!output->write_image(file_type, clamped.data) || !output->close()) {
+      throw InputError(path.string(), "", "a writable image file (" + output->geterror() + ")");
+    }
+  });
+}
+
+void write_folder_atomically(const std::filesystem::path& folder,
+                             const std::function<void(const std::filesystem::path&)>& write) {
+  std::error_code error;
+  if (std::filesystem::exists(folder, error)) {
+    if (!std::filesystem::is_directory(folder, error) ||
+        !std::filesystem::is_empty(folder, error)) {
+      throw InputError(folder.string(), "", "an output folder that does not exist yet or is empty");
+    }
+  }
+  static std::atomic<unsigned> counter{0};
+  const std::filesystem::path absolute = std::filesystem::absolute(folder).lexically_normal();
+  std::filesystem::path parent = absolute.has_filename() ? absolute.parent_path()
+                                                         : absolute.parent_path().parent_path();
+  const std::string name = absolute.has_filename() ? absolute.filename().string()
+                                                   : absolute.parent_path().filename().string();
+  std::filesystem::create_directories(parent, error);
+  if (error) throw InputError(parent.string(), "", "a folder that can be created: " + error.message());
+  const std::filesystem::path temporary =
+      parent / ("." + name + ".tmp" + std::to_string(::getpid()) + "-" + std::to_string(counter++));
+  std::filesystem::create_directory(temporary, error);
+  if (error) {
+    throw InputError(temporary.string(), "", "a folder that can be created: " + error.message());
+  }
+  try {
+    write(temporary);
+    // rename() replaces an empty folder but not a full one, which the check above excluded.
+    std::filesystem::rename(temporary, parent / name);
+  } catch (...) {
+    std::filesystem::remove_all(temporary, error);
+    throw;
+  }
+}
+
+}  // namespace facet::calibration
