@@ -1,0 +1,76 @@
+#pragma once
+// Per-pass GPU timings from GL_TIME_ELAPSED queries, read back frames later so that timing never
+// stalls the pipeline.
+//
+//   GpuTimer timer;
+//   { auto t = timer.scope("pass1 coverage"); ... }   // or begin("...") / end()
+//   { auto t = timer.scope("pass3 draw"); ... }
+//   timer.end_frame();
+//   while (auto frame = timer.poll()) report(*frame);   // frames come out in order
+//
+// GL allows one GL_TIME_ELAPSED query at a time, so passes must not nest (asserted).
+#include <cstdint>
+#include <deque>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "facet/driver/gl_objects.hpp"
+
+namespace facet::driver {
+
+struct PassTime {
+  std::string pass;
+  double milliseconds = 0;  // GPU time between the pass's begin and end
+};
+
+class GpuTimer {
+ public:
+  GpuTimer() = default;
+  GpuTimer(GpuTimer&&) noexcept = default;
+  GpuTimer& operator=(GpuTimer&&) noexcept = default;
+
+  // Starts timing a pass. Needs a current context; no other pass of this timer may be open.
+  void begin(std::string_view pass);
+  void end();
+
+  class Scope {
+   public:
+    explicit Scope(GpuTimer& timer) : timer_(&timer) {}
+    Scope(const Scope&) = delete;
+    Scope& operator=(const Scope&) = delete;
+    ~Scope() { timer_->end(); }
+
+   private:
+    GpuTimer* timer_;
+  };
+  // begin(pass) now, end() when the returned object goes out of scope.
+  [[nodiscard]] Scope scope(std::string_view pass) {
+    begin(pass);
+    return Scope(*this);
+  }
+
+  // Closes the passes recorded since the last end_frame() into one frame.
+  void end_frame();
+  // The oldest closed frame's timings once all its queries are done (immediately with
+  // wait = true, which blocks on the GPU), or nullopt when none is ready.
+  std::optional<std::vector<PassTime>> poll(bool wait = false);
+  // Frames closed but not yet returned by poll().
+  std::size_t pending_frames() const { return frames_.size(); }
+
+  // The GPU clock now, in nanoseconds (GL_TIMESTAMP; only differences mean anything).
+  static std::int64_t timestamp_ns();
+
+ private:
+  struct Pending {
+    std::string pass;
+    Query query;
+  };
+  std::vector<Pending> open_frame_;
+  std::deque<std::vector<Pending>> frames_;
+  std::vector<Query> free_;  // finished queries, reused instead of recreated
+  bool in_pass_ = false;
+};
+
+}  // namespace facet::driver

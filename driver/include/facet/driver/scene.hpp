@@ -1,0 +1,84 @@
+#pragma once
+// A scene as plain CPU data: no GL. `upload_scene` (gpu_scene.hpp) turns it into buffers.
+//
+// Frames and units: vertex positions are in the object's own frame, in metres; an object's
+// T_world_object maps them into the world frame (metres, y up, ground at y = 0 for the built-in
+// city, as in glTF). Triangles are counter-clockwise when seen from their front side.
+#include <glm/mat4x4.hpp>
+#include <glm/vec2.hpp>
+#include <glm/vec3.hpp>
+#include <glm/vec4.hpp>
+
+#include <cstdint>
+#include <limits>
+#include <string>
+#include <vector>
+
+namespace facet::driver {
+
+// Axis-aligned box. Empty (p_min > p_max) until a point is added.
+struct Aabb {
+  glm::vec3 p_min{std::numeric_limits<float>::infinity()};
+  glm::vec3 p_max{-std::numeric_limits<float>::infinity()};
+
+  bool empty() const { return p_min.x > p_max.x || p_min.y > p_max.y || p_min.z > p_max.z; }
+  void extend(const glm::vec3& p);
+  void extend(const Aabb& box);
+  // True when p lies inside the box grown by `margin` (same units) on every side.
+  bool contains(const glm::vec3& p, float margin = 0) const;
+  glm::vec3 centre() const { return 0.5f * (p_min + p_max); }
+};
+
+// An RGBA8 image, rows from the top, sRGB-encoded colour with linear alpha.
+struct Image {
+  std::string name;
+  int width = 0, height = 0;
+  std::vector<std::uint8_t> rgba;  // width * height * 4 bytes
+};
+
+struct Material {
+  std::string name;
+  glm::vec4 base_colour{1.0f};  // linear RGBA factor, multiplied with the texture
+  int texture = -1;             // index into Scene::images, or -1 for none
+  bool repeat = true;           // texture coordinates wrap (else clamp to edge)
+};
+
+// A run of triangles that share one material: indices [first_index, first_index + index_count).
+struct Primitive {
+  std::uint32_t first_index = 0;
+  std::uint32_t index_count = 0;  // a multiple of 3
+  std::uint32_t material = 0;     // index into Scene::materials
+};
+
+// One placed mesh instance. Several objects may share primitives (instancing).
+struct Object {
+  std::string name;
+  glm::mat4 T_world_object{1.0f};
+  std::uint32_t first_primitive = 0, primitive_count = 0;  // range in Scene::primitives
+  Aabb bounds_world;  // tight box around this object's vertices, in the world frame
+};
+
+struct Scene {
+  std::string name;
+  // Vertex attributes, one entry per vertex, in the object frame of the objects using them.
+  std::vector<glm::vec3> positions;  // metres
+  std::vector<glm::vec3> normals;    // unit length
+  std::vector<glm::vec2> uvs;        // texture coordinates, (0,0) = first texel of the first row
+  std::vector<std::uint32_t> indices;  // triangle list into the vertex arrays
+  std::vector<Primitive> primitives;
+  std::vector<Object> objects;
+  std::vector<Material> materials;
+  std::vector<Image> images;
+
+  // Triangles drawn, counting each instance: sum over objects of their primitives' triangles.
+  std::size_t triangle_count() const;
+  // Union of the objects' world bounds.
+  Aabb bounds_world() const;
+  // Recomputes every object's bounds_world from its vertices and T_world_object.
+  void update_bounds();
+};
+
+// 64-bit FNV-1a over the vertex, index and primitive data (exact bits): equal scenes hash equal.
+std::uint64_t geometry_hash(const Scene& scene);
+
+}  // namespace facet::driver

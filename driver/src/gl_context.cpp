@@ -1,0 +1,61 @@
+#include "facet/driver/gl_context.hpp"
+
+#include <epoxy/gl.h>
+
+#include <cstdio>
+
+#include "gl_context_internal.hpp"
+
+namespace facet::driver {
+
+namespace {
+
+std::string gl_string(GLenum name) {
+  const auto* s = reinterpret_cast<const char*>(glGetString(name));
+  return s ? std::string(s) : std::string();
+}
+
+void GLAPIENTRY print_debug_message(GLenum /*source*/, GLenum /*type*/, GLuint /*id*/,
+                                    GLenum severity, GLsizei length, const GLchar* message,
+                                    const void* /*user*/) {
+  if (severity != GL_DEBUG_SEVERITY_HIGH && severity != GL_DEBUG_SEVERITY_MEDIUM) return;
+  std::fprintf(stderr, "facet GL debug: %.*s\n", static_cast<int>(length), message);
+}
+
+}  // namespace
+
+void GlContext::read_info_and_check(std::string platform) {
+  info_.platform = std::move(platform);
+  info_.vendor = gl_string(GL_VENDOR);
+  info_.renderer = gl_string(GL_RENDERER);
+  info_.version = gl_string(GL_VERSION);
+  // epoxy_gl_version() parses GL_VERSION and works on contexts too old for GL_MAJOR_VERSION.
+  const int version = epoxy_gl_version();
+  info_.major = version / 10;
+  info_.minor = version % 10;
+  if (version < 45)
+    throw GlContextError("GL context (" + info_.platform + ", " + info_.renderer +
+                         ") offers OpenGL " + info_.version + "; facet needs 4.5 core");
+  info_.glsl_version = gl_string(GL_SHADING_LANGUAGE_VERSION);
+  GLint mask = 0, flags = 0;
+  glGetIntegerv(GL_CONTEXT_PROFILE_MASK, &mask);
+  glGetIntegerv(GL_CONTEXT_FLAGS, &flags);
+  info_.core_profile = (mask & GL_CONTEXT_CORE_PROFILE_BIT) != 0;
+  info_.debug = (flags & GL_CONTEXT_FLAG_DEBUG_BIT) != 0;
+  if (!info_.core_profile)
+    throw GlContextError("GL context (" + info_.platform + ", " + info_.renderer +
+                         ") is not a core profile context");
+}
+
+namespace detail {
+
+void install_debug_output() {
+  glEnable(GL_DEBUG_OUTPUT);
+  // Synchronous, so that a message's stack trace points at the offending call.
+  glEnable(GL_DEBUG_OUTPUT_SYNCHRONOUS);
+  glDebugMessageCallback(print_debug_message, nullptr);
+}
+
+}  // namespace detail
+
+}  // namespace facet::driver

@@ -1,0 +1,76 @@
+// The headless context: GL 4.5 core on whatever EGL offers (llvmpipe here), typed errors, and
+// more than one context per process.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+
+#include "facet/driver/gl_objects.hpp"
+#include "gl_test_context.hpp"
+
+namespace facet::driver {
+namespace {
+
+TEST(GlContext, HeadlessIsGl45Core) {
+  GlContext& context = test::shared_context();
+  const GlInfo& info = context.info();
+  std::printf("GL: %s | %s | %s | GLSL %s | %s\n", info.vendor.c_str(), info.renderer.c_str(),
+              info.version.c_str(), info.glsl_version.c_str(), info.platform.c_str());
+  EXPECT_GE(info.major * 10 + info.minor, 45);
+  EXPECT_TRUE(info.core_profile);
+  EXPECT_FALSE(info.renderer.empty());
+  EXPECT_FALSE(info.vendor.empty());
+  EXPECT_FALSE(context.has_default_framebuffer());
+  EXPECT_EQ(context.framebuffer_size(), glm::ivec2(0, 0));
+  // The live context agrees with what was recorded.
+  GLint major = 0, minor = 0;
+  glGetIntegerv(GL_MAJOR_VERSION, &major);
+  glGetIntegerv(GL_MINOR_VERSION, &minor);
+  EXPECT_EQ(major, info.major);
+  EXPECT_EQ(minor, info.minor);
+  EXPECT_NO_THROW(check_gl_error("HeadlessIsGl45Core"));
+}
+
+TEST(GlContext, TwoContextsCoexist) {
+  GlContext& first = test::shared_context();
+  Buffer in_first = Buffer::create(16);
+  {
+    auto second = create_headless_context({});
+    ASSERT_TRUE(second);
+    second->make_current();
+    Buffer in_second = Buffer::create(16);
+    EXPECT_TRUE(glIsBuffer(in_second.id()));
+    in_second.reset();
+  }  // destroying the second context must leave the shared EGL display usable
+  first.make_current();
+  EXPECT_TRUE(glIsBuffer(in_first.id()));
+  Buffer again = Buffer::create(16);
+  EXPECT_TRUE(glIsBuffer(again.id()));
+  EXPECT_NO_THROW(check_gl_error("TwoContextsCoexist"));
+}
+
+TEST(GlContext, NoMatchingDeviceGivesTypedError) {
+  HeadlessOptions options;
+  options.platform = EglPlatform::device;
+  options.device_index = 100000;  // no machine has this many EGL devices
+  try {
+    auto context = create_headless_context(options);
+    ADD_FAILURE() << "expected GlContextError";
+  } catch (const GlContextError& e) {
+    EXPECT_NE(std::string(e.what()).find("no OpenGL 4.5 core context"), std::string::npos)
+        << e.what();
+  }
+  test::shared_context();  // the failed attempt must not disturb the current context
+  EXPECT_NO_THROW(check_gl_error("NoMatchingDeviceGivesTypedError"));
+}
+
+TEST(GlContext, DebugContextCanBeRequested) {
+  HeadlessOptions options;
+  options.debug = true;
+  auto context = create_headless_context(options);
+  EXPECT_TRUE(context->info().debug);
+  context.reset();
+  test::shared_context();
+}
+
+}  // namespace
+}  // namespace facet::driver

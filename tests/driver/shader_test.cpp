@@ -1,0 +1,125 @@
+// Embedded shaders: all of them compile on the test driver, and compile or link errors name the
+// file and the line of the original file, whatever preamble the builder added.
+#include <gtest/gtest.h>
+
+#include "facet/driver/program.hpp"
+#include "facet/driver/shader_library.hpp"
+#include "gl_test_context.hpp"
+
+namespace facet::driver {
+namespace {
+
+TEST(Shaders, LibraryHoldsTheShaderFiles) {
+  const auto shaders = embedded_shaders();
+  ASSERT_GE(shaders.size(), 5u);
+  for (std::size_t i = 1; i < shaders.size(); ++i)
+    EXPECT_LT(shaders[i - 1].name, shaders[i].name) << "embedded_shaders() must be sorted";
+  const EmbeddedShader& fill = embedded_shader("test/fill_ssbo.comp");
+  EXPECT_NE(fill.text.find("values[i] = i * i + offset"), std::string_view::npos);
+  EXPECT_THROW(embedded_shader("test/no_such_shader.frag"), std::out_of_range);
+}
+
+TEST(Shaders, EveryEmbeddedShaderCompiles) {
+  test::shared_context();
+  for (const EmbeddedShader& shader : embedded_shaders()) {
+    SCOPED_TRACE(std::string(shader.name));
+    EXPECT_NO_THROW({
+      Shader compiled = compile_shader(stage_from_name(shader.name), shader.name, shader.text);
+      EXPECT_NE(compiled.id(), 0u);
+    });
+  }
+}
+
+TEST(Shaders, ComposedSourceKeepsLineNumbers) {
+  const std::string composed =
+      compose_shader_source("// comment\n#version 460 core\nvoid main() {}\n",
+                            {{"A", "1"}, {"B", ""}});
+  EXPECT_EQ(composed,
+            "#version 460 core\n#define A 1\n#define B \n#line 1\n// comment\n\nvoid main() {}\n");
+  EXPECT_EQ(compose_shader_source("void main() {}", {}),
+            "#version 450 core\n#line 1\nvoid main() {}");
+}
+
+// Line 6 of this text has the error. It is an undeclared name rather than a missing semicolon,
+// because drivers report a missing semicolon on the line of the next token.
+constexpr const char* broken_fragment =
+    "// A shader with one error.\n"               // 1
+    "layout(location = 0) out vec4 colour;\n"     // 2
+    "\n"                                          // 3
+    "void main() {\n"                             // 4
+    "  vec4 base = vec4(SCALE);\n"                // 5
+    "  colour = base * undeclared_name;\n"        // 6
+    "}\n";                                        // 7
+
+TEST(Shaders, CompileErrorNamesFileAndLine) {
+  test::shared_context();
+  const std::vector<ShaderDefine> defines = {{"SCALE", "0.5"}, {"UNUSED_A", "1"}, {"UNUSED_B", ""}};
+  try {
+    compile_shader(ShaderStage::fragment, "shaders/broken.frag", broken_fragment, defines);
+    FAIL() << "expected ShaderError";
+  } catch (const ShaderError& e) {
+    EXPECT_EQ(e.file(), "shaders/broken.frag");
+    EXPECT_EQ(e.line(), 6) << e.what();
+    EXPECT_NE(std::string(e.what()).find("shaders/broken.frag:6"), std::string::npos) << e.what();
+  }
+}
+
+TEST(Shaders, CompileErrorLineWithTheFilesOwnVersion) {
+  test::shared_context();
+  // The file's own #version (line 2) moves above the defines; numbering must not shift.
+  const std::string text = std::string("// header\n#version 450 core\n") +
+                           "layout(location = 0) out vec4 colour;\n"  // 3
+                           "void main() {\n"                          // 4
+                           "  colour = vec4(missing);\n"              // 5
+                           "}\n";
+  try {
+    ProgramBuilder().define("X", 3).source(ShaderStage::fragment, "own_version.frag", text).link();
+    FAIL() << "expected ShaderError";
+  } catch (const ShaderError& e) {
+    EXPECT_EQ(e.file(), "own_version.frag");
+    EXPECT_EQ(e.line(), 5) << e.what();
+  }
+}
+
+TEST(Shaders, LinkErrorNamesTheProgramsFiles) {
+  test::shared_context();
+  ProgramBuilder builder;
+  builder.source(ShaderStage::vertex, "a.vert", "void main() { gl_Position = vec4(0.0); }\n");
+  builder.source(ShaderStage::fragment, "b.frag",
+                 "in vec4 never_written;\nlayout(location = 0) out vec4 c;\n"
+                 "void main() { c = never_written; }\n");
+  try {
+    builder.link();
+    FAIL() << "expected ShaderError";
+  } catch (const ShaderError& e) {
+    EXPECT_NE(e.file().find("a.vert"), std::string::npos);
+    EXPECT_NE(e.file().find("b.frag"), std::string::npos);
+    EXPECT_EQ(e.line(), 0);
+  }
+}
+
+TEST(Shaders, EmbeddedErrorsUseTheShadersPath) {
+  test::shared_context();
+  // A bad define breaks the fragment shader where the macro is used; the error names the
+  // embedded file by its path under shaders/.
+  try {
+    ProgramBuilder().shader("test/triangle.vert").shader("test/triangle.frag")
+        .define("TEST_COLOUR_SCALE", "not a number +").link();
+    FAIL() << "expected ShaderError";
+  } catch (const ShaderError& e) {
+    EXPECT_EQ(e.file(), "shaders/test/triangle.frag") << e.what();
+  }
+}
+
+TEST(Shaders, StageFromName) {
+  EXPECT_EQ(stage_from_name("x/y.vert"), ShaderStage::vertex);
+  EXPECT_EQ(stage_from_name("y.tesc"), ShaderStage::tess_control);
+  EXPECT_EQ(stage_from_name("y.tese"), ShaderStage::tess_evaluation);
+  EXPECT_EQ(stage_from_name("y.geom"), ShaderStage::geometry);
+  EXPECT_EQ(stage_from_name("y.frag"), ShaderStage::fragment);
+  EXPECT_EQ(stage_from_name("y.comp"), ShaderStage::compute);
+  EXPECT_THROW(stage_from_name("y.glsl"), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace facet::driver
