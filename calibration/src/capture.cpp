@@ -1,0 +1,338 @@
+#include "facet/calibration/capture.hpp"
+
+#include <cmath>
+#include <fstream>
+#include <set>
+
+#include "facet/calibration/image_io.hpp"
+#include "facet/projection/atomic_file.hpp"
+#include "facet/projection/errors.hpp"
+#include "json_fields.hpp"
+
+namespace facet::calibration {
+namespace {
+
+using detail::JsonContext;
+
+bool valid_name(const std::string& name) {
+  if (name.empty() || name.front() == '.' || name.size() > 128) return false;
+  for (char ch : name) {
+    const bool ok = (ch >= 'a' && ch <= 'z') || (ch >= 'A' && ch <= 'Z') ||
+                    (ch >= '0' && ch <= '9') || ch == '_' || ch == '-' || ch == '.';
+    if (!ok) return false;
+  }
+  return true;
+}
+
+void check_relative_path(const std::filesystem::path& path, const JsonContext& at) {
+  if (path.empty() || path.is_absolute()) at.fail("a file path relative to the capture folder");
+}
+
+void check_rotation(const glm::dmat3& R, const JsonContext& at) {
+  const glm::dmat3 error = glm::transpose(R) * R - glm::dmat3(1.0);
+  double worst = 0;
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) worst = std::max(worst, std::abs(error[i][j]));
+  }
+  if (worst > 1e-6 || glm::determinant(R) <= 0) {
+    at.fail("a rotation matrix (orthonormal within 1e-6, determinant +1)");
+  }
+}
+
+bool is_unit(const glm::dvec3& v) { return std::abs(glm::length(v) - 1.0) <= 1e-6; }
+
+Screen screen_from_json(const nlohmann::json& object, const JsonContext& at) {
+  using namespace detail;
+  require_object(object, at);
+  const std::string expected_type = "\"sphere\", \"cylinder\" or \"plane\"";
+  const std::string type =
+      to_string(require_member(object, "type", at, expected_type), at.at("type"));
+  Screen screen;
+  auto read_radius = [&] {
+    const double radius =
+        to_number(require_member(object, "radius", at, "a positive number of metres"),
+                  at.at("radius"));
+    if (!(radius > 0)) at.at("radius").fail("a positive number of metres");
+    return radius;
+  };
+  auto read_unit = [&](const std::string& key) {
+    const glm::dvec3 v = to_dvec3(require_member(object, key, at, "a list of 3 numbers"), at.at(key));
+    const double length = glm::length(v);
+    if (!(length > 1e-12)) at.at(key).fail("a non-zero vector");
+    return v / length;
+  };
+  if (type == "sphere") {
+    screen.type = Screen::Type::sphere;
+    screen.center = to_dvec3(require_member(object, "center", at, "a point in metres"),
+                             at.at("center"));
+    screen.radius = read_radius();
+  } else if (type == "cylinder") {
+    screen.type = Screen::Type::cylinder;
+    screen.center = to_dvec3(require_member(object, "center", at, "a point in metres"),
+                             at.at("center"));
+    screen.axis = read_unit("axis");
+    screen.radius = read_radius();
+  } else if (type == "plane") {
+    screen.type = Screen::Type::plane;
+    screen.point = to_dvec3(require_member(object, "point", at, "a point in metres"),
+                            at.at("point"));
+    screen.normal = read_unit("normal");
+  } else {
+    at.at("type").fail(expected_type);
+  }
+  return screen;
+}
+
+nlohmann::json screen_to_json(const Screen& screen) {
+  using detail::from_dvec3;
+  switch (screen.type) {
+    case Screen::Type::sphere:
+      return {{"type", "sphere"}, {"center", from_dvec3(screen.center)}, {"radius", screen.radius}};
+    case Screen::Type::cylinder:
+      return {{"type", "cylinder"},
+              {"center", from_dvec3(screen.center)},
+              {"axis", from_dvec3(screen.axis)},
+              {"radius", screen.radius}};
+    case Screen::Type::plane:
+      return {{"type", "plane"},
+              {"point", from_dvec3(screen.point)},
+              {"normal", from_dvec3(screen.normal)}};
+  }
+  FACET_ASSERT(false);
+}
+
+CaptureProjector projector_from_json(const nlohmann::json& object, const JsonContext& at) {
+  using namespace detail;
+  require_object(object, at);
+  CaptureProjector projector;
+  projector.name = to_string(require_member(object, "name", at, "a name"), at.at("name"));
+  const auto& size = require_member(object, "size", at, "[width, height] in projector pixels");
+  if (!size.is_array() || size.size() != 2) {
+    at.at("size").fail("[width, height] in projector pixels");
+  }
+  projector.size = {to_int(size[0], at.at("size").at(0)), to_int(size[1], at.at("size").at(1))};
+  if (const auto* gamma = find_member(object, "gamma")) {
+    projector.gamma = to_number(*gamma, at.at("gamma"));
+  }
+  const auto& frames = require_member(object, "frames", at, "a list of frames");
+  if (!frames.is_array()) at.at("frames").fail("a list of frames");
+  for (std::size_t k = 0; k < frames.size(); ++k) {
+    const JsonContext frame_at = at.at("frames").at(k);
+    require_object(frames[k], frame_at);
+    CaptureFrame frame;
+    frame.file = to_string(require_member(frames[k], "file", frame_at, "an image file name"),
+                           frame_at.at("file"));
+    frame.pattern =
+        pattern_from_json(require_member(frames[k], "pattern", frame_at, "a pattern object"),
+                          at.source, frame_at.member("pattern"));
+    projector.frames.push_back(std::move(frame));
+  }
+  return projector;
+}
+
+}  // namespace
+
+void validate_capture(const Capture& capture, const std::string& source) {
+  const JsonContext root{source, ""};
+  check_relative_path(capture.camera.model, root.at("camera").at("model"));
+  check_rotation(capture.camera.R_eye_camera, root.at("camera").at("R_eye_camera"));
+  for (int i = 0; i < 3; ++i) {
+    if (!std::isfinite(capture.camera.t_eye_camera[i])) {
+      root.at("camera").at("t_eye_camera").fail("a list of 3 finite numbers");
+    }
+  }
+  if (!(capture.camera.gamma > 0) || !std::isfinite(capture.camera.gamma)) {
+    root.at("camera").at("gamma").fail("a positive number");
+  }
+  if (capture.camera.t_eye_camera != glm::dvec3(0.0) && !capture.screen) {
+    root.at("screen").fail(
+        "a screen description: the camera is not at the eye point (t_eye_camera is not 0), so "
+        "directions from the eye need the surface");
+  }
+  if (capture.screen) {
+    const Screen& screen = *capture.screen;
+    const JsonContext at = root.at("screen");
+    if (screen.type != Screen::Type::plane && !(screen.radius > 0)) {
+      at.at("radius").fail("a positive number of metres");
+    }
+    if (screen.type == Screen::Type::cylinder && !is_unit(screen.axis)) {
+      at.at("axis").fail("a unit vector");
+    }
+    if (screen.type == Screen::Type::plane && !is_unit(screen.normal)) {
+      at.at("normal").fail("a unit vector");
+    }
+  }
+  if (capture.projectors.empty()) root.at("projectors").fail("a non-empty list of projectors");
+  std::set<std::string> names;
+  for (std::size_t p = 0; p < capture.projectors.size(); ++p) {
+    const CaptureProjector& projector = capture.projectors[p];
+    const JsonContext at = root.at("projectors").at(p);
+    if (!valid_name(projector.name)) {
+      at.at("name").fail(
+          "a name of letters, digits, '_', '-' and '.' that does not start with '.' (it names "
+          "files)");
+    }
+    if (!names.insert(projector.name).second) {
+      at.at("name").fail("a name no other projector has, but '" + projector.name + "' repeats");
+    }
+    if (projector.size.x < 1 || projector.size.y < 1 || projector.size.x > 65536 ||
+        projector.size.y > 65536) {
+      at.at("size").fail("[width, height], each from 1 to 65536");
+    }
+    if (!(projector.gamma > 0) || !std::isfinite(projector.gamma)) {
+      at.at("gamma").fail("a positive number");
+    }
+    if (projector.frames.empty()) at.at("frames").fail("a non-empty list of frames");
+    std::set<std::string> seen;
+    for (std::size_t k = 0; k < projector.frames.size(); ++k) {
+      const CaptureFrame& frame = projector.frames[k];
+      const JsonContext frame_at = at.at("frames").at(k);
+      check_relative_path(frame.file, frame_at.at("file"));
+      const Pattern& pattern = frame.pattern;
+      if (pattern.type == PatternType::gray) {
+        const int axis_size = pattern.axis == Axis::x ? projector.size.x : projector.size.y;
+        const int bits = gray_bits(axis_size);
+        if (pattern.bit < 0 || pattern.bit >= bits) {
+          frame_at.at("pattern").at("bit").fail(
+              "a bit from 0 to " + std::to_string(bits - 1) + " (ceil(log2(" +
+              std::to_string(axis_size) + ")) bits identify every pixel of this axis)");
+        }
+      }
+      if (pattern.type == PatternType::phase &&
+          (!(pattern.period > 0) || pattern.steps < 3 || pattern.step < 0 ||
+           pattern.step >= pattern.steps)) {
+        frame_at.at("pattern").fail("a phase pattern with period > 0, steps >= 3, 0 <= step < steps");
+      }
+      if (!seen.insert(pattern_to_json(pattern).dump()).second) {
+        frame_at.at("pattern").fail("a pattern that no other frame of this projector shows");
+      }
+    }
+  }
+  if (capture.truth) check_relative_path(*capture.truth, root.at("truth"));
+}
+
+Capture read_capture(const std::filesystem::path& path) {
+  using namespace detail;
+  std::error_code error;
+  const std::filesystem::path file =
+      std::filesystem::is_directory(path, error) ? path / "capture.json" : path;
+  const std::string source = file.string();
+  std::ifstream stream(file);
+  if (!stream) throw InputError(source, "", "a readable capture.json file");
+  nlohmann::json root;
+  try {
+    root = nlohmann::json::parse(stream);
+  } catch (const nlohmann::json::parse_error& parse_error) {
+    throw InputError(source, "", std::string("valid JSON (") + parse_error.what() + ")");
+  }
+  const JsonContext at{source, ""};
+  require_object(root, at);
+  const auto& format = require_member(root, "format", at, std::string("\"") + kCaptureFormat + "\"");
+  if (!format.is_string() || format.get<std::string>() != kCaptureFormat) {
+    at.at("format").fail(std::string("\"") + kCaptureFormat + "\"");
+  }
+
+  Capture capture;
+  capture.folder = file.parent_path();
+  const JsonContext camera_at = at.at("camera");
+  const auto& camera = require_object(require_member(root, "camera", at, "a camera object"),
+                                      camera_at);
+  capture.camera.model =
+      to_string(require_member(camera, "model", camera_at, "an mrcal .cameramodel file"),
+                camera_at.at("model"));
+  if (const auto* R = find_member(camera, "R_eye_camera")) {
+    capture.camera.R_eye_camera = to_dmat3(*R, camera_at.at("R_eye_camera"));
+  }
+  if (const auto* t = find_member(camera, "t_eye_camera")) {
+    capture.camera.t_eye_camera = to_dvec3(*t, camera_at.at("t_eye_camera"));
+  }
+  if (const auto* gamma = find_member(camera, "gamma")) {
+    capture.camera.gamma = to_number(*gamma, camera_at.at("gamma"));
+  }
+  if (const auto* screen = find_member(root, "screen"); screen != nullptr && !screen->is_null()) {
+    capture.screen = screen_from_json(*screen, at.at("screen"));
+  }
+  const auto& projectors = require_member(root, "projectors", at, "a list of projectors");
+  if (!projectors.is_array()) at.at("projectors").fail("a list of projectors");
+  for (std::size_t p = 0; p < projectors.size(); ++p) {
+    capture.projectors.push_back(projector_from_json(projectors[p], at.at("projectors").at(p)));
+  }
+  if (const auto* truth = find_member(root, "truth"); truth != nullptr && !truth->is_null()) {
+    capture.truth = to_string(*truth, at.at("truth"));
+  }
+  validate_capture(capture, source);
+  if (!std::filesystem::is_regular_file(capture.resolve(capture.camera.model), error)) {
+    camera_at.at("model").fail("an mrcal .cameramodel file, but '" +
+                               capture.resolve(capture.camera.model).string() +
+                               "' does not exist");
+  }
+  return capture;
+}
+
+nlohmann::json capture_to_json(const Capture& capture) {
+  nlohmann::json camera{{"model", capture.camera.model.generic_string()},
+                        {"R_eye_camera", detail::from_dmat3(capture.camera.R_eye_camera)},
+                        {"t_eye_camera", detail::from_dvec3(capture.camera.t_eye_camera)}};
+  if (capture.camera.gamma != 1.0) camera["gamma"] = capture.camera.gamma;
+  nlohmann::json projectors = nlohmann::json::array();
+  for (const CaptureProjector& projector : capture.projectors) {
+    nlohmann::json frames = nlohmann::json::array();
+    for (const CaptureFrame& frame : projector.frames) {
+      frames.push_back({{"file", frame.file.generic_string()},
+                        {"pattern", pattern_to_json(frame.pattern)}});
+    }
+    projectors.push_back({{"name", projector.name},
+                          {"size", {projector.size.x, projector.size.y}},
+                          {"gamma", projector.gamma},
+                          {"frames", frames}});
+  }
+  nlohmann::json root{{"format", kCaptureFormat}, {"camera", camera}, {"projectors", projectors}};
+  if (capture.screen) root["screen"] = screen_to_json(*capture.screen);
+  if (capture.truth) root["truth"] = capture.truth->generic_string();
+  return root;
+}
+
+void write_capture(const Capture& capture, const std::filesystem::path& capture_json) {
+  validate_capture(capture, capture_json.string());
+  const std::string text = capture_to_json(capture).dump(1) + "\n";
+  write_atomically(capture_json, [&](const std::filesystem::path& temporary) {
+    std::ofstream stream(temporary);
+    stream << text;
+    stream.close();
+    if (!stream) throw InputError(capture_json.string(), "", "a writable file");
+  });
+}
+
+glm::ivec2 check_capture_images(const Capture& capture, std::size_t projector_index) {
+  FACET_ASSERT(projector_index < capture.projectors.size());
+  const CaptureProjector& projector = capture.projectors[projector_index];
+  std::optional<glm::ivec2> size;
+  std::filesystem::path first;
+  for (const CaptureFrame& frame : projector.frames) {
+    const std::filesystem::path path = capture.resolve(frame.file);
+    const ImageInfo info = read_image_info(path);
+    if (!size) {
+      size = info.size;
+      first = path;
+    } else if (info.size != *size) {
+      throw InputError(path.string(), "",
+                       "an image of the same size as the other frames (" +
+                           std::to_string(size->x) + "x" + std::to_string(size->y) + ", as " +
+                           first.filename().string() + "), but it is " +
+                           std::to_string(info.size.x) + "x" + std::to_string(info.size.y));
+    }
+  }
+  FACET_ASSERT(size.has_value());
+  return *size;
+}
+
+cv::Mat load_frame(const Capture& capture, const CaptureFrame& frame) {
+  cv::Mat image = read_luminance(capture.resolve(frame.file));
+  if (capture.camera.gamma != 1.0) {
+    cv::max(image, 0.0, image);
+    cv::pow(image, capture.camera.gamma, image);
+  }
+  return image;
+}
+
+}  // namespace facet::calibration
