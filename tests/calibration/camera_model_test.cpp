@@ -1,0 +1,125 @@
+#include <filesystem>
+#include <fstream>
+
+#include <gtest/gtest.h>
+
+#include "facet/calibration/camera_model.hpp"
+#include "facet/projection/errors.hpp"
+#include "test_folder.hpp"
+
+namespace fc = facet::calibration;
+
+namespace {
+
+const std::filesystem::path kData(FACET_SHARED_DATA_DIR);
+
+struct RoundTrip {
+  double worst_px = 0;
+  int samples = 0;
+  int failures = 0;
+};
+
+// project(unproject(q)) over a grid of pixels inside the model's valid region.
+RoundTrip round_trip(const fc::CameraModel& camera, int nx, int ny) {
+  RoundTrip result;
+  const glm::dvec2 size(camera.imager_size());
+  for (int j = 0; j < ny; ++j) {
+    for (int i = 0; i < nx; ++i) {
+      const glm::dvec2 q((i + 0.5) / nx * size.x - 0.5, (j + 0.5) / ny * size.y - 0.5);
+      if (!camera.is_valid_pixel(q)) continue;
+      ++result.samples;
+      const auto v = camera.unproject(q);
+      const auto q_back = v ? camera.project(*v) : std::nullopt;
+      if (!q_back) {
+        ++result.failures;
+        continue;
+      }
+      EXPECT_NEAR(glm::length(*v), 1.0, 1e-12);
+      result.worst_px = std::max(result.worst_px, glm::length(*q_back - q));
+    }
+  }
+  return result;
+}
+
+}  // namespace
+
+TEST(CameraModel, ReadsRealMrcalModels) {
+  const auto opencv8 = fc::CameraModel::read(kData / "cameras/mrcal-figueroa/opencv8-0.cameramodel");
+  EXPECT_EQ(opencv8.lensmodel(), "LENSMODEL_OPENCV8");
+  EXPECT_EQ(opencv8.intrinsics().size(), 12u);
+  EXPECT_EQ(opencv8.imager_size(), glm::ivec2(6016, 4016));
+  EXPECT_GE(opencv8.valid_intrinsics_region().size(), 10u);
+  EXPECT_EQ(opencv8.valid_intrinsics_region().front(), glm::dvec2(622, 0));
+
+  const auto splined = fc::CameraModel::read(kData / "cameras/mrcal-figueroa/splined-0.cameramodel");
+  EXPECT_EQ(splined.lensmodel(),
+            "LENSMODEL_SPLINED_STEREOGRAPHIC_order=3_Nx=30_Ny=20_fov_x_deg=170");
+  EXPECT_EQ(splined.intrinsics().size(), 4u + 2u * 30 * 20);
+
+  const auto board = fc::CameraModel::read(kData / "captures/procam-board/camera.cameramodel");
+  EXPECT_EQ(board.lensmodel(), "LENSMODEL_OPENCV5");
+  EXPECT_TRUE(board.valid_intrinsics_region().empty());
+  // The principal point looks straight ahead.
+  const auto v = board.unproject({board.intrinsics()[2], board.intrinsics()[3]});
+  ASSERT_TRUE(v.has_value());
+  EXPECT_NEAR(glm::length(*v - glm::dvec3(0, 0, 1)), 0.0, 1e-12);
+}
+
+TEST(CameraModel, ProjectUnprojectRoundTripWithinOneMicropixel) {
+  for (const char* file : {"cameras/mrcal-figueroa/opencv8-0.cameramodel",
+                           "cameras/mrcal-figueroa/splined-0.cameramodel",
+                           "captures/procam-board/camera.cameramodel"}) {
+    const auto camera = fc::CameraModel::read(kData / file);
+    const RoundTrip result = round_trip(camera, 41, 31);
+    // Worst case over the grid, in camera pixels.
+    EXPECT_LT(result.worst_px, 1e-6) << file;
+    EXPECT_EQ(result.failures, 0) << file;
+    EXPECT_GT(result.samples, 500) << file;
+    std::printf("%s: %d samples, worst round trip %.3g px\n", file, result.samples,
+                result.worst_px);
+  }
+}
+
+TEST(CameraModel, PinholeProjectsAsExpected) {
+  const fc::CameraModel pinhole("LENSMODEL_PINHOLE", {1000, 900, 320.5, 240.25}, {640, 480});
+  const auto q = pinhole.project({1, 2, 4});
+  ASSERT_TRUE(q.has_value());
+  EXPECT_NEAR(q->x, 1000 * 0.25 + 320.5, 1e-12);
+  EXPECT_NEAR(q->y, 900 * 0.5 + 240.25, 1e-12);
+  std::vector<glm::dvec2> qs{{0, 0}, {639, 479}};
+  std::vector<glm::dvec3> vs(2);
+  pinhole.unproject(qs, vs);
+  std::vector<glm::dvec2> back(2);
+  pinhole.project(vs, back);
+  EXPECT_LT(glm::length(back[1] - qs[1]), 1e-9);
+  EXPECT_FALSE(pinhole.project(glm::dvec3(0.0)).has_value());
+}
+
+TEST(CameraModel, WriteThenReadGivesTheSameModel) {
+  const facet::test::TempFolder temp;
+  const auto splined = fc::CameraModel::read(kData / "cameras/mrcal-figueroa/splined-0.cameramodel");
+  splined.write(temp.path() / "copy.cameramodel");
+  const auto copy = fc::CameraModel::read(temp.path() / "copy.cameramodel");
+  EXPECT_EQ(copy.lensmodel(), splined.lensmodel());
+  EXPECT_EQ(copy.imager_size(), splined.imager_size());
+  ASSERT_EQ(copy.intrinsics().size(), splined.intrinsics().size());
+  double worst = 0;
+  for (std::size_t k = 0; k < copy.intrinsics().size(); ++k) {
+    worst = std::max(worst, std::abs(copy.intrinsics()[k] - splined.intrinsics()[k]) /
+                                std::max(1.0, std::abs(splined.intrinsics()[k])));
+  }
+  EXPECT_EQ(worst, 0.0);
+  EXPECT_EQ(copy.valid_intrinsics_region(), splined.valid_intrinsics_region());
+  const glm::dvec2 q(1000.25, 3000.75);
+  EXPECT_EQ(*copy.unproject(q), *splined.unproject(q));
+}
+
+TEST(CameraModel, BadModelsAreInputErrors) {
+  const facet::test::TempFolder temp;
+  EXPECT_THROW(fc::CameraModel::read(temp.path() / "missing.cameramodel"), facet::InputError);
+  std::ofstream(temp.path() / "bad.cameramodel") << "{ 'lensmodel': 'LENSMODEL_OPENCV8', }";
+  EXPECT_THROW(fc::CameraModel::read(temp.path() / "bad.cameramodel"), facet::InputError);
+  EXPECT_THROW(fc::CameraModel("LENSMODEL_NOPE", {1, 1, 0, 0}, {10, 10}), facet::InputError);
+  EXPECT_THROW(fc::CameraModel("LENSMODEL_OPENCV4", {1, 1, 0, 0}, {10, 10}), facet::InputError);
+  EXPECT_THROW(fc::CameraModel("LENSMODEL_PINHOLE", {1, 1, 0, 0}, {0, 10}), facet::InputError);
+}
