@@ -1,0 +1,27 @@
+#pragma once
+// glTF 2.0 scenes (through tinygltf) into the plain CPU Scene.
+#include <filesystem>
+
+#include "facet/driver/scene.hpp"
+
+namespace facet::driver {
+
+// Loads a .gltf (JSON with embedded base64 or external buffers and images) or .glb file.
+//
+// - Units and frames as glTF: metres, y up. Each node with a mesh becomes one Object whose
+//   T_world_object is the product of the node transforms from the root; vertex data stays in the
+//   mesh's frame and is shared between nodes that instance the same mesh.
+// - The default scene is loaded (the first one when none is marked; every root node when the
+//   file has no scenes).
+// - Triangles, triangle strips and fans are loaded (strips and fans become lists); points and
+//   lines are skipped. Missing normals are computed (area-weighted); missing texture
+//   coordinates are 0.
+// - Materials: pbrMetallicRoughness base colour factor and base colour texture (converted to
+//   RGBA8). Primitives without a material get a default white one.
+//
+// Throws facet::InputError naming the file (and the glTF field, where known) for unreadable,
+// malformed or unsupported input: bad JSON, out-of-range indices or accessors, missing POSITION,
+// sparse accessors, cyclic node graphs.
+Scene load_gltf(const std::filesystem::path& path);
+
+}  // namespace facet::driver

@@ -1,0 +1,58 @@
+#pragma once
+// GPU copies of a Scene: buffers for vertex attributes and indices (usable both as vertex
+// arrays and as shader storage for vertex pulling), per-material and per-object tables, and
+// textures.
+#include <cstdint>
+#include <vector>
+
+#include "facet/driver/gl_objects.hpp"
+#include "facet/driver/scene.hpp"
+
+namespace facet::driver {
+
+// std430 layout of one entry of GpuScene::materials.
+struct GpuMaterial {
+  float base_colour[4];  // linear RGBA
+  std::int32_t texture;  // index into GpuScene::textures, or -1
+  std::uint32_t repeat;  // 1: texture coordinates wrap, 0: clamp
+  std::uint32_t padding[2];
+};
+static_assert(sizeof(GpuMaterial) == 32);
+
+// std430 layout of one entry of GpuScene::objects.
+struct GpuObject {
+  float T_world_object[16];  // column-major
+  float bounds_min[4];       // world frame, metres; w unused
+  float bounds_max[4];
+  std::uint32_t first_primitive, primitive_count, padding[2];
+};
+static_assert(sizeof(GpuObject) == 112);
+
+struct GpuScene {
+  // Tightly packed floats, 3 per vertex (12-byte stride): in GLSL `float positions[]`, not
+  // `vec3[]`, whose std430 stride is 16 bytes.
+  Buffer positions;  // metres, object frame
+  Buffer normals;
+  Buffer uvs;        // 2 floats per vertex
+  Buffer indices;    // uint32 triangle list (Scene::indices)
+  Buffer materials;  // GpuMaterial per Scene::materials entry
+  Buffer objects;    // GpuObject per Scene::objects entry
+  // Attribute 0: position (vec3), 1: normal (vec3), 2: uv (vec2); element buffer = indices.
+  VertexArray vertex_array;
+  // One SRGB8_ALPHA8 texture per Scene::images entry, mipmapped, trilinear + 8x anisotropic
+  // where available; wrap mode comes from the samplers below.
+  std::vector<Texture> textures;
+  Texture white;  // 1x1 white, bound for materials with no texture
+  Sampler repeat_sampler, clamp_sampler;
+  std::vector<std::int32_t> material_texture;  // Scene::materials[i].texture, kept for binding
+  std::vector<bool> material_repeat;
+
+  // Binds material `m`'s texture (or `white`) and sampler to texture unit `unit`.
+  void bind_material_texture(std::uint32_t m, GLuint unit) const;
+};
+
+// Uploads the scene. Needs a current GL context; the GpuScene must be destroyed while a context
+// of the same share group is current.
+GpuScene upload_scene(const Scene& scene);
+
+}  // namespace facet::driver
