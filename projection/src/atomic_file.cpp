@@ -1,1 +1,28 @@
-// in progress
+#include "facet/projection/atomic_file.hpp"
+
+#include <atomic>
+#include <string>
+#include <system_error>
+
+#include <unistd.h>
+
+namespace facet {
+
+void write_atomically(const std::filesystem::path& path,
+                      const std::function<void(const std::filesystem::path&)>& write) {
+  static std::atomic<unsigned> counter{0};
+  // Keep the extension last so that writers that choose a format by extension still do.
+  std::filesystem::path temporary = path;
+  temporary.replace_filename("." + path.stem().string() + ".tmp" + std::to_string(::getpid()) +
+                             "-" + std::to_string(counter++) + path.extension().string());
+  try {
+    write(temporary);
+    std::filesystem::rename(temporary, path);
+  } catch (...) {
+    std::error_code ignored;
+    std::filesystem::remove(temporary, ignored);
+    throw;
+  }
+}
+
+}  // namespace facet

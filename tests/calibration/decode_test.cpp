@@ -331,3 +331,33 @@ TEST(Decode, RealProcamBoardCapture) {
   EXPECT_LT(p99, 1.5);
   EXPECT_GT(inlier_fraction, 0.93);
 }
+
+TEST(Decode, CaptureWithMissingFramesNamesTheFieldAndLoadsNothing) {
+  const std::filesystem::path folder =
+      std::filesystem::path(FACET_SHARED_DATA_DIR) / "captures/procam-board";
+  auto capture = fc::read_capture(folder);
+  // Drop the inverse of y bit 4 and the black frame: nothing to compare bit 4 with.
+  auto& frames = capture.projectors[0].frames;
+  std::erase_if(frames, [](const fc::CaptureFrame& frame) {
+    return frame.pattern == fc::Pattern::gray(fc::Axis::y, 4, true) ||
+           frame.pattern == fc::Pattern::black();
+  });
+  try {
+    fc::decode_capture(capture, 0);
+    FAIL() << "decoded a capture with missing frames";
+  } catch (const facet::InputError& error) {
+    EXPECT_EQ(error.source(), (folder / "capture.json").string());
+    EXPECT_EQ(error.field(), "projectors[0].frames");
+    EXPECT_NE(std::string(error.what()).find("inverse of Gray bit 4 of axis y"), std::string::npos)
+        << error.what();
+  }
+  // A frame whose file is missing is named before decoding starts.
+  capture = fc::read_capture(folder);
+  capture.projectors[0].frames[7].file = "graycode_missing.png";
+  try {
+    fc::decode_capture(capture, 0);
+    FAIL() << "decoded a capture with a missing image";
+  } catch (const facet::InputError& error) {
+    EXPECT_NE(error.source().find("graycode_missing.png"), std::string::npos) << error.what();
+  }
+}

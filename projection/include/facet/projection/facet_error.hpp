@@ -24,6 +24,7 @@ struct FacetError {
   double float32_max_px = 0;  // worst extra distance that float32 matrices and points add
   double float32_rms_px = 0;
   std::size_t samples = 0;
+  std::size_t missed_samples = 0;  // covered directions that no facet contains (holes)
   glm::dvec2 worst_q{0.0};  // exact output pixel of the worst sample
 };
 

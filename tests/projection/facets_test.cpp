@@ -1,0 +1,192 @@
+// Facets: continuity across shared edges, the tolerance, the clip matrix and float32 error.
+#include <map>
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "facet/projection/errors.hpp"
+#include "facet/projection/facet_error.hpp"
+#include "facet/projection/facets.hpp"
+#include "test_displays.hpp"
+
+namespace facet {
+namespace {
+
+// Every edge shared by two facets (the same two vertex indices) maps to the same pixels from both
+// sides, within 1e-6 px worst case over 33 points per edge, in double.
+double worst_shared_edge_gap(const FacetMesh& mesh) {
+  std::map<std::pair<std::uint32_t, std::uint32_t>, std::uint32_t> first_owner;
+  double worst = 0;
+  std::size_t shared = 0;
+  for (std::uint32_t f = 0; f < mesh.facets.size(); ++f) {
+    for (int k = 0; k < 3; ++k) {
+      std::uint32_t a = mesh.facets[f].vertex[k], b = mesh.facets[f].vertex[(k + 1) % 3];
+      if (a > b) std::swap(a, b);
+      auto [it, inserted] = first_owner.emplace(std::pair{a, b}, f);
+      if (inserted) continue;
+      ++shared;
+      const Facet& other = mesh.facets[it->second];
+      for (int m = 0; m <= 32; ++m) {
+        const double u = m / 32.0;
+        const glm::dvec3 X = (1 - u) * mesh.vertices[a].p_eye + u * mesh.vertices[b].p_eye;
+        // Scale the point along its ray: the projection must not depend on the distance.
+        const glm::dvec3 far_X = X * (1.0 + 1000.0 * u);
+        worst = std::max(worst, glm::length(mesh.facets[f].project(far_X) - other.project(far_X)));
+      }
+    }
+  }
+  EXPECT_GT(shared, 0u);
+  return worst;
+}
+
+TEST(Facets, SharedEdgesMapToTheSamePixels) {
+  for (const auto& [name, warp] : test::displays_for_tolerance_tests()) {
+    SCOPED_TRACE(name);
+    for (const FacetLayout& layout :
+         {FacetLayout{FacetTolerance{0.25}}, FacetLayout{FacetGrid{12, 9}}}) {
+      const FacetMesh mesh = build_facets(warp, {layout});
+      EXPECT_LE(worst_shared_edge_gap(mesh), 1e-6);
+    }
+  }
+}
+
+TEST(Facets, SeamOfA360CylinderIsContinuousModuloTheWidth) {
+  const Warp warp = Warp::analytic(BaseProjection::cylindrical(-180, 180, 1, -1), {1600, 1200});
+  const FacetMesh mesh = build_facets(warp, {FacetStrips{160}});
+  ASSERT_EQ(mesh.facets.size(), 320u);
+  // The first and the last strip both hold the seam direction (s = 0 and s = 1).
+  const int columns = int(mesh.s_breaks.size()) - 1;
+  const std::uint32_t first = mesh.cell_first_facet[0], last = mesh.cell_first_facet[columns - 1];
+  const glm::dvec3 top = warp.p_eye_surface_from_st({0, 0}), bottom = warp.p_eye_surface_from_st({0, 1});
+  double worst = 0;
+  for (int m = 0; m <= 32; ++m) {
+    const glm::dvec3 X = top + (bottom - top) * (m / 32.0);
+    auto on_seam = [&](std::uint32_t cell_first) {
+      // Of the cell's two facets, the one whose pyramid holds the seam edge.
+      for (std::uint32_t f = cell_first; f < cell_first + 2; ++f) {
+        const Facet& facet = mesh.facets[f];
+        if (std::min({glm::dot(facet.edge_normal[0], X), glm::dot(facet.edge_normal[1], X),
+                      glm::dot(facet.edge_normal[2], X)}) > -1e-12) {
+          return facet.project(X);
+        }
+      }
+      ADD_FAILURE() << "seam point outside its cell's facets";
+      return glm::dvec2(0.0);
+    };
+    const glm::dvec2 q_left = on_seam(first), q_right = on_seam(last);
+    EXPECT_NEAR(q_left.x, 0.0, 1e-6);
+    EXPECT_NEAR(q_right.x, 1600.0, 1e-6);
+    worst = std::max(worst, std::abs(q_left.y - q_right.y));
+  }
+  EXPECT_LE(worst, 1e-6);
+}
+
+TEST(Facets, ToleranceIsMetOnEveryBase) {
+  for (const auto& [name, warp] : test::displays_for_tolerance_tests()) {
+    for (double tolerance : {1.0, 0.25, 0.05}) {
+      SCOPED_TRACE(name + " at " + std::to_string(tolerance) + " px");
+      const FacetMesh mesh = build_facets(warp, {FacetTolerance{tolerance}});
+      const FacetError error = evaluate_facet_error(warp, mesh);
+      EXPECT_LE(error.max_px, tolerance);  // worst case over dense samples
+      EXPECT_LE(error.rms_px, error.max_px);
+      EXPECT_EQ(error.missed_samples, 0u) << "a covered direction fell in no facet";
+      // The builder should not be wastefully far below the tolerance either.
+      EXPECT_GE(error.max_px, 0.5 * tolerance) << mesh.facets.size() << " facets";
+      // The float32 matrices of a GPU add far less than the tolerance.
+      EXPECT_LE(error.float32_max_px, 0.01);
+    }
+  }
+}
+
+TEST(Facets, PerspectiveBaseIsExactWithTwoFacets) {
+  const Warp warp = Warp::analytic(BaseProjection::perspective_fov(120, 90), {1920, 1080});
+  const FacetMesh mesh = build_facets(warp, {FacetTolerance{0.05}});
+  EXPECT_EQ(mesh.facets.size(), 2u);
+  EXPECT_LE(evaluate_facet_error(warp, mesh).max_px, 1e-6);
+}
+
+TEST(Facets, SeedCylinderStripsArePlanarAndMatchTheirCount) {
+  const Warp warp = Warp::analytic(BaseProjection::cylindrical(-180, 180, 1, -1), {1600, 1200});
+  const FacetMesh mesh = build_facets(warp, {FacetStrips{160}});
+  for (std::size_t cell = 0; cell < 160; ++cell) {
+    const Facet& a = mesh.facets[2 * cell];
+    const Facet& b = mesh.facets[2 * cell + 1];
+    EXPECT_NEAR(glm::dot(a.n, b.n), 1.0, 1e-12);  // both halves of a strip share one plane
+  }
+  const FacetError error = evaluate_facet_error(warp, mesh);
+  // A strip of w = 2.25° has its largest error at mid-width on the top and bottom rows: about
+  // 0.116 px from the secant plane (1 − cos(w/2)) · 600 px plus the tan-versus-angle term.
+  EXPECT_NEAR(error.max_px, 0.1155, 0.002);
+}
+
+TEST(Facets, GridModeGivesTwoFacetsPerCell) {
+  const Warp warp = test::with_smooth_offsets(
+      Warp::analytic(BaseProjection::perspective_fov(90, 70), {80, 60}), {5, 5}, 3);
+  const FacetMesh mesh = build_facets(warp, {FacetGrid{80, 60}});
+  EXPECT_EQ(mesh.facets.size(), 2u * 80 * 60);
+  EXPECT_EQ(mesh.vertices.size(), 81u * 61);
+}
+
+TEST(Facets, ClipMatrixAgreesWithTheProjection) {
+  const Warp warp = Warp::analytic(BaseProjection::fisheye(200), {1024, 1024});
+  const FacetMesh mesh = build_facets(warp, {FacetGrid{16, 16}});
+  std::mt19937_64 random(3);
+  std::uniform_real_distribution<double> unit(0, 1);
+  const double z_near = 0.05;
+  for (std::uint32_t f = 0; f < mesh.facets.size(); f += 7) {
+    const Facet& facet = mesh.facets[f];
+    const glm::dmat4 clip_from_eye = facet.clip_from_eye(mesh.output_size, z_near);
+    const auto p = mesh.corners(f);
+    double a = unit(random), b = unit(random);
+    if (a + b > 1) a = 1 - a, b = 1 - b;
+    const double distance = 0.1 + 100 * unit(random);
+    const glm::dvec3 X = distance * (p[0] + a * (p[1] - p[0]) + b * (p[2] - p[0]));
+    const glm::dvec4 clip = clip_from_eye * glm::dvec4(X, 1);
+    const glm::dvec2 q{(clip.x / clip.w + 1) / 2 * 1024, (1 - clip.y / clip.w) / 2 * 1024};
+    EXPECT_LE(glm::length(q - facet.project(X)), 1e-9);
+    const double depth = clip.z / clip.w;
+    EXPECT_NEAR(depth, z_near / glm::dot(facet.n, X), 1e-12);
+    EXPECT_GT(depth, 0);
+    EXPECT_LE(depth, 1);
+    for (const auto& plane : mesh.clip_planes(f)) EXPECT_GE(glm::dot(plane, X), 0);
+  }
+}
+
+TEST(Facets, GuardBandIsAtMostTheRequestedPixels) {
+  const Warp warp = Warp::analytic(BaseProjection::cylindrical(-90, 90, 1, -1), {1000, 800});
+  const FacetMesh mesh = build_facets(warp, {FacetStrips{40}});
+  // Points just outside an edge, at known pixel distances, are inside the guarded planes only
+  // up to guard_px.
+  for (std::uint32_t f = 0; f < mesh.facets.size(); ++f) {
+    const auto planes = mesh.clip_planes(f, 0.05);
+    const auto p = mesh.corners(f);
+    const glm::dvec3 centroid = (p[0] + p[1] + p[2]) / 3.0;
+    for (int k = 0; k < 3; ++k) {
+      const glm::dvec3 mid = (p[k] + p[(k + 1) % 3]) / 2.0;
+      // Walk outwards from the edge midpoint along the chord plane until leaving the guard.
+      const glm::dvec3 out = mid + (mid - centroid) * 1e-6;
+      const double px_per_step = glm::length(mesh.facets[f].project(out) - mesh.facets[f].project(mid));
+      double inside_px = 0;
+      for (int step = 1; step < 200000; ++step) {
+        const glm::dvec3 X = mid + (mid - centroid) * (1e-6 * step);
+        if (glm::dot(planes[k], X) < 0) break;
+        inside_px = px_per_step * step;
+      }
+      EXPECT_LE(inside_px, 0.05 + 1e-3);
+      EXPECT_GE(inside_px, 0.001);  // some guard on every edge
+    }
+  }
+}
+
+TEST(Facets, ImpossibleLayoutsAreRejected) {
+  const Warp cylinder = Warp::analytic(BaseProjection::cylindrical(-180, 180, 1, -1), {1600, 1200});
+  EXPECT_THROW(build_facets(cylinder, {FacetStrips{2}}), InputError);  // 180° strips
+  EXPECT_THROW(build_facets(cylinder, {FacetStrips{0}}), InputError);
+  EXPECT_THROW(build_facets(cylinder, {FacetTolerance{-1}}), InputError);
+  EXPECT_THROW(build_facets(cylinder, {FacetTolerance{NAN}}), InputError);
+  // A tolerance that needs more cells than allowed gives a clear error, not a runaway build.
+  EXPECT_THROW(build_facets(cylinder, {FacetTolerance{1e-4}, 64}), InputError);
+}
+
+}  // namespace
+}  // namespace facet

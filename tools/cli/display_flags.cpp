@@ -1,0 +1,120 @@
+#include "display_flags.hpp"
+
+#include <sstream>
+#include <vector>
+
+#include "facet/projection/errors.hpp"
+#include "facet/projection_io/warp_file.hpp"
+
+namespace facet::cli {
+namespace {
+
+std::vector<double> parse_numbers(const std::string& text, const std::string& flag,
+                                  std::size_t count_min, std::size_t count_max) {
+  std::vector<double> values;
+  std::stringstream stream(text);
+  std::string item;
+  while (std::getline(stream, item, ',')) {
+    try {
+      std::size_t used = 0;
+      values.push_back(std::stod(item, &used));
+      if (used != item.size()) throw std::invalid_argument(item);
+    } catch (const std::exception&) {
+      throw InputError("command line", flag, "expected comma-separated numbers; got '" + text + "'");
+    }
+  }
+  if (values.size() < count_min || values.size() > count_max) {
+    throw InputError("command line", flag,
+                     "expected " + std::to_string(count_min) +
+                         (count_max > count_min ? " to " + std::to_string(count_max) : "") +
+                         " comma-separated numbers; got '" + text + "'");
+  }
+  return values;
+}
+
+}  // namespace
+
+glm::ivec2 parse_size(const std::string& text, const std::string& flag) {
+  int w = 0, h = 0;
+  char x = 0, extra = 0;
+  std::stringstream stream(text);
+  if (!(stream >> w >> x >> h) || (x != 'x' && x != 'X') || (stream >> extra) || w < 1 || h < 1) {
+    throw InputError("command line", flag, "expected WxH with positive integers; got '" + text + "'");
+  }
+  return {w, h};
+}
+
+void DisplayFlags::add_to(CLI::App& command) {
+  command.add_option("--warp", warp_path, "Offset map (.warp.exr) instead of an analytic display");
+  command.add_option("--base", base, "perspective | fisheye | cylindrical | equirectangular")
+      ->capture_default_str();
+  command.add_option("--size", size, "Output size WxH in pixels")->capture_default_str();
+  command.add_option("--azimuth", azimuth, "Cylindrical/equirectangular azimuth a0,a1 (degrees)")
+      ->capture_default_str();
+  command.add_option("--tan-elevation", tan_elevation, "Cylindrical tan(elevation) top,bottom")
+      ->capture_default_str();
+  command.add_option("--elevation", elevation, "Equirectangular elevation top,bottom (degrees)")
+      ->capture_default_str();
+  command.add_option("--tan-extent", tan_extent, "Perspective tangents left,right,top,bottom")
+      ->capture_default_str();
+  command.add_option("--fov", fov,
+                     "Fisheye field of view (degrees), or perspective X[,Y] fields of view");
+}
+
+Warp DisplayFlags::make_warp() const {
+  if (!warp_path.empty()) return read_warp(warp_path);
+  const BaseKind kind = base_kind_from_string(base, "command line", "--base");
+  BaseProjection projection;
+  switch (kind) {
+    case BaseKind::perspective:
+      if (!fov.empty()) {
+        const auto f = parse_numbers(fov, "--fov", 1, 2);
+        try {
+          projection = BaseProjection::perspective_fov(f[0], f.size() > 1 ? f[1] : f[0]);
+        } catch (const InputError& e) {
+          throw InputError("command line", "--fov", e.expected());
+        }
+      } else {
+        const auto t = parse_numbers(tan_extent, "--tan-extent", 4, 4);
+        projection = BaseProjection::perspective(t[0], t[1], t[2], t[3]);
+      }
+      break;
+    case BaseKind::fisheye:
+      projection = BaseProjection::fisheye(
+          fov.empty() ? 180.0 : parse_numbers(fov, "--fov", 1, 1)[0]);
+      break;
+    case BaseKind::cylindrical: {
+      const auto a = parse_numbers(azimuth, "--azimuth", 2, 2);
+      const auto t = parse_numbers(tan_elevation, "--tan-elevation", 2, 2);
+      projection = BaseProjection::cylindrical(a[0], a[1], t[0], t[1]);
+      break;
+    }
+    case BaseKind::equirectangular: {
+      const auto a = parse_numbers(azimuth, "--azimuth", 2, 2);
+      const auto e = parse_numbers(elevation, "--elevation", 2, 2);
+      projection = BaseProjection::equirectangular(a[0], a[1], e[0], e[1]);
+      break;
+    }
+  }
+  projection.validate("command line");
+  return Warp::analytic(projection, parse_size(size, "--size"));
+}
+
+void LayoutFlags::add_to(CLI::App& command) {
+  auto* group = command.add_option_group("facets", "How to choose the facets (one of)");
+  group->add_option("--pieces", pieces, "N vertical strips, one row (the seed's cylinder)");
+  group->add_option("--grid", grid, "A uniform GXxGY grid of cells, two facets each");
+  group->add_option("--tolerance", tolerance_px, "Fewest facets with max error <= PX pixels");
+  group->require_option(0, 1);
+}
+
+FacetLayout LayoutFlags::layout() const {
+  if (pieces) return FacetStrips{*pieces};
+  if (!grid.empty()) {
+    const glm::ivec2 g = parse_size(grid, "--grid");
+    return FacetGrid{g.x, g.y};
+  }
+  return FacetTolerance{tolerance_px.value_or(0.25)};
+}
+
+}  // namespace facet::cli
