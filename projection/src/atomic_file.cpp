@@ -1,10 +1,10 @@
 #include "facet/projection/atomic_file.hpp"
 
+#include <unistd.h>
+
 #include <atomic>
 #include <string>
 #include <system_error>
-
-#include <unistd.h>
 
 namespace facet {
 

@@ -39,10 +39,14 @@ double s_from_azimuth(double alpha, double a0, double a1, double s_hint) {
 
 std::string to_string(BaseKind kind) {
   switch (kind) {
-    case BaseKind::perspective: return "perspective";
-    case BaseKind::fisheye: return "fisheye";
-    case BaseKind::cylindrical: return "cylindrical";
-    case BaseKind::equirectangular: return "equirectangular";
+    case BaseKind::perspective:
+      return "perspective";
+    case BaseKind::fisheye:
+      return "fisheye";
+    case BaseKind::cylindrical:
+      return "cylindrical";
+    case BaseKind::equirectangular:
+      return "equirectangular";
   }
   return "unknown";
 }
@@ -53,9 +57,9 @@ BaseKind base_kind_from_string(const std::string& name, const std::string& sourc
                         BaseKind::equirectangular}) {
     if (name == to_string(kind)) return kind;
   }
-  throw InputError(source, field,
-                   "expected one of perspective, fisheye, cylindrical, equirectangular; got '" +
-                       name + "'");
+  throw InputError(
+      source, field,
+      "expected one of perspective, fisheye, cylindrical, equirectangular; got '" + name + "'");
 }
 
 BaseProjection BaseProjection::perspective(double left, double right, double top, double bottom) {
@@ -68,9 +72,9 @@ BaseProjection BaseProjection::perspective(double left, double right, double top
 BaseProjection BaseProjection::perspective_fov(double fov_x_deg, double fov_y_deg) {
   for (auto [fov, field] : {std::pair{fov_x_deg, "fov_x"}, std::pair{fov_y_deg, "fov_y"}}) {
     if (!(fov > 0 && fov < 180)) {
-      throw InputError({}, field,
-                       "a perspective field of view must lie in (0°, 180°); got " + number(fov) +
-                           "°");
+      throw InputError(
+          {}, field,
+          "a perspective field of view must lie in (0°, 180°); got " + number(fov) + "°");
     }
   }
   const double x = std::tan(radians(fov_x_deg) / 2), y = std::tan(radians(fov_y_deg) / 2);
@@ -139,8 +143,8 @@ void BaseProjection::validate(const std::string& source) const {
     case BaseKind::equirectangular: {
       check_azimuth();
       const auto [top, bottom] = elevation_deg;
-      require(std::isfinite(top) && std::isfinite(bottom) && top != bottom &&
-                  std::abs(top) <= 90 && std::abs(bottom) <= 90,
+      require(std::isfinite(top) && std::isfinite(bottom) && top != bottom && std::abs(top) <= 90 &&
+                  std::abs(bottom) <= 90,
               "elevation", "expected two different elevations within [-90°, 90°]");
       break;
     }
@@ -205,8 +209,8 @@ std::optional<glm::dvec2> BaseProjection::st_from_direction(glm::dvec3 b, double
     case BaseKind::cylindrical: {
       const double horizontal = std::hypot(b.x, b.z);
       if (!(horizontal > 0)) return std::nullopt;
-      const double s = s_from_azimuth(azimuth(b), radians(azimuth_deg[0]),
-                                      radians(azimuth_deg[1]), s_hint);
+      const double s =
+          s_from_azimuth(azimuth(b), radians(azimuth_deg[0]), radians(azimuth_deg[1]), s_hint);
       const double y = b.y / horizontal;
       return glm::dvec2{s, (y - tan_elevation[0]) / (tan_elevation[1] - tan_elevation[0])};
     }
@@ -214,10 +218,9 @@ std::optional<glm::dvec2> BaseProjection::st_from_direction(glm::dvec3 b, double
       const double horizontal = std::hypot(b.x, b.z);
       const double e = std::atan2(b.y, horizontal);
       // At the poles every azimuth is right; take the hint's, or the middle.
-      const double s =
-          horizontal > 0 ? s_from_azimuth(azimuth(b), radians(azimuth_deg[0]),
-                                           radians(azimuth_deg[1]), s_hint)
-                         : (std::isfinite(s_hint) ? s_hint : 0.5);
+      const double s = horizontal > 0 ? s_from_azimuth(azimuth(b), radians(azimuth_deg[0]),
+                                                       radians(azimuth_deg[1]), s_hint)
+                                      : (std::isfinite(s_hint) ? s_hint : 0.5);
       return glm::dvec2{s, (e - radians(elevation_deg[0])) /
                                (radians(elevation_deg[1]) - radians(elevation_deg[0]))};
     }

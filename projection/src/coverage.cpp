@@ -95,7 +95,8 @@ CoverageIndex::CoverageIndex(const FacetMesh& mesh, double guard_px) {
     node.axis = axis_length > 0 ? axis / axis_length : glm::dvec3(0, 0, -1);
     double cos_half = 1;
     for (std::uint32_t k = task.first; k < task.first + task.count; ++k) {
-      for (const auto& p : guarded[order_[k]]) cos_half = std::min(cos_half, glm::dot(node.axis, p));
+      for (const auto& p : guarded[order_[k]])
+        cos_half = std::min(cos_half, glm::dot(node.axis, p));
     }
     // A bounding cone of corners holds the whole geodesic triangles only while it is convex.
     if (axis_length > 0 && cos_half > kMaxBoundedCos) {
@@ -112,7 +113,9 @@ CoverageIndex::CoverageIndex(const FacetMesh& mesh, double guard_px) {
       continue;
     }
     const glm::dvec3 spread = hi - lo;
-    const int split_axis = spread.x >= spread.y && spread.x >= spread.z ? 0 : spread.y >= spread.z ? 1 : 2;
+    const int split_axis = spread.x >= spread.y && spread.x >= spread.z ? 0
+                           : spread.y >= spread.z                       ? 1
+                                                                        : 2;
     const std::uint32_t half = task.count / 2;
     std::nth_element(order_.begin() + task.first, order_.begin() + task.first + half,
                      order_.begin() + task.first + task.count,
@@ -196,8 +199,8 @@ std::optional<std::uint32_t> CoverageIndex::locate(glm::dvec3 v) const {
     if (node.count > 0) {
       for (std::uint32_t k = node.first; k < node.first + node.count; ++k) {
         const std::uint32_t f = order_[k];
-        const double margin = std::min({glm::dot(edges_[f][0], v), glm::dot(edges_[f][1], v),
-                                        glm::dot(edges_[f][2], v)});
+        const double margin = std::min(
+            {glm::dot(edges_[f][0], v), glm::dot(edges_[f][1], v), glm::dot(edges_[f][2], v)});
         if (margin > best_margin) {
           best_margin = margin;
           best = f;

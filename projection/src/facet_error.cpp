@@ -31,8 +31,10 @@ double lattice_error(const Warp& warp, const Facet& facet, const std::array<glm:
   for (int i = 0; i <= subdivisions; ++i) {
     for (int j = 0; i + j <= subdivisions; ++j) {
       const int k = subdivisions - i - j;
-      if (i == subdivisions || j == subdivisions || k == subdivisions) continue;  // corners are exact
-      const glm::dvec3 X = (double(i) * p[0] + double(j) * p[1] + double(k) * p[2]) / double(subdivisions);
+      if (i == subdivisions || j == subdivisions || k == subdivisions)
+        continue;  // corners are exact
+      const glm::dvec3 X =
+          (double(i) * p[0] + double(j) * p[1] + double(k) * p[2]) / double(subdivisions);
       const auto exact = warp.project(X, s_hint);
       if (!exact || !exact->covered) continue;
       const double distance = pixel_distance(warp, facet.project(X), exact->q);
@@ -112,9 +114,10 @@ glm::dvec2 q_float32(const glm::mat4& clip_from_eye, glm::dvec3 X, glm::ivec2 si
 
 double facet_max_error(const Warp& warp, const FacetMesh& mesh, std::uint32_t f, int subdivisions) {
   const auto p = mesh.corners(f);
-  const double s_hint = (mesh.vertices[mesh.facets[f].vertex[0]].st.x +
-                         mesh.vertices[mesh.facets[f].vertex[1]].st.x +
-                         mesh.vertices[mesh.facets[f].vertex[2]].st.x) / 3;
+  const double s_hint =
+      (mesh.vertices[mesh.facets[f].vertex[0]].st.x + mesh.vertices[mesh.facets[f].vertex[1]].st.x +
+       mesh.vertices[mesh.facets[f].vertex[2]].st.x) /
+      3;
   return detail::lattice_error(warp, mesh.facets[f], p, s_hint, subdivisions);
 }
 
@@ -130,7 +133,8 @@ FacetError evaluate_facet_error(const Warp& warp, const FacetMesh& mesh,
 
   double per_axis = options.grid_samples_per_px;
   const double full = double(warp.output_size.x) * warp.output_size.y * per_axis * per_axis;
-  if (full > double(options.max_grid_samples)) per_axis *= std::sqrt(double(options.max_grid_samples) / full);
+  if (full > double(options.max_grid_samples))
+    per_axis *= std::sqrt(double(options.max_grid_samples) / full);
   const int nx = std::max(2, int(warp.output_size.x * per_axis));
   const int ny = std::max(2, int(warp.output_size.y * per_axis));
 

@@ -49,8 +49,7 @@ std::array<glm::dvec3, 3> FacetMesh::clip_planes(std::uint32_t f, double guard_p
 
 namespace detail {
 
-std::array<glm::dvec3, 3> guarded_corners(const FacetMesh& mesh, std::uint32_t f,
-                                          double guard_px) {
+std::array<glm::dvec3, 3> guarded_corners(const FacetMesh& mesh, std::uint32_t f, double guard_px) {
   const Facet& facet = mesh.facets[f];
   std::array<glm::dvec3, 3> p = mesh.corners(f);
   if (guard_px <= 0) return p;
@@ -58,12 +57,13 @@ std::array<glm::dvec3, 3> guarded_corners(const FacetMesh& mesh, std::uint32_t f
   // distance from the centroid to edge k is a third of the triangle's height over that edge.
   std::array<glm::dvec2, 3> q;
   for (int k = 0; k < 3; ++k) q[k] = mesh.vertices[facet.vertex[k]].q;
-  const double twice_area = std::abs((q[1].x - q[0].x) * (q[2].y - q[0].y) -
-                                     (q[1].y - q[0].y) * (q[2].x - q[0].x));
+  const double twice_area =
+      std::abs((q[1].x - q[0].x) * (q[2].y - q[0].y) - (q[1].y - q[0].y) * (q[2].x - q[0].x));
   double largest_centroid_distance = 0;
   for (int k = 0; k < 3; ++k) {
     const double edge = glm::length(q[(k + 1) % 3] - q[k]);
-    if (edge > 0) largest_centroid_distance = std::max(largest_centroid_distance, twice_area / edge / 3);
+    if (edge > 0)
+      largest_centroid_distance = std::max(largest_centroid_distance, twice_area / edge / 3);
   }
   if (!(largest_centroid_distance > 0)) return p;
   const double scale = 1 + guard_px / largest_centroid_distance;
@@ -143,7 +143,8 @@ double max_coverage(const Warp& warp, double s0, double s1, double t0, double t1
   };
   double best = 0;
   for (double s : lines(s0, s1, warp.grid_size.x)) {
-    for (double t : lines(t0, t1, warp.grid_size.y)) best = std::max(best, warp.coverage_at({s, t}));
+    for (double t : lines(t0, t1, warp.grid_size.y))
+      best = std::max(best, warp.coverage_at({s, t}));
   }
   return best;
 }
@@ -188,8 +189,9 @@ double st_lattice_error(const Warp& warp, const std::array<Facet, 2>& facets, do
       const glm::dvec3 p = warp.p_eye_surface_from_st(st);
       const Facet& facet =
           detail::inside_margin(facets[0], p) >= detail::inside_margin(facets[1], p) ? facets[0]
-                                                                                      : facets[1];
-      largest = std::max(largest, detail::pixel_distance(warp, facet.project(p), warp.q_from_st(st)));
+                                                                                     : facets[1];
+      largest =
+          std::max(largest, detail::pixel_distance(warp, facet.project(p), warp.q_from_st(st)));
       if (largest > stop_above) return largest;
     }
   }
@@ -224,12 +226,12 @@ std::optional<Cell> fit_cell(const Warp& warp, double s0, double s1, double t0, 
       const std::array<glm::dvec3, 3> p{cell.corner[corner_of[k][0]].p_eye,
                                         cell.corner[corner_of[k][1]].p_eye,
                                         cell.corner[corner_of[k][2]].p_eye};
-      error = std::max(error, detail::lattice_error(warp, facets[k], p, s_hint, subdivisions,
-                                                    best_error));
+      error = std::max(error,
+                       detail::lattice_error(warp, facets[k], p, s_hint, subdivisions, best_error));
     }
     if (ok && error < best_error) {
-      error = std::max(error,
-                       st_lattice_error(warp, facets, s0, s1, t0, t1, subdivisions, best_error));
+      error =
+          std::max(error, st_lattice_error(warp, facets, s0, s1, t0, t1, subdivisions, best_error));
     }
     if (ok && error < best_error) {
       best_error = error;
@@ -267,11 +269,12 @@ FacetMesh assemble(const Warp& warp, std::vector<double> s_breaks, std::vector<d
       if (max_coverage(warp, s0, s1, t0, t1) < 0.5) continue;
       const double angle = cell_angle({vertex_at(warp, {s0, t0}), vertex_at(warp, {s1, t0}),
                                        vertex_at(warp, {s0, t1}), vertex_at(warp, {s1, t1})});
-      auto cell = angle <= kMaxFacetAngle ? fit_cell(warp, s0, s1, t0, t1, subdivisions)
-                                          : std::nullopt;
+      auto cell =
+          angle <= kMaxFacetAngle ? fit_cell(warp, s0, s1, t0, t1, subdivisions) : std::nullopt;
       if (!cell) {
         throw InputError({}, "facets",
-                         "a facet would span " + std::to_string(int(std::round(angle * 180 / kPi))) +
+                         "a facet would span " +
+                             std::to_string(int(std::round(angle * 180 / kPi))) +
                              "°, and at most 150° is allowed; use more pieces");
       }
       const std::uint32_t corner_vertex[4] = {vertex_index(c, r), vertex_index(c + 1, r),
@@ -424,7 +427,6 @@ class GridFitter {
     });
     return all_fit;
   }
-
 
   const Warp& warp_;
   double tolerance_px_;

@@ -14,7 +14,8 @@ void parallel_for(std::size_t count, Body&& body, std::size_t min_parallel = 8) 
   const std::size_t threads =
       count < min_parallel
           ? 1
-          : std::max<std::size_t>(1, std::min<std::size_t>(std::thread::hardware_concurrency(), count));
+          : std::max<std::size_t>(
+                1, std::min<std::size_t>(std::thread::hardware_concurrency(), count));
   if (threads <= 1) {
     for (std::size_t k = 0; k < count; ++k) body(k, std::size_t{0});
     return;

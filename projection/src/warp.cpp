@@ -79,10 +79,9 @@ std::optional<glm::ivec2> Warp::find_fold() const {
   };
   for (int j = 0; j + 1 < grid_size.y; ++j) {
     for (int i = 0; i + 1 < grid_size.x; ++i) {
-      const bool covered = coverage[node_index(i, j)] >= 0.5f &&
-                           coverage[node_index(i + 1, j)] >= 0.5f &&
-                           coverage[node_index(i, j + 1)] >= 0.5f &&
-                           coverage[node_index(i + 1, j + 1)] >= 0.5f;
+      const bool covered =
+          coverage[node_index(i, j)] >= 0.5f && coverage[node_index(i + 1, j)] >= 0.5f &&
+          coverage[node_index(i, j + 1)] >= 0.5f && coverage[node_index(i + 1, j + 1)] >= 0.5f;
       if (!covered) continue;
       // The bilinear cell keeps its orientation (s right, t down) iff the Jacobian is positive at
       // all four corners.

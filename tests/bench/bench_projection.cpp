@@ -1,7 +1,7 @@
 // Benchmarks of the projection core: facet building, error evaluation and coverage queries.
-#include <random>
-
 #include <benchmark/benchmark.h>
+
+#include <random>
 
 #include "facet/projection/coverage.hpp"
 #include "facet/projection/facet_error.hpp"
@@ -12,7 +12,9 @@ namespace {
 facet::Warp cylinder() {
   return facet::Warp::analytic(facet::BaseProjection::cylindrical(-180, 180, 1, -1), {1600, 1200});
 }
-facet::Warp dome() { return facet::Warp::analytic(facet::BaseProjection::fisheye(180), {2048, 2048}); }
+facet::Warp dome() {
+  return facet::Warp::analytic(facet::BaseProjection::fisheye(180), {2048, 2048});
+}
 
 void BM_BuildCylinderTolerance(benchmark::State& state) {
   const auto warp = cylinder();

@@ -1,9 +1,10 @@
 // Base projections and the exact warp map: round trips and domain checks.
-#include <random>
+#include "facet/projection/base_projection.hpp"
 
 #include <gtest/gtest.h>
 
-#include "facet/projection/base_projection.hpp"
+#include <random>
+
 #include "facet/projection/errors.hpp"
 #include "facet/projection/warp.hpp"
 

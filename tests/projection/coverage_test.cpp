@@ -1,11 +1,12 @@
 // The CPU coverage reference: conservative against dense point sampling, over 10^5 triangles of
 // every size and distance, through the eye, through the axis and partly behind the eye.
-#include <cmath>
-#include <random>
+#include "facet/projection/coverage.hpp"
 
 #include <gtest/gtest.h>
 
-#include "facet/projection/coverage.hpp"
+#include <cmath>
+#include <random>
+
 #include "facet/projection/errors.hpp"
 #include "facet/projection/facets.hpp"
 
@@ -118,14 +119,16 @@ TEST(Coverage, TriangleBehindAPerspectiveDisplayCoversNothing) {
   index.query({glm::dvec3(-1, -1, 2), glm::dvec3(1, -1, 2), glm::dvec3(0, 1, 2)}, facets);
   EXPECT_TRUE(facets.empty());
   // Partly behind: only the part in front counts, and it reaches the centre cells.
-  index.query({glm::dvec3(-0.1, -0.1, -5), glm::dvec3(0.1, -0.1, -5), glm::dvec3(0, 0.1, 5)}, facets);
+  index.query({glm::dvec3(-0.1, -0.1, -5), glm::dvec3(0.1, -0.1, -5), glm::dvec3(0, 0.1, 5)},
+              facets);
   EXPECT_FALSE(facets.empty());
   // Seen edge-on through the eye, a triangle in the plane x = 0 covers only the centre column.
   facets.clear();
   index.query({glm::dvec3(0, -1, -1), glm::dvec3(0, 1, -1), glm::dvec3(0, 0, 1)}, facets);
   for (std::uint32_t f : facets) {
     const auto p = mesh.corners(f);
-    const double min_x = std::min({p[0].x, p[1].x, p[2].x}), max_x = std::max({p[0].x, p[1].x, p[2].x});
+    const double min_x = std::min({p[0].x, p[1].x, p[2].x}),
+                 max_x = std::max({p[0].x, p[1].x, p[2].x});
     EXPECT_LE(min_x, 1e-3);
     EXPECT_GE(max_x, -1e-3);
   }
@@ -152,10 +155,13 @@ TEST(Coverage, NonFiniteTriangleIsRejected) {
   const FacetMesh mesh = build_facets(warp, {FacetGrid{4, 4}});
   const CoverageIndex index(mesh);
   std::vector<std::uint32_t> facets;
-  EXPECT_THROW(index.query({glm::dvec3(0, 0, -1), glm::dvec3(NAN, 0, -1), glm::dvec3(0, 1, -1)}, facets),
-               InputError);
-  EXPECT_THROW(index.query({glm::dvec3(0, 0, -1), glm::dvec3(1, 0, -1), glm::dvec3(0, INFINITY, -1)}, facets),
-               InputError);
+  EXPECT_THROW(
+      index.query({glm::dvec3(0, 0, -1), glm::dvec3(NAN, 0, -1), glm::dvec3(0, 1, -1)}, facets),
+      InputError);
+  EXPECT_THROW(
+      index.query({glm::dvec3(0, 0, -1), glm::dvec3(1, 0, -1), glm::dvec3(0, INFINITY, -1)},
+                  facets),
+      InputError);
 }
 
 }  // namespace

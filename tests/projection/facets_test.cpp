@@ -1,12 +1,13 @@
 // Facets: continuity across shared edges, the tolerance, the clip matrix and float32 error.
-#include <map>
-#include <random>
+#include "facet/projection/facets.hpp"
 
 #include <gtest/gtest.h>
 
+#include <map>
+#include <random>
+
 #include "facet/projection/errors.hpp"
 #include "facet/projection/facet_error.hpp"
-#include "facet/projection/facets.hpp"
 #include "test_displays.hpp"
 
 namespace facet {
@@ -57,7 +58,8 @@ TEST(Facets, SeamOfA360CylinderIsContinuousModuloTheWidth) {
   // The first and the last strip both hold the seam direction (s = 0 and s = 1).
   const int columns = int(mesh.s_breaks.size()) - 1;
   const std::uint32_t first = mesh.cell_first_facet[0], last = mesh.cell_first_facet[columns - 1];
-  const glm::dvec3 top = warp.p_eye_surface_from_st({0, 0}), bottom = warp.p_eye_surface_from_st({0, 1});
+  const glm::dvec3 top = warp.p_eye_surface_from_st({0, 0}),
+                   bottom = warp.p_eye_surface_from_st({0, 1});
   double worst = 0;
   for (int m = 0; m <= 32; ++m) {
     const glm::dvec3 X = top + (bottom - top) * (m / 32.0);
@@ -165,7 +167,8 @@ TEST(Facets, GuardBandIsAtMostTheRequestedPixels) {
       const glm::dvec3 mid = (p[k] + p[(k + 1) % 3]) / 2.0;
       // Walk outwards from the edge midpoint along the chord plane until leaving the guard.
       const glm::dvec3 out = mid + (mid - centroid) * 1e-6;
-      const double px_per_step = glm::length(mesh.facets[f].project(out) - mesh.facets[f].project(mid));
+      const double px_per_step =
+          glm::length(mesh.facets[f].project(out) - mesh.facets[f].project(mid));
       double inside_px = 0;
       for (int step = 1; step < 200000; ++step) {
         const glm::dvec3 X = mid + (mid - centroid) * (1e-6 * step);

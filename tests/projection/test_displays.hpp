@@ -22,8 +22,8 @@ inline Warp with_smooth_offsets(Warp warp, glm::ivec2 grid, double amplitude) {
     for (int i = 0; i < grid.x; ++i) {
       const double s = double(i) / (grid.x - 1), t = double(j) / (grid.y - 1);
       const double u = 2 * s - 1, v = 2 * t - 1;
-      warp.offset_px[warp.node_index(i, j)] =
-          glm::vec2(float(amplitude * u * (u * u + v * v) / 2), float(amplitude * 0.5 * v * (1 - u * u)));
+      warp.offset_px[warp.node_index(i, j)] = glm::vec2(float(amplitude * u * (u * u + v * v) / 2),
+                                                        float(amplitude * 0.5 * v * (1 - u * u)));
     }
   }
   return warp;
@@ -31,10 +31,12 @@ inline Warp with_smooth_offsets(Warp warp, glm::ivec2 grid, double amplitude) {
 
 inline std::vector<NamedWarp> displays_for_tolerance_tests() {
   return {
-      {"cylinder 360x90", Warp::analytic(BaseProjection::cylindrical(-180, 180, 1, -1), {480, 360})},
+      {"cylinder 360x90",
+       Warp::analytic(BaseProjection::cylindrical(-180, 180, 1, -1), {480, 360})},
       {"cylinder 120x60 with offsets",
-       with_smooth_offsets(Warp::analytic(BaseProjection::cylindrical(-60, 60, 0.6, -0.6), {400, 200}),
-                           {17, 9}, 6)},
+       with_smooth_offsets(
+           Warp::analytic(BaseProjection::cylindrical(-60, 60, 0.6, -0.6), {400, 200}), {17, 9},
+           6)},
       {"fisheye 180", Warp::analytic(BaseProjection::fisheye(180), {256, 256})},
       {"fisheye 220", Warp::analytic(BaseProjection::fisheye(220), {192, 192})},
       {"equirectangular 360x150",

@@ -1,8 +1,8 @@
 // Offset maps: files, validation, folds and bad values.
-#include <filesystem>
-
 #include <OpenImageIO/imageio.h>
 #include <gtest/gtest.h>
+
+#include <filesystem>
 
 #include "facet/projection/errors.hpp"
 #include "facet/projection_io/warp_file.hpp"
@@ -16,9 +16,10 @@ namespace fs = std::filesystem;
 class WarpFile : public ::testing::Test {
  protected:
   void SetUp() override {
-    folder_ = fs::temp_directory_path() /
-              ("facet-warp-test-" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) +
-               "-" + ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    folder_ =
+        fs::temp_directory_path() /
+        ("facet-warp-test-" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) +
+         "-" + ::testing::UnitTest::GetInstance()->current_test_info()->name());
     fs::remove_all(folder_);
     fs::create_directories(folder_);
   }
@@ -79,11 +80,12 @@ void write_raw(const std::string& path, int w, int h, const std::vector<float>& 
   out->close();
 }
 
-const char* kMeta =
-    R"({"format":"facet-warp/1","output_size":[100,100],"base":"perspective",)"
-    R"("tan_extent":[-1,1,1,-1]})";
+const char* kMeta = R"({"format":"facet-warp/1","output_size":[100,100],"base":"perspective",)"
+                    R"("tan_extent":[-1,1,1,-1]})";
 
-std::vector<float> identity_nodes(int w, int h) { return std::vector<float>(std::size_t(w) * h * 3, 1.0f); }
+std::vector<float> identity_nodes(int w, int h) {
+  return std::vector<float>(std::size_t(w) * h * 3, 1.0f);
+}
 
 void expect_input_error(const std::string& path, const std::string& field_part) {
   try {
@@ -137,12 +139,15 @@ TEST_F(WarpFile, MissingOrWrongMetadataIsRejected) {
   expect_input_error(path, "facet:warp");
   write_raw(path, 2, 2, nodes, "{not json");
   expect_input_error(path, "facet:warp");
-  write_raw(path, 2, 2, nodes, R"({"format":"facet-warp/2","output_size":[10,10],"base":"fisheye","fov":180})");
-  expect_input_error(path, "format");
-  write_raw(path, 2, 2, nodes, R"({"format":"facet-warp/1","output_size":[10,10],"base":"fisheye"})");
-  expect_input_error(path, "fov");
   write_raw(path, 2, 2, nodes,
-            R"({"format":"facet-warp/1","output_size":[10,10],"base":"perspective","tan_extent":[-1e400,1,1,-1]})");
+            R"({"format":"facet-warp/2","output_size":[10,10],"base":"fisheye","fov":180})");
+  expect_input_error(path, "format");
+  write_raw(path, 2, 2, nodes,
+            R"({"format":"facet-warp/1","output_size":[10,10],"base":"fisheye"})");
+  expect_input_error(path, "fov");
+  write_raw(
+      path, 2, 2, nodes,
+      R"({"format":"facet-warp/1","output_size":[10,10],"base":"perspective","tan_extent":[-1e400,1,1,-1]})");
   expect_input_error(path, "");
   expect_input_error((folder_ / "missing.warp.exr").string(), "");
 }

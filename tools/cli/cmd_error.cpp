@@ -2,9 +2,8 @@
 #include <chrono>
 #include <cstdio>
 #include <iostream>
-#include <variant>
-
 #include <nlohmann/json.hpp>
+#include <variant>
 
 #include "command.hpp"
 #include "display_flags.hpp"
@@ -59,8 +58,8 @@ nlohmann::json to_json(const ErrorRow& row) {
 }
 
 void print_header() {
-  std::printf("%-34s %-18s %8s %10s %10s %12s %10s\n", "display", "facets from", "facets",
-              "max px", "rms px", "float32 px", "build ms");
+  std::printf("%-34s %-18s %8s %10s %10s %12s %10s\n", "display", "facets from", "facets", "max px",
+              "rms px", "float32 px", "build ms");
 }
 
 void print_row(const ErrorRow& row) {
@@ -74,8 +73,7 @@ void print_row(const ErrorRow& row) {
 }
 
 void sweep(bool json) {
-  const Warp cylinder =
-      Warp::analytic(BaseProjection::cylindrical(-180, 180, 1, -1), {1600, 1200});
+  const Warp cylinder = Warp::analytic(BaseProjection::cylindrical(-180, 180, 1, -1), {1600, 1200});
   const Warp dome = Warp::analytic(BaseProjection::fisheye(180), {2048, 2048});
   std::vector<std::tuple<std::string, const Warp*, FacetLayout>> cases;
   for (int n : {20, 40, 80, 160, 320, 640}) {
@@ -86,8 +84,9 @@ void sweep(bool json) {
   }
   for (const auto* warp : {&cylinder, &dome}) {
     for (double tolerance : {1.0, 0.5, 0.25, 0.1, 0.05}) {
-      cases.emplace_back(warp == &cylinder ? "cylinder 360x90 1600x1200" : "dome fisheye 180 2048x2048",
-                         warp, FacetTolerance{tolerance});
+      cases.emplace_back(
+          warp == &cylinder ? "cylinder 360x90 1600x1200" : "dome fisheye 180 2048x2048", warp,
+          FacetTolerance{tolerance});
     }
   }
   nlohmann::json rows = nlohmann::json::array();
@@ -103,37 +102,39 @@ void sweep(bool json) {
   if (json) std::cout << rows.dump(2) << "\n";
 }
 
-const Registration registration{10, [](CLI::App& app) {
-  auto* command = app.add_subcommand(
-      "error", "Facet count, max and RMS error (output px), float32 error and build time");
-  struct Options {
-    DisplayFlags display;
-    LayoutFlags layout;
-    bool json = false;
-    bool sweep = false;
-  };
-  auto options = std::make_shared<Options>();
-  options->display.add_to(*command);
-  options->layout.add_to(*command);
-  command->add_flag("--json", options->json, "Print one JSON object");
-  command->add_flag("--sweep", options->sweep,
-                    "Error against facet count for the seed's 360°×90° cylinder at 1600×1200 and a "
-                    "180° dome master at 2048×2048");
-  command->callback([options] {
-    if (options->sweep) return sweep(options->json);
-    const Warp warp = options->display.make_warp();
-    const std::string name = options->display.warp_path.empty()
-                                 ? options->display.base + " " + options->display.size
-                                 : options->display.warp_path;
-    const ErrorRow row = measure(name, warp, options->layout.layout());
-    if (options->json) {
-      std::cout << to_json(row).dump() << "\n";
-    } else {
-      print_header();
-      print_row(row);
-    }
-  });
-}};
+const Registration registration{
+    10, [](CLI::App& app) {
+      auto* command = app.add_subcommand(
+          "error", "Facet count, max and RMS error (output px), float32 error and build time");
+      struct Options {
+        DisplayFlags display;
+        LayoutFlags layout;
+        bool json = false;
+        bool sweep = false;
+      };
+      auto options = std::make_shared<Options>();
+      options->display.add_to(*command);
+      options->layout.add_to(*command);
+      command->add_flag("--json", options->json, "Print one JSON object");
+      command->add_flag(
+          "--sweep", options->sweep,
+          "Error against facet count for the seed's 360°×90° cylinder at 1600×1200 and a "
+          "180° dome master at 2048×2048");
+      command->callback([options] {
+        if (options->sweep) return sweep(options->json);
+        const Warp warp = options->display.make_warp();
+        const std::string name = options->display.warp_path.empty()
+                                     ? options->display.base + " " + options->display.size
+                                     : options->display.warp_path;
+        const ErrorRow row = measure(name, warp, options->layout.layout());
+        if (options->json) {
+          std::cout << to_json(row).dump() << "\n";
+        } else {
+          print_header();
+          print_row(row);
+        }
+      });
+    }};
 
 }  // namespace
 }  // namespace facet::cli

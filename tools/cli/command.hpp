@@ -2,11 +2,10 @@
 // Subcommands register themselves here, one file each, so that adding a command never touches
 // main.cpp. The callback set up by `add` runs after parsing; an InputError it throws becomes exit
 // status 2.
+#include <CLI/CLI.hpp>
 #include <functional>
 #include <string>
 #include <vector>
-
-#include <CLI/CLI.hpp>
 
 namespace facet::cli {
 

@@ -20,7 +20,8 @@ std::vector<double> parse_numbers(const std::string& text, const std::string& fl
       values.push_back(std::stod(item, &used));
       if (used != item.size()) throw std::invalid_argument(item);
     } catch (const std::exception&) {
-      throw InputError("command line", flag, "expected comma-separated numbers; got '" + text + "'");
+      throw InputError("command line", flag,
+                       "expected comma-separated numbers; got '" + text + "'");
     }
   }
   if (values.size() < count_min || values.size() > count_max) {
@@ -39,7 +40,8 @@ glm::ivec2 parse_size(const std::string& text, const std::string& flag) {
   char x = 0, extra = 0;
   std::stringstream stream(text);
   if (!(stream >> w >> x >> h) || (x != 'x' && x != 'X') || (stream >> extra) || w < 1 || h < 1) {
-    throw InputError("command line", flag, "expected WxH with positive integers; got '" + text + "'");
+    throw InputError("command line", flag,
+                     "expected WxH with positive integers; got '" + text + "'");
   }
   return {w, h};
 }
@@ -80,8 +82,8 @@ Warp DisplayFlags::make_warp() const {
       }
       break;
     case BaseKind::fisheye:
-      projection = BaseProjection::fisheye(
-          fov.empty() ? 180.0 : parse_numbers(fov, "--fov", 1, 1)[0]);
+      projection =
+          BaseProjection::fisheye(fov.empty() ? 180.0 : parse_numbers(fov, "--fov", 1, 1)[0]);
       break;
     case BaseKind::cylindrical: {
       const auto a = parse_numbers(azimuth, "--azimuth", 2, 2);

@@ -1,11 +1,10 @@
 #pragma once
 // Command-line description of a display: an analytic base projection given by flags, or a
 // `.warp.exr` file.
-#include <optional>
-#include <string>
-
 #include <CLI/CLI.hpp>
 #include <glm/glm.hpp>
+#include <optional>
+#include <string>
 
 #include "facet/projection/facets.hpp"
 #include "facet/projection/warp.hpp"

@@ -19,8 +19,9 @@ Registration::Registration(int order, CommandSetup setup) {
 }  // namespace facet::cli
 
 int main(int argc, char** argv) {
-  CLI::App app{"facet: calibration and piecewise perspective rendering for dome, cylinder and "
-               "wall projector displays"};
+  CLI::App app{
+      "facet: calibration and piecewise perspective rendering for dome, cylinder and "
+      "wall projector displays"};
   app.require_subcommand(1);
   auto commands = facet::cli::CommandRegistry::commands();
   std::stable_sort(commands.begin(), commands.end(),

@@ -43,8 +43,12 @@ json base_to_json(const Warp& warp) {
   }
   meta["rotation"] = rotation;
   switch (base.kind) {
-    case BaseKind::perspective: meta["tan_extent"] = base.tan_extent; break;
-    case BaseKind::fisheye: meta["fov"] = base.fov_deg; break;
+    case BaseKind::perspective:
+      meta["tan_extent"] = base.tan_extent;
+      break;
+    case BaseKind::fisheye:
+      meta["fov"] = base.fov_deg;
+      break;
     case BaseKind::cylindrical:
       meta["azimuth"] = base.azimuth_deg;
       meta["tan_elevation"] = base.tan_elevation;
@@ -73,7 +77,8 @@ void base_from_json(const json& meta, const std::string& path, Warp& warp) {
   if (!meta.contains("base") || !meta["base"].is_string()) {
     throw InputError(path, field_prefix + "base", "expected a string");
   }
-  warp.base.kind = base_kind_from_string(meta["base"].get<std::string>(), path, field_prefix + "base");
+  warp.base.kind =
+      base_kind_from_string(meta["base"].get<std::string>(), path, field_prefix + "base");
   if (meta.contains("rotation")) {
     const json& rotation = meta["rotation"];
     if (!rotation.is_array() || rotation.size() != 3) {
@@ -92,7 +97,9 @@ void base_from_json(const json& meta, const std::string& path, Warp& warp) {
     }
   }
   switch (warp.base.kind) {
-    case BaseKind::perspective: warp.base.tan_extent = numbers<4>(meta, "tan_extent", path); break;
+    case BaseKind::perspective:
+      warp.base.tan_extent = numbers<4>(meta, "tan_extent", path);
+      break;
     case BaseKind::fisheye:
       if (!meta.contains("fov") || !meta["fov"].is_number()) {
         throw InputError(path, field_prefix + "fov", "expected a number of degrees");

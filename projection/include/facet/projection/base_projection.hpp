@@ -1,12 +1,12 @@
 #pragma once
 // Base projections of FORMATS.md §2: maps between normalised base-image coordinates st = (s, t)
-// in [0,1]² (t grows downwards) and directions b in the base frame (x right, y up, looking down -z).
+// in [0,1]² (t grows downwards) and directions b in the base frame (x right, y up, looking down
+// -z).
 #include <array>
+#include <glm/glm.hpp>
 #include <limits>
 #include <optional>
 #include <string>
-
-#include <glm/glm.hpp>
 
 namespace facet {
 
@@ -36,7 +36,8 @@ struct BaseProjection {
   // (0, 180).
   static BaseProjection perspective_fov(double fov_x_deg, double fov_y_deg);
   static BaseProjection fisheye(double fov_deg);
-  static BaseProjection cylindrical(double a0_deg, double a1_deg, double tan_top, double tan_bottom);
+  static BaseProjection cylindrical(double a0_deg, double a1_deg, double tan_top,
+                                    double tan_bottom);
   static BaseProjection equirectangular(double a0_deg, double a1_deg, double top_deg,
                                         double bottom_deg);
 

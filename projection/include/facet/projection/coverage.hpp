@@ -8,10 +8,9 @@
 // the cylinder axis, and triangles partly behind the eye need no special cases.
 #include <array>
 #include <cstdint>
+#include <glm/glm.hpp>
 #include <optional>
 #include <vector>
-
-#include <glm/glm.hpp>
 
 #include "facet/projection/facets.hpp"
 
@@ -20,11 +19,13 @@ namespace facet {
 class CoverageIndex {
  public:
   struct Node {
-    glm::dvec3 axis{0.0};      // unit axis of a cone holding every guarded facet pyramid below
-    double sin_half_angle = 1;  // half-angle of that cone; >= 1 means no bound (a half-space or more)
+    glm::dvec3 axis{0.0};  // unit axis of a cone holding every guarded facet pyramid below
+    double sin_half_angle =
+        1;  // half-angle of that cone; >= 1 means no bound (a half-space or more)
     double cos_half_angle = 0;
-    std::uint32_t first = 0;   // leaf: facets order[first, first+count); inner: children first, first+1
-    std::uint32_t count = 0;   // 0 for an inner node
+    std::uint32_t first =
+        0;  // leaf: facets order[first, first+count); inner: children first, first+1
+    std::uint32_t count = 0;  // 0 for an inner node
   };
 
   explicit CoverageIndex(const FacetMesh& mesh, double guard_px = kDefaultGuardPx);

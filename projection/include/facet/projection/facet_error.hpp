@@ -1,7 +1,6 @@
 #pragma once
 // How far facets are from the exact warp, in output pixels.
 #include <cstddef>
-
 #include <glm/glm.hpp>
 
 #include "facet/projection/facets.hpp"
@@ -25,7 +24,7 @@ struct FacetError {
   double float32_rms_px = 0;
   std::size_t samples = 0;
   std::size_t missed_samples = 0;  // covered directions that no facet contains (holes)
-  glm::dvec2 worst_q{0.0};  // exact output pixel of the worst sample
+  glm::dvec2 worst_q{0.0};         // exact output pixel of the worst sample
 };
 
 // Compares, over dense samples of covered directions, the exact P with the facet containing each

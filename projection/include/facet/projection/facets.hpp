@@ -8,11 +8,10 @@
 // w = n·X. Neighbours share corners, so shared edges map identically: no cracks, no T-junctions.
 #include <array>
 #include <cstdint>
+#include <glm/glm.hpp>
 #include <string>
 #include <variant>
 #include <vector>
-
-#include <glm/glm.hpp>
 
 #include "facet/projection/warp.hpp"
 

@@ -2,11 +2,10 @@
 // Camera-texture offset maps (FORMATS.md §2): the exact map P from an eye-frame direction to an
 // output pixel, as a base projection plus bilinearly interpolated pixel offsets.
 #include <cstdint>
+#include <glm/glm.hpp>
 #include <optional>
 #include <string>
 #include <vector>
-
-#include <glm/glm.hpp>
 
 #include "facet/projection/base_projection.hpp"
 
@@ -49,8 +48,8 @@ struct Warp {
     bool covered;   // st in [0,1]² and coverage >= 0.5
   };
   // The exact map P for an eye-frame direction. nullopt where the base has no value.
-  std::optional<Projected> project(
-      glm::dvec3 v_eye, double s_hint = std::numeric_limits<double>::quiet_NaN()) const;
+  std::optional<Projected> project(glm::dvec3 v_eye,
+                                   double s_hint = std::numeric_limits<double>::quiet_NaN()) const;
 };
 
 }  // namespace facet
