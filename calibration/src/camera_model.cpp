@@ -4,10 +4,9 @@
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
+#include <opencv2/imgproc.hpp>
 #include <regex>
 #include <sstream>
-
-#include <opencv2/imgproc.hpp>
 
 extern "C" {
 #include <mrcal/mrcal.h>
@@ -83,9 +82,9 @@ CameraModel::CameraModel(const std::string& lensmodel, std::vector<double> intri
   auto impl = std::make_shared<Impl>();
   if (!mrcal_lensmodel_from_name(&impl->lensmodel, lensmodel.c_str()) ||
       !mrcal_lensmodel_type_is_valid(impl->lensmodel.type)) {
-    throw InputError(source, "lensmodel",
-                     "a configured mrcal lens model name such as LENSMODEL_OPENCV8, not '" +
-                         lensmodel + "'");
+    throw InputError(
+        source, "lensmodel",
+        "a configured mrcal lens model name such as LENSMODEL_OPENCV8, not '" + lensmodel + "'");
   }
   const int count = mrcal_lensmodel_num_params(&impl->lensmodel);
   if (int(intrinsics.size()) != count) {

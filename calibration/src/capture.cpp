@@ -49,33 +49,33 @@ Screen screen_from_json(const nlohmann::json& object, const JsonContext& at) {
       to_string(require_member(object, "type", at, expected_type), at.at("type"));
   Screen screen;
   auto read_radius = [&] {
-    const double radius =
-        to_number(require_member(object, "radius", at, "a positive number of metres"),
-                  at.at("radius"));
+    const double radius = to_number(
+        require_member(object, "radius", at, "a positive number of metres"), at.at("radius"));
     if (!(radius > 0)) at.at("radius").fail("a positive number of metres");
     return radius;
   };
   auto read_unit = [&](const std::string& key) {
-    const glm::dvec3 v = to_dvec3(require_member(object, key, at, "a list of 3 numbers"), at.at(key));
+    const glm::dvec3 v =
+        to_dvec3(require_member(object, key, at, "a list of 3 numbers"), at.at(key));
     const double length = glm::length(v);
     if (!(length > 1e-12)) at.at(key).fail("a non-zero vector");
     return v / length;
   };
   if (type == "sphere") {
     screen.type = Screen::Type::sphere;
-    screen.center = to_dvec3(require_member(object, "center", at, "a point in metres"),
-                             at.at("center"));
+    screen.center =
+        to_dvec3(require_member(object, "center", at, "a point in metres"), at.at("center"));
     screen.radius = read_radius();
   } else if (type == "cylinder") {
     screen.type = Screen::Type::cylinder;
-    screen.center = to_dvec3(require_member(object, "center", at, "a point in metres"),
-                             at.at("center"));
+    screen.center =
+        to_dvec3(require_member(object, "center", at, "a point in metres"), at.at("center"));
     screen.axis = read_unit("axis");
     screen.radius = read_radius();
   } else if (type == "plane") {
     screen.type = Screen::Type::plane;
-    screen.point = to_dvec3(require_member(object, "point", at, "a point in metres"),
-                            at.at("point"));
+    screen.point =
+        to_dvec3(require_member(object, "point", at, "a point in metres"), at.at("point"));
     screen.normal = read_unit("normal");
   } else {
     at.at("type").fail(expected_type);
@@ -193,15 +193,16 @@ void validate_capture(const Capture& capture, const std::string& source) {
         const int axis_size = pattern.axis == Axis::x ? projector.size.x : projector.size.y;
         const int bits = gray_bits(axis_size);
         if (pattern.bit < 0 || pattern.bit >= bits) {
-          frame_at.at("pattern").at("bit").fail(
-              "a bit from 0 to " + std::to_string(bits - 1) + " (ceil(log2(" +
-              std::to_string(axis_size) + ")) bits identify every pixel of this axis)");
+          frame_at.at("pattern").at("bit").fail("a bit from 0 to " + std::to_string(bits - 1) +
+                                                " (ceil(log2(" + std::to_string(axis_size) +
+                                                ")) bits identify every pixel of this axis)");
         }
       }
       if (pattern.type == PatternType::phase &&
           (!(pattern.period > 0) || pattern.steps < 3 || pattern.step < 0 ||
            pattern.step >= pattern.steps)) {
-        frame_at.at("pattern").fail("a phase pattern with period > 0, steps >= 3, 0 <= step < steps");
+        frame_at.at("pattern").fail(
+            "a phase pattern with period > 0, steps >= 3, 0 <= step < steps");
       }
       if (!seen.insert(pattern_to_json(pattern).dump()).second) {
         frame_at.at("pattern").fail("a pattern that no other frame of this projector shows");
@@ -227,7 +228,8 @@ Capture read_capture(const std::filesystem::path& path) {
   }
   const JsonContext at{source, ""};
   require_object(root, at);
-  const auto& format = require_member(root, "format", at, std::string("\"") + kCaptureFormat + "\"");
+  const auto& format =
+      require_member(root, "format", at, std::string("\"") + kCaptureFormat + "\"");
   if (!format.is_string() || format.get<std::string>() != kCaptureFormat) {
     at.at("format").fail(std::string("\"") + kCaptureFormat + "\"");
   }
@@ -235,8 +237,8 @@ Capture read_capture(const std::filesystem::path& path) {
   Capture capture;
   capture.folder = file.parent_path();
   const JsonContext camera_at = at.at("camera");
-  const auto& camera = require_object(require_member(root, "camera", at, "a camera object"),
-                                      camera_at);
+  const auto& camera =
+      require_object(require_member(root, "camera", at, "a camera object"), camera_at);
   capture.camera.model =
       to_string(require_member(camera, "model", camera_at, "an mrcal .cameramodel file"),
                 camera_at.at("model"));
@@ -263,8 +265,7 @@ Capture read_capture(const std::filesystem::path& path) {
   validate_capture(capture, source);
   if (!std::filesystem::is_regular_file(capture.resolve(capture.camera.model), error)) {
     camera_at.at("model").fail("an mrcal .cameramodel file, but '" +
-                               capture.resolve(capture.camera.model).string() +
-                               "' does not exist");
+                               capture.resolve(capture.camera.model).string() + "' does not exist");
   }
   return capture;
 }
@@ -278,8 +279,8 @@ nlohmann::json capture_to_json(const Capture& capture) {
   for (const CaptureProjector& projector : capture.projectors) {
     nlohmann::json frames = nlohmann::json::array();
     for (const CaptureFrame& frame : projector.frames) {
-      frames.push_back({{"file", frame.file.generic_string()},
-                        {"pattern", pattern_to_json(frame.pattern)}});
+      frames.push_back(
+          {{"file", frame.file.generic_string()}, {"pattern", pattern_to_json(frame.pattern)}});
     }
     projectors.push_back({{"name", projector.name},
                           {"size", {projector.size.x, projector.size.y}},
@@ -316,10 +317,10 @@ glm::ivec2 check_capture_images(const Capture& capture, std::size_t projector_in
       first = path;
     } else if (info.size != *size) {
       throw InputError(path.string(), "",
-                       "an image of the same size as the other frames (" +
-                           std::to_string(size->x) + "x" + std::to_string(size->y) + ", as " +
-                           first.filename().string() + "), but it is " +
-                           std::to_string(info.size.x) + "x" + std::to_string(info.size.y));
+                       "an image of the same size as the other frames (" + std::to_string(size->x) +
+                           "x" + std::to_string(size->y) + ", as " + first.filename().string() +
+                           "), but it is " + std::to_string(info.size.x) + "x" +
+                           std::to_string(info.size.y));
     }
   }
   FACET_ASSERT(size.has_value());

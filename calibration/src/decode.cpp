@@ -17,12 +17,12 @@ constexpr std::size_t kNone = std::numeric_limits<std::size_t>::max();
 // Which frame plays which role, found once before any image is loaded.
 struct AxisPlan {
   bool used = false;
-  int size = 0;               // projector pixels along the axis
-  int bits = 0;               // gray_bits(size)
-  int lowest_bit = 0;         // Gray bits below this are left out (phase decides there)
+  int size = 0;        // projector pixels along the axis
+  int bits = 0;        // gray_bits(size)
+  int lowest_bit = 0;  // Gray bits below this are left out (phase decides there)
   std::vector<std::size_t> gray, inverse;  // frame index per bit, kNone when absent
-  double period = 0;          // phase, 0 when none
-  std::vector<std::size_t> phase;  // frame index per step
+  double period = 0;                       // phase, 0 when none
+  std::vector<std::size_t> phase;          // frame index per step
 };
 
 struct Plan {
@@ -97,12 +97,14 @@ Plan plan_decode(std::span<const Pattern> patterns, glm::ivec2 projector_size, d
         }
       }
       if (gamma != 1.0 && !white_black) {
-        fail("white and black frames: phase frames of a projector with gamma != 1 are "
-             "linearised with them");
+        fail(
+            "white and black frames: phase frames of a projector with gamma != 1 are "
+            "linearised with them");
       }
       // Leaving out bits below k puts the Gray estimate within 2^(k-1) of the truth; keeping
       // that below a quarter period leaves the unwrapping a margin.
-      while (axis.lowest_bit < axis.bits && std::ldexp(1.0, axis.lowest_bit + 1) <= axis.period / 2) {
+      while (axis.lowest_bit < axis.bits &&
+             std::ldexp(1.0, axis.lowest_bit + 1) <= axis.period / 2) {
         ++axis.lowest_bit;
       }
       // Use the low bits that are there, as long as the ones above them are complete.
@@ -131,7 +133,8 @@ Plan plan_decode(std::span<const Pattern> patterns, glm::ivec2 projector_size, d
       }
     }
     bool any_pair = false;
-    for (const AxisPlan& axis : plan.axes) any_pair = any_pair || (axis.used && axis.bits > axis.lowest_bit);
+    for (const AxisPlan& axis : plan.axes)
+      any_pair = any_pair || (axis.used && axis.bits > axis.lowest_bit);
     if (!any_pair) fail("white and black frames (to tell lit pixels from shadow)");
   }
   return plan;
@@ -152,9 +155,12 @@ cv::Mat as_float(const cv::Mat& image) {
 
 template <typename Body>
 void for_rows(int rows, const Body& body) {
-  cv::parallel_for_(cv::Range(0, rows), [&](const cv::Range& range) {
-    for (int y = range.start; y < range.end; ++y) body(y);
-  }, std::max(1.0, rows / 16.0));
+  cv::parallel_for_(
+      cv::Range(0, rows),
+      [&](const cv::Range& range) {
+        for (int y = range.start; y < range.end; ++y) body(y);
+      },
+      std::max(1.0, rows / 16.0));
 }
 
 std::uint32_t gray_to_binary(std::uint32_t gray) {
@@ -179,15 +185,17 @@ DecodedMap decode(std::span<const Pattern> patterns, const FrameLoader& load,
   auto load_checked = [&](std::size_t frame) {
     cv::Mat image = as_float(load(frame));
     if (image.empty() || image.channels() != 1) {
-      throw InputError(source, field, "frame " + std::to_string(frame) + ": a single-channel image");
+      throw InputError(source, field,
+                       "frame " + std::to_string(frame) + ": a single-channel image");
     }
     if (!size) {
       size = image.size();
     } else if (image.size() != *size) {
       throw InputError(source, field,
-                       "frame " + std::to_string(frame) + ": an image of the same size as the "
-                       "others (" + std::to_string(size->width) + "x" +
-                           std::to_string(size->height) + ")");
+                       "frame " + std::to_string(frame) +
+                           ": an image of the same size as the "
+                           "others (" +
+                           std::to_string(size->width) + "x" + std::to_string(size->height) + ")");
     }
     return image;
   };
@@ -201,8 +209,8 @@ DecodedMap decode(std::span<const Pattern> patterns, const FrameLoader& load,
 
   // Per-axis accumulators, filled one frame pair at a time so that only a few images are held.
   struct AxisState {
-    cv::Mat code;          // CV_32S Gray code bits
-    cv::Mat min_contrast;  // CV_32F weakest bit contrast relative to white − black
+    cv::Mat code;              // CV_32S Gray code bits
+    cv::Mat min_contrast;      // CV_32F weakest bit contrast relative to white − black
     cv::Mat sum_sin, sum_cos;  // CV_64F phase sums
   };
   AxisState states[2];
@@ -233,7 +241,8 @@ DecodedMap decode(std::span<const Pattern> patterns, const FrameLoader& load,
         for (int x = 0; x < size->width; ++x) {
           // Compare with the inverse, not with a threshold: ambient light and the projector's
           // gamma move both alike.
-          const float difference = inv != nullptr ? p[x] - inv[x] : 2 * (p[x] - 0.5f * (w[x] + k[x]));
+          const float difference =
+              inv != nullptr ? p[x] - inv[x] : 2 * (p[x] - 0.5f * (w[x] + k[x]));
           if (difference > 0) code[x] |= std::int32_t(1) << bit;
           contrast[x] = std::min(contrast[x], std::abs(difference));
         }

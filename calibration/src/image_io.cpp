@@ -1,13 +1,13 @@
 #include "facet/calibration/image_io.hpp"
 
+#include <OpenImageIO/imageio.h>
+#include <unistd.h>
+
 #include <atomic>
 #include <cmath>
 #include <memory>
 #include <system_error>
 #include <vector>
-
-#include <OpenImageIO/imageio.h>
-#include <unistd.h>
 
 #include "facet/projection/atomic_file.hpp"
 #include "facet/projection/errors.hpp"
@@ -31,8 +31,7 @@ std::unique_ptr<OIIO::ImageInput> open_image(const std::filesystem::path& path) 
   const OIIO::ImageSpec config = unassociated_config();
   auto input = OIIO::ImageInput::open(path.string(), &config);
   if (!input) {
-    throw InputError(path.string(), "",
-                     "a readable PNG or EXR image (" + OIIO::geterror() + ")");
+    throw InputError(path.string(), "", "a readable PNG or EXR image (" + OIIO::geterror() + ")");
   }
   return input;
 }
@@ -74,7 +73,8 @@ void write_grey_image(const std::filesystem::path& path, const cv::Mat& image, i
   const bool exr = path.extension() == ".exr";
   FACET_ASSERT(exr || bit_depth == 8 || bit_depth == 16);
   const OIIO::TypeDesc file_type =
-      exr ? OIIO::TypeDesc::FLOAT : (bit_depth == 8 ? OIIO::TypeDesc::UINT8 : OIIO::TypeDesc::UINT16);
+      exr ? OIIO::TypeDesc::FLOAT
+          : (bit_depth == 8 ? OIIO::TypeDesc::UINT8 : OIIO::TypeDesc::UINT16);
   OIIO::ImageSpec spec(image.cols, image.rows, 1, file_type);
   spec.attribute("oiio:UnassociatedAlpha", 1);
   cv::Mat clamped;
@@ -110,12 +110,13 @@ void write_folder_atomically(const std::filesystem::path& folder,
   }
   static std::atomic<unsigned> counter{0};
   const std::filesystem::path absolute = std::filesystem::absolute(folder).lexically_normal();
-  std::filesystem::path parent = absolute.has_filename() ? absolute.parent_path()
-                                                         : absolute.parent_path().parent_path();
+  std::filesystem::path parent =
+      absolute.has_filename() ? absolute.parent_path() : absolute.parent_path().parent_path();
   const std::string name = absolute.has_filename() ? absolute.filename().string()
                                                    : absolute.parent_path().filename().string();
   std::filesystem::create_directories(parent, error);
-  if (error) throw InputError(parent.string(), "", "a folder that can be created: " + error.message());
+  if (error)
+    throw InputError(parent.string(), "", "a folder that can be created: " + error.message());
   const std::filesystem::path temporary =
       parent / ("." + name + ".tmp" + std::to_string(::getpid()) + "-" + std::to_string(counter++));
   std::filesystem::create_directory(temporary, error);

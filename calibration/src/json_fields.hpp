@@ -1,11 +1,10 @@
 #pragma once
 // Internal: typed access to JSON members that throws InputError naming the file and the field.
 #include <cmath>
-#include <optional>
-#include <string>
-
 #include <glm/glm.hpp>
 #include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
 
 #include "facet/projection/errors.hpp"
 
@@ -93,7 +92,9 @@ inline glm::dmat3 to_dmat3(const nlohmann::json& value, const JsonContext& at) {
   return matrix;
 }
 
-inline nlohmann::json from_dvec3(const glm::dvec3& v) { return nlohmann::json::array({v.x, v.y, v.z}); }
+inline nlohmann::json from_dvec3(const glm::dvec3& v) {
+  return nlohmann::json::array({v.x, v.y, v.z});
+}
 
 inline nlohmann::json from_dmat3(const glm::dmat3& m) {
   nlohmann::json rows = nlohmann::json::array();

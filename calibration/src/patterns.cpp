@@ -106,8 +106,11 @@ nlohmann::json pattern_to_json(const Pattern& pattern) {
       return object;
     }
     case PatternType::phase:
-      return {{"type", "phase"},        {"axis", axis},          {"period", pattern.period},
-              {"step", pattern.step}, {"steps", pattern.steps}};
+      return {{"type", "phase"},
+              {"axis", axis},
+              {"period", pattern.period},
+              {"step", pattern.step},
+              {"steps", pattern.steps}};
   }
   FACET_ASSERT(false);
 }
@@ -146,11 +149,10 @@ Pattern pattern_from_json(const nlohmann::json& object, const std::string& sourc
     pattern.period = to_number(require_member(object, "period", at, "a positive number of pixels"),
                                at.at("period"));
     if (!(pattern.period > 0)) at.at("period").fail("a positive number of pixels");
-    pattern.steps =
-        to_int(require_member(object, "steps", at, "an integer >= 3"), at.at("steps"));
+    pattern.steps = to_int(require_member(object, "steps", at, "an integer >= 3"), at.at("steps"));
     if (pattern.steps < 3) at.at("steps").fail("an integer >= 3");
-    pattern.step = to_int(require_member(object, "step", at, "an integer from 0 to steps-1"),
-                          at.at("step"));
+    pattern.step =
+        to_int(require_member(object, "step", at, "an integer from 0 to steps-1"), at.at("step"));
     if (pattern.step < 0 || pattern.step >= pattern.steps) {
       at.at("step").fail("an integer from 0 to steps-1 = " + std::to_string(pattern.steps - 1));
     }

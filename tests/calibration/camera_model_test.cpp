@@ -1,9 +1,10 @@
-#include <filesystem>
-#include <fstream>
+#include "facet/calibration/camera_model.hpp"
 
 #include <gtest/gtest.h>
 
-#include "facet/calibration/camera_model.hpp"
+#include <filesystem>
+#include <fstream>
+
 #include "facet/projection/errors.hpp"
 #include "test_folder.hpp"
 
@@ -44,14 +45,16 @@ RoundTrip round_trip(const fc::CameraModel& camera, int nx, int ny) {
 }  // namespace
 
 TEST(CameraModel, ReadsRealMrcalModels) {
-  const auto opencv8 = fc::CameraModel::read(kData / "cameras/mrcal-figueroa/opencv8-0.cameramodel");
+  const auto opencv8 =
+      fc::CameraModel::read(kData / "cameras/mrcal-figueroa/opencv8-0.cameramodel");
   EXPECT_EQ(opencv8.lensmodel(), "LENSMODEL_OPENCV8");
   EXPECT_EQ(opencv8.intrinsics().size(), 12u);
   EXPECT_EQ(opencv8.imager_size(), glm::ivec2(6016, 4016));
   EXPECT_GE(opencv8.valid_intrinsics_region().size(), 10u);
   EXPECT_EQ(opencv8.valid_intrinsics_region().front(), glm::dvec2(622, 0));
 
-  const auto splined = fc::CameraModel::read(kData / "cameras/mrcal-figueroa/splined-0.cameramodel");
+  const auto splined =
+      fc::CameraModel::read(kData / "cameras/mrcal-figueroa/splined-0.cameramodel");
   EXPECT_EQ(splined.lensmodel(),
             "LENSMODEL_SPLINED_STEREOGRAPHIC_order=3_Nx=30_Ny=20_fov_x_deg=170");
   EXPECT_EQ(splined.intrinsics().size(), 4u + 2u * 30 * 20);
@@ -97,7 +100,8 @@ TEST(CameraModel, PinholeProjectsAsExpected) {
 
 TEST(CameraModel, WriteThenReadGivesTheSameModel) {
   const facet::test::TempFolder temp;
-  const auto splined = fc::CameraModel::read(kData / "cameras/mrcal-figueroa/splined-0.cameramodel");
+  const auto splined =
+      fc::CameraModel::read(kData / "cameras/mrcal-figueroa/splined-0.cameramodel");
   splined.write(temp.path() / "copy.cameramodel");
   const auto copy = fc::CameraModel::read(temp.path() / "copy.cameramodel");
   EXPECT_EQ(copy.lensmodel(), splined.lensmodel());

@@ -1,10 +1,11 @@
-#include <filesystem>
-#include <fstream>
+#include "facet/calibration/capture.hpp"
 
 #include <OpenImageIO/imageio.h>
 #include <gtest/gtest.h>
 
-#include "facet/calibration/capture.hpp"
+#include <filesystem>
+#include <fstream>
+
 #include "facet/calibration/image_io.hpp"
 #include "facet/projection/errors.hpp"
 #include "test_folder.hpp"

@@ -1,11 +1,11 @@
 // The `facet patterns` command, run as a user would.
+#include <gtest/gtest.h>
+
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
-#include <string>
-
-#include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
+#include <string>
 
 #include "facet/calibration/image_io.hpp"
 #include "facet/calibration/patterns.hpp"
@@ -26,8 +26,9 @@ int run(const std::string& arguments) {
 TEST(CliPatterns, WritesImagesAndManifest) {
   const facet::test::TempFolder temp;
   const auto out = temp.path() / "p";
-  ASSERT_EQ(run("patterns --size 48x20 --out " + out.string() + " --phase-period 6.5 --phase-steps 3"),
-            0);
+  ASSERT_EQ(
+      run("patterns --size 48x20 --out " + out.string() + " --phase-period 6.5 --phase-steps 3"),
+      0);
   std::ifstream stream(out / "manifest.json");
   const auto manifest = nlohmann::json::parse(stream);
   EXPECT_EQ(manifest["size"], nlohmann::json({48, 20}));
@@ -36,7 +37,8 @@ TEST(CliPatterns, WritesImagesAndManifest) {
   for (const auto& frame : manifest["frames"]) {
     const auto pattern = fc::pattern_from_json(frame["pattern"], "manifest", "frames");
     const cv::Mat image = fc::read_luminance(out / frame["file"].get<std::string>());
-    EXPECT_LE(cv::norm(image, fc::render_pattern(pattern, {48, 20}), cv::NORM_INF), 0.5 / 255 + 1e-6)
+    EXPECT_LE(cv::norm(image, fc::render_pattern(pattern, {48, 20}), cv::NORM_INF),
+              0.5 / 255 + 1e-6)
         << frame.dump();
   }
 }

@@ -1,13 +1,14 @@
+#include "facet/calibration/decode.hpp"
+
+#include <gtest/gtest.h>
+
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
-
-#include <gtest/gtest.h>
 #include <opencv2/calib3d.hpp>
 
 #include "facet/calibration/camera_model.hpp"
 #include "facet/calibration/capture.hpp"
-#include "facet/calibration/decode.hpp"
 #include "facet/calibration/patterns.hpp"
 #include "facet/projection/errors.hpp"
 
@@ -45,7 +46,8 @@ std::vector<cv::Mat> render(const Scene& scene, const std::vector<fc::Pattern>& 
         const glm::ivec2 q = scene.seen(i, j);
         const bool lit = j < size.y - scene.shadow_rows;
         const double v = values.at<float>(q.y, q.x);
-        image.at<float>(j, i) = float(scene.ambient + (lit ? scene.gain * std::pow(v, scene.gamma) : 0));
+        image.at<float>(j, i) =
+            float(scene.ambient + (lit ? scene.gain * std::pow(v, scene.gamma) : 0));
       }
     }
     images.push_back(image);
@@ -139,8 +141,8 @@ TEST(Decode, PhaseRefinesToWithinAHundredthOfAPixel) {
     std::vector<fc::Pattern> patterns;
     for (const auto& pattern : fc::standard_patterns(scene.projector_size, options)) {
       // Bits whose blocks are at most a quarter period wide may be left out.
-      const bool low = pattern.type == fc::PatternType::gray &&
-                       std::ldexp(1.0, pattern.bit + 1) <= c.period / 2;
+      const bool low =
+          pattern.type == fc::PatternType::gray && std::ldexp(1.0, pattern.bit + 1) <= c.period / 2;
       if (!(c.drop_low_bits && low)) patterns.push_back(pattern);
     }
     const auto map = fc::decode(patterns, render(scene, patterns), scene.projector_size, c.gamma);
@@ -246,20 +248,20 @@ TEST(Decode, MissingFramesAreInputErrors) {
                "inverse of Gray bit 2 of axis x");
   fc::PatternSetOptions options;
   options.phase_period = 16;
-  expect_error(without(fc::standard_patterns(size, options), fc::Pattern::phase(fc::Axis::y, 16, 2, 4)),
-               "phase step 2");
+  expect_error(
+      without(fc::standard_patterns(size, options), fc::Pattern::phase(fc::Axis::y, 16, 2, 4)),
+      "phase step 2");
   // A 16 px period lets bits 0 to 2 go (blocks of 8 px, at most a quarter period off), not 3.
   expect_error(without(fc::standard_patterns(size, options), fc::Pattern::gray(fc::Axis::x, 3)),
                "Gray bit 3 of axis x");
   expect_error({fc::Pattern::white(), fc::Pattern::black()}, "at least one axis");
 
   // Images of two sizes.
-  EXPECT_THROW(fc::decode(all,
-                          [&](std::size_t frame) {
-                            return cv::Mat(frame == 5 ? 5 : 4, 4, CV_32F, 0.5f);
-                          },
-                          size, 1.0),
-               facet::InputError);
+  EXPECT_THROW(
+      fc::decode(
+          all, [&](std::size_t frame) { return cv::Mat(frame == 5 ? 5 : 4, 4, CV_32F, 0.5f); },
+          size, 1.0),
+      facet::InputError);
 }
 
 // The real capture: a 1024x768 projector's Gray code on a planar board in front of a wall, seen

@@ -1,7 +1,7 @@
 // Our Gray code decoding against OpenCV's structured_light module on the real capture.
-#include <filesystem>
-
 #include <gtest/gtest.h>
+
+#include <filesystem>
 #include <opencv2/structured_light.hpp>
 
 #include "facet/calibration/capture.hpp"

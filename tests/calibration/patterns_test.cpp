@@ -1,11 +1,12 @@
-#include <filesystem>
-#include <fstream>
+#include "facet/calibration/patterns.hpp"
 
 #include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
 #include <nlohmann/json.hpp>
 
 #include "facet/calibration/image_io.hpp"
-#include "facet/calibration/patterns.hpp"
 #include "facet/projection/errors.hpp"
 #include "test_folder.hpp"
 

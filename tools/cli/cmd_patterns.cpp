@@ -17,8 +17,8 @@ glm::ivec2 parse_size(const std::string& text) {
   if (std::sscanf(text.c_str(), "%d%c%d%c", &width, &separator, &height, &extra) != 3 ||
       (separator != 'x' && separator != 'X') || width < 1 || height < 1 || width > 65536 ||
       height > 65536) {
-    throw facet::InputError("--size", "", "WxH with positive integers, e.g. 1920x1080, got '" +
-                                              text + "'");
+    throw facet::InputError("--size", "",
+                            "WxH with positive integers, e.g. 1920x1080, got '" + text + "'");
   }
   return {width, height};
 }
@@ -31,32 +31,35 @@ struct PatternsArgs {
   int bit_depth = 8;
 };
 
-const facet::cli::Registration registration{20, [](CLI::App& app) {
-  auto args = std::make_shared<PatternsArgs>();
-  auto* cmd = app.add_subcommand(
-      "patterns",
-      "Write structured-light patterns (white, black, Gray code with inverses, optional phase "
-      "shift) for one projector, plus manifest.json listing each file and its pattern");
-  cmd->add_option("--size", args->size, "projector resolution WxH, e.g. 1920x1080")->required();
-  cmd->add_option("--out", args->out, "output folder (must not exist, or be empty)")->required();
-  cmd->add_option("--phase-period", args->phase_period,
-                  "add phase-shift frames with this period in projector pixels");
-  cmd->add_option("--phase-steps", args->phase_steps, "number of phase shifts per axis")
-      ->check(CLI::Range(3, 64));
-  cmd->add_option("--bit-depth", args->bit_depth, "PNG bit depth")->check(CLI::IsMember({8, 16}));
-  cmd->callback([args] {
-    const glm::ivec2 size = parse_size(args->size);
-    facet::calibration::PatternSetOptions options;
-    if (args->phase_period) {
-      if (!std::isfinite(*args->phase_period) || !(*args->phase_period > 0)) {
-        throw facet::InputError("--phase-period", "", "a positive number of projector pixels");
-      }
-      options.phase_period = args->phase_period;
-    }
-    options.phase_steps = args->phase_steps;
-    const auto patterns = facet::calibration::standard_patterns(size, options);
-    facet::calibration::write_pattern_folder(args->out, size, patterns, args->bit_depth);
-  });
-}};
+const facet::cli::Registration registration{
+    20, [](CLI::App& app) {
+      auto args = std::make_shared<PatternsArgs>();
+      auto* cmd = app.add_subcommand(
+          "patterns",
+          "Write structured-light patterns (white, black, Gray code with inverses, optional phase "
+          "shift) for one projector, plus manifest.json listing each file and its pattern");
+      cmd->add_option("--size", args->size, "projector resolution WxH, e.g. 1920x1080")->required();
+      cmd->add_option("--out", args->out, "output folder (must not exist, or be empty)")
+          ->required();
+      cmd->add_option("--phase-period", args->phase_period,
+                      "add phase-shift frames with this period in projector pixels");
+      cmd->add_option("--phase-steps", args->phase_steps, "number of phase shifts per axis")
+          ->check(CLI::Range(3, 64));
+      cmd->add_option("--bit-depth", args->bit_depth, "PNG bit depth")
+          ->check(CLI::IsMember({8, 16}));
+      cmd->callback([args] {
+        const glm::ivec2 size = parse_size(args->size);
+        facet::calibration::PatternSetOptions options;
+        if (args->phase_period) {
+          if (!std::isfinite(*args->phase_period) || !(*args->phase_period > 0)) {
+            throw facet::InputError("--phase-period", "", "a positive number of projector pixels");
+          }
+          options.phase_period = args->phase_period;
+        }
+        options.phase_steps = args->phase_steps;
+        const auto patterns = facet::calibration::standard_patterns(size, options);
+        facet::calibration::write_pattern_folder(args->out, size, patterns, args->bit_depth);
+      });
+    }};
 
 }  // namespace

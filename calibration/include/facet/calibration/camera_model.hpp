@@ -7,13 +7,12 @@
 // mrcal's and OpenCV's: x right, y down, z forward.
 #include <array>
 #include <filesystem>
+#include <glm/glm.hpp>
 #include <memory>
 #include <optional>
 #include <span>
 #include <string>
 #include <vector>
-
-#include <glm/glm.hpp>
 
 namespace facet::calibration {
 

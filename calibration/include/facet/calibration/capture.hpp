@@ -1,13 +1,12 @@
 #pragma once
 // Recorded capture folders (FORMATS.md §1): capture.json and its images, as plain values.
 #include <filesystem>
-#include <optional>
-#include <string>
-#include <vector>
-
 #include <glm/glm.hpp>
 #include <nlohmann/json.hpp>
 #include <opencv2/core.hpp>
+#include <optional>
+#include <string>
+#include <vector>
 
 #include "facet/calibration/patterns.hpp"
 
@@ -19,10 +18,10 @@ inline constexpr const char* kCaptureFormat = "facet-capture/1";
 struct Screen {
   enum class Type { sphere, cylinder, plane };
   Type type = Type::sphere;
-  glm::dvec3 center{0.0};        // sphere, cylinder: a point on the axis
-  glm::dvec3 axis{0.0, 1.0, 0.0};  // cylinder: unit direction of the axis
-  double radius = 0;             // sphere, cylinder: > 0
-  glm::dvec3 point{0.0};         // plane: a point on it
+  glm::dvec3 center{0.0};            // sphere, cylinder: a point on the axis
+  glm::dvec3 axis{0.0, 1.0, 0.0};    // cylinder: unit direction of the axis
+  double radius = 0;                 // sphere, cylinder: > 0
+  glm::dvec3 point{0.0};             // plane: a point on it
   glm::dvec3 normal{0.0, 0.0, 1.0};  // plane: unit normal
 
   bool operator==(const Screen&) const = default;
@@ -47,9 +46,9 @@ struct CaptureFrame {
 };
 
 struct CaptureProjector {
-  std::string name;           // letters, digits, '_', '-', '.'; unique in the capture
-  glm::ivec2 size{0, 0};      // W, H in projector pixels
-  double gamma = 1;           // pattern value v emits light proportional to v^gamma
+  std::string name;       // letters, digits, '_', '-', '.'; unique in the capture
+  glm::ivec2 size{0, 0};  // W, H in projector pixels
+  double gamma = 1;       // pattern value v emits light proportional to v^gamma
   std::vector<CaptureFrame> frames;
 
   bool operator==(const CaptureProjector&) const = default;

@@ -3,11 +3,10 @@
 // a confidence, and why it was masked.
 #include <cstdint>
 #include <functional>
-#include <span>
-#include <string>
-
 #include <glm/glm.hpp>
 #include <opencv2/core.hpp>
+#include <span>
+#include <string>
 
 #include "facet/calibration/capture.hpp"
 #include "facet/calibration/patterns.hpp"
@@ -47,8 +46,8 @@ struct DecodeOptions {
 };
 
 struct DecodedMap {
-  glm::ivec2 camera_size{0, 0};     // width, height in camera pixels
-  glm::ivec2 projector_size{0, 0};  // W, H in projector pixels
+  glm::ivec2 camera_size{0, 0};       // width, height in camera pixels
+  glm::ivec2 projector_size{0, 0};    // W, H in projector pixels
   bool has_x = false, has_y = false;  // which axes the patterns measured
   // CV_64FC2, camera_size: the projector position (x, y) seen by each camera pixel, in output
   // pixels (projector pixel c spans [c, c+1), so Gray code alone gives centres c + 0.5). NaN in

@@ -3,10 +3,9 @@
 // atomically.
 #include <filesystem>
 #include <functional>
-#include <string>
-
 #include <glm/glm.hpp>
 #include <opencv2/core.hpp>
+#include <string>
 
 namespace facet::calibration {
 

@@ -3,13 +3,12 @@
 // shifting. Pattern values are in [0,1] *before* the projector's gamma: a value v emits light
 // proportional to v^gamma.
 #include <filesystem>
-#include <optional>
-#include <string>
-#include <vector>
-
 #include <glm/glm.hpp>
 #include <nlohmann/json.hpp>
 #include <opencv2/core.hpp>
+#include <optional>
+#include <string>
+#include <vector>
 
 namespace facet::calibration {
 
@@ -18,12 +17,12 @@ enum class Axis { x, y };  // x: projector columns c, y: projector rows r
 
 struct Pattern {
   PatternType type = PatternType::white;
-  Axis axis = Axis::x;     // gray and phase
-  int bit = 0;             // gray: bit b of g = c XOR (c >> 1), bit 0 least significant
-  bool inverted = false;   // gray: the complement
-  double period = 0;       // phase: projector pixels per cycle, > 0
-  int step = 0;            // phase: 0 <= step < steps
-  int steps = 0;           // phase: number of shifts, >= 3
+  Axis axis = Axis::x;    // gray and phase
+  int bit = 0;            // gray: bit b of g = c XOR (c >> 1), bit 0 least significant
+  bool inverted = false;  // gray: the complement
+  double period = 0;      // phase: projector pixels per cycle, > 0
+  int step = 0;           // phase: 0 <= step < steps
+  int steps = 0;          // phase: number of shifts, >= 3
 
   bool operator==(const Pattern&) const = default;
 
@@ -33,8 +32,8 @@ struct Pattern {
     return {.type = PatternType::gray, .axis = axis, .bit = bit, .inverted = inverted};
   }
   static Pattern phase(Axis axis, double period, int step, int steps) {
-    return {.type = PatternType::phase, .axis = axis, .period = period, .step = step,
-            .steps = steps};
+    return {
+        .type = PatternType::phase, .axis = axis, .period = period, .step = step, .steps = steps};
   }
 };
 
