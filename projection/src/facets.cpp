@@ -115,8 +115,8 @@ namespace {
 using detail::make_facet;
 
 constexpr double kPi = std::numbers::pi;
-// Largest angle a facet edge may span: far from the 180° at which a chord plane meets the eye,
-// and small enough that every facet pyramid is a thin, well-conditioned cone.
+// Largest angle between two corners of a cell, well short of the 180° at which a chord plane
+// passes through the eye and the facet's matrix degenerates.
 constexpr double kMaxFacetAngle = 150.0 * kPi / 180.0;
 // The builder aims below the requested tolerance because the final evaluation samples more
 // densely than the builder does.
@@ -133,18 +133,20 @@ double angle_between(glm::dvec3 a, glm::dvec3 b) {
 
 // Largest coverage inside the cell. Coverage is bilinear between nodes, so its maximum over a
 // rectangle lies on a node line crossing or a rectangle corner.
+// The node lines of an axis with `nodes` nodes that lie in [a, b], appended to `values`.
+void append_node_lines(double a, double b, int nodes, std::vector<double>& values) {
+  for (int i = int(std::ceil(a * (nodes - 1))); i <= int(std::floor(b * (nodes - 1))); ++i) {
+    values.push_back(double(i) / (nodes - 1));
+  }
+}
+
 double max_coverage(const Warp& warp, double s0, double s1, double t0, double t1) {
-  auto lines = [](double a, double b, int nodes) {
-    std::vector<double> values{a, b};
-    for (int i = int(std::ceil(a * (nodes - 1))); i <= int(std::floor(b * (nodes - 1))); ++i) {
-      values.push_back(double(i) / (nodes - 1));
-    }
-    return values;
-  };
+  std::vector<double> s_values{s0, s1}, t_values{t0, t1};
+  append_node_lines(s0, s1, warp.grid_size.x, s_values);
+  append_node_lines(t0, t1, warp.grid_size.y, t_values);
   double best = 0;
-  for (double s : lines(s0, s1, warp.grid_size.x)) {
-    for (double t : lines(t0, t1, warp.grid_size.y))
-      best = std::max(best, warp.coverage_at({s, t}));
+  for (double s : s_values) {
+    for (double t : t_values) best = std::max(best, warp.coverage_at({s, t}));
   }
   return best;
 }
@@ -174,9 +176,7 @@ double st_lattice_error(const Warp& warp, const std::array<Facet, 2>& facets, do
   auto positions = [subdivisions](double a, double b, int nodes) {
     std::vector<double> values;
     for (int k = 0; k <= subdivisions; ++k) values.push_back(a + (b - a) * k / subdivisions);
-    for (int i = int(std::ceil(a * (nodes - 1))); i <= int(std::floor(b * (nodes - 1))); ++i) {
-      values.push_back(double(i) / (nodes - 1));
-    }
+    append_node_lines(a, b, nodes, values);
     return values;
   };
   const auto s_values = positions(s0, s1, warp.grid_size.x);
