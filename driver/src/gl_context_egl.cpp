@@ -8,8 +8,8 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
-#include <map>
 #include <mutex>
+#include <set>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -53,8 +53,11 @@ std::string egl_error_name(EGLint error) {
   }
 }
 
-// EGL displays are process-wide singletons per (platform, device): two contexts on one device get
-// the same EGLDisplay, and eglTerminate would pull it from under the other. Count the users.
+// EGL displays are process-wide singletons per (platform, device): two contexts on one device
+// get the same EGLDisplay, and eglTerminate would pull it from under the other. Displays are
+// therefore initialised once and kept until the process exits. Terminating them when the last
+// context goes would also unload the driver (slow to load again), and Mesa loses some of its
+// driver's allocations on that unload, which LeakSanitizer then reports.
 class DisplayRegistry {
  public:
   static DisplayRegistry& instance() {
@@ -64,30 +67,16 @@ class DisplayRegistry {
   // Initializes the display on first use. Returns false (with EGL's error) when that fails.
   bool acquire(EGLDisplay display) {
     std::lock_guard lock(mutex_);
-    auto& count = users_[display];
-    if (count == 0) {
-      EGLint major = 0, minor = 0;
-      if (!eglInitialize(display, &major, &minor)) {
-        users_.erase(display);
-        return false;
-      }
-    }
-    ++count;
+    if (initialized_.count(display)) return true;
+    EGLint major = 0, minor = 0;
+    if (!eglInitialize(display, &major, &minor)) return false;
+    initialized_.insert(display);
     return true;
-  }
-  void release(EGLDisplay display) {
-    std::lock_guard lock(mutex_);
-    const auto it = users_.find(display);
-    if (it == users_.end()) return;
-    if (--it->second == 0) {
-      users_.erase(it);
-      eglTerminate(display);
-    }
   }
 
  private:
   std::mutex mutex_;
-  std::map<EGLDisplay, int> users_;
+  std::set<EGLDisplay> initialized_;
 };
 
 class EglHeadlessContext final : public GlContext {
@@ -106,6 +95,8 @@ class EglHeadlessContext final : public GlContext {
   ~EglHeadlessContext() override { destroy(); }
 
   void make_current() override {
+    // The bound API is per thread, and a new thread starts with OpenGL ES.
+    eglBindAPI(EGL_OPENGL_API);
     if (!eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, context_))
       throw GlContextError("eglMakeCurrent (surfaceless) failed: " +
                            egl_error_name(eglGetError()));
@@ -117,11 +108,11 @@ class EglHeadlessContext final : public GlContext {
  private:
   void destroy() {
     if (!context_) return;
+    eglBindAPI(EGL_OPENGL_API);  // eglGetCurrentContext answers for the bound API only
     if (eglGetCurrentContext() == context_)
       eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
     eglDestroyContext(display_, context_);
     context_ = EGL_NO_CONTEXT;
-    DisplayRegistry::instance().release(display_);
   }
 
   EGLDisplay display_;
@@ -146,14 +137,6 @@ std::unique_ptr<GlContext> try_display(const Attempt& attempt, bool debug,
   auto& registry = DisplayRegistry::instance();
   if (!registry.acquire(attempt.display))
     return fail("eglInitialize failed (" + egl_error_name(eglGetError()) + ")");
-  struct Release {
-    EGLDisplay display;
-    bool armed = true;
-    ~Release() {
-      if (armed) DisplayRegistry::instance().release(display);
-    }
-  } release{attempt.display};
-
   const char* extensions = eglQueryString(attempt.display, EGL_EXTENSIONS);
   if (!has_extension(extensions, "EGL_KHR_surfaceless_context"))
     return fail("no EGL_KHR_surfaceless_context");
@@ -179,7 +162,6 @@ std::unique_ptr<GlContext> try_display(const Attempt& attempt, bool debug,
       eglCreateContext(attempt.display, config, EGL_NO_CONTEXT, context_attributes);
   if (context == EGL_NO_CONTEXT)
     return fail("eglCreateContext(GL 4.5 core) failed (" + egl_error_name(eglGetError()) + ")");
-  release.armed = false;  // the context owns the display reference from here
   try {
     return std::make_unique<EglHeadlessContext>(attempt.display, context, attempt.platform, debug);
   } catch (const GlContextError& e) {
