@@ -63,6 +63,31 @@ TEST(GlContext, NoMatchingDeviceGivesTypedError) {
   EXPECT_NO_THROW(check_gl_error("NoMatchingDeviceGivesTypedError"));
 }
 
+TEST(GlContext, ExplicitPlatformsReportThemselves) {
+  HeadlessOptions options;
+  options.platform = EglPlatform::surfaceless;
+  // Mesa's surfaceless platform exists wherever Mesa is the EGL vendor; NVIDIA-only machines
+  // lack it, and must then say so with GlContextError.
+  try {
+    auto context = create_headless_context(options);
+    EXPECT_EQ(context->info().platform, "egl-surfaceless");
+  } catch (const GlContextError& e) {
+    EXPECT_NE(std::string(e.what()).find("EGL_MESA_platform_surfaceless"), std::string::npos)
+        << e.what();
+  }
+  options.platform = EglPlatform::device;
+  try {
+    auto context = create_headless_context(options);
+    EXPECT_EQ(context->info().platform, "egl-device");
+  } catch (const GlContextError& e) {
+    const std::string message = e.what();
+    EXPECT_TRUE(message.find("EGL_EXT_platform_device") != std::string::npos ||
+                message.find("EGL device") != std::string::npos)
+        << message;
+  }
+  test::shared_context();
+}
+
 TEST(GlContext, DebugContextCanBeRequested) {
   HeadlessOptions options;
   options.debug = true;
