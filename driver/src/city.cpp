@@ -5,13 +5,12 @@
 // file is compiled with -ffp-contract=off (see driver/CMakeLists.txt).
 #include "facet/driver/city.hpp"
 
-#include <glm/common.hpp>
-#include <glm/geometric.hpp>
-#include <glm/mat4x4.hpp>
-
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <glm/common.hpp>
+#include <glm/geometric.hpp>
+#include <glm/mat4x4.hpp>
 #include <stdexcept>
 #include <string>
 
@@ -71,7 +70,8 @@ float value_noise(int x, int y, int cell, int size, std::uint32_t seed) {
   const float fy = static_cast<float>(y % cell) / static_cast<float>(cell);
   auto lattice = [&](int i, int j) {
     return static_cast<float>(hash3(static_cast<std::uint32_t>(i % period),
-                                    static_cast<std::uint32_t>(j % period), seed) >> 8) *
+                                    static_cast<std::uint32_t>(j % period), seed) >>
+                              8) *
            (1.0f / 16777216.0f);
   };
   const float sx = fx * fx * (3.0f - 2.0f * fx), sy = fy * fy * (3.0f - 2.0f * fy);
@@ -82,9 +82,10 @@ float value_noise(int x, int y, int cell, int size, std::uint32_t seed) {
 
 // Two octaves plus per-texel grain, in [0, 1].
 float texture_noise(int x, int y, int size, std::uint32_t seed) {
-  const float grain = static_cast<float>(hash3(static_cast<std::uint32_t>(x),
-                                               static_cast<std::uint32_t>(y), seed + 7u) >> 24) /
-                      255.0f;
+  const float grain =
+      static_cast<float>(
+          hash3(static_cast<std::uint32_t>(x), static_cast<std::uint32_t>(y), seed + 7u) >> 24) /
+      255.0f;
   return 0.5f * value_noise(x, y, std::max(1, size / 8), size, seed) +
          0.3f * value_noise(x, y, std::max(1, size / 32), size, seed + 1u) + 0.2f * grain;
 }
@@ -127,7 +128,8 @@ struct Window {
   float x0, x1, y0, y1;
   bool contains(float u, float v) const { return u >= x0 && u < x1 && v >= y0 && v < y1; }
   bool frame(float u, float v, float width) const {
-    return contains(u, v) && !(u >= x0 + width && u < x1 - width && v >= y0 + width && v < y1 - width);
+    return contains(u, v) &&
+           !(u >= x0 + width && u < x1 - width && v >= y0 + width && v < y1 - width);
   }
 };
 
@@ -139,8 +141,10 @@ Rgb glass(float u, float v, float n) {
 
 std::vector<Image> city_textures(int size) {
   const float s = static_cast<float>(size);
-  auto uv = [s](int x, int y) { return std::array<float, 2>{(static_cast<float>(x) + 0.5f) / s,
-                                                            (static_cast<float>(y) + 0.5f) / s}; };
+  auto uv = [s](int x, int y) {
+    return std::array<float, 2>{(static_cast<float>(x) + 0.5f) / s,
+                                (static_cast<float>(y) + 0.5f) / s};
+  };
   std::vector<Image> images;
   images.push_back(make_image("grass", size, [&](int x, int y) {
     const float n = texture_noise(x, y, size, 11u);
@@ -169,8 +173,10 @@ std::vector<Image> city_textures(int size) {
     const int row = static_cast<int>(course);
     const float along = u * 4.0f + (row % 2 == 0 ? 0.0f : 0.5f);
     const bool mortar = course - std::floor(course) < 0.15f || along - std::floor(along) < 0.05f;
-    const float tone = static_cast<float>(hash3(static_cast<std::uint32_t>(along),
-                                                static_cast<std::uint32_t>(row), 5u) >> 24) / 255.0f;
+    const float tone =
+        static_cast<float>(
+            hash3(static_cast<std::uint32_t>(along), static_cast<std::uint32_t>(row), 5u) >> 24) /
+        255.0f;
     return mortar ? Rgb{0.62f, 0.60f, 0.55f}
                   : scale(Rgb{0.55f, 0.25f, 0.18f}, 0.8f + 0.25f * tone + 0.1f * n);
   }));
@@ -245,13 +251,13 @@ std::vector<Image> city_textures(int size) {
 
 constexpr float root_half = 0.70710678118654752f;  // sqrt(1/2), the octagon's diagonal
 constexpr std::array<glm::vec2, 8> octagon = {{{1, 0},
-                                                {root_half, root_half},
-                                                {0, 1},
-                                                {-root_half, root_half},
-                                                {-1, 0},
-                                                {-root_half, -root_half},
-                                                {0, -1},
-                                                {root_half, -root_half}}};
+                                               {root_half, root_half},
+                                               {0, 1},
+                                               {-root_half, root_half},
+                                               {-1, 0},
+                                               {-root_half, -root_half},
+                                               {0, -1},
+                                               {root_half, -root_half}}};
 constexpr glm::vec3 up{0, 1, 0};
 
 constexpr std::uint32_t material_index(CityMaterial m) { return static_cast<std::uint32_t>(m); }
@@ -316,7 +322,10 @@ class CityBuilder {
     // Shared corner vertices keep the quad one piece for any later welding or tessellation.
     std::array<std::uint32_t, 4> v{};
     const bool flip = glm::dot(glm::cross(p[1] - p[0], p[3] - p[0]), n_front) < 0;
-    for (int i = 0; i < 4; ++i) v[static_cast<std::size_t>(i)] = vertex(p[static_cast<std::size_t>(i)], n[static_cast<std::size_t>(i)], uv[static_cast<std::size_t>(i)]);
+    for (int i = 0; i < 4; ++i)
+      v[static_cast<std::size_t>(i)] =
+          vertex(p[static_cast<std::size_t>(i)], n[static_cast<std::size_t>(i)],
+                 uv[static_cast<std::size_t>(i)]);
     auto& out = pending_[material_index(m)];
     if (flip) {
       out.insert(out.end(), {v[0], v[2], v[1], v[0], v[3], v[2]});
@@ -345,10 +354,10 @@ class CityBuilder {
 
   // A vertical wall from a to b (ground-plane points x, z) between heights y0 and y1, facing
   // to the right of a -> b seen from above (outward for a footprint listed counter-clockwise
-  // seen from above). Split into `rows` x ceil(length / max_width) panels. Texture: one tile per bay
-  // (the wall holds a whole number of bays) and per `floor_height`, tile tops at floor tops.
-  void wall(CityMaterial m, glm::vec2 a, glm::vec2 b, float y0, float y1, int rows,
-            float max_width, float nominal_bay, float floor_height) {
+  // seen from above). Split into `rows` x ceil(length / max_width) panels. Texture: one tile per
+  // bay (the wall holds a whole number of bays) and per `floor_height`, tile tops at floor tops.
+  void wall(CityMaterial m, glm::vec2 a, glm::vec2 b, float y0, float y1, int rows, float max_width,
+            float nominal_bay, float floor_height) {
     const glm::vec2 d = b - a;
     const float length = glm::length(d);
     if (length <= 0) return;
@@ -364,19 +373,20 @@ class CityBuilder {
         const float yb = y0 + (y1 - y0) * static_cast<float>(r + 1) / static_cast<float>(rows);
         quad(m, {glm::vec3{pa.x, ya, pa.y}, {pb.x, ya, pb.y}, {pb.x, yb, pb.y}, {pa.x, yb, pa.y}},
              n,
-             {glm::vec2{s0 * bays, -ya / floor_height}, {s1 * bays, -ya / floor_height},
-              {s1 * bays, -yb / floor_height}, {s0 * bays, -yb / floor_height}});
+             {glm::vec2{s0 * bays, -ya / floor_height},
+              {s1 * bays, -ya / floor_height},
+              {s1 * bays, -yb / floor_height},
+              {s0 * bays, -yb / floor_height}});
       }
     }
   }
 
   // The four walls of an axis-aligned footprint [x0, x1] x [z0, z1], facing outwards.
-  void walls(CityMaterial m, float x0, float x1, float z0, float z1, float y0, float y1,
-             int rows, float max_width, float nominal_bay, float floor_height) {
+  void walls(CityMaterial m, float x0, float x1, float z0, float z1, float y0, float y1, int rows,
+             float max_width, float nominal_bay, float floor_height) {
     const std::array<glm::vec2, 4> corners = {{{x0, z1}, {x1, z1}, {x1, z0}, {x0, z0}}};
     for (std::size_t i = 0; i < 4; ++i)
-      wall(m, corners[i], corners[(i + 1) % 4], y0, y1, rows, max_width, nominal_bay,
-           floor_height);
+      wall(m, corners[i], corners[(i + 1) % 4], y0, y1, rows, max_width, nominal_bay, floor_height);
   }
 
   // A closed box (all six faces, or five without the bottom), texture in metres / uv_metres.
@@ -385,8 +395,11 @@ class CityBuilder {
     ground(m, p_min.x, p_max.x, p_min.z, p_max.z, p_max.y, 1e9f, uv_metres);
     if (bottom) {
       const float y = p_min.y;
-      quad(m, {glm::vec3{p_min.x, y, p_min.z}, {p_max.x, y, p_min.z}, {p_max.x, y, p_max.z},
-               {p_min.x, y, p_max.z}},
+      quad(m,
+           {glm::vec3{p_min.x, y, p_min.z},
+            {p_max.x, y, p_min.z},
+            {p_max.x, y, p_max.z},
+            {p_min.x, y, p_max.z}},
            -up, {glm::vec2{0, 0}, {1, 0}, {1, 1}, {0, 1}});
     }
   }
@@ -474,7 +487,8 @@ void add_lamp(CityBuilder& city, glm::vec2 c, glm::vec2 towards_street, const st
   const float height = 6.5f;
   city.prism(CityMaterial::metal, c, 0.09f, kerb, height);
   const glm::vec2 head = c + towards_street * 1.2f;
-  const glm::vec2 lo = glm::min(c, head) - glm::vec2(0.15f), hi = glm::max(c, head) + glm::vec2(0.15f);
+  const glm::vec2 lo = glm::min(c, head) - glm::vec2(0.15f),
+                  hi = glm::max(c, head) + glm::vec2(0.15f);
   city.box(CityMaterial::metal, {lo.x, height - 0.25f, lo.y}, {hi.x, height, hi.y}, 1.0f, true);
   city.end_object();
 }
@@ -487,8 +501,8 @@ struct Style {
   bool pitched_roof;
 };
 
-void add_building(CityBuilder& city, Pcg32& rng, float x0, float x1, float z0, float z1,
-                  float ring, const std::string& name) {
+void add_building(CityBuilder& city, Pcg32& rng, float x0, float x1, float z0, float z1, float ring,
+                  const std::string& name) {
   // Downtown (ring 0-1) is tall glass and concrete; then stone, brick and concrete; the outer
   // rings are low plastered and brick houses with pitched roofs.
   Style style{};
@@ -524,29 +538,39 @@ void add_building(CityBuilder& city, Pcg32& rng, float x0, float x1, float z0, f
       const float u1 = (x1 - x0) / 2.0f, v1 = slope / 2.0f;
       city.quad(CityMaterial::roof_tiles,
                 {glm::vec3{x0, top, z1}, {x1, top, z1}, {x1, ridge_y, zc}, {x0, ridge_y, zc}},
-                glm::normalize(glm::vec3{0, half, rise}), {glm::vec2{0, v1}, {u1, v1}, {u1, 0}, {0, 0}});
+                glm::normalize(glm::vec3{0, half, rise}),
+                {glm::vec2{0, v1}, {u1, v1}, {u1, 0}, {0, 0}});
       city.quad(CityMaterial::roof_tiles,
                 {glm::vec3{x1, top, z0}, {x0, top, z0}, {x0, ridge_y, zc}, {x1, ridge_y, zc}},
-                glm::normalize(glm::vec3{0, half, -rise}), {glm::vec2{0, v1}, {u1, v1}, {u1, 0}, {0, 0}});
+                glm::normalize(glm::vec3{0, half, -rise}),
+                {glm::vec2{0, v1}, {u1, v1}, {u1, 0}, {0, 0}});
       for (const float x : {x0, x1}) {
         const glm::vec3 n{x == x0 ? -1.0f : 1.0f, 0, 0};
         city.triangle(style.facade, {glm::vec3{x, top, z0}, {x, top, z1}, {x, ridge_y, zc}},
-                      {n, n, n}, {glm::vec2{0, -top / style.floor_height}, {1, -top / style.floor_height},
-                                  {0.5f, -ridge_y / style.floor_height}}, n);
+                      {n, n, n},
+                      {glm::vec2{0, -top / style.floor_height},
+                       {1, -top / style.floor_height},
+                       {0.5f, -ridge_y / style.floor_height}},
+                      n);
       }
     } else {
       const float u1 = (z1 - z0) / 2.0f, v1 = slope / 2.0f;
       city.quad(CityMaterial::roof_tiles,
                 {glm::vec3{x1, top, z1}, {x1, top, z0}, {xc, ridge_y, z0}, {xc, ridge_y, z1}},
-                glm::normalize(glm::vec3{rise, half, 0}), {glm::vec2{0, v1}, {u1, v1}, {u1, 0}, {0, 0}});
+                glm::normalize(glm::vec3{rise, half, 0}),
+                {glm::vec2{0, v1}, {u1, v1}, {u1, 0}, {0, 0}});
       city.quad(CityMaterial::roof_tiles,
                 {glm::vec3{x0, top, z0}, {x0, top, z1}, {xc, ridge_y, z1}, {xc, ridge_y, z0}},
-                glm::normalize(glm::vec3{-rise, half, 0}), {glm::vec2{0, v1}, {u1, v1}, {u1, 0}, {0, 0}});
+                glm::normalize(glm::vec3{-rise, half, 0}),
+                {glm::vec2{0, v1}, {u1, v1}, {u1, 0}, {0, 0}});
       for (const float z : {z0, z1}) {
         const glm::vec3 n{0, 0, z == z0 ? -1.0f : 1.0f};
         city.triangle(style.facade, {glm::vec3{x0, top, z}, {x1, top, z}, {xc, ridge_y, z}},
-                      {n, n, n}, {glm::vec2{0, -top / style.floor_height}, {1, -top / style.floor_height},
-                                  {0.5f, -ridge_y / style.floor_height}}, n);
+                      {n, n, n},
+                      {glm::vec2{0, -top / style.floor_height},
+                       {1, -top / style.floor_height},
+                       {0.5f, -ridge_y / style.floor_height}},
+                      n);
       }
     }
   } else {
@@ -596,8 +620,10 @@ void add_block(CityBuilder& city, Pcg32& rng, int bx, int bz) {
     for (int i = 0; i < 4; ++i)
       for (int j = 0; j < 4; ++j) {
         if (!rng.chance(0.75f)) continue;
-        const float cx = lx0 + (static_cast<float>(i) + 0.5f) * (lx1 - lx0) / 4.0f + rng.uniform(-3, 3);
-        const float cz = lz0 + (static_cast<float>(j) + 0.5f) * (lz1 - lz0) / 4.0f + rng.uniform(-3, 3);
+        const float cx =
+            lx0 + (static_cast<float>(i) + 0.5f) * (lx1 - lx0) / 4.0f + rng.uniform(-3, 3);
+        const float cz =
+            lz0 + (static_cast<float>(j) + 0.5f) * (lz1 - lz0) / 4.0f + rng.uniform(-3, 3);
         add_tree(city, rng, {cx, cz}, kerb, "park " + id + " tree " + std::to_string(tree++));
       }
     return;
@@ -632,16 +658,20 @@ void add_streets(CityBuilder& city, Pcg32& rng, int n) {
         city.begin_object("street " + std::to_string(axis) + ":" + std::to_string(k) + ":" +
                           std::to_string(m));
         if (axis == 0)
-          city.ground(CityMaterial::asphalt, c - asphalt_half, c + asphalt_half, a, b, 0.0f, 12.0f, 8.0f);
+          city.ground(CityMaterial::asphalt, c - asphalt_half, c + asphalt_half, a, b, 0.0f, 12.0f,
+                      8.0f);
         else
-          city.ground(CityMaterial::asphalt, a, b, c - asphalt_half, c + asphalt_half, 0.0f, 12.0f, 8.0f);
+          city.ground(CityMaterial::asphalt, a, b, c - asphalt_half, c + asphalt_half, 0.0f, 12.0f,
+                      8.0f);
         // Dashed centre line: 3 m dashes every 9 m, 5 mm above the asphalt.
         for (float s = a + 3.0f; s + 3.0f <= b; s += 9.0f) {
           const float y = 0.005f;
           if (axis == 0)
-            city.ground(CityMaterial::road_marking, c - 0.08f, c + 0.08f, s, s + 3.0f, y, 1e9f, 1.0f);
+            city.ground(CityMaterial::road_marking, c - 0.08f, c + 0.08f, s, s + 3.0f, y, 1e9f,
+                        1.0f);
           else
-            city.ground(CityMaterial::road_marking, s, s + 3.0f, c - 0.08f, c + 0.08f, y, 1e9f, 1.0f);
+            city.ground(CityMaterial::road_marking, s, s + 3.0f, c - 0.08f, c + 0.08f, y, 1e9f,
+                        1.0f);
         }
         city.end_object();
       }
@@ -664,7 +694,8 @@ void add_streets(CityBuilder& city, Pcg32& rng, int n) {
   // Walls listed the other way round face into the street.
   const std::array<glm::vec2, 4> corners = {{{-e0, -e0}, {e0, -e0}, {e0, e0}, {-e0, e0}}};
   for (std::size_t i = 0; i < 4; ++i)
-    city.wall(CityMaterial::sidewalk, corners[i], corners[(i + 1) % 4], 0.0f, kerb, 1, 30.0f, 1.0f, 1.0f);
+    city.wall(CityMaterial::sidewalk, corners[i], corners[(i + 1) % 4], 0.0f, kerb, 1, 30.0f, 1.0f,
+              1.0f);
   city.end_object();
 
   // Avenues through the origin: trees and lamps alternating on both sidewalks.
@@ -672,7 +703,8 @@ void add_streets(CityBuilder& city, Pcg32& rng, int n) {
   for (int axis = 0; axis < 2; ++axis)
     for (int m = -n; m < n; ++m)
       for (int slot = 0; slot < 3; ++slot) {
-        const float s = static_cast<float>(m) * pitch + street_half + 8.0f + 16.0f * static_cast<float>(slot);
+        const float s =
+            static_cast<float>(m) * pitch + street_half + 8.0f + 16.0f * static_cast<float>(slot);
         for (const float side : {-1.0f, 1.0f}) {
           const float offset = side * (asphalt_half + 1.5f);
           const glm::vec2 p = axis == 0 ? glm::vec2{offset, s} : glm::vec2{s, offset};
@@ -689,8 +721,8 @@ void add_countryside(CityBuilder& city, int n) {
   // Grass beyond the outer sidewalk, out to a horizon ring at 10 blocks.
   const float e = static_cast<float>(n) * pitch + street_half;
   const float r = std::max(600.0f, e + 4.0f * pitch);
-  const std::array<std::array<float, 4>, 4> strips = {{{-r, r, -r, -e}, {-r, r, e, r},
-                                                       {-r, -e, -e, e}, {e, r, -e, e}}};
+  const std::array<std::array<float, 4>, 4> strips = {
+      {{-r, r, -r, -e}, {-r, r, e, r}, {-r, -e, -e, e}, {e, r, -e, e}}};
   int index = 0;
   for (const auto& s : strips) {
     city.begin_object("countryside " + std::to_string(index++));
@@ -707,11 +739,19 @@ std::vector<Material> city_materials() {
     return m;
   };
   std::vector<Material> materials = {
-      textured("grass", 0),           textured("asphalt", 1),        textured("sidewalk", 2),
+      textured("grass", 0),
+      textured("asphalt", 1),
+      textured("sidewalk", 2),
       Material{"road_marking", {0.85f, 0.85f, 0.80f, 1.0f}, -1, true},
-      textured("facade_brick", 3),    textured("facade_glass", 4),   textured("facade_concrete", 5),
-      textured("facade_plaster", 6),  textured("facade_stone", 7),   textured("roof_flat", 8),
-      textured("roof_tiles", 9),      textured("bark", 10),          textured("foliage", 11),
+      textured("facade_brick", 3),
+      textured("facade_glass", 4),
+      textured("facade_concrete", 5),
+      textured("facade_plaster", 6),
+      textured("facade_stone", 7),
+      textured("roof_flat", 8),
+      textured("roof_tiles", 9),
+      textured("bark", 10),
+      textured("foliage", 11),
       Material{"metal", {0.35f, 0.37f, 0.40f, 1.0f}, -1, true}};
   return materials;
 }
@@ -724,8 +764,8 @@ Scene build_city(const CityOptions& options) {
                                 std::to_string(options.blocks_per_side));
   const int t = options.texture_size;
   if (t < 8 || t > 1024 || (t & (t - 1)) != 0)
-    throw std::invalid_argument("build_city: texture_size must be a power of two in [8, 1024], got " +
-                                std::to_string(t));
+    throw std::invalid_argument(
+        "build_city: texture_size must be a power of two in [8, 1024], got " + std::to_string(t));
   CityBuilder city;
   city.scene.name = "facet city (seed " + std::to_string(options.seed) + ")";
   city.scene.materials = city_materials();
@@ -763,8 +803,7 @@ CityCameraPath::CityCameraPath(const CityOptions& options) {
   const double p = pitch;
   // Intersections visited, in order (x, z); the loop closes back to the first. Every leg runs
   // along a street centre line.
-  const std::vector<glm::dvec2> corners = {{0, 0},  {0, -p}, {p, -p}, {p, p},
-                                           {-p, p}, {-p, 0}};
+  const std::vector<glm::dvec2> corners = {{0, 0}, {0, -p}, {p, -p}, {p, p}, {-p, p}, {-p, 0}};
   const double turn_radius = 6.0;
   const std::size_t n = corners.size();
   auto add = [&](glm::dvec2 a, glm::dvec2 control, glm::dvec2 b) {
@@ -804,8 +843,10 @@ glm::dmat4 CityCameraPath::T_world_eye(double time_s) const {
   // Invert the arc-length table: find the Bezier parameter at distance s - start along it.
   const double local = std::min(std::max(s - seg.start_m, 0.0), seg.length_m);
   const auto k = std::upper_bound(seg.arc_m.begin(), seg.arc_m.end(), local);
-  const auto i = static_cast<int>(std::clamp<std::ptrdiff_t>(k - seg.arc_m.begin(), 1, arc_samples));
-  const double a0 = seg.arc_m[static_cast<std::size_t>(i - 1)], a1 = seg.arc_m[static_cast<std::size_t>(i)];
+  const auto i =
+      static_cast<int>(std::clamp<std::ptrdiff_t>(k - seg.arc_m.begin(), 1, arc_samples));
+  const double a0 = seg.arc_m[static_cast<std::size_t>(i - 1)],
+               a1 = seg.arc_m[static_cast<std::size_t>(i)];
   const double f = a1 > a0 ? (local - a0) / (a1 - a0) : 0.0;
   const double t = (static_cast<double>(i - 1) + f) / arc_samples;
 

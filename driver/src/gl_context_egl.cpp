@@ -35,17 +35,28 @@ bool has_extension(const char* list, std::string_view name) {
 
 std::string egl_error_name(EGLint error) {
   switch (error) {
-    case EGL_SUCCESS: return "EGL_SUCCESS";
-    case EGL_NOT_INITIALIZED: return "EGL_NOT_INITIALIZED";
-    case EGL_BAD_ACCESS: return "EGL_BAD_ACCESS";
-    case EGL_BAD_ALLOC: return "EGL_BAD_ALLOC";
-    case EGL_BAD_ATTRIBUTE: return "EGL_BAD_ATTRIBUTE";
-    case EGL_BAD_CONFIG: return "EGL_BAD_CONFIG";
-    case EGL_BAD_CONTEXT: return "EGL_BAD_CONTEXT";
-    case EGL_BAD_DISPLAY: return "EGL_BAD_DISPLAY";
-    case EGL_BAD_MATCH: return "EGL_BAD_MATCH";
-    case EGL_BAD_PARAMETER: return "EGL_BAD_PARAMETER";
-    default: return "EGL error 0x" + [&] {
+    case EGL_SUCCESS:
+      return "EGL_SUCCESS";
+    case EGL_NOT_INITIALIZED:
+      return "EGL_NOT_INITIALIZED";
+    case EGL_BAD_ACCESS:
+      return "EGL_BAD_ACCESS";
+    case EGL_BAD_ALLOC:
+      return "EGL_BAD_ALLOC";
+    case EGL_BAD_ATTRIBUTE:
+      return "EGL_BAD_ATTRIBUTE";
+    case EGL_BAD_CONFIG:
+      return "EGL_BAD_CONFIG";
+    case EGL_BAD_CONTEXT:
+      return "EGL_BAD_CONTEXT";
+    case EGL_BAD_DISPLAY:
+      return "EGL_BAD_DISPLAY";
+    case EGL_BAD_MATCH:
+      return "EGL_BAD_MATCH";
+    case EGL_BAD_PARAMETER:
+      return "EGL_BAD_PARAMETER";
+    default:
+      return "EGL error 0x" + [&] {
         char buffer[16];
         std::snprintf(buffer, sizeof buffer, "%x", static_cast<unsigned>(error));
         return std::string(buffer);
@@ -98,8 +109,7 @@ class EglHeadlessContext final : public GlContext {
     // The bound API is per thread, and a new thread starts with OpenGL ES.
     eglBindAPI(EGL_OPENGL_API);
     if (!eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, context_))
-      throw GlContextError("eglMakeCurrent (surfaceless) failed: " +
-                           egl_error_name(eglGetError()));
+      throw GlContextError("eglMakeCurrent (surfaceless) failed: " + egl_error_name(eglGetError()));
   }
   void swap_buffers() override { glFlush(); }
   glm::ivec2 framebuffer_size() const override { return {0, 0}; }
@@ -133,7 +143,8 @@ std::unique_ptr<GlContext> try_display(const Attempt& attempt, bool debug,
     failures.push_back(attempt.label + ": " + why);
     return nullptr;
   };
-  if (attempt.display == EGL_NO_DISPLAY) return fail("no display (" + egl_error_name(eglGetError()) + ")");
+  if (attempt.display == EGL_NO_DISPLAY)
+    return fail("no display (" + egl_error_name(eglGetError()) + ")");
   auto& registry = DisplayRegistry::instance();
   if (!registry.acquire(attempt.display))
     return fail("eglInitialize failed (" + egl_error_name(eglGetError()) + ")");
@@ -152,12 +163,15 @@ std::unique_ptr<GlContext> try_display(const Attempt& attempt, bool debug,
     if (!eglChooseConfig(attempt.display, config_attributes, &config, 1, &count) || count < 1)
       return fail("no EGL config for desktop OpenGL");
   }
-  const EGLint context_attributes[] = {
-      EGL_CONTEXT_MAJOR_VERSION_KHR, 4,
-      EGL_CONTEXT_MINOR_VERSION_KHR, 5,
-      EGL_CONTEXT_OPENGL_PROFILE_MASK_KHR, EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT_KHR,
-      EGL_CONTEXT_FLAGS_KHR, debug ? EGL_CONTEXT_OPENGL_DEBUG_BIT_KHR : 0,
-      EGL_NONE};
+  const EGLint context_attributes[] = {EGL_CONTEXT_MAJOR_VERSION_KHR,
+                                       4,
+                                       EGL_CONTEXT_MINOR_VERSION_KHR,
+                                       5,
+                                       EGL_CONTEXT_OPENGL_PROFILE_MASK_KHR,
+                                       EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT_KHR,
+                                       EGL_CONTEXT_FLAGS_KHR,
+                                       debug ? EGL_CONTEXT_OPENGL_DEBUG_BIT_KHR : 0,
+                                       EGL_NONE};
   EGLContext context =
       eglCreateContext(attempt.display, config, EGL_NO_CONTEXT, context_attributes);
   if (context == EGL_NO_CONTEXT)
@@ -183,8 +197,7 @@ EglPlatform platform_from_environment(EglPlatform requested) {
 }  // namespace
 
 std::unique_ptr<GlContext> create_headless_context(const HeadlessOptions& options) {
-  if (!epoxy_has_egl())
-    throw GlContextError("create_headless_context: libEGL could not be loaded");
+  if (!epoxy_has_egl()) throw GlContextError("create_headless_context: libEGL could not be loaded");
   const EglPlatform platform = platform_from_environment(options.platform);
   const char* client_extensions = eglQueryString(EGL_NO_DISPLAY, EGL_EXTENSIONS);
   if (!has_extension(client_extensions, "EGL_EXT_platform_base"))

@@ -23,7 +23,8 @@ namespace {
 
 // glCreate* returns 0 only without a current context or on GL_OUT_OF_MEMORY.
 GLuint checked(GLuint id, const char* what) {
-  if (id == 0) throw std::runtime_error(std::string(what) + ": GL returned no object (no current context?)");
+  if (id == 0)
+    throw std::runtime_error(std::string(what) + ": GL returned no object (no current context?)");
   return id;
 }
 
@@ -52,8 +53,7 @@ void Buffer::sub_data(std::size_t offset, std::size_t bytes, const void* data) {
 
 void Buffer::get_sub_data(std::size_t offset, std::size_t bytes, void* out) const {
   if (bytes == 0) return;
-  glGetNamedBufferSubData(id(), static_cast<GLintptr>(offset), static_cast<GLsizeiptr>(bytes),
-                          out);
+  glGetNamedBufferSubData(id(), static_cast<GLintptr>(offset), static_cast<GLsizeiptr>(bytes), out);
 }
 
 void Buffer::bind_base(GLenum target, GLuint index) const { glBindBufferBase(target, index, id()); }
@@ -105,16 +105,23 @@ void Framebuffer::check_complete() const {
   if (status == GL_FRAMEBUFFER_COMPLETE) return;
   const char* name = "unknown status";
   switch (status) {
-    case GL_FRAMEBUFFER_UNDEFINED: name = "GL_FRAMEBUFFER_UNDEFINED"; break;
-    case GL_FRAMEBUFFER_INCOMPLETE_ATTACHMENT: name = "GL_FRAMEBUFFER_INCOMPLETE_ATTACHMENT"; break;
+    case GL_FRAMEBUFFER_UNDEFINED:
+      name = "GL_FRAMEBUFFER_UNDEFINED";
+      break;
+    case GL_FRAMEBUFFER_INCOMPLETE_ATTACHMENT:
+      name = "GL_FRAMEBUFFER_INCOMPLETE_ATTACHMENT";
+      break;
     case GL_FRAMEBUFFER_INCOMPLETE_MISSING_ATTACHMENT:
       name = "GL_FRAMEBUFFER_INCOMPLETE_MISSING_ATTACHMENT";
       break;
-    case GL_FRAMEBUFFER_UNSUPPORTED: name = "GL_FRAMEBUFFER_UNSUPPORTED"; break;
+    case GL_FRAMEBUFFER_UNSUPPORTED:
+      name = "GL_FRAMEBUFFER_UNSUPPORTED";
+      break;
     case GL_FRAMEBUFFER_INCOMPLETE_MULTISAMPLE:
       name = "GL_FRAMEBUFFER_INCOMPLETE_MULTISAMPLE";
       break;
-    default: break;
+    default:
+      break;
   }
   throw std::runtime_error(std::string("Framebuffer::check_complete: ") + name);
 }
@@ -125,7 +132,9 @@ VertexArray VertexArray::create() {
   return VertexArray(checked(id, "VertexArray::create"));
 }
 
-Shader Shader::create(GLenum type) { return Shader(checked(glCreateShader(type), "Shader::create")); }
+Shader Shader::create(GLenum type) {
+  return Shader(checked(glCreateShader(type), "Shader::create"));
+}
 
 Program Program::create() { return Program(checked(glCreateProgram(), "Program::create")); }
 
@@ -165,15 +174,24 @@ Sampler Sampler::create() {
 
 std::string gl_error_name(GLenum error) {
   switch (error) {
-    case GL_NO_ERROR: return "GL_NO_ERROR";
-    case GL_INVALID_ENUM: return "GL_INVALID_ENUM";
-    case GL_INVALID_VALUE: return "GL_INVALID_VALUE";
-    case GL_INVALID_OPERATION: return "GL_INVALID_OPERATION";
-    case GL_INVALID_FRAMEBUFFER_OPERATION: return "GL_INVALID_FRAMEBUFFER_OPERATION";
-    case GL_OUT_OF_MEMORY: return "GL_OUT_OF_MEMORY";
-    case GL_STACK_UNDERFLOW: return "GL_STACK_UNDERFLOW";
-    case GL_STACK_OVERFLOW: return "GL_STACK_OVERFLOW";
-    default: return "GL error " + std::to_string(error);
+    case GL_NO_ERROR:
+      return "GL_NO_ERROR";
+    case GL_INVALID_ENUM:
+      return "GL_INVALID_ENUM";
+    case GL_INVALID_VALUE:
+      return "GL_INVALID_VALUE";
+    case GL_INVALID_OPERATION:
+      return "GL_INVALID_OPERATION";
+    case GL_INVALID_FRAMEBUFFER_OPERATION:
+      return "GL_INVALID_FRAMEBUFFER_OPERATION";
+    case GL_OUT_OF_MEMORY:
+      return "GL_OUT_OF_MEMORY";
+    case GL_STACK_UNDERFLOW:
+      return "GL_STACK_UNDERFLOW";
+    case GL_STACK_OVERFLOW:
+      return "GL_STACK_OVERFLOW";
+    default:
+      return "GL error " + std::to_string(error);
   }
 }
 

@@ -4,14 +4,13 @@
 
 #include <tiny_gltf.h>
 
+#include <algorithm>
+#include <cctype>
+#include <cstring>
 #include <glm/geometric.hpp>
 #include <glm/gtc/quaternion.hpp>
 #include <glm/gtc/type_ptr.hpp>
 #include <glm/mat4x4.hpp>
-
-#include <algorithm>
-#include <cctype>
-#include <cstring>
 #include <map>
 #include <string>
 
@@ -186,8 +185,9 @@ class GltfReader {
     const auto& mesh = model_.meshes[static_cast<std::size_t>(mesh_index)];
     const auto first = static_cast<std::uint32_t>(scene.primitives.size());
     for (std::size_t p = 0; p < mesh.primitives.size(); ++p)
-      read_primitive(scene, mesh.primitives[p],
-                     "meshes[" + std::to_string(mesh_index) + "].primitives[" + std::to_string(p) + "]");
+      read_primitive(
+          scene, mesh.primitives[p],
+          "meshes[" + std::to_string(mesh_index) + "].primitives[" + std::to_string(p) + "]");
     const auto range =
         std::pair{first, static_cast<std::uint32_t>(scene.primitives.size()) - first};
     meshes_.emplace(mesh_index, range);
@@ -196,9 +196,11 @@ class GltfReader {
 
   // The accessor's elements as floats, `components` per element. Normalized integer types map
   // to [0, 1]; anything else fails.
-  std::vector<float> read_floats(int accessor_index, int components, const std::string& field) const {
+  std::vector<float> read_floats(int accessor_index, int components,
+                                 const std::string& field) const {
     const auto& accessor = checked_accessor(accessor_index, field);
-    const int type_components = tinygltf::GetNumComponentsInType(static_cast<std::uint32_t>(accessor.type));
+    const int type_components =
+        tinygltf::GetNumComponentsInType(static_cast<std::uint32_t>(accessor.type));
     if (type_components != components)
       fail(field, std::to_string(components) + "-component elements");
     const auto [data, stride] = element_data(accessor, field);
@@ -239,15 +241,20 @@ class GltfReader {
     for (std::size_t i = 0; i < accessor.count; ++i) {
       const unsigned char* element = data + i * stride;
       switch (accessor.componentType) {
-        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: out[i] = element[0]; break;
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE:
+          out[i] = element[0];
+          break;
         case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: {
           std::uint16_t v = 0;
           std::memcpy(&v, element, 2);
           out[i] = v;
           break;
         }
-        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: std::memcpy(&out[i], element, 4); break;
-        default: fail(field, "unsigned byte, short or int indices");
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT:
+          std::memcpy(&out[i], element, 4);
+          break;
+        default:
+          fail(field, "unsigned byte, short or int indices");
       }
     }
     return out;
@@ -269,7 +276,8 @@ class GltfReader {
       fail(field, "a bufferView index below " + std::to_string(model_.bufferViews.size()));
     const auto& view = model_.bufferViews[static_cast<std::size_t>(accessor.bufferView)];
     if (view.buffer < 0 || view.buffer >= static_cast<int>(model_.buffers.size()))
-      fail(field, "a bufferView whose buffer index is below " + std::to_string(model_.buffers.size()));
+      fail(field,
+           "a bufferView whose buffer index is below " + std::to_string(model_.buffers.size()));
     const auto& buffer = model_.buffers[static_cast<std::size_t>(view.buffer)];
     const int element_size =
         tinygltf::GetComponentSizeInBytes(static_cast<std::uint32_t>(accessor.componentType)) *
@@ -288,7 +296,8 @@ class GltfReader {
     return {buffer.data.data() + begin, step};
   }
 
-  void read_primitive(Scene& scene, const tinygltf::Primitive& primitive, const std::string& field) {
+  void read_primitive(Scene& scene, const tinygltf::Primitive& primitive,
+                      const std::string& field) {
     const int mode = primitive.mode < 0 ? TINYGLTF_MODE_TRIANGLES : primitive.mode;
     if (mode != TINYGLTF_MODE_TRIANGLES && mode != TINYGLTF_MODE_TRIANGLE_STRIP &&
         mode != TINYGLTF_MODE_TRIANGLE_FAN)
@@ -304,7 +313,8 @@ class GltfReader {
       order = read_indices(primitive.indices, field + ".indices");
       for (const std::uint32_t index : order)
         if (index >= vertex_count)
-          fail(field + ".indices", "indices below the vertex count " + std::to_string(vertex_count));
+          fail(field + ".indices",
+               "indices below the vertex count " + std::to_string(vertex_count));
     } else {
       order.resize(vertex_count);
       for (std::size_t i = 0; i < vertex_count; ++i) order[i] = static_cast<std::uint32_t>(i);
@@ -337,7 +347,8 @@ class GltfReader {
     const auto base = static_cast<std::uint32_t>(scene.positions.size());
     for (std::size_t i = 0; i < vertex_count; ++i) {
       scene.positions.emplace_back(p[3 * i], p[3 * i + 1], p[3 * i + 2]);
-      scene.normals.emplace_back(n.empty() ? glm::vec3(0) : glm::vec3(n[3 * i], n[3 * i + 1], n[3 * i + 2]));
+      scene.normals.emplace_back(n.empty() ? glm::vec3(0)
+                                           : glm::vec3(n[3 * i], n[3 * i + 1], n[3 * i + 2]));
       scene.uvs.emplace_back(uv.empty() ? glm::vec2(0) : glm::vec2(uv[2 * i], uv[2 * i + 1]));
     }
     if (n.empty()) {
@@ -347,7 +358,8 @@ class GltfReader {
         const glm::vec3 b = scene.positions[base + triangles[t + 1]];
         const glm::vec3 c = scene.positions[base + triangles[t + 2]];
         const glm::vec3 weighted = glm::cross(b - a, c - a);
-        for (int k = 0; k < 3; ++k) scene.normals[base + triangles[t + static_cast<std::size_t>(k)]] += weighted;
+        for (int k = 0; k < 3; ++k)
+          scene.normals[base + triangles[t + static_cast<std::size_t>(k)]] += weighted;
       }
       for (std::size_t i = 0; i < vertex_count; ++i) {
         glm::vec3& normal = scene.normals[base + i];
@@ -361,7 +373,8 @@ class GltfReader {
     out.index_count = static_cast<std::uint32_t>(triangles.size());
     for (const std::uint32_t index : triangles) scene.indices.push_back(base + index);
     if (primitive.material >= static_cast<int>(model_.materials.size()))
-      fail(field + ".material", "a material index below " + std::to_string(model_.materials.size()));
+      fail(field + ".material",
+           "a material index below " + std::to_string(model_.materials.size()));
     if (primitive.material < 0) {
       out.material = no_material;
       needs_default_material_ = true;
@@ -400,7 +413,8 @@ Scene load_gltf(const std::filesystem::path& path) {
                                       : loader.LoadASCIIFromFile(&model, &error, &warning, source);
   if (!ok || !error.empty()) {
     while (!error.empty() && (error.back() == '\n' || error.back() == ' ')) error.pop_back();
-    throw InputError(source, "", "a valid glTF 2.0 file (" + (error.empty() ? "parse failed" : error) + ")");
+    throw InputError(source, "",
+                     "a valid glTF 2.0 file (" + (error.empty() ? "parse failed" : error) + ")");
   }
   Scene scene = GltfReader(model, source).read();
   scene.name = path.stem().string();

@@ -1,10 +1,9 @@
 #include "facet/driver/gpu_scene.hpp"
 
-#include <glm/gtc/type_ptr.hpp>
-
 #include <algorithm>
 #include <bit>
 #include <cstring>
+#include <glm/gtc/type_ptr.hpp>
 
 #include "facet/projection/errors.hpp"
 
@@ -73,14 +72,14 @@ GpuScene upload_scene(const Scene& scene) {
                            epoxy_has_gl_extension("GL_EXT_texture_filter_anisotropic");
   if (anisotropic) glGetFloatv(GL_MAX_TEXTURE_MAX_ANISOTROPY, &max_anisotropy);
   for (const auto& image : scene.images) {
-    FACET_ASSERT(image.rgba.size() ==
-                 static_cast<std::size_t>(image.width) * static_cast<std::size_t>(image.height) * 4u);
+    FACET_ASSERT(image.rgba.size() == static_cast<std::size_t>(image.width) *
+                                          static_cast<std::size_t>(image.height) * 4u);
     const auto largest = static_cast<unsigned>(std::max(image.width, image.height));
     const int levels = std::bit_width(largest);  // down to 1x1
     Texture texture = Texture::create_2d(GL_SRGB8_ALPHA8, image.width, image.height, levels);
     glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
-    glTextureSubImage2D(texture.id(), 0, 0, 0, image.width, image.height, GL_RGBA,
-                        GL_UNSIGNED_BYTE, image.rgba.data());
+    glTextureSubImage2D(texture.id(), 0, 0, 0, image.width, image.height, GL_RGBA, GL_UNSIGNED_BYTE,
+                        image.rgba.data());
     glGenerateTextureMipmap(texture.id());
     gpu.textures.push_back(std::move(texture));
   }

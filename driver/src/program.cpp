@@ -69,24 +69,30 @@ ShaderStage stage_from_name(std::string_view name) {
   if (ends_with(name, ".geom")) return ShaderStage::geometry;
   if (ends_with(name, ".frag")) return ShaderStage::fragment;
   if (ends_with(name, ".comp")) return ShaderStage::compute;
-  throw std::invalid_argument("stage_from_name: '" + std::string(name) +
-                              "' has no shader stage extension (.vert .tesc .tese .geom .frag .comp)");
+  throw std::invalid_argument(
+      "stage_from_name: '" + std::string(name) +
+      "' has no shader stage extension (.vert .tesc .tese .geom .frag .comp)");
 }
 
 GLenum gl_shader_type(ShaderStage stage) {
   switch (stage) {
-    case ShaderStage::vertex: return GL_VERTEX_SHADER;
-    case ShaderStage::tess_control: return GL_TESS_CONTROL_SHADER;
-    case ShaderStage::tess_evaluation: return GL_TESS_EVALUATION_SHADER;
-    case ShaderStage::geometry: return GL_GEOMETRY_SHADER;
-    case ShaderStage::fragment: return GL_FRAGMENT_SHADER;
-    case ShaderStage::compute: return GL_COMPUTE_SHADER;
+    case ShaderStage::vertex:
+      return GL_VERTEX_SHADER;
+    case ShaderStage::tess_control:
+      return GL_TESS_CONTROL_SHADER;
+    case ShaderStage::tess_evaluation:
+      return GL_TESS_EVALUATION_SHADER;
+    case ShaderStage::geometry:
+      return GL_GEOMETRY_SHADER;
+    case ShaderStage::fragment:
+      return GL_FRAGMENT_SHADER;
+    case ShaderStage::compute:
+      return GL_COMPUTE_SHADER;
   }
   return GL_VERTEX_SHADER;
 }
 
-std::string compose_shader_source(std::string_view text,
-                                  const std::vector<ShaderDefine>& defines) {
+std::string compose_shader_source(std::string_view text, const std::vector<ShaderDefine>& defines) {
   std::string version = "#version 450 core";
   std::string body;
   body.reserve(text.size());
@@ -151,8 +157,7 @@ ProgramBuilder& ProgramBuilder::shader(std::string_view embedded_name) {
   return *this;
 }
 
-ProgramBuilder& ProgramBuilder::source(ShaderStage stage, std::string file_name,
-                                       std::string text) {
+ProgramBuilder& ProgramBuilder::source(ShaderStage stage, std::string file_name, std::string text) {
   stages_.push_back({stage, std::move(file_name), std::move(text)});
   return *this;
 }

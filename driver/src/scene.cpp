@@ -1,8 +1,7 @@
 #include "facet/driver/scene.hpp"
 
-#include <glm/common.hpp>
-
 #include <cstring>
+#include <glm/common.hpp>
 
 namespace facet::driver {
 

@@ -1,15 +1,14 @@
 // The built-in city: deterministic, in the triangle and material budget of the paper's test
 // model, well-formed, with tight bounds, buildings all around the origin, and a camera path that
 // loops along the streets.
+#include "facet/driver/city.hpp"
+
 #include <gtest/gtest.h>
 
-#include <glm/geometric.hpp>
-
 #include <cmath>
+#include <glm/geometric.hpp>
 #include <numbers>
 #include <set>
-
-#include "facet/driver/city.hpp"
 
 namespace facet::driver {
 namespace {
@@ -65,7 +64,8 @@ TEST(City, IsWellFormed) {
   }
   // No degenerate triangles: every one has an area above 1 cm^2.
   for (std::size_t t = 0; t + 2 < scene.indices.size(); t += 3) {
-    const glm::vec3 a = scene.positions[scene.indices[t]], b = scene.positions[scene.indices[t + 1]],
+    const glm::vec3 a = scene.positions[scene.indices[t]],
+                    b = scene.positions[scene.indices[t + 1]],
                     c = scene.positions[scene.indices[t + 2]];
     ASSERT_GT(0.5f * glm::length(glm::cross(b - a, c - a)), 1e-4f) << "triangle " << t / 3;
   }
@@ -78,7 +78,8 @@ TEST(City, IsWellFormed) {
     EXPECT_EQ(image.rgba.size(), static_cast<std::size_t>(image.width * image.height * 4));
     // Generated, not flat: the texels are not all the same.
     bool varies = false;
-    for (std::size_t i = 4; i < image.rgba.size() && !varies; ++i) varies = image.rgba[i] != image.rgba[i % 4];
+    for (std::size_t i = 4; i < image.rgba.size() && !varies; ++i)
+      varies = image.rgba[i] != image.rgba[i % 4];
     EXPECT_TRUE(varies) << image.name;
   }
 }
@@ -92,7 +93,8 @@ TEST(City, BoundsContainTheirTriangles) {
       const Primitive& p = scene.primitives[object.first_primitive + k];
       for (std::uint32_t i = 0; i < p.index_count; ++i) {
         const glm::vec3 p_world =
-            glm::vec3(object.T_world_object * glm::vec4(scene.positions[scene.indices[p.first_index + i]], 1));
+            glm::vec3(object.T_world_object *
+                      glm::vec4(scene.positions[scene.indices[p.first_index + i]], 1));
         ASSERT_TRUE(object.bounds_world.contains(p_world, 0.0f)) << object.name;
       }
     }
@@ -114,7 +116,8 @@ TEST(City, SurroundsTheOrigin) {
     const glm::vec3 c = object.bounds_world.centre();
     if (std::hypot(c.x, c.z) > 150.0f) continue;
     const double azimuth = std::atan2(static_cast<double>(c.z), static_cast<double>(c.x));
-    sectors.insert(static_cast<int>(std::floor((azimuth + std::numbers::pi) / (std::numbers::pi / 4))) % 8);
+    sectors.insert(
+        static_cast<int>(std::floor((azimuth + std::numbers::pi) / (std::numbers::pi / 4))) % 8);
   }
   EXPECT_EQ(sectors.size(), 8u);
 }
@@ -132,8 +135,8 @@ TEST(CityCameraPath, LoopsSmoothlyAlongTheStreets) {
   const CityCameraPath path;
   const double period = path.period_s();
   ASSERT_GT(period, 10.0);
-  constexpr double speed = 8.0;     // m/s, as documented
-  constexpr double street = 4.0;    // asphalt half-width, metres
+  constexpr double speed = 8.0;   // m/s, as documented
+  constexpr double street = 4.0;  // asphalt half-width, metres
   for (double t = 0; t < period; t += 0.05) {
     const glm::dmat4 T = path.T_world_eye(t);
     const glm::dmat4 T_later = path.T_world_eye(t + period);

@@ -1,10 +1,11 @@
 // The move-only GL object wrappers: moves leave the source empty, destruction deletes, and no
 // wrapper can be copied.
+#include "facet/driver/gl_objects.hpp"
+
 #include <gtest/gtest.h>
 
 #include <type_traits>
 
-#include "facet/driver/gl_objects.hpp"
 #include "facet/driver/gpu_timer.hpp"
 #include "gl_test_context.hpp"
 
@@ -12,9 +13,9 @@ namespace facet::driver {
 namespace {
 
 template <class T>
-constexpr bool move_only = !std::is_copy_constructible_v<T> && !std::is_copy_assignable_v<T> &&
-                           std::is_nothrow_move_constructible_v<T> &&
-                           std::is_nothrow_move_assignable_v<T>;
+constexpr bool move_only =
+    !std::is_copy_constructible_v<T> && !std::is_copy_assignable_v<T> &&
+    std::is_nothrow_move_constructible_v<T> && std::is_nothrow_move_assignable_v<T>;
 static_assert(move_only<Buffer>);
 static_assert(move_only<Texture>);
 static_assert(move_only<Renderbuffer>);
@@ -54,9 +55,7 @@ void check_lifecycle(Make make, Exists exists) {
   EXPECT_EQ(c.id(), a_id);
   EXPECT_TRUE(exists(a_id));
 
-  {
-    T d(std::move(c));
-  }
+  { T d(std::move(c)); }
   EXPECT_FALSE(exists(a_id)) << "destruction must delete the object";
 
   T f = make();
@@ -130,8 +129,9 @@ TEST(GlObjects, QueryLifecycle) {
 
 TEST(GlObjects, TransformFeedbackAndSamplerLifecycle) {
   test::shared_context();
-  check_lifecycle<TransformFeedback>([] { return TransformFeedback::create(); },
-                                     [](GLuint id) { return glIsTransformFeedback(id) == GL_TRUE; });
+  check_lifecycle<TransformFeedback>(
+      [] { return TransformFeedback::create(); },
+      [](GLuint id) { return glIsTransformFeedback(id) == GL_TRUE; });
   check_lifecycle<Sampler>([] { return Sampler::create(); },
                            [](GLuint id) { return glIsSampler(id) == GL_TRUE; });
 }

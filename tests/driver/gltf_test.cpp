@@ -44,9 +44,10 @@ void append(std::vector<unsigned char>& out, const T& value) {
 class TempDir {
  public:
   TempDir() {
-    path_ = fs::temp_directory_path() /
-            ("facet_gltf_test_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) +
-             "_" + ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    path_ =
+        fs::temp_directory_path() /
+        ("facet_gltf_test_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) +
+         "_" + ::testing::UnitTest::GetInstance()->current_test_info()->name());
     fs::create_directories(path_);
   }
   ~TempDir() {
@@ -121,7 +122,8 @@ TEST(Gltf, LoadsCountsTransformsAndBounds) {
   EXPECT_EQ(scene.primitives[0].material, 0u);
 
   // Missing normals are computed: the square faces +z (counter-clockwise from +z).
-  for (const auto& n : scene.normals) EXPECT_NEAR(glm::distance(n, glm::vec3(0, 0, 1)), 0.0f, 1e-6f);
+  for (const auto& n : scene.normals)
+    EXPECT_NEAR(glm::distance(n, glm::vec3(0, 0, 1)), 0.0f, 1e-6f);
   EXPECT_EQ(scene.uvs[0], glm::vec2(0, 1));
 
   const Object& first = scene.objects[0];

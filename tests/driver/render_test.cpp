@@ -24,7 +24,8 @@ TEST(Render, Rgba32fTriangleReadsBackExpectedPixels) {
   // Red, green and blue corners at the lower-left, lower-right and upper-left of the target:
   // the triangle covers the pixels below the diagonal from (w,0) to (0,h) in GL's bottom-up
   // window coordinates.
-  const std::array<Vertex, 3> vertices = {{{-1, -1, 1, 0, 0, 1}, {1, -1, 0, 1, 0, 1}, {-1, 1, 0, 0, 1, 1}}};
+  const std::array<Vertex, 3> vertices = {
+      {{-1, -1, 1, 0, 0, 1}, {1, -1, 0, 1, 0, 1}, {-1, 1, 0, 0, 1, 1}}};
   Buffer vbo = Buffer::create_from(vertices);
   VertexArray vao = VertexArray::create();
   glVertexArrayVertexBuffer(vao.id(), 0, vbo.id(), 0, sizeof(Vertex));

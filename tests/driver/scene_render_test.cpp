@@ -5,7 +5,6 @@
 
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/type_ptr.hpp>
-
 #include <vector>
 
 #include "facet/driver/city.hpp"
@@ -52,8 +51,9 @@ std::vector<float> draw(const Scene& scene, const GpuScene& gpu, const Program& 
       glUniform4fv(8, 1, glm::value_ptr(m.base_colour));
       glUniform1i(9, m.texture >= 0 ? 1 : 0);
       gpu.bind_material_texture(p.material, 0);
-      glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(p.index_count), GL_UNSIGNED_INT,
-                     reinterpret_cast<const void*>(static_cast<std::uintptr_t>(p.first_index) * 4u));
+      glDrawElements(
+          GL_TRIANGLES, static_cast<GLsizei>(p.index_count), GL_UNSIGNED_INT,
+          reinterpret_cast<const void*>(static_cast<std::uintptr_t>(p.first_index) * 4u));
     }
   }
   glBindVertexArray(0);

@@ -31,9 +31,8 @@ TEST(Shaders, EveryEmbeddedShaderCompiles) {
 }
 
 TEST(Shaders, ComposedSourceKeepsLineNumbers) {
-  const std::string composed =
-      compose_shader_source("// comment\n#version 460 core\nvoid main() {}\n",
-                            {{"A", "1"}, {"B", ""}});
+  const std::string composed = compose_shader_source(
+      "// comment\n#version 460 core\nvoid main() {}\n", {{"A", "1"}, {"B", ""}});
   EXPECT_EQ(composed,
             "#version 460 core\n#define A 1\n#define B \n#line 1\n// comment\n\nvoid main() {}\n");
   EXPECT_EQ(compose_shader_source("void main() {}", {}),
@@ -43,13 +42,13 @@ TEST(Shaders, ComposedSourceKeepsLineNumbers) {
 // Line 6 of this text has the error. It is an undeclared name rather than a missing semicolon,
 // because drivers report a missing semicolon on the line of the next token.
 constexpr const char* broken_fragment =
-    "// A shader with one error.\n"               // 1
-    "layout(location = 0) out vec4 colour;\n"     // 2
-    "\n"                                          // 3
-    "void main() {\n"                             // 4
-    "  vec4 base = vec4(SCALE);\n"                // 5
-    "  colour = base * undeclared_name;\n"        // 6
-    "}\n";                                        // 7
+    "// A shader with one error.\n"            // 1
+    "layout(location = 0) out vec4 colour;\n"  // 2
+    "\n"                                       // 3
+    "void main() {\n"                          // 4
+    "  vec4 base = vec4(SCALE);\n"             // 5
+    "  colour = base * undeclared_name;\n"     // 6
+    "}\n";                                     // 7
 
 TEST(Shaders, CompileErrorNamesFileAndLine) {
   test::shared_context();
@@ -103,8 +102,11 @@ TEST(Shaders, EmbeddedErrorsUseTheShadersPath) {
   // A bad define breaks the fragment shader where the macro is used; the error names the
   // embedded file by its path under shaders/.
   try {
-    ProgramBuilder().shader("test/triangle.vert").shader("test/triangle.frag")
-        .define("TEST_COLOUR_SCALE", "not a number +").link();
+    ProgramBuilder()
+        .shader("test/triangle.vert")
+        .shader("test/triangle.frag")
+        .define("TEST_COLOUR_SCALE", "not a number +")
+        .link();
     FAIL() << "expected ShaderError";
   } catch (const ShaderError& e) {
     EXPECT_EQ(e.file(), "shaders/test/triangle.frag") << e.what();

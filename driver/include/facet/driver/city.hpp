@@ -9,10 +9,9 @@
 //
 // Deterministic: the same options give bit-identical scenes on every machine (a fixed PCG32
 // generator and only +, -, *, / and sqrt, compiled without fused multiply-add contraction).
+#include <cstdint>
 #include <glm/mat4x4.hpp>
 #include <glm/vec2.hpp>
-
-#include <cstdint>
 #include <vector>
 
 #include "facet/driver/scene.hpp"
@@ -28,9 +27,20 @@ struct CityOptions {
 
 // The material groups of the city, in Scene::materials order.
 enum class CityMaterial : std::uint32_t {
-  grass, asphalt, sidewalk, road_marking,
-  facade_brick, facade_glass, facade_concrete, facade_plaster, facade_stone,
-  roof_flat, roof_tiles, bark, foliage, metal,
+  grass,
+  asphalt,
+  sidewalk,
+  road_marking,
+  facade_brick,
+  facade_glass,
+  facade_concrete,
+  facade_plaster,
+  facade_stone,
+  roof_flat,
+  roof_tiles,
+  bark,
+  foliage,
+  metal,
   count
 };
 

@@ -3,7 +3,6 @@
 // or a GLFW window. GL functions are loaded through libepoxy, so any code that includes
 // <epoxy/gl.h> may call GL once a context is current on the calling thread.
 #include <glm/vec2.hpp>
-
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -81,8 +80,8 @@ std::unique_ptr<GlContext> create_headless_context(const HeadlessOptions& option
 struct WindowOptions {
   int width = 1280, height = 720;  // window size in screen coordinates (windowed mode)
   std::string title = "facet";
-  int monitor = -1;    // -1: windowed; otherwise full screen on this GLFW monitor index
-  bool vsync = true;   // swap interval 1 (else 0)
+  int monitor = -1;   // -1: windowed; otherwise full screen on this GLFW monitor index
+  bool vsync = true;  // swap interval 1 (else 0)
   bool visible = true;
   bool debug = false;  // as in HeadlessOptions
 };

@@ -4,12 +4,11 @@
 // Frames and units: vertex positions are in the object's own frame, in metres; an object's
 // T_world_object maps them into the world frame (metres, y up, ground at y = 0 for the built-in
 // city, as in glTF). Triangles are counter-clockwise when seen from their front side.
+#include <cstdint>
 #include <glm/mat4x4.hpp>
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 #include <glm/vec4.hpp>
-
-#include <cstdint>
 #include <limits>
 #include <string>
 #include <vector>
@@ -61,9 +60,9 @@ struct Object {
 struct Scene {
   std::string name;
   // Vertex attributes, one entry per vertex, in the object frame of the objects using them.
-  std::vector<glm::vec3> positions;  // metres
-  std::vector<glm::vec3> normals;    // unit length
-  std::vector<glm::vec2> uvs;        // texture coordinates, (0,0) = first texel of the first row
+  std::vector<glm::vec3> positions;    // metres
+  std::vector<glm::vec3> normals;      // unit length
+  std::vector<glm::vec2> uvs;          // texture coordinates, (0,0) = first texel of the first row
   std::vector<std::uint32_t> indices;  // triangle list into the vertex arrays
   std::vector<Primitive> primitives;
   std::vector<Object> objects;
