@@ -1,0 +1,119 @@
+#pragma once
+// The interface every renderer of a display implements: the facet replication pipelines (modern
+// and the seed's geometry-shader form) and the baselines (cube map, naive multi-pass, per-vertex
+// projection). One scene, one view, several outputs per frame; each output is one projector.
+//
+// Triangle IDs. Every renderer can write a triangle-ID image (R32UI) beside colour and depth, and
+// the CPU ray-cast reference writes the same numbering, so images compare pixel by pixel:
+//   id = 1 + (triangles of all objects before this one, in Scene::objects order)
+//          + (ordinal of the triangle inside this object's primitive range, primitives in order)
+//   id = 0 where no triangle was drawn.
+// scene_triangle_base() gives the first term.
+#include <cstdint>
+#include <glm/glm.hpp>
+#include <memory>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "facet/driver/gl_objects.hpp"
+#include "facet/driver/gpu_scene.hpp"
+#include "facet/driver/scene.hpp"
+#include "facet/projection/facets.hpp"
+#include "facet/projection/warp.hpp"
+
+namespace facet::driver {
+
+// One projector output as a renderer sees it: its exact warp (the map from eye directions to
+// its output pixels) and its name.
+struct OutputSpec {
+  std::string name;
+  Warp warp;
+};
+
+struct RenderSettings {
+  // Facet methods: how the warp is cut into facets.
+  FacetBuildOptions facets;
+  // Cube-map baseline: edge length of a cube face in pixels.
+  int cube_face_size = 1024;
+  // Per-vertex baseline: tessellation level cap (1 = no tessellation).
+  int max_tessellation = 1;
+  // Colour samples per pixel (0 or 1: no multisampling). IDs and depth are then resolved from
+  // sample 0.
+  int msaa_samples = 0;
+  // Near distance in metres along the facet normal (reversed-Z: depth = z_near / (n·X)).
+  double z_near = 0.05;
+};
+
+// The GPU images of one output, all at the warp's output size. Colour is SRGB8_ALPHA8, IDs
+// R32UI, depth DEPTH_COMPONENT32F cleared to 0 (reversed-Z: greater is nearer).
+// Row 0 of every texture is the bottom row of the output image (GL convention); the read_*
+// functions return images with row 0 at the top (DESIGN.md output pixels).
+class OutputTarget {
+ public:
+  static OutputTarget create(glm::ivec2 size, int msaa_samples = 0);
+
+  glm::ivec2 size() const { return size_; }
+  const Framebuffer& framebuffer() const { return framebuffer_; }
+  const Texture& colour() const { return colour_; }
+  const Texture& ids() const { return ids_; }
+  const Texture& depth() const { return depth_; }
+
+  // Clears colour to `background` (linear RGBA), IDs to 0 and depth to 0 (far).
+  void clear(const glm::vec4& background = {0, 0, 0, 1});
+  // Binds the framebuffer and sets the viewport to the whole output.
+  void bind() const;
+
+  std::vector<std::uint8_t> read_colour_rgba8() const;  // sRGB, top row first
+  std::vector<std::uint32_t> read_ids() const;         // top row first
+  std::vector<float> read_depth() const;               // top row first, reversed-Z
+
+ private:
+  glm::ivec2 size_{0, 0};
+  int msaa_samples_ = 0;
+  Framebuffer framebuffer_;
+  Texture colour_, ids_, depth_;
+};
+
+struct RenderStats {
+  std::uint64_t triangles_in = 0;       // triangles of the objects that survived bounds culling
+  std::uint64_t triangles_visible = 0;  // after per-triangle culling (back face, behind, coverage)
+  std::uint64_t replicas = 0;           // triangle draws issued, summed over outputs
+  std::uint64_t facets = 0;             // facets over all outputs (0 for non-facet methods)
+  bool reused_replication = false;      // passes 1+2 skipped: neither view nor scene changed
+  // replicas / triangles_in; the seed paper's replication ratio.
+  double replication_ratio() const {
+    return triangles_in == 0 ? 0.0 : double(replicas) / double(triangles_in);
+  }
+};
+
+class RenderMethod {
+ public:
+  virtual ~RenderMethod() = default;
+  // "facets", "facets-gs", "cubemap", "naive", "vertex".
+  virtual std::string_view name() const = 0;
+
+  // Builds everything that depends only on the outputs and the scene: facets, matrices, cube
+  // faces, lookup textures, programs. Needs a current context. Throws InputError for settings
+  // that cannot work (for example a cube face size <= 0).
+  virtual void prepare(const Scene& scene, const GpuScene& gpu_scene,
+                       std::span<const OutputSpec> outputs, const RenderSettings& settings) = 0;
+
+  // Renders one frame of every output into `targets` (one per output, same order, already
+  // sized). T_eye_world maps world points (metres) into the eye frame of DESIGN.md. Passes are
+  // timed with `timer` when it is given.
+  virtual RenderStats render(const glm::dmat4& T_eye_world, std::span<OutputTarget> targets,
+                             class GpuTimer* timer = nullptr) = 0;
+};
+
+// Every method name make_render_method accepts, in the order `facet bench` lists them.
+std::span<const std::string_view> render_method_names();
+// Throws InputError("--method", ...) for an unknown name.
+std::unique_ptr<RenderMethod> make_render_method(std::string_view name);
+
+// First triangle ID minus one of every object (see the numbering above), plus the total at the
+// end: size objects + 1.
+std::vector<std::uint32_t> scene_triangle_base(const Scene& scene);
+
+}  // namespace facet::driver
