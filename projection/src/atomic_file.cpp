@@ -13,8 +13,12 @@ void write_atomically(const std::filesystem::path& path,
   static std::atomic<unsigned> counter{0};
   // Keep the extension last so that writers that choose a format by extension still do.
   std::filesystem::path temporary = path;
-  temporary.replace_filename("." + path.stem().string() + ".tmp" + std::to_string(::getpid()) +
-                             "-" + std::to_string(counter++) + path.extension().string());
+  // Appending (rather than `"." + ...`) also keeps GCC 12's -Wrestrict false positive at -O3 away.
+  std::string name = ".";
+  name += path.stem().string();
+  name += ".tmp" + std::to_string(::getpid()) + "-" + std::to_string(counter++);
+  name += path.extension().string();
+  temporary.replace_filename(name);
   try {
     write(temporary);
     std::filesystem::rename(temporary, path);
