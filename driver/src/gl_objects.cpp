@@ -2,6 +2,8 @@
 
 #include <stdexcept>
 
+#include "facet/projection/errors.hpp"
+
 namespace facet::driver {
 
 namespace detail {
@@ -62,6 +64,19 @@ Texture Texture::create(GLenum target) {
   GLuint id = 0;
   glCreateTextures(target, 1, &id);
   return Texture(checked(id, "Texture::create"), target);
+}
+
+Texture Texture::create_view(const Texture& source, GLenum internal_format) {
+  GLint levels = 0;
+  glGetTextureParameteriv(source.id(), GL_TEXTURE_IMMUTABLE_LEVELS, &levels);
+  FACET_ASSERT(levels > 0);
+  // glTextureView needs a name that was never bound, which glGenTextures gives and
+  // glCreateTextures does not.
+  GLuint id = 0;
+  glGenTextures(1, &id);
+  glTextureView(checked(id, "Texture::create_view"), source.target(), source.id(), internal_format,
+                0, GLuint(levels), 0, 1);
+  return Texture(id, source.target());
 }
 
 Texture Texture::create_2d(GLenum internal_format, int width, int height, int levels) {

@@ -107,6 +107,10 @@ class Texture : public detail::GlName<detail::delete_texture> {
   static Texture create(GLenum target);
   // Immutable 2D storage, `levels` mip levels, sampling clamped to edge with linear filtering.
   static Texture create_2d(GLenum internal_format, int width, int height, int levels = 1);
+  // A view of all levels of `source` (which must have immutable storage) reinterpreted as
+  // `internal_format` of the same size class, e.g. an SRGB8_ALPHA8 texture as RGBA8 so that
+  // compute shaders can load and store its raw bytes.
+  static Texture create_view(const Texture& source, GLenum internal_format);
 
   GLenum target() const { return target_; }
   void bind_unit(GLuint unit) const { glBindTextureUnit(unit, id()); }
