@@ -1,0 +1,109 @@
+#pragma once
+// display.json (FORMATS.md §4): one display's eye point, screen, projectors (output, warp, blend,
+// black level, gamma) and render settings, as a plain value. The JSON schema of the file is
+// configs/display.schema.json; this reader is the validator the project trusts.
+//
+// Units: metres for the eye and the screen (in the display's world frame, which shares its axes
+// with the eye frame: x right, y up, the eye looking down −z), output pixels for sizes and window
+// rectangles (desktop pixels, y down).
+#include <filesystem>
+#include <glm/glm.hpp>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace facet::projection_io {
+
+inline constexpr const char* kDisplayFormat = "facet-display/1";
+
+// The display surface, in the same JSON shape as capture.json's `screen` (FORMATS.md §1).
+struct DisplayScreen {
+  enum class Type { sphere, cylinder, plane };
+  Type type = Type::sphere;
+  glm::dvec3 center{0.0};            // sphere, cylinder: a point on the axis
+  glm::dvec3 axis{0.0, 1.0, 0.0};    // cylinder: unit direction of the axis
+  double radius = 1;                 // sphere, cylinder: > 0
+  glm::dvec3 point{0.0};             // plane: a point on it
+  glm::dvec3 normal{0.0, 0.0, 1.0};  // plane: unit normal
+
+  bool operator==(const DisplayScreen&) const = default;
+};
+
+// Where a projector's image goes. A monitor name (EDID/connector name as the window system
+// reports it) survives a reboot; `position`/`size` say where that monitor sat on the desktop and
+// serve as the fallback window when it is missing and `missing_monitor` is "window". A window is a
+// fixed desktop rectangle.
+struct DisplayOutput {
+  enum class Kind { monitor, window };
+  Kind kind = Kind::window;
+  std::string monitor;                 // kind == monitor: non-empty
+  std::optional<glm::ivec2> position;  // kind == monitor: optional fallback position
+  std::optional<glm::ivec2> size;      // kind == monitor: optional fallback size (> 0)
+  glm::ivec4 window{0, 0, 0, 0};       // kind == window: x, y, width (> 0), height (> 0)
+
+  bool operator==(const DisplayOutput&) const = default;
+};
+
+struct DisplayProjector {
+  std::string name;                            // letters, digits, '_', '-', '.'; unique
+  glm::ivec2 size{0, 0};                       // W, H in output pixels
+  std::filesystem::path warp;                  // .warp.exr, relative to the display.json folder
+  std::optional<std::filesystem::path> blend;  // .blend.exr (FORMATS.md §3), relative
+  std::optional<std::filesystem::path> black;  // .black.exr black level β, relative
+  double gamma = 2.2;                          // output encoding exponent, > 0
+  DisplayOutput output;
+
+  bool operator==(const DisplayProjector&) const = default;
+};
+
+struct RenderSettings {
+  // The render method (see the driver's render_method_names()); checked there, since the set of
+  // methods belongs to the driver. Here: a non-empty name of [a-z0-9_-].
+  std::string method = "facets";
+  double tolerance_px = 0.25;  // facet builder tolerance, output pixels, > 0
+  double z_near = 0.05;        // near plane distance, metres, > 0
+
+  bool operator==(const RenderSettings&) const = default;
+};
+
+enum class MissingMonitor { error, window };
+
+struct DisplayConfig {
+  // The folder relative paths resolve against (the folder of display.json). Not stored.
+  std::filesystem::path folder;
+  std::string name;     // non-empty
+  glm::dvec3 eye{0.0};  // eye point in the display's world frame, metres
+  std::optional<DisplayScreen> screen;
+  std::vector<DisplayProjector> projectors;  // at least one
+  RenderSettings render;
+  MissingMonitor missing_monitor = MissingMonitor::error;
+
+  bool operator==(const DisplayConfig&) const = default;
+
+  std::filesystem::path resolve(const std::filesystem::path& relative) const {
+    return folder / relative;
+  }
+};
+
+// Parses and validates a display.json document. `source` names the file in errors; `folder` is
+// stored in the result. When `check_files` is set, every referenced warp, blend and black file
+// must exist under `folder`. Throws InputError(source, field, expected) on the first problem:
+// missing or mistyped fields, NaN or Inf, unknown enumerated values, duplicate projector names,
+// missing files. Unknown fields are ignored (FORMATS.md).
+DisplayConfig display_config_from_json(const nlohmann::json& root, const std::string& source,
+                                       const std::filesystem::path& folder, bool check_files);
+
+// Reads display.json (`path` may also be its folder), checking that referenced files exist.
+DisplayConfig read_display_config(const std::filesystem::path& path, bool check_files = true);
+
+// Validates a value as the reader would (without touching files when check_files is false).
+void validate_display_config(const DisplayConfig& config, const std::string& source,
+                             bool check_files);
+
+nlohmann::json display_config_to_json(const DisplayConfig& config);
+
+// Validates (without checking files), then writes atomically. Paths are written as stored.
+void write_display_config(const DisplayConfig& config, const std::filesystem::path& path);
+
+}  // namespace facet::projection_io
