@@ -8,6 +8,7 @@
 #include <string>
 
 #include "facet/driver/gl_context.hpp"
+#include "facet/driver/monitors.hpp"
 #include "gl_context_internal.hpp"
 
 namespace facet::driver {
@@ -49,6 +50,7 @@ GlfwWindowContext::GlfwWindowContext(const WindowOptions& options) {
     glfwWindowHint(GLFW_OPENGL_FORWARD_COMPAT, GLFW_TRUE);
     glfwWindowHint(GLFW_OPENGL_DEBUG_CONTEXT, options.debug ? GLFW_TRUE : GLFW_FALSE);
     glfwWindowHint(GLFW_VISIBLE, options.visible ? GLFW_TRUE : GLFW_FALSE);
+    glfwWindowHint(GLFW_DECORATED, options.decorated ? GLFW_TRUE : GLFW_FALSE);
     // Projector outputs are linear-light framebuffers converted on write.
     glfwWindowHint(GLFW_SRGB_CAPABLE, GLFW_TRUE);
 
@@ -67,11 +69,14 @@ GlfwWindowContext::GlfwWindowContext(const WindowOptions& options) {
       height = mode->height;
       glfwWindowHint(GLFW_REFRESH_RATE, mode->refreshRate);
     }
-    GLFWwindow* window = glfwCreateWindow(width, height, options.title.c_str(), monitor, nullptr);
+    GLFWwindow* share = options.share ? as_window(options.share->native_window()) : nullptr;
+    GLFWwindow* window = glfwCreateWindow(width, height, options.title.c_str(), monitor, share);
     if (!window)
       throw GlContextError("GlfwWindowContext: no GL 4.5 core window could be made: " +
                            glfw_last_error);
     window_ = window;
+    if (!monitor && options.position)
+      glfwSetWindowPos(window, options.position->x, options.position->y);
     glfwSetKeyCallback(window, key_callback);
     glfwMakeContextCurrent(window);
     glfwSwapInterval(options.vsync ? 1 : 0);
@@ -108,6 +113,30 @@ bool GlfwWindowContext::should_close() const {
 }
 
 void GlfwWindowContext::poll_events() { glfwPollEvents(); }
+
+std::vector<MonitorInfo> list_monitors() {
+  std::lock_guard lock(glfw_mutex);
+  glfwSetErrorCallback(record_glfw_error);
+  if (glfw_windows == 0 && !glfwInit())
+    throw GlContextError("list_monitors: glfwInit failed (no display server?): " + glfw_last_error);
+  std::vector<MonitorInfo> result;
+  int count = 0;
+  GLFWmonitor** monitors = glfwGetMonitors(&count);
+  for (int i = 0; i < count; ++i) {
+    MonitorInfo info;
+    info.index = i;
+    const char* name = glfwGetMonitorName(monitors[i]);
+    info.name = name ? name : "";
+    glfwGetMonitorPos(monitors[i], &info.position.x, &info.position.y);
+    if (const GLFWvidmode* mode = glfwGetVideoMode(monitors[i])) {
+      info.size = {mode->width, mode->height};
+      info.refresh_hz = mode->refreshRate;
+    }
+    result.push_back(std::move(info));
+  }
+  if (glfw_windows == 0) glfwTerminate();
+  return result;
+}
 
 std::unique_ptr<GlContext> create_window_context(const WindowOptions& options) {
   return std::make_unique<GlfwWindowContext>(options);

@@ -4,6 +4,7 @@
 // <epoxy/gl.h> may call GL once a context is current on the calling thread.
 #include <glm/vec2.hpp>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 #include <string>
 
@@ -77,13 +78,21 @@ struct HeadlessOptions {
 // `automatic`. Throws GlContextError when no GL 4.5 core context can be made.
 std::unique_ptr<GlContext> create_headless_context(const HeadlessOptions& options = {});
 
+class GlfwWindowContext;
+
 struct WindowOptions {
   int width = 1280, height = 720;  // window size in screen coordinates (windowed mode)
   std::string title = "facet";
-  int monitor = -1;   // -1: windowed; otherwise full screen on this GLFW monitor index
-  bool vsync = true;  // swap interval 1 (else 0)
+  int monitor = -1;  // -1: windowed; otherwise full screen on this GLFW monitor index
+  // Windowed mode: the desktop position of the window's content area (top-left, y down); unset
+  // lets the window system choose.
+  std::optional<glm::ivec2> position;
+  bool decorated = true;  // windowed mode: title bar and borders
+  bool vsync = true;      // swap interval 1 (else 0)
   bool visible = true;
   bool debug = false;  // as in HeadlessOptions
+  // Shares textures and buffers (not framebuffers or vertex arrays) with this window's context.
+  const GlfwWindowContext* share = nullptr;
 };
 
 // A GLFW window with a GL 4.5 core context, current on the calling thread after construction.
