@@ -42,6 +42,8 @@ struct RenderSettings {
   // Colour samples per pixel (0 or 1: no multisampling). IDs and depth are then resolved from
   // sample 0.
   int msaa_samples = 0;
+  // Skip triangles that face away from the eye (counter-clockwise seen from the eye is front).
+  bool cull_back_faces = true;
   // Near distance in metres along the facet normal (reversed-Z: depth = z_near / (n·X)).
   double z_near = 0.05;
 };
@@ -62,18 +64,24 @@ class OutputTarget {
 
   // Clears colour to `background` (linear RGBA), IDs to 0 and depth to 0 (far).
   void clear(const glm::vec4& background = {0, 0, 0, 1});
-  // Binds the framebuffer and sets the viewport to the whole output.
+  // Binds the framebuffer (the multisampled one when there is one) and sets the viewport to the
+  // whole output; enables GL_FRAMEBUFFER_SRGB. Colour is draw buffer 0, IDs draw buffer 1.
   void bind() const;
+  // Copies the multisampled images into colour(), ids() and depth() (IDs and depth from one
+  // sample). Renderers call it at the end of a frame; a no-op without multisampling.
+  void resolve() const;
 
   std::vector<std::uint8_t> read_colour_rgba8() const;  // sRGB, top row first
-  std::vector<std::uint32_t> read_ids() const;         // top row first
-  std::vector<float> read_depth() const;               // top row first, reversed-Z
+  std::vector<std::uint32_t> read_ids() const;          // top row first
+  std::vector<float> read_depth() const;                // top row first, reversed-Z
 
  private:
   glm::ivec2 size_{0, 0};
   int msaa_samples_ = 0;
   Framebuffer framebuffer_;
   Texture colour_, ids_, depth_;
+  Framebuffer msaa_framebuffer_;  // empty without multisampling
+  Renderbuffer msaa_colour_, msaa_ids_, msaa_depth_;
 };
 
 struct RenderStats {

@@ -1,0 +1,28 @@
+#pragma once
+// The projector outputs of a display named on the command line.
+#include <glm/glm.hpp>
+#include <optional>
+#include <string_view>
+#include <vector>
+
+#include "facet/driver/render_method.hpp"
+
+namespace facet::driver {
+
+// `display` is one of
+//   builtin:cylinder360  the seed paper's cylinder: cylindrical base, azimuth [-180°, 180°],
+//                        tan(elevation) from 1 (top row) to -1 (bottom row); default 1600x1200.
+//   builtin:dome180      a 180° fisheye dome master, default 2048x2048, looking straight up: the
+//                        image centre is eye +y (up), the bottom edge of the image is eye -z
+//                        (the viewer's front), its top edge +z (behind), its right edge +x.
+//   FILE.warp.exr        one projector's offset map (FORMATS.md §2); the output is named after the
+//                        file.
+//   FILE.json            a display.json (FORMATS.md §4): one output per projector, named and
+//                        sized as there.
+// `size` overrides a built-in's default output size; for a file it must equal the file's size.
+// Throws InputError("command line", "--display" or "--size", ...) for anything else, and the
+// file's own InputError for a bad file.
+std::vector<OutputSpec> load_display_outputs(std::string_view display,
+                                             std::optional<glm::ivec2> size = std::nullopt);
+
+}  // namespace facet::driver

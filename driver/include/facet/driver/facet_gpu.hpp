@@ -1,0 +1,96 @@
+#pragma once
+// GPU layout of facet data, shared by the naive multi-pass baseline and both replication
+// pipelines (DESIGN.md, "The replication pipeline"). Everything is built in double on the CPU
+// (projection/facets.hpp, projection/coverage.hpp) and uploaded as float.
+//
+// Shader storage bindings used by shaders/replication/** (one table so that every program sees
+// the same buffers at the same points):
+//   0 positions   1 normals   2 uvs   3 indices            (GpuScene, tightly packed)
+//   4 records     5 object frames (T_eye_object, T_world_object per object, per frame)
+//   6 facets      7 coverage nodes   8 coverage order      (GpuFacetSet, per output)
+//   9 triangle list of the frame (record, first triangle)  10 counts / exclusive scan
+//   11 pairs (modern: triangle, facet; seed: triangle, replica)  12 stats
+//   13 material ranges of the triangle list   14 indirect draw arguments   15 scan block sums
+#include <epoxy/gl.h>
+
+#include <cstdint>
+#include <glm/glm.hpp>
+#include <vector>
+
+#include "facet/driver/gl_objects.hpp"
+#include "facet/driver/scene.hpp"
+#include "facet/projection/coverage.hpp"
+#include "facet/projection/facets.hpp"
+
+namespace facet::driver {
+
+namespace binding {
+inline constexpr GLuint positions = 0, normals = 1, uvs = 2, indices = 3, records = 4,
+                        object_frames = 5, facets = 6, nodes = 7, order = 8, list = 9, scan = 10,
+                        pairs = 11, stats = 12, material_ranges = 13, draw_args = 14,
+                        block_sums = 15;
+}  // namespace binding
+
+// std430, one per facet. Eye-frame X is inside the facet's guarded pyramid when
+// dot(clip_planes[k].xyz, X) >= 0 for k = 0..2; these are also its gl_ClipDistance values.
+struct GpuFacet {
+  float clip_from_eye[16];  // column-major Facet::clip_from_eye(output_size, z_near): GL clip
+                            // coordinates with the y flip and reversed-Z depth z_near / (n·X)
+  float clip_planes[3][4];  // FacetMesh::clip_planes(f, guard_px): unit normals, w = 0
+};
+static_assert(sizeof(GpuFacet) == 112);
+
+// std430, one per node of CoverageIndex::nodes(), in the same order. A bounded node holds the
+// four planes through the eye of the pyramid around its cone (as CoverageIndex::query uses them);
+// an unbounded node (bounded = 0) admits everything. Leaves (count > 0) hold facets
+// order[first, first + count); inner nodes have children first and first + 1.
+struct GpuCoverageNode {
+  float pyramid[4][4];
+  std::uint32_t first, count, bounded, padding;
+};
+static_assert(sizeof(GpuCoverageNode) == 80);
+
+// std430: one run of triangles that share an object and a material (an object's primitive).
+struct GpuRecord {
+  std::uint32_t first_index;     // into Scene::indices
+  std::uint32_t triangle_count;  // index_count / 3
+  std::uint32_t object;          // into Scene::objects
+  std::uint32_t material;        // into Scene::materials
+  std::uint32_t first_id;        // triangle ID (render_method.hpp) of the run's first triangle
+  std::uint32_t padding[3];
+};
+static_assert(sizeof(GpuRecord) == 32);
+
+// std430, per object, per frame.
+struct GpuObjectFrame {
+  float T_eye_object[16];  // column-major, metres
+  float T_world_object[16];
+};
+static_assert(sizeof(GpuObjectFrame) == 128);
+
+std::vector<GpuFacet> pack_facets(const FacetMesh& mesh, double z_near,
+                                  double guard_px = kDefaultGuardPx);
+std::vector<GpuCoverageNode> pack_coverage_nodes(const CoverageIndex& index);
+// Records of every object's primitives, in Scene::objects order, then primitive order.
+std::vector<GpuRecord> make_records(const Scene& scene);
+
+// The facets of one output on the CPU (double) and on the GPU (float).
+struct FacetSet {
+  FacetMesh mesh;
+  CoverageIndex index;
+  std::vector<GpuFacet> gpu_facets;  // kept for the naive baseline's per-facet culling
+  Buffer facets, nodes, order;       // bind at binding::facets, nodes, order
+
+  // Builds the facets of `warp` (InputError when the layout cannot be met) and uploads them.
+  // Needs a current context.
+  static FacetSet build(const Warp& warp, const FacetBuildOptions& options, double z_near);
+  void bind() const;
+};
+
+// True when a sphere (eye frame, metres) may meet the cone {X : plane_k·X >= 0}; conservative.
+bool sphere_may_meet_cone(const glm::dvec3& centre, double radius, const glm::dvec3* planes,
+                          int plane_count);
+// True when a sphere may meet any facet's guarded pyramid (walks the coverage hierarchy).
+bool sphere_may_meet_facets(const FacetSet& set, const glm::dvec3& centre, double radius);
+
+}  // namespace facet::driver

@@ -1,0 +1,70 @@
+#include "facet/driver/display_outputs.hpp"
+
+#include <filesystem>
+#include <string>
+
+#include "facet/projection/errors.hpp"
+#include "facet/projection_io/display_config.hpp"
+#include "facet/projection_io/warp_file.hpp"
+
+namespace facet::driver {
+namespace {
+
+bool ends_with(std::string_view text, std::string_view suffix) {
+  return text.size() >= suffix.size() && text.substr(text.size() - suffix.size()) == suffix;
+}
+
+}  // namespace
+
+std::vector<OutputSpec> load_display_outputs(std::string_view display,
+                                             std::optional<glm::ivec2> size) {
+  if (size && (size->x < 1 || size->y < 1)) {
+    throw InputError("command line", "--size", "expected a positive output size");
+  }
+  std::vector<OutputSpec> outputs;
+  if (display == "builtin:cylinder360") {
+    outputs.push_back({"cylinder360", Warp::analytic(BaseProjection::cylindrical(-180, 180, 1, -1),
+                                                     size.value_or(glm::ivec2(1600, 1200)))});
+  } else if (display == "builtin:dome180") {
+    // Rotates the base's view axis (-z) onto eye +y and the base's up (+y) onto eye +z, so the
+    // bottom of the dome master is the viewer's front, as in the usual dome master layout.
+    const glm::dmat3 R_eye_base(glm::dvec3(1, 0, 0), glm::dvec3(0, 0, 1), glm::dvec3(0, -1, 0));
+    outputs.push_back({"dome180", Warp::analytic(BaseProjection::fisheye(180),
+                                                 size.value_or(glm::ivec2(2048, 2048)),
+                                                 glm::ivec2(2, 2), R_eye_base)});
+  } else if (ends_with(display, ".warp.exr")) {
+    const std::string path(display);
+    Warp warp = read_warp(path);
+    if (size && *size != warp.output_size) {
+      throw InputError("command line", "--size",
+                       "expected the size of " + path + " (" + std::to_string(warp.output_size.x) +
+                           "x" + std::to_string(warp.output_size.y) + ") or no --size");
+    }
+    std::string name = std::filesystem::path(path).filename().string();
+    name = name.substr(0, name.size() - std::string_view(".warp.exr").size());
+    outputs.push_back({name.empty() ? "output" : name, std::move(warp)});
+  } else if (ends_with(display, ".json")) {
+    const auto config = projection_io::read_display_config(std::filesystem::path(display));
+    if (size) {
+      throw InputError("command line", "--size",
+                       "expected no --size with a display.json (each projector has its own)");
+    }
+    for (const auto& projector : config.projectors) {
+      const std::string path = config.resolve(projector.warp).string();
+      Warp warp = read_warp(path);
+      if (warp.output_size != projector.size) {
+        throw InputError(std::string(display), "projectors." + projector.name + ".size",
+                         "expected the size of " + path);
+      }
+      outputs.push_back({projector.name, std::move(warp)});
+    }
+  } else {
+    throw InputError("command line", "--display",
+                     "expected builtin:cylinder360, builtin:dome180, a .warp.exr file or a "
+                     "display.json; got '" +
+                         std::string(display) + "'");
+  }
+  return outputs;
+}
+
+}  // namespace facet::driver

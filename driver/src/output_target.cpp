@@ -1,0 +1,122 @@
+#include <algorithm>
+#include <cstring>
+
+#include "facet/driver/render_method.hpp"
+#include "facet/projection/errors.hpp"
+
+namespace facet::driver {
+namespace {
+
+// GL rows start at the bottom; images here start at the top.
+template <typename T>
+void flip_rows(std::vector<T>& pixels, std::size_t row_values) {
+  const std::size_t rows = pixels.size() / row_values;
+  for (std::size_t j = 0; j < rows / 2; ++j) {
+    std::swap_ranges(pixels.begin() + std::ptrdiff_t(j * row_values),
+                     pixels.begin() + std::ptrdiff_t((j + 1) * row_values),
+                     pixels.begin() + std::ptrdiff_t((rows - 1 - j) * row_values));
+  }
+}
+
+void set_draw_buffers(const Framebuffer& framebuffer) {
+  const GLenum buffers[2] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
+  glNamedFramebufferDrawBuffers(framebuffer.id(), 2, buffers);
+}
+
+}  // namespace
+
+OutputTarget OutputTarget::create(glm::ivec2 size, int msaa_samples) {
+  FACET_ASSERT(size.x > 0 && size.y > 0);
+  OutputTarget target;
+  target.size_ = size;
+  target.msaa_samples_ = msaa_samples > 1 ? msaa_samples : 0;
+  target.colour_ = Texture::create_2d(GL_SRGB8_ALPHA8, size.x, size.y);
+  target.ids_ = Texture::create_2d(GL_R32UI, size.x, size.y);
+  glTextureParameteri(target.ids_.id(), GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+  glTextureParameteri(target.ids_.id(), GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+  target.depth_ = Texture::create_2d(GL_DEPTH_COMPONENT32F, size.x, size.y);
+  target.framebuffer_ = Framebuffer::create();
+  target.framebuffer_.attach(GL_COLOR_ATTACHMENT0, target.colour_);
+  target.framebuffer_.attach(GL_COLOR_ATTACHMENT1, target.ids_);
+  target.framebuffer_.attach(GL_DEPTH_ATTACHMENT, target.depth_);
+  set_draw_buffers(target.framebuffer_);
+  target.framebuffer_.check_complete();
+  if (target.msaa_samples_ > 0) {
+    const int s = target.msaa_samples_;
+    target.msaa_colour_ = Renderbuffer::create(GL_SRGB8_ALPHA8, size.x, size.y, s);
+    target.msaa_ids_ = Renderbuffer::create(GL_R32UI, size.x, size.y, s);
+    target.msaa_depth_ = Renderbuffer::create(GL_DEPTH_COMPONENT32F, size.x, size.y, s);
+    target.msaa_framebuffer_ = Framebuffer::create();
+    target.msaa_framebuffer_.attach(GL_COLOR_ATTACHMENT0, target.msaa_colour_);
+    target.msaa_framebuffer_.attach(GL_COLOR_ATTACHMENT1, target.msaa_ids_);
+    target.msaa_framebuffer_.attach(GL_DEPTH_ATTACHMENT, target.msaa_depth_);
+    set_draw_buffers(target.msaa_framebuffer_);
+    target.msaa_framebuffer_.check_complete();
+  }
+  return target;
+}
+
+void OutputTarget::clear(const glm::vec4& background) {
+  glEnable(GL_FRAMEBUFFER_SRGB);
+  const GLuint zero_id[4] = {0, 0, 0, 0};
+  const float far_depth = 0.0f;
+  for (const Framebuffer* fb : {&framebuffer_, &msaa_framebuffer_}) {
+    if (!*fb) continue;
+    glClearNamedFramebufferfv(fb->id(), GL_COLOR, 0, &background.x);
+    glClearNamedFramebufferuiv(fb->id(), GL_COLOR, 1, zero_id);
+    glClearNamedFramebufferfv(fb->id(), GL_DEPTH, 0, &far_depth);
+  }
+}
+
+void OutputTarget::bind() const {
+  glBindFramebuffer(GL_FRAMEBUFFER, msaa_framebuffer_ ? msaa_framebuffer_.id() : framebuffer_.id());
+  glViewport(0, 0, size_.x, size_.y);
+  glEnable(GL_FRAMEBUFFER_SRGB);
+}
+
+void OutputTarget::resolve() const {
+  if (!msaa_framebuffer_) return;
+  const int w = size_.x, h = size_.y;
+  // Colour is averaged; integer IDs and depth cannot be, so NEAREST takes one sample.
+  glNamedFramebufferReadBuffer(msaa_framebuffer_.id(), GL_COLOR_ATTACHMENT0);
+  glNamedFramebufferDrawBuffer(framebuffer_.id(), GL_COLOR_ATTACHMENT0);
+  glBlitNamedFramebuffer(msaa_framebuffer_.id(), framebuffer_.id(), 0, 0, w, h, 0, 0, w, h,
+                         GL_COLOR_BUFFER_BIT, GL_LINEAR);
+  glNamedFramebufferReadBuffer(msaa_framebuffer_.id(), GL_COLOR_ATTACHMENT1);
+  glNamedFramebufferDrawBuffer(framebuffer_.id(), GL_COLOR_ATTACHMENT1);
+  glBlitNamedFramebuffer(msaa_framebuffer_.id(), framebuffer_.id(), 0, 0, w, h, 0, 0, w, h,
+                         GL_COLOR_BUFFER_BIT, GL_NEAREST);
+  glBlitNamedFramebuffer(msaa_framebuffer_.id(), framebuffer_.id(), 0, 0, w, h, 0, 0, w, h,
+                         GL_DEPTH_BUFFER_BIT, GL_NEAREST);
+  glNamedFramebufferReadBuffer(msaa_framebuffer_.id(), GL_COLOR_ATTACHMENT0);
+  set_draw_buffers(framebuffer_);
+}
+
+std::vector<std::uint8_t> OutputTarget::read_colour_rgba8() const {
+  std::vector<std::uint8_t> pixels(std::size_t(size_.x) * size_.y * 4);
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  glGetTextureImage(colour_.id(), 0, GL_RGBA, GL_UNSIGNED_BYTE, GLsizei(pixels.size()),
+                    pixels.data());
+  flip_rows(pixels, std::size_t(size_.x) * 4);
+  return pixels;
+}
+
+std::vector<std::uint32_t> OutputTarget::read_ids() const {
+  std::vector<std::uint32_t> pixels(std::size_t(size_.x) * size_.y);
+  glPixelStorei(GL_PACK_ALIGNMENT, 4);
+  glGetTextureImage(ids_.id(), 0, GL_RED_INTEGER, GL_UNSIGNED_INT,
+                    GLsizei(pixels.size() * sizeof(std::uint32_t)), pixels.data());
+  flip_rows(pixels, std::size_t(size_.x));
+  return pixels;
+}
+
+std::vector<float> OutputTarget::read_depth() const {
+  std::vector<float> pixels(std::size_t(size_.x) * size_.y);
+  glPixelStorei(GL_PACK_ALIGNMENT, 4);
+  glGetTextureImage(depth_.id(), 0, GL_DEPTH_COMPONENT, GL_FLOAT,
+                    GLsizei(pixels.size() * sizeof(float)), pixels.data());
+  flip_rows(pixels, std::size_t(size_.x));
+  return pixels;
+}
+
+}  // namespace facet::driver

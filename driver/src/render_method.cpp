@@ -1,0 +1,65 @@
+#include "facet/driver/render_method.hpp"
+
+#include <array>
+#include <functional>
+#include <utility>
+
+#include "facet/projection/errors.hpp"
+#include "render_methods_internal.hpp"
+
+namespace facet::driver {
+namespace {
+
+constexpr std::array<std::string_view, 5> kNames = {"facets", "facets-gs", "cubemap", "naive",
+                                                    "vertex"};
+
+using Factory = std::unique_ptr<RenderMethod> (*)();
+
+// The methods built so far; a listed name with no factory here is not available yet.
+const std::array<std::pair<std::string_view, Factory>, 3> kFactories = {{
+    {"facets", &detail::make_facet_pipeline},
+    {"facets-gs", &detail::make_facet_gs_pipeline},
+    {"naive", &detail::make_naive_method},
+}};
+
+std::string joined_names() {
+  std::string text;
+  for (std::string_view name : kNames) {
+    if (!text.empty()) text += ", ";
+    text += name;
+  }
+  return text;
+}
+
+}  // namespace
+
+std::span<const std::string_view> render_method_names() { return kNames; }
+
+std::unique_ptr<RenderMethod> make_render_method(std::string_view name) {
+  for (const auto& [known, factory] : kFactories) {
+    if (known == name) return factory();
+  }
+  for (std::string_view known : kNames) {
+    if (known == name) {
+      throw InputError("command line", "--method",
+                       "method '" + std::string(name) + "' is not available in this build");
+    }
+  }
+  throw InputError("command line", "--method",
+                   "expected one of " + joined_names() + "; got '" + std::string(name) + "'");
+}
+
+std::vector<std::uint32_t> scene_triangle_base(const Scene& scene) {
+  std::vector<std::uint32_t> base(scene.objects.size() + 1, 0);
+  for (std::size_t o = 0; o < scene.objects.size(); ++o) {
+    const Object& object = scene.objects[o];
+    std::uint32_t triangles = 0;
+    for (std::uint32_t k = 0; k < object.primitive_count; ++k) {
+      triangles += scene.primitives[object.first_primitive + k].index_count / 3;
+    }
+    base[o + 1] = base[o] + triangles;
+  }
+  return base;
+}
+
+}  // namespace facet::driver

@@ -1,0 +1,14 @@
+#pragma once
+// Factories of the render methods, one per implementation file; make_render_method
+// (render_method.cpp) picks one by name.
+#include <memory>
+
+#include "facet/driver/render_method.hpp"
+
+namespace facet::driver::detail {
+
+std::unique_ptr<RenderMethod> make_facet_pipeline();     // "facets" (facet_pipeline.cpp)
+std::unique_ptr<RenderMethod> make_facet_gs_pipeline();  // "facets-gs" (facet_gs_pipeline.cpp)
+std::unique_ptr<RenderMethod> make_naive_method();       // "naive" (naive_method.cpp)
+
+}  // namespace facet::driver::detail
