@@ -10,6 +10,16 @@ layout(binding = 0) uniform sampler2D base_texture;  // sRGB texture: sampling r
 
 layout(location = 0) out vec4 out_colour;
 
+// Renderers that keep a triangle-ID image (driver/render_method.hpp) define WRITE_TRIANGLE_ID 1
+// and pass the ID from their last vertex stage; it goes to draw buffer 1 (R32UI) unchanged.
+#ifndef WRITE_TRIANGLE_ID
+#define WRITE_TRIANGLE_ID 0
+#endif
+#if WRITE_TRIANGLE_ID
+flat in uint v_triangle_id;
+layout(location = 1) out uint out_triangle_id;
+#endif
+
 const vec3 d_world_sun = normalize(vec3(0.35, 0.85, 0.4));
 
 void main() {
@@ -21,4 +31,7 @@ void main() {
   float sun = max(dot(n, d_world_sun), 0.0);
   float sky = 0.55 + 0.45 * n.y;
   out_colour = vec4(albedo.rgb * (0.75 * sun + 0.35 * sky), albedo.a);
+#if WRITE_TRIANGLE_ID
+  out_triangle_id = v_triangle_id;
+#endif
 }
