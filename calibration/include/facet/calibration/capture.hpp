@@ -9,23 +9,14 @@
 #include <vector>
 
 #include "facet/calibration/patterns.hpp"
+#include "facet/projection/screen.hpp"
 
 namespace facet::calibration {
 
 inline constexpr const char* kCaptureFormat = "facet-capture/1";
 
-// The display surface in the eye frame, metres.
-struct Screen {
-  enum class Type { sphere, cylinder, plane };
-  Type type = Type::sphere;
-  glm::dvec3 center{0.0};            // sphere, cylinder: a point on the axis
-  glm::dvec3 axis{0.0, 1.0, 0.0};    // cylinder: unit direction of the axis
-  double radius = 0;                 // sphere, cylinder: > 0
-  glm::dvec3 point{0.0};             // plane: a point on it
-  glm::dvec3 normal{0.0, 0.0, 1.0};  // plane: unit normal
-
-  bool operator==(const Screen&) const = default;
-};
+// The display surface in the eye frame, metres (facet/projection/screen.hpp).
+using Screen = facet::Screen;
 
 struct CaptureCamera {
   std::filesystem::path model;  // mrcal .cameramodel, relative to the capture folder
