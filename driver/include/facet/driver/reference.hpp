@@ -1,0 +1,91 @@
+#pragma once
+// The accuracy oracle: a CPU ray cast (Embree 3) of the exact ray through every output pixel
+// centre, writing the triangle-ID image that every RenderMethod writes too (numbering in
+// render_method.hpp), and the comparison of a tested ID image against it.
+//
+// The exact ray of output pixel (x, y) (row 0 at the top) leaves the eye along
+// v_eye = WarpInverse::invert((x + 0.5, y + 0.5)).v_eye: the direction whose exact image under the
+// warp is that pixel centre. Pixels without a covered preimage get ID 0.
+//
+// Precision: triangles are the scene's float vertices mapped to the world frame by the float
+// T_world_object in float arithmetic, as a vertex shader does; Embree intersects in float in the
+// world frame (robust, watertight mode). Rays start at the eye, rounded to float, with the
+// direction R_world_eye · v_eye computed in double and rounded to float. At 100 m a float
+// direction is good to about 1e-5 m, far below a pixel of any display this project drives.
+#include <cstdint>
+#include <glm/glm.hpp>
+#include <memory>
+#include <vector>
+
+#include "facet/driver/scene.hpp"
+#include "facet/projection/warp.hpp"
+#include "facet/projection/warp_inverse.hpp"
+
+namespace facet::driver {
+
+struct ReferenceOptions {
+  // Ignore hits on triangles seen from the back or edge-on (clockwise as seen from the eye), as
+  // RenderSettings::cull_back_faces (on by default there too). Off: the nearest triangle of
+  // either side.
+  bool cull_back_faces = true;
+  // Hits nearer than this distance from the eye (metres, along the ray) are ignored.
+  double near_m = 0.0;
+};
+
+// An Embree scene of one Scene's triangles, built once and cast against from any eye and warp.
+// Casting is thread-safe; ids() uses every hardware thread.
+class ReferenceRaycaster {
+ public:
+  explicit ReferenceRaycaster(const Scene& scene, const ReferenceOptions& options = {});
+  ~ReferenceRaycaster();
+  ReferenceRaycaster(ReferenceRaycaster&&) noexcept;
+  ReferenceRaycaster& operator=(ReferenceRaycaster&&) noexcept;
+
+  // Triangle ID of the nearest hit along the ray from p_world (metres) in direction v_world
+  // (any length > 0), world frame; 0 where the ray hits nothing.
+  std::uint32_t id_along(const glm::dvec3& p_world, const glm::dvec3& v_world) const;
+
+  // The reference ID image of `inverse`'s warp seen from T_eye_world (maps world points into the
+  // eye frame): output-sized, row 0 at the top, as OutputTarget::read_ids.
+  std::vector<std::uint32_t> ids(const WarpInverse& inverse, const glm::dmat4& T_eye_world) const;
+
+  // Triangles in the Embree scene (every object's instance counted).
+  std::size_t triangle_count() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+// One-shot convenience: builds the ray caster and the warp inverse, then casts.
+std::vector<std::uint32_t> reference_ids(const Scene& scene, const Warp& warp,
+                                         const glm::dmat4& T_eye_world,
+                                         const ReferenceOptions& options = {});
+
+// How far a tested ID image is from the reference (both row-major, same size, any row order as
+// long as both share it).
+//
+// - A pixel is "near an edge" when one of its 8 neighbours in the reference has a different ID.
+//   id_mismatch = mismatched_pixels / compared_pixels over the pixels NOT near an edge: the
+//   fraction of pixels whose triangle is wrong where a correct renderer has no excuse.
+// - For every tested pixel whose ID differs from the reference (edge pixels included), its edge
+//   distance is the Euclidean distance, centre to centre in output pixels, to the nearest
+//   reference pixel showing the tested ID. A perfect image has none; an edge drawn one pixel off
+//   gives 1. max_edge_px is the largest, p99_edge_px the 99th percentile. Tested IDs that
+//   appear nowhere in the reference (a triangle the reference hits at no pixel centre, or a
+//   wrong ID) have no distance: they are counted in absent_id_pixels and left out of both.
+struct IdComparison {
+  double id_mismatch = 0;
+  double max_edge_px = 0;
+  double p99_edge_px = 0;
+  std::size_t compared_pixels = 0;    // pixels not near a reference edge
+  std::size_t mismatched_pixels = 0;  // of those, the ones whose ID differs
+  std::size_t differing_pixels = 0;   // every pixel whose ID differs, edges included
+  std::size_t absent_id_pixels = 0;   // differing pixels whose ID is nowhere in the reference
+};
+
+// InputError when either image is not size.x · size.y pixels.
+IdComparison compare_ids(const std::vector<std::uint32_t>& reference,
+                         const std::vector<std::uint32_t>& tested, glm::ivec2 size);
+
+}  // namespace facet::driver

@@ -1,0 +1,263 @@
+#include <embree3/rtcore.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <exception>
+#include <limits>
+#include <stdexcept>
+#include <string>
+#include <thread>
+#include <unordered_map>
+
+#include "facet/driver/reference.hpp"
+#include "facet/projection/errors.hpp"
+
+namespace facet::driver {
+namespace {
+
+// Rows handed out one at a time to every hardware thread: rows cost very different amounts
+// (sky against dense city), so a shared counter balances better than a static split.
+template <typename Body>
+void for_each_row(int rows, Body&& body) {
+  const int threads =
+      std::max(1, std::min<int>(int(std::thread::hardware_concurrency()), std::max(rows, 1)));
+  std::atomic<int> next{0};
+  std::vector<std::exception_ptr> failures(threads);
+  auto work = [&](int worker) {
+    try {
+      for (int row = next++; row < rows; row = next++) body(row);
+    } catch (...) {
+      failures[worker] = std::current_exception();
+    }
+  };
+  std::vector<std::thread> pool;
+  for (int worker = 1; worker < threads; ++worker) pool.emplace_back(work, worker);
+  work(0);
+  for (auto& thread : pool) thread.join();
+  for (auto& failure : failures) {
+    if (failure) std::rethrow_exception(failure);
+  }
+}
+
+[[noreturn]] void throw_embree_error(RTCDevice device, const char* what) {
+  throw std::runtime_error(std::string("Embree: ") + what + " failed (error " +
+                           std::to_string(int(rtcGetDeviceError(device))) + ")");
+}
+
+}  // namespace
+
+struct ReferenceRaycaster::Impl {
+  ReferenceOptions options;
+  RTCDevice device = nullptr;
+  RTCScene scene = nullptr;
+  std::vector<glm::vec3> p_world;  // 3 per triangle, in triangle-ID order (ID = index + 1)
+
+  ~Impl() {
+    if (scene) rtcReleaseScene(scene);
+    if (device) rtcReleaseDevice(device);
+  }
+
+  // Rejects hits on back faces: the triangle's counter-clockwise normal points along the ray.
+  static void cull_back_faces(const RTCFilterFunctionNArguments* args) {
+    const auto* self = static_cast<const Impl*>(args->geometryUserPtr);
+    for (unsigned i = 0; i < args->N; ++i) {
+      if (args->valid[i] == 0) continue;
+      const unsigned triangle = RTCHitN_primID(args->hit, args->N, i);
+      const glm::vec3& p0 = self->p_world[3 * std::size_t(triangle)];
+      const glm::vec3 n = glm::cross(self->p_world[3 * std::size_t(triangle) + 1] - p0,
+                                     self->p_world[3 * std::size_t(triangle) + 2] - p0);
+      const glm::vec3 v(RTCRayN_dir_x(args->ray, args->N, i), RTCRayN_dir_y(args->ray, args->N, i),
+                        RTCRayN_dir_z(args->ray, args->N, i));
+      if (!(glm::dot(n, v) < 0)) args->valid[i] = 0;
+    }
+  }
+};
+
+ReferenceRaycaster::ReferenceRaycaster(const Scene& scene, const ReferenceOptions& options)
+    : impl_(std::make_unique<Impl>()) {
+  impl_->options = options;
+  // Same order as the triangle-ID numbering: objects in order, their primitives in order.
+  for (const Object& object : scene.objects) {
+    for (std::uint32_t k = 0; k < object.primitive_count; ++k) {
+      const Primitive& primitive = scene.primitives.at(object.first_primitive + k);
+      for (std::uint32_t i = 0; i < primitive.index_count; ++i) {
+        const glm::vec3& p = scene.positions.at(scene.indices.at(primitive.first_index + i));
+        impl_->p_world.push_back(glm::vec3(object.T_world_object * glm::vec4(p, 1.0f)));
+      }
+    }
+  }
+  RTCDevice device = impl_->device = rtcNewDevice(nullptr);
+  if (!device) throw std::runtime_error("Embree: rtcNewDevice failed");
+  impl_->scene = rtcNewScene(device);
+  if (!impl_->scene) throw_embree_error(device, "rtcNewScene");
+  rtcSetSceneFlags(impl_->scene, RTC_SCENE_FLAG_ROBUST);
+  rtcSetSceneBuildQuality(impl_->scene, RTC_BUILD_QUALITY_HIGH);
+  const std::size_t triangles = impl_->p_world.size() / 3;
+  if (triangles > 0) {
+    RTCGeometry geometry = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
+    if (!geometry) throw_embree_error(device, "rtcNewGeometry");
+    auto* vertices = static_cast<float*>(rtcSetNewGeometryBuffer(
+        geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, sizeof(float) * 3, triangles * 3));
+    auto* indices = static_cast<std::uint32_t*>(
+        rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                sizeof(std::uint32_t) * 3, triangles));
+    if (!vertices || !indices) {
+      rtcReleaseGeometry(geometry);
+      throw_embree_error(device, "rtcSetNewGeometryBuffer");
+    }
+    for (std::size_t k = 0; k < impl_->p_world.size(); ++k) {
+      vertices[3 * k] = impl_->p_world[k].x;
+      vertices[3 * k + 1] = impl_->p_world[k].y;
+      vertices[3 * k + 2] = impl_->p_world[k].z;
+      indices[k] = std::uint32_t(k);
+    }
+    if (options.cull_back_faces) {
+      rtcSetGeometryUserData(geometry, impl_.get());
+      rtcSetGeometryIntersectFilterFunction(geometry, &Impl::cull_back_faces);
+    }
+    rtcCommitGeometry(geometry);
+    rtcAttachGeometry(impl_->scene, geometry);
+    rtcReleaseGeometry(geometry);
+  }
+  rtcCommitScene(impl_->scene);
+  if (rtcGetDeviceError(device) != RTC_ERROR_NONE) throw_embree_error(device, "building the scene");
+}
+
+ReferenceRaycaster::~ReferenceRaycaster() = default;
+ReferenceRaycaster::ReferenceRaycaster(ReferenceRaycaster&&) noexcept = default;
+ReferenceRaycaster& ReferenceRaycaster::operator=(ReferenceRaycaster&&) noexcept = default;
+
+std::size_t ReferenceRaycaster::triangle_count() const { return impl_->p_world.size() / 3; }
+
+std::uint32_t ReferenceRaycaster::id_along(const glm::dvec3& p_world,
+                                           const glm::dvec3& v_world) const {
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  RTCRayHit rayhit{};
+  rayhit.ray.org_x = float(p_world.x);
+  rayhit.ray.org_y = float(p_world.y);
+  rayhit.ray.org_z = float(p_world.z);
+  const glm::dvec3 v = glm::normalize(v_world);
+  rayhit.ray.dir_x = float(v.x);
+  rayhit.ray.dir_y = float(v.y);
+  rayhit.ray.dir_z = float(v.z);
+  rayhit.ray.tnear = float(impl_->options.near_m);
+  rayhit.ray.tfar = std::numeric_limits<float>::infinity();
+  rayhit.ray.mask = 0xFFFFFFFFu;
+  rayhit.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+  rayhit.hit.primID = RTC_INVALID_GEOMETRY_ID;
+  rtcIntersect1(impl_->scene, &context, &rayhit);
+  return rayhit.hit.geomID == RTC_INVALID_GEOMETRY_ID ? 0 : rayhit.hit.primID + 1;
+}
+
+std::vector<std::uint32_t> ReferenceRaycaster::ids(const WarpInverse& inverse,
+                                                   const glm::dmat4& T_eye_world) const {
+  const glm::ivec2 size = inverse.warp().output_size;
+  const glm::dmat4 T_world_eye = glm::inverse(T_eye_world);
+  const glm::dvec3 p_eye_world(T_world_eye[3]);
+  const glm::dmat3 R_world_eye(T_world_eye);
+  std::vector<std::uint32_t> ids(std::size_t(size.x) * size.y, 0);
+  for_each_row(size.y, [&](int y) {
+    for (int x = 0; x < size.x; ++x) {
+      const auto found = inverse.invert(glm::dvec2(x + 0.5, y + 0.5));
+      if (!found) continue;
+      ids[std::size_t(y) * size.x + x] = id_along(p_eye_world, R_world_eye * found->v_eye);
+    }
+  });
+  return ids;
+}
+
+std::vector<std::uint32_t> reference_ids(const Scene& scene, const Warp& warp,
+                                         const glm::dmat4& T_eye_world,
+                                         const ReferenceOptions& options) {
+  const ReferenceRaycaster raycaster(scene, options);
+  return raycaster.ids(WarpInverse(warp), T_eye_world);
+}
+
+IdComparison compare_ids(const std::vector<std::uint32_t>& reference,
+                         const std::vector<std::uint32_t>& tested, glm::ivec2 size) {
+  const std::size_t pixels = std::size_t(std::max(size.x, 0)) * std::max(size.y, 0);
+  if (reference.size() != pixels) {
+    throw InputError("reference ID image", "size",
+                     "expected " + std::to_string(size.x) + "×" + std::to_string(size.y) +
+                         " pixels, got " + std::to_string(reference.size()));
+  }
+  if (tested.size() != pixels) {
+    throw InputError("tested ID image", "size",
+                     "expected " + std::to_string(size.x) + "×" + std::to_string(size.y) +
+                         " pixels, got " + std::to_string(tested.size()));
+  }
+  auto at = [&](const std::vector<std::uint32_t>& image, int x, int y) {
+    return image[std::size_t(y) * size.x + x];
+  };
+
+  // Where each ID lies in the reference, for edge distances beyond the local search.
+  std::unordered_map<std::uint32_t, std::vector<glm::ivec2>> pixels_of_id;
+  for (int y = 0; y < size.y; ++y) {
+    for (int x = 0; x < size.x; ++x) pixels_of_id[at(reference, x, y)].push_back({x, y});
+  }
+  // Rings up to this Chebyshev radius are searched pixel by pixel; beyond, the ID's pixel list.
+  constexpr int kLocalRadius = 8;
+
+  IdComparison result;
+  std::vector<double> edge_px;
+  for (int y = 0; y < size.y; ++y) {
+    for (int x = 0; x < size.x; ++x) {
+      const std::uint32_t expected = at(reference, x, y), id = at(tested, x, y);
+      bool near_edge = false;
+      for (int dy = -1; dy <= 1 && !near_edge; ++dy) {
+        for (int dx = -1; dx <= 1 && !near_edge; ++dx) {
+          const int nx = x + dx, ny = y + dy;
+          if (nx < 0 || ny < 0 || nx >= size.x || ny >= size.y) continue;
+          near_edge = at(reference, nx, ny) != expected;
+        }
+      }
+      if (!near_edge) {
+        ++result.compared_pixels;
+        if (id != expected) ++result.mismatched_pixels;
+      }
+      if (id == expected) continue;
+      ++result.differing_pixels;
+      const auto list = pixels_of_id.find(id);
+      if (list == pixels_of_id.end()) {
+        ++result.absent_id_pixels;
+        continue;
+      }
+      // Every pixel on Chebyshev ring r is at least r away, so the search ends once r² passes
+      // the best squared distance.
+      long best = std::numeric_limits<long>::max();
+      for (int r = 1; r <= kLocalRadius && long(r) * r <= best; ++r) {
+        for (int dy = -r; dy <= r; ++dy) {
+          const int ny = y + dy;
+          if (ny < 0 || ny >= size.y) continue;
+          const int step = (dy == -r || dy == r) ? 1 : 2 * r;
+          for (int dx = -r; dx <= r; dx += step) {
+            const int nx = x + dx;
+            if (nx < 0 || nx >= size.x || at(reference, nx, ny) != id) continue;
+            best = std::min(best, long(dx) * dx + long(dy) * dy);
+          }
+        }
+      }
+      if (best > long(kLocalRadius) * kLocalRadius) {
+        for (const glm::ivec2& p : list->second) {
+          const long dx = p.x - x, dy = p.y - y;
+          best = std::min(best, dx * dx + dy * dy);
+        }
+      }
+      edge_px.push_back(std::sqrt(double(best)));
+    }
+  }
+  result.id_mismatch = result.compared_pixels == 0
+                           ? 0.0
+                           : double(result.mismatched_pixels) / double(result.compared_pixels);
+  if (!edge_px.empty()) {
+    result.max_edge_px = *std::max_element(edge_px.begin(), edge_px.end());
+    const std::size_t k = std::min(edge_px.size() - 1, std::size_t(0.99 * double(edge_px.size())));
+    std::nth_element(edge_px.begin(), edge_px.begin() + std::ptrdiff_t(k), edge_px.end());
+    result.p99_edge_px = edge_px[k];
+  }
+  return result;
+}
+
+}  // namespace facet::driver

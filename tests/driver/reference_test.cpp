@@ -1,0 +1,204 @@
+// The accuracy oracle: the Embree ray cast on hand-made scenes whose ID images are known
+// pixel-exactly, and compare_ids on crafted images with known mismatches and edge shifts.
+#include "facet/driver/reference.hpp"
+
+#include <gtest/gtest.h>
+
+#include <glm/gtc/matrix_transform.hpp>
+
+#include "facet/driver/render_method.hpp"
+#include "facet/projection/errors.hpp"
+
+namespace facet::driver {
+namespace {
+
+// Appends an axis-aligned rectangle in the plane z = z0 (object frame) as one object of two
+// triangles, (0,1,2) and (0,2,3), counter-clockwise seen from +z (the eye at the origin looking
+// down −z sees the front when front_to_eye, else the back).
+void add_rectangle(Scene& scene, glm::vec2 lo, glm::vec2 hi, float z0, bool front_to_eye = true,
+                   const glm::mat4& T_world_object = glm::mat4(1)) {
+  const auto first_vertex = std::uint32_t(scene.positions.size());
+  const glm::vec3 corners[4] = {
+      {lo.x, lo.y, z0}, {hi.x, lo.y, z0}, {hi.x, hi.y, z0}, {lo.x, hi.y, z0}};
+  for (const auto& p : corners) {
+    scene.positions.push_back(p);
+    scene.normals.push_back({0, 0, 1});
+    scene.uvs.push_back({0, 0});
+  }
+  Primitive primitive;
+  primitive.first_index = std::uint32_t(scene.indices.size());
+  primitive.index_count = 6;
+  const std::uint32_t front[6] = {0, 1, 2, 0, 2, 3}, back[6] = {0, 2, 1, 0, 3, 2};
+  for (std::uint32_t k : front_to_eye ? front : back) scene.indices.push_back(first_vertex + k);
+  Object object;
+  object.name = "rectangle " + std::to_string(scene.objects.size());
+  object.T_world_object = T_world_object;
+  object.first_primitive = std::uint32_t(scene.primitives.size());
+  object.primitive_count = 1;
+  scene.primitives.push_back(primitive);
+  scene.objects.push_back(object);
+  if (scene.materials.empty()) scene.materials.push_back(Material{});
+  scene.update_bounds();
+}
+
+// A perspective output of 200×200 with tangents ±1: pixel centre (x + 0.5, y + 0.5) looks along
+// (tan_x, tan_y, −1) with tan_x = (x + 0.5)/100 − 1 and tan_y = 1 − (y + 0.5)/100.
+Warp square_view() { return Warp::analytic(BaseProjection::perspective(-1, 1, 1, -1), {200, 200}); }
+
+// The expected ID image of a rectangle spanning tan_x in (-0.5, 0.5), tan_y in (-0.25, 0.25):
+// x in [50, 149], y in [75, 124]. Its diagonal from the (-0.5, -0.25) corner to (0.5, 0.25) is
+// tan_y = tan_x / 2, i.e. x + 2y = 298.5, which no pixel centre meets: the first triangle
+// (lower right) holds x + 2y > 298.5.
+std::uint32_t expected_rectangle_id(int x, int y, std::uint32_t first_id) {
+  if (x < 50 || x > 149 || y < 75 || y > 124) return 0;
+  return x + 2 * y > 298 ? first_id : first_id + 1;
+}
+
+TEST(ReferenceIds, RectangleStraightAheadIsPixelExact) {
+  Scene scene;
+  add_rectangle(scene, {-1, -0.5f}, {1, 0.5f}, -2);
+  const auto ids = reference_ids(scene, square_view(), glm::dmat4(1));
+  ASSERT_EQ(ids.size(), 200u * 200u);
+  int wrong = 0;
+  for (int y = 0; y < 200; ++y) {
+    for (int x = 0; x < 200; ++x) {
+      if (ids[std::size_t(y) * 200 + x] != expected_rectangle_id(x, y, 1)) ++wrong;
+    }
+  }
+  EXPECT_EQ(wrong, 0);
+}
+
+TEST(ReferenceIds, NumberingOcclusionTransformsAndBackFaces) {
+  Scene scene;
+  // Object 0: far behind, large, seen from the back: hidden by culling.
+  add_rectangle(scene, {-100, -100}, {100, 100}, -50, /*front_to_eye=*/false);
+  // Object 1: a wall behind the rectangle covering the whole view, front facing; in the eye
+  // frame it spans x in [-80, 80], y in [-40, 40], so its diagonal is tan_y = tan_x / 2 too.
+  add_rectangle(scene, {-80, -37}, {80, 43}, -20);
+  // Object 2: the rectangle of expected_rectangle_id, built 5 m to the left of the origin and
+  // moved back by its object transform; the eye sits 3 m up the y axis and is moved back by
+  // T_eye_world.
+  add_rectangle(scene, {-6, 2.5f}, {-4, 3.5f}, -2, true,
+                glm::translate(glm::mat4(1), glm::vec3(5, 0, 0)));
+  const glm::dmat4 T_eye_world = glm::translate(glm::dmat4(1), glm::dvec3(0, -3, 0));
+  const auto base = scene_triangle_base(scene);
+  ASSERT_EQ(base[2], 4u);
+
+  ReferenceRaycaster culled(scene);
+  EXPECT_EQ(culled.triangle_count(), 6u);
+  const auto ids = culled.ids(WarpInverse(square_view()), T_eye_world);
+  int wrong = 0;
+  for (int y = 0; y < 200; ++y) {
+    for (int x = 0; x < 200; ++x) {
+      std::uint32_t expected = expected_rectangle_id(x, y, base[2] + 1);
+      if (expected == 0) {
+        expected = base[1] + 1 + (x + 2 * y > 298 ? 0 : 1);
+      }
+      if (ids[std::size_t(y) * 200 + x] != expected) ++wrong;
+    }
+  }
+  EXPECT_EQ(wrong, 0);
+
+  // Without culling, the back-facing object 0 is still behind the wall; turn the wall around and
+  // object 0 shows through where the rectangle does not cover.
+  Scene turned;
+  add_rectangle(turned, {-100, -100}, {100, 100}, -50, false);
+  add_rectangle(turned, {-40, -40}, {40, 40}, -20, false);
+  const ReferenceRaycaster both_sides(turned, {.cull_back_faces = false});
+  const ReferenceRaycaster front_only(turned, {.cull_back_faces = true});
+  const glm::dvec3 eye(0), ahead(0.1, 0.05, -1);
+  EXPECT_NE(both_sides.id_along(eye, ahead), 0u);
+  EXPECT_LE(both_sides.id_along(eye, ahead), 4u);
+  EXPECT_GE(both_sides.id_along(eye, ahead), 3u);  // the nearer, turned wall
+  EXPECT_EQ(front_only.id_along(eye, ahead), 0u);  // every triangle faces away
+  // Looking backwards (+z) sees nothing at all.
+  EXPECT_EQ(both_sides.id_along(eye, {0, 0, 1}), 0u);
+  // The near distance skips the wall 20 m ahead but not the back plane 50 m ahead.
+  const ReferenceRaycaster far_only(turned, {.cull_back_faces = false, .near_m = 30});
+  const std::uint32_t far_id = far_only.id_along(eye, ahead);
+  EXPECT_TRUE(far_id == 1u || far_id == 2u) << far_id;
+}
+
+TEST(ReferenceIds, UncoveredPixelsAreZero) {
+  Scene scene;
+  add_rectangle(scene, {-40, -40}, {40, 40}, -20);
+  Warp warp = square_view();
+  warp.grid_size = {3, 3};
+  warp.offset_px.assign(9, glm::vec2(0));
+  warp.coverage.assign(9, 1.0f);
+  // The left column of nodes uncovered: coverage crosses 0.5 at s = 0.25, x = 50 px.
+  for (int j = 0; j < 3; ++j) warp.coverage[warp.node_index(0, j)] = 0;
+  const auto ids = reference_ids(scene, warp, glm::dmat4(1));
+  for (int y = 0; y < 200; y += 9) {
+    for (int x = 0; x < 200; ++x) {
+      EXPECT_EQ(ids[std::size_t(y) * 200 + x] == 0, x < 50) << x << ", " << y;
+    }
+  }
+}
+
+// Reference: ID 1 left of x = 50, ID 2 from x = 50 on, 100×40.
+std::vector<std::uint32_t> two_halves() {
+  std::vector<std::uint32_t> image(100 * 40);
+  for (int y = 0; y < 40; ++y) {
+    for (int x = 0; x < 100; ++x) image[std::size_t(y) * 100 + x] = x < 50 ? 1 : 2;
+  }
+  return image;
+}
+
+TEST(CompareIds, IdenticalImagesHaveNoError) {
+  const auto reference = two_halves();
+  const IdComparison c = compare_ids(reference, reference, {100, 40});
+  EXPECT_EQ(c.id_mismatch, 0.0);
+  EXPECT_EQ(c.max_edge_px, 0.0);
+  EXPECT_EQ(c.differing_pixels, 0u);
+  // Columns 49 and 50 touch the edge.
+  EXPECT_EQ(c.compared_pixels, 100u * 40u - 2u * 40u);
+}
+
+TEST(CompareIds, ShiftedEdgeFarBlobAndAbsentId) {
+  const auto reference = two_halves();
+  auto tested = reference;
+  // The edge drawn 3 px too far right: columns 50, 51, 52 show ID 1, at 1, 2 and 3 px from the
+  // nearest reference pixel of ID 1 (column 49).
+  for (int y = 0; y < 40; ++y) {
+    for (int x = 50; x < 53; ++x) tested[std::size_t(y) * 100 + x] = 1;
+  }
+  IdComparison c = compare_ids(reference, tested, {100, 40});
+  EXPECT_EQ(c.differing_pixels, 3u * 40u);
+  EXPECT_EQ(c.mismatched_pixels, 2u * 40u);  // column 50 is next to the edge: not compared
+  EXPECT_DOUBLE_EQ(c.id_mismatch, 80.0 / 3920.0);
+  EXPECT_DOUBLE_EQ(c.max_edge_px, 3.0);
+  EXPECT_EQ(c.absent_id_pixels, 0u);
+
+  // One pixel of ID 1 at (90, 20): 41 px from column 49, beyond the local ring search.
+  tested[20 * 100 + 90] = 1;
+  // One pixel of an ID the reference never shows.
+  tested[5 * 100 + 80] = 77;
+  c = compare_ids(reference, tested, {100, 40});
+  EXPECT_DOUBLE_EQ(c.max_edge_px, 41.0);
+  EXPECT_EQ(c.absent_id_pixels, 1u);
+  EXPECT_EQ(c.differing_pixels, 3u * 40u + 2u);
+  EXPECT_EQ(c.mismatched_pixels, 2u * 40u + 2u);
+  // 120 distances of 1, 2, 3 and one of 41: the 99th percentile is the rank-119 value, 3.
+  EXPECT_DOUBLE_EQ(c.p99_edge_px, 3.0);
+
+  // A diagonal neighbour: 2 px right and 2 px down of a reference ID-1 pixel.
+  auto diagonal = reference;
+  for (int y = 0; y < 40; ++y) {
+    for (int x = 0; x < 100; ++x) diagonal[std::size_t(y) * 100 + x] = 2;
+  }
+  diagonal[10 * 100 + 10] = 1;
+  auto tested_diagonal = diagonal;
+  tested_diagonal[12 * 100 + 12] = 1;
+  c = compare_ids(diagonal, tested_diagonal, {100, 40});
+  EXPECT_DOUBLE_EQ(c.max_edge_px, std::sqrt(8.0));
+}
+
+TEST(CompareIds, WrongSizesAreInputErrors) {
+  const auto reference = two_halves();
+  EXPECT_THROW(compare_ids(reference, std::vector<std::uint32_t>(10), {100, 40}), InputError);
+  EXPECT_THROW(compare_ids(reference, reference, {100, 41}), InputError);
+}
+
+}  // namespace
+}  // namespace facet::driver
