@@ -1,0 +1,49 @@
+#pragma once
+// Blend weights (FORMATS.md §3) from fitted warps: per output pixel of every projector, a weight
+// α in linear light, feathered by the angular distance to each projector's edge in the common
+// direction domain and normalised so that the projectors lighting a direction sum to 1.
+#include <cstddef>
+#include <optional>
+#include <span>
+#include <vector>
+
+#include "facet/projection/warp.hpp"
+#include "facet/projection_io/blend_file.hpp"
+
+namespace facet::calibration {
+
+struct BlendOptions {
+  // Angle from a projector's edge over which its raw weight rises from 0 to 1 (a smoothstep of
+  // the distance, so weights have no kink where another projector's edge crosses), radians.
+  double feather_rad = 0.35;
+  // With a value, black-level maps are made too: every projector's black emits this fraction of
+  // its white (linear light), and β lifts the black where fewer projectors overlap up to the
+  // darkest black the whole display can reach (the most overlapped part).
+  std::optional<double> black_level;
+};
+
+struct BlendResult {
+  std::vector<projection_io::BlendMap> alpha;  // one per warp, output size, channel Y
+  std::vector<projection_io::BlendMap> black;  // one per warp when black_level is set
+};
+
+// Weights for the projectors of one display. Each warp's output pixel centre is turned into an
+// eye direction with WarpInverse; pixels no direction maps to get α = 0. The raw weight of
+// projector k at direction v is smoothstep(d_k(v) / feather_rad), where d_k is the distance in
+// output pixels from k's position of v to k's image edge, times k's local angle per pixel; 0 where
+// k does not cover v. α is the raw weight over the sum of raw weights.
+BlendResult compute_blend(std::span<const Warp> warps, const BlendOptions& options = {});
+
+struct BlendCheck {
+  double sum_max_err = 0;              // max |Σ α − 1| over sampled directions in overlaps
+  std::size_t overlap_directions = 0;  // directions sampled where two or more projectors cover
+};
+
+// Measures the blend independently of how it was made: directions at every `stride`-th output
+// pixel centre of every projector (excluding pixels within `border_px` of the edge), and at each
+// one every covering projector's α, interpolated bilinearly at its own position of the
+// direction, summed.
+BlendCheck check_blend(std::span<const Warp> warps, std::span<const projection_io::BlendMap> alpha,
+                       int stride = 3, double border_px = 1.0);
+
+}  // namespace facet::calibration

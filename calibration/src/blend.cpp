@@ -1,0 +1,158 @@
+#include "facet/calibration/blend.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <opencv2/core.hpp>
+
+#include "facet/projection/errors.hpp"
+#include "facet/projection/warp_inverse.hpp"
+
+namespace facet::calibration {
+namespace {
+
+template <typename Body>
+void parallel_rows(int rows, const Body& body) {
+  cv::parallel_for_(
+      cv::Range(0, rows),
+      [&](const cv::Range& range) {
+        for (int y = range.start; y < range.end; ++y) body(y);
+      },
+      std::max(1.0, rows / 8.0));
+}
+
+// Distance from a projector's image edge to its position of v, as an angle: pixels times the
+// local angle per pixel (the square root of the area ratio of direction and output Jacobians).
+// 0 where the projector does not cover v.
+double edge_distance_rad(const Warp& warp, glm::dvec3 v_eye) {
+  const auto projected = warp.project(v_eye);
+  if (!projected || !projected->covered) return 0;
+  const glm::dvec2 q = projected->q;
+  const double d_px =
+      std::min(std::min(q.x, warp.output_size.x - q.x), std::min(q.y, warp.output_size.y - q.y));
+  if (!(d_px > 0)) return 0;
+  constexpr double h = 1e-4;
+  const glm::dvec2 st = glm::clamp(projected->st, glm::dvec2(h), glm::dvec2(1 - h));
+  const glm::dvec2 dq_ds =
+      (warp.q_from_st(st + glm::dvec2(h, 0)) - warp.q_from_st(st - glm::dvec2(h, 0)));
+  const glm::dvec2 dq_dt =
+      (warp.q_from_st(st + glm::dvec2(0, h)) - warp.q_from_st(st - glm::dvec2(0, h)));
+  const glm::dvec3 dv_ds =
+      warp.v_eye_from_st(st + glm::dvec2(h, 0)) - warp.v_eye_from_st(st - glm::dvec2(h, 0));
+  const glm::dvec3 dv_dt =
+      warp.v_eye_from_st(st + glm::dvec2(0, h)) - warp.v_eye_from_st(st - glm::dvec2(0, h));
+  const double area_q = std::abs(dq_ds.x * dq_dt.y - dq_ds.y * dq_dt.x);
+  const double area_v = glm::length(glm::cross(dv_ds, dv_dt));
+  if (!(area_q > 0) || !(area_v > 0)) return 0;
+  return d_px * std::sqrt(area_v / area_q);
+}
+
+double smoothstep(double x) {
+  x = std::clamp(x, 0.0, 1.0);
+  return x * x * (3 - 2 * x);
+}
+
+}  // namespace
+
+BlendResult compute_blend(std::span<const Warp> warps, const BlendOptions& options) {
+  FACET_ASSERT(options.feather_rad > 0);
+  FACET_ASSERT(!options.black_level || (*options.black_level >= 0 && *options.black_level < 1));
+  BlendResult result;
+  std::vector<std::vector<glm::dvec2>> st_of_pixel;
+  for (const Warp& warp : warps) {
+    st_of_pixel.push_back(WarpInverse(warp).st_at_pixel_centres());
+  }
+  // How many projectors overlap at most, for the black-level target.
+  std::vector<cv::Mat> overlap_count;
+  for (std::size_t p = 0; p < warps.size(); ++p) {
+    const Warp& warp = warps[p];
+    projection_io::BlendMap alpha = projection_io::BlendMap::constant(warp.output_size, 0.0f);
+    cv::Mat count(warp.output_size.y, warp.output_size.x, CV_8U, cv::Scalar(0));
+    parallel_rows(warp.output_size.y, [&](int y) {
+      for (int x = 0; x < warp.output_size.x; ++x) {
+        const glm::dvec2 st = st_of_pixel[p][std::size_t(y) * warp.output_size.x + x];
+        if (std::isnan(st.x)) continue;
+        const glm::dvec3 v = warp.v_eye_from_st(st);
+        double own = 0, sum = 0;
+        int covering = 0;
+        for (std::size_t k = 0; k < warps.size(); ++k) {
+          const double raw = smoothstep(edge_distance_rad(warps[k], v) / options.feather_rad);
+          if (raw > 0) ++covering;
+          sum += raw;
+          if (k == p) own = raw;
+        }
+        count.at<std::uint8_t>(y, x) = std::uint8_t(std::min(covering, 255));
+        alpha.at(x, y) = sum > 0 ? float(std::clamp(own / sum, 0.0, 1.0)) : 0.0f;
+      }
+    });
+    result.alpha.push_back(std::move(alpha));
+    overlap_count.push_back(std::move(count));
+  }
+  if (options.black_level) {
+    const double b = *options.black_level;
+    double most = 1;
+    for (const cv::Mat& count : overlap_count) {
+      double max_value = 0;
+      cv::minMaxLoc(count, nullptr, &max_value);
+      most = std::max(most, max_value);
+    }
+    for (std::size_t p = 0; p < warps.size(); ++p) {
+      projection_io::BlendMap black = projection_io::BlendMap::constant(warps[p].output_size, 0.0f);
+      for (int y = 0; y < black.size.y; ++y) {
+        for (int x = 0; x < black.size.x; ++x) {
+          const int n = overlap_count[p].at<std::uint8_t>(y, x);
+          if (n == 0) continue;
+          // Each covering projector adds its share α of the missing black; β is a pattern value,
+          // and a value β emits b + (1 − b)·β.
+          const double missing = b * (most - n);
+          black.at(x, y) =
+              float(std::clamp(result.alpha[p].at(x, y) * missing / (1 - b), 0.0, 1.0));
+        }
+      }
+      result.black.push_back(std::move(black));
+    }
+  }
+  return result;
+}
+
+BlendCheck check_blend(std::span<const Warp> warps, std::span<const projection_io::BlendMap> alpha,
+                       int stride, double border_px) {
+  FACET_ASSERT(warps.size() == alpha.size() && stride >= 1);
+  BlendCheck check;
+  for (std::size_t p = 0; p < warps.size(); ++p) {
+    const WarpInverse inverse(warps[p]);
+    const glm::ivec2 size = warps[p].output_size;
+    std::vector<double> row_error(std::size_t(size.y), 0.0);
+    std::vector<std::size_t> row_count(std::size_t(size.y), 0);
+    parallel_rows(size.y, [&](int y) {
+      if (y % stride != 0) return;
+      for (int x = 0; x < size.x; x += stride) {
+        const auto inverted = inverse.invert({x + 0.5, y + 0.5});
+        if (!inverted) continue;
+        double sum = 0;
+        int covering = 0;
+        bool near_edge = false;
+        for (std::size_t k = 0; k < warps.size(); ++k) {
+          const auto projected = warps[k].project(inverted->v_eye);
+          if (!projected || !projected->covered) continue;
+          const glm::dvec2 q = projected->q;
+          if (q.x < border_px || q.y < border_px || q.x > warps[k].output_size.x - border_px ||
+              q.y > warps[k].output_size.y - border_px) {
+            near_edge = true;
+          }
+          sum += alpha[k].sample(q);
+          ++covering;
+        }
+        if (covering < 2 || near_edge) continue;
+        row_error[std::size_t(y)] = std::max(row_error[std::size_t(y)], std::abs(sum - 1));
+        ++row_count[std::size_t(y)];
+      }
+    });
+    for (int y = 0; y < size.y; ++y) {
+      check.sum_max_err = std::max(check.sum_max_err, row_error[std::size_t(y)]);
+      check.overlap_directions += row_count[std::size_t(y)];
+    }
+  }
+  return check;
+}
+
+}  // namespace facet::calibration

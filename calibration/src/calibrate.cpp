@@ -1,0 +1,243 @@
+#include "facet/calibration/calibrate.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <random>
+
+#include "facet/calibration/camera_model.hpp"
+#include "facet/calibration/capture.hpp"
+#include "facet/projection/errors.hpp"
+#include "facet/projection/warp_inverse.hpp"
+#include "facet/projection_io/display_config.hpp"
+#include "facet/projection_io/warp_file.hpp"
+
+namespace facet::calibration {
+namespace {
+
+namespace fs = std::filesystem;
+
+double percentile(std::vector<double>& values, double fraction) {
+  if (values.empty()) return 0;
+  const std::size_t k =
+      std::min(values.size() - 1, std::size_t(std::ceil(fraction * double(values.size()))) - 1);
+  std::nth_element(values.begin(), values.begin() + std::ptrdiff_t(k), values.end());
+  return values[k];
+}
+
+// The output folder must be new or empty; returns the temporary sibling to write into.
+fs::path prepare_output(const fs::path& out) {
+  std::error_code error;
+  if (fs::exists(out, error)) {
+    if (!fs::is_directory(out, error) || !fs::is_empty(out, error)) {
+      throw InputError(out.string(), "", "an output folder that does not exist yet, or is empty");
+    }
+  }
+  const fs::path parent = out.parent_path().empty() ? fs::path(".") : out.parent_path();
+  if (!fs::is_directory(parent, error)) {
+    throw InputError(out.string(), "", "an output folder whose parent folder exists");
+  }
+  std::random_device random;
+  return parent / (out.filename().string() + ".tmp-" + std::to_string(random()));
+}
+
+}  // namespace
+
+AccuracyReport compare_warps(const Warp& truth, const Warp& calibrated, double border_px) {
+  const std::vector<glm::dvec2> st = WarpInverse(truth).st_at_pixel_centres();
+  std::vector<double> errors;
+  std::size_t truth_pixels = 0;
+  const glm::ivec2 size = truth.output_size;
+  for (int y = 0; y < size.y; ++y) {
+    for (int x = 0; x < size.x; ++x) {
+      const glm::dvec2 q(x + 0.5, y + 0.5);
+      if (q.x < border_px || q.y < border_px || q.x > size.x - border_px ||
+          q.y > size.y - border_px) {
+        continue;
+      }
+      const glm::dvec2 st_truth = st[std::size_t(y) * size.x + x];
+      if (std::isnan(st_truth.x)) continue;
+      ++truth_pixels;
+      const auto projected = calibrated.project(truth.v_eye_from_st(st_truth));
+      if (!projected || !projected->covered) continue;
+      errors.push_back(glm::length(projected->q - q));
+    }
+  }
+  AccuracyReport report;
+  report.compared = errors.size();
+  report.uncovered_fraction =
+      truth_pixels == 0 ? 1.0 : 1.0 - double(errors.size()) / double(truth_pixels);
+  if (errors.empty()) return report;
+  double sum = 0;
+  for (const double e : errors) sum += e * e;
+  report.rms_px = std::sqrt(sum / double(errors.size()));
+  report.max_px = *std::max_element(errors.begin(), errors.end());
+  report.p99_px = percentile(errors, 0.99);
+  return report;
+}
+
+nlohmann::json CalibrationReport::to_json() const {
+  nlohmann::json items = nlohmann::json::array();
+  for (const ProjectorReport& p : projectors) {
+    nlohmann::json item = {{"name", p.name},
+                           {"size", {p.size.x, p.size.y}},
+                           {"coverage", p.coverage},
+                           {"decoded_pixels", p.decoded_pixels},
+                           {"grid", {p.fit.grid.x, p.fit.grid.y}},
+                           {"residual_px", p.fit.residual_rms_px},
+                           {"residual_p50_px", p.fit.residual_p50_px},
+                           {"residual_p99_px", p.fit.residual_p99_px},
+                           {"outlier_fraction", p.fit.outlier_fraction},
+                           {"holes", p.fit.holes},
+                           {"folds", p.fit.folds}};
+    if (p.accuracy) {
+      item["rms_px"] = p.accuracy->rms_px;
+      item["p99_px"] = p.accuracy->p99_px;
+      item["max_px"] = p.accuracy->max_px;
+      item["compared_pixels"] = p.accuracy->compared;
+      item["uncovered_fraction"] = p.accuracy->uncovered_fraction;
+    }
+    items.push_back(std::move(item));
+  }
+  return {{"projectors", items},
+          {"blend_sum_max_err", blend_sum_max_err},
+          {"blend_overlap_directions", blend_overlap_directions},
+          {"seconds", seconds}};
+}
+
+CalibrationReport calibrate(const fs::path& capture_path, const fs::path& out,
+                            const CalibrateOptions& options) {
+  const auto started = std::chrono::steady_clock::now();
+  const Capture capture = read_capture(capture_path);
+  const std::string capture_json = (capture.folder / "capture.json").string();
+  const fs::path temporary = prepare_output(out);
+  const CameraModel model = CameraModel::read(capture.resolve(capture.camera.model));
+
+  // Check every projector's frames and image headers before any heavy work.
+  for (std::size_t p = 0; p < capture.projectors.size(); ++p) {
+    const glm::ivec2 camera_size = check_capture_images(capture, p);
+    if (camera_size != model.imager_size()) {
+      throw InputError(capture_json, "camera.model",
+                       "a camera model of the images' size " + std::to_string(camera_size.x) + "x" +
+                           std::to_string(camera_size.y) + ", but the model's imager is " +
+                           std::to_string(model.imager_size().x) + "x" +
+                           std::to_string(model.imager_size().y));
+    }
+  }
+  std::vector<DecodedMap> decoded;
+  for (std::size_t p = 0; p < capture.projectors.size(); ++p) {
+    decoded.push_back(decode_capture(capture, p, options.decode));
+    const DecodedMap& map = decoded.back();
+    if (!map.has_x || !map.has_y) {
+      throw InputError(capture_json, "projectors[" + std::to_string(p) + "].frames",
+                       "patterns on both axes (x and y), to locate every pixel");
+    }
+  }
+  // Unproject each camera pixel once, for every projector that decoded it.
+  const glm::ivec2 camera_size = decoded.front().camera_size;
+  cv::Mat wanted(camera_size.y, camera_size.x, CV_8U, cv::Scalar(0));
+  for (const DecodedMap& map : decoded) wanted.setTo(1, map.mask == 0);
+  const cv::Mat v_eye = eye_directions(model, capture.camera, capture.screen, camera_size, wanted);
+
+  CalibrationReport report;
+  std::vector<Warp> warps;
+  for (std::size_t p = 0; p < capture.projectors.size(); ++p) {
+    const CaptureProjector& projector = capture.projectors[p];
+    const std::vector<FitSample> samples = fit_samples(decoded[p], v_eye);
+    WarpFit fit;
+    try {
+      fit = fit_warp(samples, projector.size, options.fit, capture_json);
+    } catch (const InputError& e) {
+      throw InputError(capture_json,
+                       "projectors[" + std::to_string(p) + "] ('" + projector.name + "')",
+                       e.expected());
+    }
+    ProjectorReport item;
+    item.name = projector.name;
+    item.size = projector.size;
+    item.decoded_pixels = std::size_t(cv::countNonZero(decoded[p].mask == 0));
+    item.fit = fit.report;
+    if (capture.truth) {
+      const fs::path truth_file = capture.resolve(*capture.truth) / (projector.name + ".warp.exr");
+      std::error_code error;
+      if (fs::exists(truth_file, error)) {
+        item.accuracy =
+            compare_warps(read_warp(truth_file.string()), fit.warp, options.truth_border_px);
+      }
+    }
+    fit.warp.eye = glm::dvec3(0.0);
+    warps.push_back(std::move(fit.warp));
+    report.projectors.push_back(std::move(item));
+  }
+  decoded.clear();
+
+  const BlendResult blend = compute_blend(warps, options.blend);
+  for (std::size_t p = 0; p < warps.size(); ++p) {
+    std::size_t mapped = 0;
+    for (const float a : blend.alpha[p].values) mapped += a > 0 ? 1 : 0;
+    report.projectors[p].coverage = double(mapped) / double(blend.alpha[p].values.size());
+  }
+  const BlendCheck check = check_blend(warps, blend.alpha);
+  report.blend_sum_max_err = check.sum_max_err;
+  report.blend_overlap_directions = check.overlap_directions;
+
+  projection_io::DisplayConfig display;
+  display.name = options.display_name.empty() ? fs::absolute(capture.folder).filename().string()
+                                              : options.display_name;
+  if (display.name.empty()) display.name = "display";
+  if (capture.screen) {
+    const Screen& screen = *capture.screen;
+    projection_io::DisplayScreen converted;
+    converted.type =
+        screen.type == Screen::Type::sphere     ? projection_io::DisplayScreen::Type::sphere
+        : screen.type == Screen::Type::cylinder ? projection_io::DisplayScreen::Type::cylinder
+                                                : projection_io::DisplayScreen::Type::plane;
+    converted.center = screen.center;
+    converted.axis = screen.axis;
+    converted.radius = screen.radius;
+    converted.point = screen.point;
+    converted.normal = screen.normal;
+    display.screen = converted;
+  }
+  int x = 0;
+  for (std::size_t p = 0; p < warps.size(); ++p) {
+    const CaptureProjector& projector = capture.projectors[p];
+    projection_io::DisplayProjector item;
+    item.name = projector.name;
+    item.size = projector.size;
+    item.warp = projector.name + ".warp.exr";
+    item.blend = projector.name + ".blend.exr";
+    if (!blend.black.empty()) item.black = projector.name + ".black.exr";
+    // Until the outputs are assigned, projectors sit side by side as windows on the desktop.
+    item.output.kind = projection_io::DisplayOutput::Kind::window;
+    item.output.window = {x, 0, projector.size.x, projector.size.y};
+    x += projector.size.x;
+    display.projectors.push_back(std::move(item));
+  }
+
+  try {
+    fs::create_directories(temporary);
+    for (std::size_t p = 0; p < warps.size(); ++p) {
+      const std::string& name = capture.projectors[p].name;
+      write_warp((temporary / (name + ".warp.exr")).string(), warps[p]);
+      projection_io::write_blend_map((temporary / (name + ".blend.exr")).string(), blend.alpha[p]);
+      if (!blend.black.empty()) {
+        projection_io::write_blend_map((temporary / (name + ".black.exr")).string(),
+                                       blend.black[p]);
+      }
+    }
+    projection_io::write_display_config(display, temporary / "display.json");
+    std::error_code error;
+    if (fs::exists(out, error)) fs::remove(out);  // checked empty above
+    fs::rename(temporary, out);
+  } catch (...) {
+    std::error_code ignored;
+    fs::remove_all(temporary, ignored);
+    throw;
+  }
+  report.seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  return report;
+}
+
+}  // namespace facet::calibration

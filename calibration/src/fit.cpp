@@ -1,0 +1,414 @@
+#include "facet/calibration/fit.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <opencv2/core/matx.hpp>
+
+#include "facet/projection/errors.hpp"
+#include "facet/projection/screen.hpp"
+
+namespace facet::calibration {
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr std::size_t kMinTotalSamples = 50;
+
+template <typename Body>
+void parallel_range(int count, const Body& body, double grain = 16.0) {
+  cv::parallel_for_(
+      cv::Range(0, count),
+      [&](const cv::Range& range) {
+        for (int k = range.start; k < range.end; ++k) body(k);
+      },
+      std::max(1.0, count / grain));
+}
+
+double percentile(std::vector<double> values, double fraction) {
+  if (values.empty()) return 0;
+  const std::size_t k =
+      std::min(values.size() - 1, std::size_t(std::ceil(fraction * double(values.size()))) - 1);
+  std::nth_element(values.begin(), values.begin() + std::ptrdiff_t(k), values.end());
+  return values[k];
+}
+
+// The eye-frame direction in which the projector's rows go up (q.y decreasing), from a linear fit
+// of q.y over the tangent plane of the mean direction: the cover then lines its base up with the
+// projector's image, which keeps the offsets small.
+std::optional<glm::dvec3> projector_up(std::span<const FitSample> samples, glm::dvec3 mean) {
+  const glm::dvec3 helper = std::abs(mean.y) < 0.9 ? glm::dvec3(0, 1, 0) : glm::dvec3(0, 0, -1);
+  const glm::dvec3 e1 = glm::normalize(glm::cross(helper, mean));
+  const glm::dvec3 e2 = glm::cross(mean, e1);
+  cv::Matx33d normal = cv::Matx33d::zeros();
+  cv::Vec3d rhs(0, 0, 0);
+  const std::size_t stride = std::max<std::size_t>(1, samples.size() / 20000);
+  for (std::size_t k = 0; k < samples.size(); k += stride) {
+    const double z = glm::dot(samples[k].v_eye, mean);
+    if (!(z > 0.2)) continue;
+    const cv::Vec3d row(1, glm::dot(samples[k].v_eye, e1) / z, glm::dot(samples[k].v_eye, e2) / z);
+    normal += row * row.t();
+    rhs += row * samples[k].q.y;
+  }
+  cv::Vec3d solution;
+  if (!cv::solve(normal, rhs, solution, cv::DECOMP_SVD)) return std::nullopt;
+  const glm::dvec3 down = solution[1] * e1 + solution[2] * e2;
+  if (!(glm::length(down) > 0)) return std::nullopt;
+  return -glm::normalize(down);
+}
+
+struct NodeFit {
+  glm::dvec2 q{kNaN};
+  bool supported = false;
+};
+
+using Basis = cv::Vec<double, 6>;
+
+Basis quadratic_basis(double du, double dv) { return {1, du, dv, du * du, du * dv, dv * dv}; }
+
+}  // namespace
+
+cv::Mat eye_directions(const CameraModel& model, const CaptureCamera& camera,
+                       const std::optional<Screen>& screen, glm::ivec2 camera_size,
+                       const cv::Mat& wanted) {
+  FACET_ASSERT(camera_size.x > 0 && camera_size.y > 0);
+  FACET_ASSERT(wanted.empty() || (wanted.type() == CV_8U && wanted.cols == camera_size.x &&
+                                  wanted.rows == camera_size.y));
+  const bool at_eye = camera.t_eye_camera == glm::dvec3(0.0);
+  FACET_ASSERT(at_eye || screen.has_value());
+  cv::Mat v_eye(camera_size.y, camera_size.x, CV_64FC3, cv::Scalar::all(kNaN));
+  parallel_range(camera_size.y, [&](int y) {
+    std::vector<glm::dvec2> q;
+    std::vector<int> columns;
+    const std::uint8_t* want = wanted.empty() ? nullptr : wanted.ptr<std::uint8_t>(y);
+    for (int x = 0; x < camera_size.x; ++x) {
+      if (want != nullptr && want[x] == 0) continue;
+      if (!model.is_valid_pixel({x, y})) continue;
+      q.emplace_back(x, y);
+      columns.push_back(x);
+    }
+    std::vector<glm::dvec3> v_camera(q.size());
+    model.unproject(q, v_camera);
+    auto* row = v_eye.ptr<cv::Vec3d>(y);
+    for (std::size_t k = 0; k < q.size(); ++k) {
+      const glm::dvec3 v = camera.R_eye_camera * v_camera[k];
+      if (!std::isfinite(v.x) || !std::isfinite(v.y) || !std::isfinite(v.z)) continue;
+      glm::dvec3 direction = v;
+      if (!at_eye) {
+        const auto t = facet::intersect_screen(*screen, camera.t_eye_camera, v);
+        if (!t) continue;
+        direction = camera.t_eye_camera + *t * v;
+      }
+      const double length = glm::length(direction);
+      if (!(length > 0)) continue;
+      direction /= length;
+      row[columns[k]] = cv::Vec3d(direction.x, direction.y, direction.z);
+    }
+  });
+  return v_eye;
+}
+
+std::vector<FitSample> fit_samples(const DecodedMap& decoded, const cv::Mat& v_eye) {
+  FACET_ASSERT(v_eye.type() == CV_64FC3 && v_eye.size() == decoded.q_projector.size());
+  std::vector<FitSample> samples;
+  if (!decoded.has_x || !decoded.has_y) return samples;
+  for (int y = 0; y < decoded.camera_size.y; ++y) {
+    const auto* q = decoded.q_projector.ptr<cv::Vec2d>(y);
+    const auto* confidence = decoded.confidence.ptr<float>(y);
+    const auto* mask = decoded.mask.ptr<std::uint8_t>(y);
+    const auto* v = v_eye.ptr<cv::Vec3d>(y);
+    for (int x = 0; x < decoded.camera_size.x; ++x) {
+      if (mask[x] != 0 || !std::isfinite(q[x][0]) || !std::isfinite(q[x][1]) ||
+          !std::isfinite(v[x][0])) {
+        continue;
+      }
+      const float weight = std::clamp(confidence[x] * confidence[x], 0.01f, 1.0f);
+      samples.push_back(
+          {glm::dvec3(v[x][0], v[x][1], v[x][2]), glm::dvec2(q[x][0], q[x][1]), weight});
+    }
+  }
+  return samples;
+}
+
+WarpFit fit_warp(std::span<const FitSample> samples, glm::ivec2 output_size,
+                 const FitOptions& options, const std::string& source) {
+  FACET_ASSERT(output_size.x > 0 && output_size.y > 0);
+  FACET_ASSERT(options.radius_nodes >= 1 && options.node_spacing_px > 0);
+  if (samples.size() < kMinTotalSamples) {
+    throw InputError(source, "projectors",
+                     "a projector the camera sees, but only " + std::to_string(samples.size()) +
+                         " camera pixels decoded its patterns (at least " +
+                         std::to_string(kMinTotalSamples) + " are needed)");
+  }
+  WarpFit result;
+  result.report.samples = samples.size();
+
+  // Base and rotation covering the footprint.
+  glm::dvec3 mean(0.0);
+  for (const FitSample& sample : samples) mean += sample.v_eye;
+  CoverOptions cover_options = options.cover;
+  if (glm::length(mean) > 1e-6 * double(samples.size())) {
+    mean = glm::normalize(mean);
+    if (!cover_options.up_eye) cover_options.up_eye = projector_up(samples, mean);
+  }
+  std::vector<glm::dvec3> directions;
+  const std::size_t stride = std::max<std::size_t>(1, samples.size() / 50000);
+  directions.reserve(samples.size() / stride + 1);
+  for (std::size_t k = 0; k < samples.size(); k += stride) directions.push_back(samples[k].v_eye);
+  const BaseCover cover = cover_directions(directions, cover_options);
+  Warp& warp = result.warp;
+  warp.base = cover.base;
+  warp.R_eye_base = cover.R_eye_base;
+  warp.output_size = output_size;
+
+  // Base coordinates of every sample.
+  const glm::dmat3 R_base_eye = glm::transpose(cover.R_eye_base);
+  std::vector<glm::dvec2> st(samples.size(), glm::dvec2(kNaN));
+  parallel_range(int((samples.size() + 4095) / 4096), [&](int block) {
+    const std::size_t end = std::min(samples.size(), std::size_t(block + 1) * 4096);
+    for (std::size_t k = std::size_t(block) * 4096; k < end; ++k) {
+      const auto value = cover.base.st_from_direction(R_base_eye * samples[k].v_eye, 0.5);
+      if (value && value->x >= 0 && value->x <= 1 && value->y >= 0 && value->y <= 1) {
+        st[k] = *value;
+      }
+    }
+  });
+
+  // Grid: from the average scale of output pixels per unit of s and t (a linear fit q ~ st).
+  glm::ivec2 grid = options.grid;
+  if (grid.x == 0 || grid.y == 0) {
+    cv::Matx33d normal = cv::Matx33d::zeros();
+    cv::Matx<double, 3, 2> rhs = cv::Matx<double, 3, 2>::zeros();
+    for (std::size_t k = 0; k < samples.size(); k += stride) {
+      if (std::isnan(st[k].x)) continue;
+      const cv::Vec3d row(1, st[k].x, st[k].y);
+      normal += row * row.t();
+      rhs += row * cv::Matx12d(samples[k].q.x, samples[k].q.y);
+    }
+    cv::Matx<double, 3, 2> solution;
+    cv::solve(normal, rhs, solution, cv::DECOMP_SVD);
+    const double px_per_s = std::hypot(solution(1, 0), solution(1, 1));
+    const double px_per_t = std::hypot(solution(2, 0), solution(2, 1));
+    auto nodes = [&](double px) {
+      return std::clamp(int(std::ceil(px / options.node_spacing_px)) + 1, 4, 1024);
+    };
+    grid = {nodes(std::isfinite(px_per_s) ? px_per_s : output_size.x),
+            nodes(std::isfinite(px_per_t) ? px_per_t : output_size.y)};
+  }
+  FACET_ASSERT(grid.x >= 2 && grid.y >= 2);
+  warp.grid_size = grid;
+  result.report.grid = grid;
+  const glm::ivec2 cells = grid - 1;
+
+  // Bin samples by the cell that holds them (counting sort).
+  std::vector<std::uint32_t> start(std::size_t(cells.x) * cells.y + 1, 0);
+  std::vector<std::int32_t> cell_of(samples.size(), -1);
+  for (std::size_t k = 0; k < samples.size(); ++k) {
+    if (std::isnan(st[k].x)) continue;
+    const int i = std::min(int(st[k].x * cells.x), cells.x - 1);
+    const int j = std::min(int(st[k].y * cells.y), cells.y - 1);
+    cell_of[k] = j * cells.x + i;
+    ++start[std::size_t(cell_of[k]) + 1];
+  }
+  for (std::size_t c = 1; c < start.size(); ++c) start[c] += start[c - 1];
+  std::vector<std::uint32_t> order(start.back());
+  {
+    std::vector<std::uint32_t> fill(start.begin(), start.end() - 1);
+    for (std::size_t k = 0; k < samples.size(); ++k) {
+      if (cell_of[k] >= 0) order[fill[std::size_t(cell_of[k])]++] = std::uint32_t(k);
+    }
+  }
+
+  // Per-node robust local fits.
+  std::vector<NodeFit> nodes(std::size_t(grid.x) * grid.y);
+  const double radius = options.radius_nodes;
+  parallel_range(grid.y, [&](int j) {
+    std::vector<std::uint32_t> near;
+    std::vector<double> kernel, robust, du, dv, residual;
+    for (int i = 0; i < grid.x; ++i) {
+      near.clear();
+      kernel.clear();
+      du.clear();
+      dv.clear();
+      const int i0 = std::max(0, int(std::floor(i - radius))),
+                i1 = std::min(cells.x - 1, int(std::ceil(i + radius)) - 1);
+      const int j0 = std::max(0, int(std::floor(j - radius))),
+                j1 = std::min(cells.y - 1, int(std::ceil(j + radius)) - 1);
+      double kernel_sum = 0;
+      for (int cj = j0; cj <= j1; ++cj) {
+        for (int ci = i0; ci <= i1; ++ci) {
+          const std::size_t cell = std::size_t(cj) * cells.x + ci;
+          for (std::uint32_t n = start[cell]; n < start[cell + 1]; ++n) {
+            const std::uint32_t k = order[n];
+            const double a = st[k].x * cells.x - i, b = st[k].y * cells.y - j;
+            const double d = std::sqrt(a * a + b * b) / radius;
+            if (d >= 1) continue;
+            const double tricube = std::pow(1 - d * d * d, 3);
+            const double w = tricube * samples[k].weight;
+            near.push_back(k);
+            kernel.push_back(w);
+            du.push_back(a);
+            dv.push_back(b);
+            kernel_sum += tricube;
+          }
+        }
+      }
+      NodeFit& node = nodes[std::size_t(j) * grid.x + i];
+      if (kernel_sum < options.min_samples) continue;
+      robust.assign(near.size(), 1.0);
+      residual.assign(near.size(), 0.0);
+      for (int iteration = 0; iteration <= options.irls_iterations; ++iteration) {
+        cv::Matx66d normal = cv::Matx66d::zeros();
+        Basis rhs_x = Basis::all(0), rhs_y = Basis::all(0);
+        double weight_sum = 0;
+        for (std::size_t n = 0; n < near.size(); ++n) {
+          const double w = kernel[n] * robust[n];
+          if (w <= 0) continue;
+          const Basis basis = quadratic_basis(du[n], dv[n]);
+          for (int r = 0; r < 6; ++r) {
+            const double wb = w * basis[r];
+            for (int c = r; c < 6; ++c) normal(r, c) += wb * basis[c];
+            rhs_x[r] += wb * samples[near[n]].q.x;
+            rhs_y[r] += wb * samples[near[n]].q.y;
+          }
+          weight_sum += w;
+        }
+        for (int r = 0; r < 6; ++r) {
+          for (int c = 0; c < r; ++c) normal(r, c) = normal(c, r);
+        }
+        cv::Matx66d inverse;
+        if (cv::invert(normal, inverse, cv::DECOMP_CHOLESKY) == 0) {
+          node.supported = false;
+          break;
+        }
+        // The noise gain of the value at the node: large when the node lies outside the samples.
+        const double gain = inverse(0, 0) * weight_sum;
+        if (!(gain <= options.max_gain)) {
+          node.supported = false;
+          break;
+        }
+        const Basis coefficient_x = inverse * rhs_x, coefficient_y = inverse * rhs_y;
+        node.q = {coefficient_x[0], coefficient_y[0]};
+        node.supported = true;
+        if (iteration == options.irls_iterations) break;
+        for (std::size_t n = 0; n < near.size(); ++n) {
+          const Basis basis = quadratic_basis(du[n], dv[n]);
+          residual[n] = std::hypot(coefficient_x.dot(basis) - samples[near[n]].q.x,
+                                   coefficient_y.dot(basis) - samples[near[n]].q.y);
+        }
+        std::vector<double> sorted = residual;
+        const double sigma = 1.4826 * percentile(std::move(sorted), 0.5);
+        const double cutoff = std::max(options.tukey_sigmas * sigma, options.min_cutoff_px);
+        for (std::size_t n = 0; n < near.size(); ++n) {
+          const double u = residual[n] / cutoff;
+          robust[n] = u < 1 ? (1 - u * u) * (1 - u * u) : 0.0;
+        }
+      }
+    }
+  });
+
+  // Offsets of supported nodes; the rest are filled outwards from them, each unsupported node
+  // taking the mean of the linear extrapolations (or, failing those, the values) of its
+  // already-filled neighbours, ring by ring.
+  const glm::dvec2 step{double(output_size.x) / cells.x, double(output_size.y) / cells.y};
+  std::vector<glm::dvec2> offset(nodes.size(), glm::dvec2(kNaN));
+  std::vector<char> known(nodes.size(), 0);
+  for (int j = 0; j < grid.y; ++j) {
+    for (int i = 0; i < grid.x; ++i) {
+      const std::size_t k = std::size_t(j) * grid.x + i;
+      if (nodes[k].supported) {
+        offset[k] = nodes[k].q - glm::dvec2(i * step.x, j * step.y);
+        known[k] = 1;
+        ++result.report.supported;
+      }
+    }
+  }
+  if (result.report.supported == 0) {
+    throw InputError(source, "projectors",
+                     "a projector whose decoded pixels support a fit, but no node of its " +
+                         std::to_string(grid.x) + "x" + std::to_string(grid.y) +
+                         " grid has enough samples around it");
+  }
+  for (bool changed = true; changed;) {
+    changed = false;
+    std::vector<std::size_t> filled;
+    std::vector<glm::dvec2> values;
+    for (int j = 0; j < grid.y; ++j) {
+      for (int i = 0; i < grid.x; ++i) {
+        const std::size_t k = std::size_t(j) * grid.x + i;
+        if (known[k]) continue;
+        glm::dvec2 extrapolated(0.0), nearest(0.0);
+        int extrapolations = 0, neighbours = 0;
+        static constexpr int di[4] = {1, -1, 0, 0}, dj[4] = {0, 0, 1, -1};
+        for (int d = 0; d < 4; ++d) {
+          const int i1 = i + di[d], j1 = j + dj[d], i2 = i + 2 * di[d], j2 = j + 2 * dj[d];
+          if (i1 < 0 || i1 >= grid.x || j1 < 0 || j1 >= grid.y) continue;
+          const std::size_t k1 = std::size_t(j1) * grid.x + i1;
+          if (!known[k1]) continue;
+          nearest += offset[k1];
+          ++neighbours;
+          if (i2 < 0 || i2 >= grid.x || j2 < 0 || j2 >= grid.y) continue;
+          const std::size_t k2 = std::size_t(j2) * grid.x + i2;
+          if (!known[k2]) continue;
+          extrapolated += 2.0 * offset[k1] - offset[k2];
+          ++extrapolations;
+        }
+        if (neighbours == 0) continue;
+        filled.push_back(k);
+        values.push_back(extrapolations > 0 ? extrapolated / double(extrapolations)
+                                            : nearest / double(neighbours));
+      }
+    }
+    for (std::size_t n = 0; n < filled.size(); ++n) {
+      offset[filled[n]] = values[n];
+      known[filled[n]] = 1;
+      changed = true;
+    }
+  }
+
+  // Coverage: a ramp across one node spacing centred on the image edge, so that A = 0.5 (the
+  // covered boundary after bilinear interpolation) falls close to where q leaves the image.
+  const double spacing_px = 0.5 * (step.x + step.y);
+  warp.offset_px.resize(nodes.size());
+  warp.coverage.resize(nodes.size());
+  for (int j = 0; j < grid.y; ++j) {
+    for (int i = 0; i < grid.x; ++i) {
+      const std::size_t k = std::size_t(j) * grid.x + i;
+      const glm::dvec2 q = glm::dvec2(i * step.x, j * step.y) + offset[k];
+      const double inside =
+          std::min(std::min(q.x, output_size.x - q.x), std::min(q.y, output_size.y - q.y));
+      warp.offset_px[k] = glm::vec2(offset[k]);
+      warp.coverage[k] = float(std::clamp(0.5 + inside / spacing_px, 0.0, 1.0));
+      if (!nodes[k].supported && inside > 0) ++result.report.holes;
+    }
+  }
+
+  // Folds: uncover nodes until no covered cell reverses orientation.
+  while (const auto fold = warp.find_fold()) {
+    warp.coverage[warp.node_index(fold->x, fold->y)] = 0.0f;
+    ++result.report.folds;
+  }
+
+  // Residuals of the decoded samples against the fitted warp.
+  std::vector<double> residuals;
+  residuals.reserve(samples.size());
+  for (std::size_t k = 0; k < samples.size(); ++k) {
+    if (std::isnan(st[k].x) || warp.coverage_at(st[k]) < 0.5) continue;
+    residuals.push_back(glm::length(warp.q_from_st(st[k]) - samples[k].q));
+  }
+  if (!residuals.empty()) {
+    double sum = 0;
+    std::size_t outliers = 0;
+    for (const double r : residuals) {
+      sum += r * r;
+      outliers += r > options.outlier_px ? 1 : 0;
+    }
+    result.report.residual_rms_px = std::sqrt(sum / double(residuals.size()));
+    result.report.outlier_fraction = double(outliers) / double(residuals.size());
+    result.report.residual_p50_px = percentile(residuals, 0.5);
+    result.report.residual_p99_px = percentile(std::move(residuals), 0.99);
+  }
+  warp.validate(source);
+  return result;
+}
+
+}  // namespace facet::calibration

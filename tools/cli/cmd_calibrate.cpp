@@ -1,0 +1,102 @@
+// facet calibrate: a recorded capture → display.json, <p>.warp.exr and <p>.blend.exr.
+#include <cmath>
+#include <cstdio>
+#include <iostream>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "command.hpp"
+#include "facet/calibration/calibrate.hpp"
+#include "facet/projection/errors.hpp"
+
+namespace {
+
+struct CalibrateArgs {
+  std::string capture;
+  std::string out;
+  bool json = false;
+  std::string grid;
+  std::optional<double> node_spacing_px;
+  std::optional<double> black_level;
+  double feather_deg = 20;
+  std::string name;
+};
+
+glm::ivec2 parse_grid(const std::string& text) {
+  int width = 0, height = 0;
+  char separator = 0, extra = 0;
+  if (std::sscanf(text.c_str(), "%d%c%d%c", &width, &separator, &height, &extra) != 3 ||
+      (separator != 'x' && separator != 'X') || width < 2 || height < 2 || width > 4096 ||
+      height > 4096) {
+    throw facet::InputError("--grid", "",
+                            "GWxGH nodes, each in 2..4096, e.g. 65x49, got '" + text + "'");
+  }
+  return {width, height};
+}
+
+const facet::cli::Registration registration{
+    40, [](CLI::App& app) {
+      auto args = std::make_shared<CalibrateArgs>();
+      auto* cmd = app.add_subcommand(
+          "calibrate",
+          "Fit every projector's warp and blend from a recorded capture (capture.json and its "
+          "images) and write display.json, <p>.warp.exr and <p>.blend.exr");
+      cmd->add_option("capture", args->capture, "capture folder, or its capture.json")->required();
+      cmd->add_option("--out", args->out, "output folder (must not exist, or be empty)")
+          ->required();
+      cmd->add_flag("--json", args->json,
+                    "print the report as JSON: per projector coverage, decoded pixels, fit "
+                    "residual and, with truth/, rms_px, p99_px and max_px; blend_sum_max_err; "
+                    "seconds");
+      cmd->add_option("--grid", args->grid,
+                      "offset-map nodes GWxGH for every projector (default: one node about "
+                      "every 16 output pixels)");
+      cmd->add_option("--node-spacing", args->node_spacing_px,
+                      "node spacing in output pixels when --grid is not given");
+      cmd->add_option("--black-level", args->black_level,
+                      "also write <p>.black.exr for projectors whose black emits this fraction "
+                      "of their white");
+      cmd->add_option("--feather", args->feather_deg,
+                      "blend feather: degrees from a projector's edge to its full weight");
+      cmd->add_option("--name", args->name, "display name (default: the capture folder's name)");
+      cmd->callback([args] {
+        facet::calibration::CalibrateOptions options;
+        if (!args->grid.empty()) options.fit.grid = parse_grid(args->grid);
+        if (args->node_spacing_px) {
+          if (!(*args->node_spacing_px >= 2 && *args->node_spacing_px <= 1024)) {
+            throw facet::InputError("--node-spacing", "", "a number of output pixels in 2..1024");
+          }
+          options.fit.node_spacing_px = *args->node_spacing_px;
+        }
+        if (args->black_level) {
+          if (!(*args->black_level >= 0 && *args->black_level < 1)) {
+            throw facet::InputError("--black-level", "", "a fraction of white in [0, 1)");
+          }
+          options.blend.black_level = args->black_level;
+        }
+        if (!(args->feather_deg > 0 && args->feather_deg <= 180)) {
+          throw facet::InputError("--feather", "", "an angle in degrees in (0, 180]");
+        }
+        options.blend.feather_rad = args->feather_deg * M_PI / 180;
+        options.display_name = args->name;
+        const auto report = facet::calibration::calibrate(args->capture, args->out, options);
+        if (args->json) {
+          std::cout << report.to_json().dump(2) << "\n";
+          return;
+        }
+        for (const auto& p : report.projectors) {
+          std::printf("%s: %zu decoded camera pixels, coverage %.3f, grid %dx%d, residual %.3f px",
+                      p.name.c_str(), p.decoded_pixels, p.coverage, p.fit.grid.x, p.fit.grid.y,
+                      p.fit.residual_rms_px);
+          if (p.accuracy) {
+            std::printf(", against truth: rms %.3f px, p99 %.3f px, max %.3f px",
+                        p.accuracy->rms_px, p.accuracy->p99_px, p.accuracy->max_px);
+          }
+          std::printf("\n");
+        }
+        std::printf("blend sum max error %.5f; %.1f s\n", report.blend_sum_max_err, report.seconds);
+      });
+    }};
+
+}  // namespace
