@@ -1,0 +1,23 @@
+// Cube-map baseline, pass 1: the scene into one cube face. Pulls triangles of one primitive
+// (glDrawArrays of index_count vertices); the triangle ID is the primitive's first ID plus the
+// triangle's ordinal.
+layout(location = 0) uniform mat4 T_clip_object;  // face projection · T_eye_object
+layout(location = 1) uniform mat4 T_world_object;
+layout(location = 3) uniform uint first_id;
+
+out vec3 v_n_world;
+out vec2 v_uv;
+flat out uint v_triangle_id;
+
+uint pulled_vertex();
+vec3 pulled_position(uint v);
+vec3 pulled_normal(uint v);
+vec2 pulled_uv(uint v);
+
+void main() {
+  uint v = pulled_vertex();
+  gl_Position = T_clip_object * vec4(pulled_position(v), 1.0);
+  v_n_world = mat3(T_world_object) * pulled_normal(v);
+  v_uv = pulled_uv(v);
+  v_triangle_id = first_id + uint(gl_VertexID) / 3u;
+}
