@@ -1,0 +1,195 @@
+// display.json (FORMATS.md §4) and blend map files (§3): round trips and clear errors.
+#include "facet/projection_io/display_config.hpp"
+
+#include <OpenImageIO/imageio.h>
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <string>
+
+#include "facet/projection/errors.hpp"
+#include "facet/projection_io/blend_file.hpp"
+
+namespace fs = std::filesystem;
+namespace pio = facet::projection_io;
+using nlohmann::json;
+
+namespace {
+
+struct Folder {
+  fs::path path = fs::temp_directory_path() / ("facet-display-test-" + std::to_string(::getpid()) +
+                                               "-" + std::to_string(counter()++));
+  Folder() { fs::create_directories(path); }
+  ~Folder() {
+    std::error_code ignored;
+    fs::remove_all(path, ignored);
+  }
+  static int& counter() {
+    static int value = 0;
+    return value;
+  }
+};
+
+json sample_document() {
+  std::ifstream stream(fs::path(FACET_SOURCE_DIR) /
+                       "configs/displays/sample_two_projectors.display.json");
+  return json::parse(stream);
+}
+
+// The field an InputError names, or "" when none is thrown.
+std::string failing_field(const json& document, const fs::path& folder = ".",
+                          bool check_files = false) {
+  try {
+    pio::display_config_from_json(document, "display.json", folder, check_files);
+  } catch (const facet::InputError& e) {
+    EXPECT_EQ(e.source(), "display.json");
+    return e.field();
+  }
+  return "";
+}
+
+}  // namespace
+
+TEST(DisplayConfig, SampleFileValidatesAndRoundTrips) {
+  const pio::DisplayConfig config =
+      pio::display_config_from_json(sample_document(), "sample", ".", false);
+  ASSERT_EQ(config.projectors.size(), 2u);
+  EXPECT_EQ(config.projectors[0].output.kind, pio::DisplayOutput::Kind::monitor);
+  EXPECT_EQ(config.projectors[0].output.monitor, "DP-1");
+  EXPECT_EQ(config.projectors[1].output.window, glm::ivec4(1024, 0, 1024, 768));
+  EXPECT_EQ(config.projectors[1].gamma, 2.2);  // the default
+  EXPECT_EQ(config.missing_monitor, pio::MissingMonitor::window);
+  EXPECT_EQ(config.eye, glm::dvec3(0, 1.2, 0));
+
+  const Folder folder;
+  pio::write_display_config(config, folder.path / "display.json");
+  const pio::DisplayConfig again = pio::read_display_config(folder.path, false);
+  pio::DisplayConfig expected = config;
+  expected.folder = folder.path;
+  EXPECT_EQ(again, expected);
+}
+
+TEST(DisplayConfig, SchemaParsesAndRequiresWhatTheReaderRequires) {
+  std::ifstream stream(fs::path(FACET_SOURCE_DIR) / "configs/display.schema.json");
+  const json schema = json::parse(stream);
+  EXPECT_EQ(schema["properties"]["format"]["const"], pio::kDisplayFormat);
+  for (const std::string field : {"format", "name", "eye", "projectors"}) {
+    json document = sample_document();
+    document.erase(field);
+    EXPECT_EQ(failing_field(document), field);
+    EXPECT_NE(std::find(schema["required"].begin(), schema["required"].end(), field),
+              schema["required"].end());
+  }
+  for (const std::string field : {"name", "size", "warp", "output"}) {
+    json document = sample_document();
+    document["projectors"][1].erase(field);
+    EXPECT_EQ(failing_field(document), "projectors[1]." + field);
+    const json& required = schema["$defs"]["projector"]["required"];
+    EXPECT_NE(std::find(required.begin(), required.end(), field), required.end());
+  }
+}
+
+TEST(DisplayConfig, BadFieldsNameFileFieldAndExpectation) {
+  auto with = [](const std::string& pointer, const json& value) {
+    json document = sample_document();
+    document[json::json_pointer(pointer)] = value;
+    return document;
+  };
+  EXPECT_EQ(failing_field(with("/format", "facet-display/2")), "format");
+  EXPECT_EQ(failing_field(with("/eye", json::array({0, "up", 0}))), "eye[1]");
+  EXPECT_EQ(failing_field(with("/projectors/0/size", json::array({1024}))), "projectors[0].size");
+  EXPECT_EQ(failing_field(with("/projectors/0/size", json::array({1024, 0}))),
+            "projectors[0].size");
+  EXPECT_EQ(failing_field(with("/projectors/0/gamma", -1)), "projectors[0].gamma");
+  EXPECT_EQ(failing_field(with("/projectors/0/warp", 3)), "projectors[0].warp");
+  EXPECT_EQ(failing_field(with("/projectors/0/warp", "/abs/p0.warp.exr")), "projectors[0].warp");
+  EXPECT_EQ(failing_field(with("/projectors/1/name", "p0")), "projectors[1].name");
+  EXPECT_EQ(failing_field(with("/projectors/1/output", json{{"window", {0, 0, 0, 10}}})),
+            "projectors[1].output.window");
+  EXPECT_EQ(failing_field(with("/projectors/1/output", json{{"screen", "HDMI-1"}})),
+            "projectors[1].output");
+  EXPECT_EQ(failing_field(with("/missing_monitor", "ignore")), "missing_monitor");
+  EXPECT_EQ(failing_field(with("/render/tolerance_px", 0)), "render.tolerance_px");
+  EXPECT_EQ(failing_field(with("/render/method", "Facets!")), "render.method");
+  EXPECT_EQ(failing_field(with("/screen/type", "torus")), "screen.type");
+  // Unknown fields are ignored.
+  EXPECT_EQ(failing_field(with("/comment", "hello")), "");
+
+  // NaN cannot be written in JSON, but a value built in code can hold it.
+  pio::DisplayConfig config = pio::display_config_from_json(sample_document(), "s", ".", false);
+  config.eye.y = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_THROW(pio::validate_display_config(config, "s", false), facet::InputError);
+  const Folder folder;
+  EXPECT_THROW(pio::write_display_config(config, folder.path / "display.json"), facet::InputError);
+  EXPECT_TRUE(fs::is_empty(folder.path));
+}
+
+TEST(DisplayConfig, MissingFilesAreNamed) {
+  const Folder folder;
+  for (const char* name : {"p0.warp.exr", "p0.blend.exr", "p1.warp.exr", "p1.blend.exr"}) {
+    std::ofstream(folder.path / name) << "x";
+  }
+  // p1.black.exr is missing.
+  EXPECT_EQ(failing_field(sample_document(), folder.path, true), "projectors[1].black");
+  std::ofstream(folder.path / "p1.black.exr") << "x";
+  EXPECT_EQ(failing_field(sample_document(), folder.path, true), "");
+  fs::remove(folder.path / "p0.warp.exr");
+  EXPECT_EQ(failing_field(sample_document(), folder.path, true), "projectors[0].warp");
+}
+
+TEST(BlendFile, RoundTripsAndSamples) {
+  const Folder folder;
+  pio::BlendMap map = pio::BlendMap::constant({5, 3}, 0.0f);
+  for (int y = 0; y < 3; ++y) {
+    for (int x = 0; x < 5; ++x) map.at(x, y) = float(x) / 4.0f;
+  }
+  const std::string path = (folder.path / "p.blend.exr").string();
+  pio::write_blend_map(path, map);
+  const pio::BlendMap again = pio::read_blend_map(path, glm::ivec2(5, 3));
+  EXPECT_EQ(again.values, map.values);
+  EXPECT_EQ(again.channels, 1);
+  // Bilinear between pixel centres (x + 0.5).
+  EXPECT_NEAR(again.sample({1.0, 1.5}), 0.125, 1e-7);
+  EXPECT_THROW(pio::read_blend_map(path, glm::ivec2(6, 3)), facet::InputError);
+}
+
+TEST(BlendFile, BadMapsAreRejectedAndNothingIsWritten) {
+  const Folder folder;
+  pio::BlendMap map = pio::BlendMap::constant({4, 4}, 0.5f);
+  map.at(2, 1) = 1.5f;
+  try {
+    pio::write_blend_map((folder.path / "bad.blend.exr").string(), map);
+    FAIL() << "no error";
+  } catch (const facet::InputError& e) {
+    EXPECT_EQ(e.field(), "pixel (2, 1)");
+  }
+  map.at(2, 1) = std::numeric_limits<float>::quiet_NaN();
+  EXPECT_THROW(pio::write_blend_map((folder.path / "bad.blend.exr").string(), map),
+               facet::InputError);
+  EXPECT_TRUE(fs::is_empty(folder.path));
+
+  // An EXR without the facet:blend attribute.
+  const std::string plain = (folder.path / "plain.exr").string();
+  {
+    auto output = OIIO::ImageOutput::create("openexr");
+    OIIO::ImageSpec spec(2, 2, 1, OIIO::TypeDesc::FLOAT);
+    spec.channelnames = {"Y"};
+    ASSERT_TRUE(output->open(plain, spec));
+    const float pixels[4] = {0, 0, 0, 0};
+    ASSERT_TRUE(output->write_image(OIIO::TypeDesc::FLOAT, pixels));
+    output->close();
+  }
+  try {
+    pio::read_blend_map(plain);
+    FAIL() << "no error";
+  } catch (const facet::InputError& e) {
+    EXPECT_EQ(e.field(), "facet:blend");
+    EXPECT_EQ(e.source(), plain);
+  }
+  EXPECT_THROW(pio::read_blend_map((folder.path / "missing.blend.exr").string()),
+               facet::InputError);
+}
