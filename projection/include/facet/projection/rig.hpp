@@ -120,7 +120,14 @@ struct TrueWarpOptions {
   // covered node). Kept below FORMATS.md's 0.01 px, since the largest error lies between them.
   double max_error_px = 0.004;
   int max_nodes_per_axis = 2049;  // the grid stops growing here (the result may then miss)
-  CoverOptions cover;             // up_eye defaults to the projector's up
+  // up_eye defaults to the projector's up. Perspective bases are allowed up to 80° off their
+  // centre: a projector is a perspective device, so the map from a perspective base to its pixels
+  // stays nearly projective and needs far fewer nodes than a fisheye for the same error.
+  CoverOptions cover = [] {
+    CoverOptions wide;
+    wide.max_perspective_half_angle_rad = 1.40;
+    return wide;
+  }();
 };
 
 struct TrueWarpReport {

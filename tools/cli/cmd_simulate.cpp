@@ -1,0 +1,129 @@
+// facet simulate: renders the capture a rig's camera would record, with its ground truth.
+#include <cmath>
+#include <cstdio>
+#include <iostream>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+
+#include "command.hpp"
+#include "facet/calibration/simulate.hpp"
+#include "facet/projection/errors.hpp"
+#include "facet/projection_io/rig_file.hpp"
+
+namespace {
+
+glm::ivec2 parse_size(const std::string& text) {
+  int width = 0, height = 0;
+  char separator = 0, extra = 0;
+  if (std::sscanf(text.c_str(), "%d%c%d%c", &width, &separator, &height, &extra) != 3 ||
+      (separator != 'x' && separator != 'X') || width < 1 || height < 1 || width > 32768 ||
+      height > 32768) {
+    throw facet::InputError("--camera-size", "",
+                            "WxH with positive integers, e.g. 1280x1024, got '" + text + "'");
+  }
+  return {width, height};
+}
+
+struct SimulateArgs {
+  std::string rig;
+  std::string out;
+  bool json = false;
+  std::optional<double> noise, defocus, camera_blur, ambient, peak, gamma, phase_period;
+  std::optional<int> bits;
+  std::optional<std::uint64_t> seed;
+  std::optional<std::string> camera_size;
+  bool no_phase = false, no_falloff = false, clean = false;
+};
+
+// Flags override the rig file; each is checked again by Rig::validate, naming the flag.
+void apply_overrides(const SimulateArgs& args, facet::Rig& rig) {
+  auto& s = rig.simulation;
+  if (args.clean) {
+    s.noise = 0;
+    s.defocus_px = 0;
+    s.camera_blur_px = 0;
+    s.ambient = 0;
+    for (auto& projector : rig.projectors) projector.gamma = 1;
+  }
+  if (args.noise) s.noise = *args.noise;
+  if (args.defocus) s.defocus_px = *args.defocus;
+  if (args.camera_blur) s.camera_blur_px = *args.camera_blur;
+  if (args.ambient) s.ambient = *args.ambient;
+  if (args.peak) s.peak = *args.peak;
+  if (args.bits) s.bits = *args.bits;
+  if (args.seed) s.seed = *args.seed;
+  if (args.phase_period) s.phase_period = *args.phase_period;
+  if (args.no_phase) s.phase = false;
+  if (args.no_falloff) s.falloff = false;
+  if (args.gamma) {
+    for (auto& projector : rig.projectors) projector.gamma = *args.gamma;
+  }
+  if (args.camera_size) {
+    if (!rig.camera.intrinsics.empty()) {
+      throw facet::InputError("--camera-size", "",
+                              "a rig camera given by fov_deg: this one has explicit intrinsics");
+    }
+    rig.camera.size = parse_size(*args.camera_size);
+  }
+}
+
+const facet::cli::Registration registration{
+    25, [](CLI::App& app) {
+      auto args = std::make_shared<SimulateArgs>();
+      auto* cmd = app.add_subcommand(
+          "simulate",
+          "Render the capture folder a rig's camera would record (capture.json, images, camera "
+          "model) with the ground-truth warps in truth/");
+      cmd->add_option("--rig", args->rig, "rig JSON file (configs/rigs/README.md)")->required();
+      cmd->add_option("--out", args->out, "capture folder to write (must not exist, or be empty)")
+          ->required();
+      cmd->add_option("--noise", args->noise, "sensor noise σ, fraction of full scale");
+      cmd->add_option("--defocus", args->defocus, "projector defocus σ in projector pixels");
+      cmd->add_option("--camera-blur", args->camera_blur, "camera blur σ in camera pixels");
+      cmd->add_option("--ambient", args->ambient, "ambient light, fraction of full scale");
+      cmd->add_option("--peak", args->peak, "brightest white, fraction of full scale");
+      cmd->add_option("--gamma", args->gamma, "gamma of every projector");
+      cmd->add_option("--bits", args->bits, "PNG bits per sample, 8 or 16");
+      cmd->add_option("--seed", args->seed, "noise seed");
+      cmd->add_option("--phase-period", args->phase_period, "phase period in projector pixels");
+      cmd->add_flag("--no-phase", args->no_phase, "Gray code only, no phase-shift frames");
+      cmd->add_flag("--no-falloff", args->no_falloff, "uniform brightness (no 1/d², no cosine)");
+      cmd->add_flag("--clean", args->clean,
+                    "no noise, blur, ambient light, and gamma 1 (later flags still apply)");
+      cmd->add_option("--camera-size", args->camera_size, "camera imager WxH, e.g. 1280x1024");
+      cmd->add_flag("--json", args->json, "Print a JSON report");
+      cmd->callback([args] {
+        facet::Rig rig = facet::read_rig(args->rig);
+        apply_overrides(*args, rig);
+        rig.validate(args->rig + " (with the command-line overrides)");
+        const auto report = facet::calibration::simulate_capture(rig, args->out, args->rig);
+        if (args->json) {
+          nlohmann::json truth = nlohmann::json::array();
+          for (const auto& t : report.truth) {
+            truth.push_back({{"projector", t.projector},
+                             {"base", t.base},
+                             {"grid", {t.grid.x, t.grid.y}},
+                             {"max_checked_error_px", t.max_checked_error_px},
+                             {"lit_fraction", t.lit_fraction}});
+          }
+          const nlohmann::json out{{"out", args->out},
+                                   {"camera_size", {report.camera_size.x, report.camera_size.y}},
+                                   {"frames", report.frames},
+                                   {"truth", truth},
+                                   {"seconds", report.seconds}};
+          std::cout << out.dump(2) << "\n";
+          return;
+        }
+        std::printf("%s: %zu frames of %dx%d in %.1f s\n", args->out.c_str(), report.frames,
+                    report.camera_size.x, report.camera_size.y, report.seconds);
+        for (const auto& t : report.truth) {
+          std::printf("  %-12s sees %5.1f%% of the camera image; truth %s %dx%d nodes, %.4f px\n",
+                      t.projector.c_str(), 100 * t.lit_fraction, t.base.c_str(), t.grid.x, t.grid.y,
+                      t.max_checked_error_px);
+        }
+      });
+    }};
+
+}  // namespace
