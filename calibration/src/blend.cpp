@@ -123,6 +123,7 @@ BlendCheck check_blend(std::span<const Warp> warps, std::span<const projection_i
     const glm::ivec2 size = warps[p].output_size;
     std::vector<double> row_error(std::size_t(size.y), 0.0);
     std::vector<std::size_t> row_count(std::size_t(size.y), 0);
+    std::vector<glm::dvec2> row_worst(std::size_t(size.y), glm::dvec2(0.0));
     parallel_rows(size.y, [&](int y) {
       if (y % stride != 0) return;
       for (int x = 0; x < size.x; x += stride) {
@@ -143,12 +144,19 @@ BlendCheck check_blend(std::span<const Warp> warps, std::span<const projection_i
           ++covering;
         }
         if (covering < 2 || near_edge) continue;
-        row_error[std::size_t(y)] = std::max(row_error[std::size_t(y)], std::abs(sum - 1));
+        if (std::abs(sum - 1) > row_error[std::size_t(y)]) {
+          row_error[std::size_t(y)] = std::abs(sum - 1);
+          row_worst[std::size_t(y)] = {x + 0.5, y + 0.5};
+        }
         ++row_count[std::size_t(y)];
       }
     });
     for (int y = 0; y < size.y; ++y) {
-      check.sum_max_err = std::max(check.sum_max_err, row_error[std::size_t(y)]);
+      if (row_error[std::size_t(y)] > check.sum_max_err) {
+        check.sum_max_err = row_error[std::size_t(y)];
+        check.worst_projector = p;
+        check.worst_q = row_worst[std::size_t(y)];
+      }
       check.overlap_directions += row_count[std::size_t(y)];
     }
   }

@@ -47,6 +47,8 @@ AccuracyReport compare_warps(const Warp& truth, const Warp& calibrated, double b
   const std::vector<glm::dvec2> st = WarpInverse(truth).st_at_pixel_centres();
   std::vector<double> errors;
   std::size_t truth_pixels = 0;
+  double worst = -1;
+  glm::dvec2 worst_at(0.0);
   const glm::ivec2 size = truth.output_size;
   for (int y = 0; y < size.y; ++y) {
     for (int x = 0; x < size.x; ++x) {
@@ -61,6 +63,10 @@ AccuracyReport compare_warps(const Warp& truth, const Warp& calibrated, double b
       const auto projected = calibrated.project(truth.v_eye_from_st(st_truth));
       if (!projected || !projected->covered) continue;
       errors.push_back(glm::length(projected->q - q));
+      if (errors.back() > worst) {
+        worst = errors.back();
+        worst_at = q;
+      }
     }
   }
   AccuracyReport report;
@@ -71,7 +77,8 @@ AccuracyReport compare_warps(const Warp& truth, const Warp& calibrated, double b
   double sum = 0;
   for (const double e : errors) sum += e * e;
   report.rms_px = std::sqrt(sum / double(errors.size()));
-  report.max_px = *std::max_element(errors.begin(), errors.end());
+  report.max_px = worst;
+  report.max_at_px = worst_at;
   report.p99_px = percentile(errors, 0.99);
   return report;
 }
@@ -94,6 +101,7 @@ nlohmann::json CalibrationReport::to_json() const {
       item["rms_px"] = p.accuracy->rms_px;
       item["p99_px"] = p.accuracy->p99_px;
       item["max_px"] = p.accuracy->max_px;
+      item["max_at_px"] = {p.accuracy->max_at_px.x, p.accuracy->max_at_px.y};
       item["compared_pixels"] = p.accuracy->compared;
       item["uncovered_fraction"] = p.accuracy->uncovered_fraction;
     }
@@ -102,6 +110,7 @@ nlohmann::json CalibrationReport::to_json() const {
   return {{"projectors", items},
           {"blend_sum_max_err", blend_sum_max_err},
           {"blend_overlap_directions", blend_overlap_directions},
+          {"blend_worst", blend_worst},
           {"seconds", seconds}};
 }
 
@@ -180,6 +189,11 @@ CalibrationReport calibrate(const fs::path& capture_path, const fs::path& out,
   const BlendCheck check = check_blend(warps, blend.alpha);
   report.blend_sum_max_err = check.sum_max_err;
   report.blend_overlap_directions = check.overlap_directions;
+  if (check.sum_max_err > 0) {
+    report.blend_worst = capture.projectors[check.worst_projector].name + " at (" +
+                         std::to_string(check.worst_q.x) + ", " + std::to_string(check.worst_q.y) +
+                         ")";
+  }
 
   projection_io::DisplayConfig display;
   display.name = options.display_name.empty() ? fs::absolute(capture.folder).filename().string()

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <opencv2/calib3d.hpp>
 #include <opencv2/core/matx.hpp>
 
 #include "facet/projection/errors.hpp"
@@ -54,6 +55,116 @@ std::optional<glm::dvec3> projector_up(std::span<const FitSample> samples, glm::
   const glm::dvec3 down = solution[1] * e1 + solution[2] * e2;
   if (!(glm::length(down) > 0)) return std::nullopt;
   return -glm::normalize(down);
+}
+
+// The homography q ~ H·v by DLT over the samples marked in `use`.
+std::optional<cv::Matx33d> fit_homography(std::span<const FitSample> samples,
+                                          std::span<const char> use, glm::ivec2 output_size) {
+  // Output pixels normalised to about [-1, 1] keep the DLT well conditioned.
+  const glm::dvec2 centre = 0.5 * glm::dvec2(output_size);
+  const double scale = 0.5 * std::max(output_size.x, output_size.y);
+  cv::Matx<double, 9, 9> normal = cv::Matx<double, 9, 9>::zeros();
+  std::size_t used = 0;
+  for (std::size_t k = 0; k < samples.size(); ++k) {
+    if (!use[k]) continue;
+    const glm::dvec3& v = samples[k].v_eye;
+    const glm::dvec2 q = (samples[k].q - centre) / scale;
+    const cv::Vec<double, 9> a(-v.x, -v.y, -v.z, 0, 0, 0, q.x * v.x, q.x * v.y, q.x * v.z);
+    const cv::Vec<double, 9> b(0, 0, 0, -v.x, -v.y, -v.z, q.y * v.x, q.y * v.y, q.y * v.z);
+    normal += a * a.t() + b * b.t();
+    ++used;
+  }
+  if (used < 8) return std::nullopt;
+  cv::Mat eigenvalues, eigenvectors;
+  if (!cv::eigen(cv::Mat(normal), eigenvalues, eigenvectors)) return std::nullopt;
+  cv::Matx33d H_normalised;
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) H_normalised(r, c) = eigenvectors.at<double>(8, r * 3 + c);
+  }
+  const cv::Matx33d T_inverse(scale, 0, centre.x, 0, scale, centre.y, 0, 0, 1);
+  return T_inverse * H_normalised;
+}
+
+// Distance in output pixels between H·v and q; infinite behind the projector.
+double homography_residual(const cv::Matx33d& H, const FitSample& sample) {
+  const cv::Vec3d v(sample.v_eye.x, sample.v_eye.y, sample.v_eye.z);
+  const cv::Vec3d h = H * v;
+  if (!(h[2] > 0)) return std::numeric_limits<double>::infinity();
+  return std::hypot(h[0] / h[2] - sample.q.x, h[1] / h[2] - sample.q.y);
+}
+
+// A perspective base lined up with the projector: q ≈ H·v (a homography from eye directions to
+// output pixels, fitted by DLT) splits as H = K·R_projector_eye with K upper triangular (RQ), and
+// the base looks down the projector's axis with its rows. Seen from near its centre, a projector
+// is close to a pinhole, so in this base q is nearly affine in st and the offsets are small and
+// smooth: bilinear interpolation between nodes then costs little. Samples far from the
+// homography (wrong codes, stray light) are left out of the fit and of the extents; the warp fit
+// ignores samples outside the base image. nullopt when the fit is ill-posed, mirrored, or a
+// consistent sample lies more than max_half_angle_rad off the axis.
+std::optional<BaseCover> projector_cover(std::span<const FitSample> samples, glm::ivec2 output_size,
+                                         double margin_rad, double max_half_angle_rad) {
+  std::vector<char> use(samples.size(), 0);
+  const std::size_t stride = std::max<std::size_t>(1, samples.size() / 40000);
+  for (std::size_t k = 0; k < samples.size(); k += stride) use[k] = 1;
+  std::optional<cv::Matx33d> H;
+  std::vector<double> residual(samples.size());
+  double threshold = 0;
+  for (int pass = 0; pass < 3; ++pass) {
+    H = fit_homography(samples, use, output_size);
+    if (!H) return std::nullopt;
+    glm::dvec3 mean(0.0);
+    for (std::size_t k = 0; k < samples.size(); k += stride) {
+      if (use[k]) mean += samples[k].v_eye;
+    }
+    const cv::Vec3d h3((*H)(2, 0), (*H)(2, 1), (*H)(2, 2));
+    if (h3.dot(cv::Vec3d(mean.x, mean.y, mean.z)) < 0) *H = *H * -1.0;
+    std::vector<double> sampled;
+    for (std::size_t k = 0; k < samples.size(); ++k) {
+      residual[k] = homography_residual(*H, samples[k]);
+      if (k % stride == 0) sampled.push_back(residual[k]);
+    }
+    // The homography misses parallax and lens distortion by a few pixels over the image; wrong
+    // codes miss by far more.
+    threshold = std::max(0.01 * std::max(output_size.x, output_size.y),
+                         4.0 * percentile(std::move(sampled), 0.9));
+    for (std::size_t k = 0; k < samples.size(); k += stride) use[k] = residual[k] <= threshold;
+  }
+  cv::Matx33d K, R;
+  cv::RQDecomp3x3(*H, K, R);
+  // RQ leaves the signs of K's diagonal free: make it positive.
+  for (int r = 0; r < 3; ++r) {
+    if (K(r, r) < 0) {
+      for (int i = 0; i < 3; ++i) {
+        K(i, r) = -K(i, r);
+        R(r, i) = -R(r, i);
+      }
+    }
+  }
+  if (!(cv::determinant(R) > 0.5)) return std::nullopt;  // a mirrored image
+  const glm::dvec3 x_projector(R(0, 0), R(0, 1), R(0, 2)), y_projector(R(1, 0), R(1, 1), R(1, 2)),
+      z_projector(R(2, 0), R(2, 1), R(2, 2));
+  BaseCover cover;
+  // Base: x right, y up, looking down −z; projector: x right, y down, z forward.
+  cover.R_eye_base = glm::dmat3(x_projector, -y_projector, -z_projector);
+  const double min_cos = std::cos(max_half_angle_rad);
+  double left = 1e300, right = -1e300, top = -1e300, bottom = 1e300;
+  for (std::size_t k = 0; k < samples.size(); ++k) {
+    if (!(residual[k] <= threshold)) continue;
+    const glm::dvec3& v = samples[k].v_eye;
+    const double z = glm::dot(v, z_projector);
+    if (!(z >= min_cos * glm::length(v))) return std::nullopt;
+    const double x = std::atan2(glm::dot(v, x_projector), z);
+    const double y = std::atan2(-glm::dot(v, y_projector), z);
+    left = std::min(left, x);
+    right = std::max(right, x);
+    top = std::max(top, y);
+    bottom = std::min(bottom, y);
+  }
+  const double limit = max_half_angle_rad;
+  cover.base = BaseProjection::perspective(
+      std::tan(std::max(left - margin_rad, -limit)), std::tan(std::min(right + margin_rad, limit)),
+      std::tan(std::min(top + margin_rad, limit)), std::tan(std::max(bottom - margin_rad, -limit)));
+  return cover;
 }
 
 struct NodeFit {
@@ -154,7 +265,12 @@ WarpFit fit_warp(std::span<const FitSample> samples, glm::ivec2 output_size,
   const std::size_t stride = std::max<std::size_t>(1, samples.size() / 50000);
   directions.reserve(samples.size() / stride + 1);
   for (std::size_t k = 0; k < samples.size(); k += stride) directions.push_back(samples[k].v_eye);
-  const BaseCover cover = cover_directions(directions, cover_options);
+  std::optional<BaseCover> aligned;
+  if (options.projector_aligned_base) {
+    aligned = projector_cover(samples, output_size, cover_options.margin_rad,
+                              options.max_aligned_half_angle_rad);
+  }
+  const BaseCover cover = aligned ? *aligned : cover_directions(directions, cover_options);
   Warp& warp = result.warp;
   warp.base = cover.base;
   warp.R_eye_base = cover.R_eye_base;

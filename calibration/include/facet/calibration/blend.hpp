@@ -3,6 +3,7 @@
 // α in linear light, feathered by the angular distance to each projector's edge in the common
 // direction domain and normalised so that the projectors lighting a direction sum to 1.
 #include <cstddef>
+#include <glm/glm.hpp>
 #include <optional>
 #include <span>
 #include <vector>
@@ -37,6 +38,8 @@ BlendResult compute_blend(std::span<const Warp> warps, const BlendOptions& optio
 struct BlendCheck {
   double sum_max_err = 0;              // max |Σ α − 1| over sampled directions in overlaps
   std::size_t overlap_directions = 0;  // directions sampled where two or more projectors cover
+  std::size_t worst_projector = 0;     // the sampled direction with the largest error: whose
+  glm::dvec2 worst_q{0.0};             // output pixel centre it came from
 };
 
 // Measures the blend independently of how it was made: directions at every `stride`-th output

@@ -30,6 +30,7 @@ struct CalibrateOptions {
 // position of the true direction and the pixel centre, over directions both warps cover.
 struct AccuracyReport {
   double rms_px = 0, p99_px = 0, max_px = 0;
+  glm::dvec2 max_at_px{0.0};      // the truth's pixel centre where max_px occurs
   std::size_t compared = 0;       // pixel centres compared
   double uncovered_fraction = 0;  // share of the truth's pixels the calibrated warp misses
 };
@@ -49,6 +50,7 @@ struct CalibrationReport {
   std::vector<ProjectorReport> projectors;
   double blend_sum_max_err = 0;  // see check_blend
   std::size_t blend_overlap_directions = 0;
+  std::string blend_worst;  // where blend_sum_max_err occurs: "projector at (x, y)"
   double seconds = 0;
 
   nlohmann::json to_json() const;

@@ -52,6 +52,11 @@ struct FitOptions {
   double min_cutoff_px = 0.75;
   // Residuals above this count as outliers in the report (output pixels).
   double outlier_px = 2.0;
+  // Base projection: a perspective lined up with the projector (its axis and rows, from a
+  // homography fitted to the samples) when every sample lies within max_aligned_half_angle_rad of
+  // its axis; otherwise, or when disabled, cover_directions with `cover`.
+  bool projector_aligned_base = true;
+  double max_aligned_half_angle_rad = 1.40;  // about 80°
   CoverOptions cover;
 };
 
