@@ -1,0 +1,119 @@
+#pragma once
+// An immersive session: one shared scene rendered every frame into every projector output of a
+// display, followed by each output's blend and black-level pass. The same Session drives the
+// headless runner (EGL, frames to files) and the windowed one (a GLFW window per projector).
+//
+// Cluster-ready: everything a frame depends on is the small value FrameState, so one node can
+// broadcast it and every node render its own outputs from it.
+#include <cstdint>
+#include <glm/glm.hpp>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "facet/driver/blend_pass.hpp"
+#include "facet/driver/gpu_scene.hpp"
+#include "facet/driver/gpu_timer.hpp"
+#include "facet/driver/render_method.hpp"
+#include "facet/driver/scene.hpp"
+#include "facet/projection_io/display_config.hpp"
+
+namespace facet::driver {
+
+struct SessionOutput {
+  OutputSpec spec;  // name and exact warp
+  BlendMaps blend;  // empty maps: weight 1 and black level 0 everywhere
+  OutputEncoding encoding;
+  projection_io::DisplayOutput placement;  // where a windowed session shows it
+};
+
+// What a session shows: the outputs with their blends, and how to render them.
+struct SessionDisplay {
+  std::string source;  // the display argument, for messages
+  std::vector<SessionOutput> outputs;
+  std::string method = "facets";
+  RenderSettings settings;
+  projection_io::MissingMonitor missing_monitor = projection_io::MissingMonitor::window;
+};
+
+// Loads a display the way `facet render` names it (see load_display_outputs): a built-in, a
+// .warp.exr, or a display.json, whose blend and black maps, gammas, outputs, render method and
+// tolerance are used too. Built-ins and warp files get one window each, sRGB encoding and no
+// blend. `size` overrides a built-in's output size. Throws InputError for bad input.
+SessionDisplay load_session_display(std::string_view display,
+                                    std::optional<glm::ivec2> size = std::nullopt);
+
+// The whole state one frame depends on.
+struct FrameState {
+  std::uint64_t frame = 0;
+  double time_s = 0;            // scene time, seconds
+  glm::dmat4 T_world_eye{1.0};  // eye pose: eye-frame points into the world frame (metres)
+
+  bool operator==(const FrameState&) const = default;
+};
+nlohmann::json frame_state_to_json(const FrameState& state);
+// Throws InputError(source, field, ...) for a malformed value.
+FrameState frame_state_from_json(const nlohmann::json& value, const std::string& source);
+
+struct OutputFrameStats {
+  std::string name;
+  bool rendered = false;  // false: no object can be seen by this output, so it was only cleared
+  RenderStats render;
+  std::size_t blend_tiles = 0;  // tiles the blend pass touched
+};
+
+struct FrameStats {
+  std::uint64_t frame = 0;
+  double time_s = 0;
+  double cpu_ms = 0;  // wall time of Session::render on the CPU, including glFinish when asked
+  std::vector<OutputFrameStats> outputs;
+  std::vector<PassTime> pass_ms;  // GPU time per pass summed over outputs, from an earlier frame
+
+  std::uint64_t triangles_in() const;
+  std::uint64_t replicas() const;
+  double replication_ratio() const;
+};
+nlohmann::json frame_stats_to_json(const FrameStats& stats);
+
+class Session {
+ public:
+  // Uploads the scene and prepares one renderer per output. Needs a current GL context, which
+  // must stay current (on this thread) for the session's life.
+  Session(SessionDisplay display, const Scene& scene);
+  ~Session();
+  Session(const Session&) = delete;
+  Session& operator=(const Session&) = delete;
+
+  // Renders every output that can see part of the scene, then blends every output. With
+  // `finish`, waits for the GPU so that cpu_ms is the frame's full time.
+  FrameStats render(const FrameState& state, bool finish = false);
+
+  const SessionDisplay& display() const { return display_; }
+  std::span<const OutputTarget> targets() const { return targets_; }
+
+  // Whether any object's bounds meet the directions output `index` covers, seen from the eye
+  // pose T_world_eye. Conservative: false only when the output cannot see anything.
+  bool output_sees_scene(std::size_t index, const glm::dmat4& T_world_eye) const;
+
+ private:
+  struct CoverageCone {
+    glm::dvec3 axis{0, 0, -1};  // eye frame, unit
+    double half_angle = 0;      // radians; >= pi covers every direction
+  };
+
+  SessionDisplay display_;
+  const Scene* scene_;
+  GpuScene gpu_scene_;
+  std::vector<std::unique_ptr<RenderMethod>> methods_;
+  std::vector<OutputTarget> targets_;
+  std::vector<BlendPass> blends_;
+  std::vector<CoverageCone> cones_;
+  GpuTimer timer_;
+  std::vector<PassTime> last_pass_ms_;
+};
+
+}  // namespace facet::driver

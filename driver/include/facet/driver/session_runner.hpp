@@ -1,0 +1,64 @@
+#pragma once
+// Running a Session: headless through EGL (frames to files) or in GLFW windows on the projector
+// monitors, with navigation and an overlay.
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "facet/driver/monitors.hpp"
+#include "facet/driver/scene.hpp"
+#include "facet/driver/session.hpp"
+
+namespace facet::driver {
+
+// Frames advance scene time by this much: a 60 Hz projector.
+inline constexpr double kFramePeriod_s = 1.0 / 60.0;
+
+// The eye pose over time when nobody steers: the city's camera path for the built-in city, and
+// for any other scene a slow turn about the vertical at the centre of its bounds.
+using CameraPath = std::function<glm::dmat4(double time_s)>;
+CameraPath default_camera_path(const Scene& scene, bool builtin_city);
+
+struct HeadlessRunOptions {
+  std::uint64_t frames = 1;
+  std::filesystem::path out_dir;  // receives <output>/<frame>.png and stats.jsonl
+  bool finish_each_frame = true;  // glFinish per frame, so cpu_ms is the frame's whole time
+};
+
+struct HeadlessRunResult {
+  std::vector<FrameStats> frames;
+  std::vector<std::filesystem::path> images;  // every PNG written, in order
+};
+
+// Renders frames 0..frames-1 at times k·kFramePeriod_s along `path` and writes
+// out_dir/<output>/<frame, 5 digits>.png and out_dir/stats.jsonl (one frame_stats_to_json line
+// per frame). The folder is written under a temporary name and renamed when complete; an existing
+// out_dir is replaced only when it is empty or holds an earlier run (a stats.jsonl), else
+// InputError.
+HeadlessRunResult run_headless_session(Session& session, const CameraPath& path,
+                                       const HeadlessRunOptions& options);
+
+struct WindowRunOptions {
+  std::optional<std::uint64_t> frames;  // stop after this many frames (tests); else until closed
+  bool span = false;                    // one borderless window spanning every output's rectangle
+  bool overlay = false;                 // start with the overlay shown (toggle with O)
+  bool play_path = true;                // start playing the camera path (toggle with P)
+  // Written when the run ends: per window its placement, its actual position and size, and
+  // whether its framebuffer held exactly its output's pixels on the last frame.
+  std::optional<std::filesystem::path> report;
+};
+
+// Opens the windows (one per output on its monitor, or one spanning window), renders until the
+// windows close or `frames` have been shown. Keys: W/S forward and back, A/D sideways, Q/E down
+// and up, arrows or dragging with the left mouse button turn, P toggles the camera path,
+// O toggles the overlay (fps, replication, ms per pass), Escape quits. Monitors that disappear
+// during the session are reported on stderr and their windows kept. Needs a display server:
+// GlContextError without one. InputError when a monitor the display needs is missing and the
+// display says "missing_monitor": "error".
+void run_windowed_session(const SessionDisplay& display, const Scene& scene, const CameraPath& path,
+                          const WindowRunOptions& options);
+
+}  // namespace facet::driver

@@ -1,0 +1,284 @@
+#include "facet/driver/session.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <map>
+#include <numbers>
+
+#include "facet/driver/display_outputs.hpp"
+#include "facet/projection/errors.hpp"
+#include "facet/projection_io/blend_file.hpp"
+
+namespace facet::driver {
+
+namespace {
+
+bool ends_with(std::string_view text, std::string_view suffix) {
+  return text.size() >= suffix.size() && text.substr(text.size() - suffix.size()) == suffix;
+}
+
+BlendMaps blend_maps_from(const projection_io::DisplayConfig& config,
+                          const projection_io::DisplayProjector& projector) {
+  BlendMaps maps;
+  maps.size = projector.size;
+  std::optional<projection_io::BlendMap> alpha, black;
+  if (projector.blend)
+    alpha =
+        projection_io::read_blend_map(config.resolve(*projector.blend).string(), projector.size);
+  if (projector.black)
+    black =
+        projection_io::read_blend_map(config.resolve(*projector.black).string(), projector.size);
+  // One weight per colour in either map makes both per colour.
+  maps.channels = (alpha && alpha->channels == 3) || (black && black->channels == 3) ? 3 : 1;
+  auto expand = [&](const projection_io::BlendMap& map) {
+    if (map.channels == maps.channels) return map.values;
+    std::vector<float> rgb(map.values.size() * 3);
+    for (std::size_t i = 0; i < map.values.size(); ++i)
+      rgb[3 * i] = rgb[3 * i + 1] = rgb[3 * i + 2] = map.values[i];
+    return rgb;
+  };
+  if (alpha) maps.alpha = expand(*alpha);
+  if (black) maps.black = expand(*black);
+  return maps;
+}
+
+double angle_between(const glm::dvec3& a, const glm::dvec3& b) {
+  return std::atan2(glm::length(glm::cross(a, b)), glm::dot(a, b));
+}
+
+}  // namespace
+
+SessionDisplay load_session_display(std::string_view display, std::optional<glm::ivec2> size) {
+  SessionDisplay result;
+  result.source = std::string(display);
+  std::vector<OutputSpec> specs = load_display_outputs(display, size);
+  if (ends_with(display, ".json")) {
+    const auto config = projection_io::read_display_config(std::filesystem::path(display));
+    result.method = config.render.method;
+    result.settings.facets.layout = FacetTolerance{config.render.tolerance_px};
+    result.settings.z_near = config.render.z_near;
+    result.missing_monitor = config.missing_monitor;
+    for (std::size_t i = 0; i < config.projectors.size(); ++i) {
+      const auto& projector = config.projectors[i];
+      SessionOutput output;
+      output.spec = std::move(specs.at(i));
+      output.blend = blend_maps_from(config, projector);
+      output.encoding.gamma = projector.gamma;
+      output.placement = projector.output;
+      result.outputs.push_back(std::move(output));
+    }
+    return result;
+  }
+  result.settings.facets.layout = FacetTolerance{0.25};
+  for (OutputSpec& spec : specs) {
+    SessionOutput output;
+    output.placement.kind = projection_io::DisplayOutput::Kind::window;
+    output.placement.window = {0, 0, spec.warp.output_size.x, spec.warp.output_size.y};
+    output.spec = std::move(spec);
+    result.outputs.push_back(std::move(output));
+  }
+  return result;
+}
+
+nlohmann::json frame_state_to_json(const FrameState& state) {
+  nlohmann::json rows = nlohmann::json::array();
+  for (int r = 0; r < 4; ++r) {
+    nlohmann::json row = nlohmann::json::array();
+    for (int c = 0; c < 4; ++c) row.push_back(state.T_world_eye[c][r]);
+    rows.push_back(row);
+  }
+  return {{"frame", state.frame}, {"time_s", state.time_s}, {"T_world_eye", rows}};
+}
+
+FrameState frame_state_from_json(const nlohmann::json& value, const std::string& source) {
+  FrameState state;
+  if (!value.is_object()) throw InputError(source, "(root)", "expected a JSON object");
+  if (!value.contains("frame") || !value["frame"].is_number_unsigned())
+    throw InputError(source, "frame", "expected a non-negative integer");
+  state.frame = value["frame"].get<std::uint64_t>();
+  if (!value.contains("time_s") || !value["time_s"].is_number() ||
+      !std::isfinite(value["time_s"].get<double>()))
+    throw InputError(source, "time_s", "expected a finite number of seconds");
+  state.time_s = value["time_s"].get<double>();
+  const nlohmann::json* rows = value.contains("T_world_eye") ? &value["T_world_eye"] : nullptr;
+  if (!rows || !rows->is_array() || rows->size() != 4)
+    throw InputError(source, "T_world_eye", "expected a 4x4 matrix as a list of 4 rows");
+  for (int r = 0; r < 4; ++r) {
+    const nlohmann::json& row = (*rows)[r];
+    if (!row.is_array() || row.size() != 4)
+      throw InputError(source, "T_world_eye[" + std::to_string(r) + "]", "expected 4 numbers");
+    for (int c = 0; c < 4; ++c) {
+      if (!row[c].is_number() || !std::isfinite(row[c].get<double>()))
+        throw InputError(source,
+                         "T_world_eye[" + std::to_string(r) + "][" + std::to_string(c) + "]",
+                         "expected a finite number");
+      state.T_world_eye[c][r] = row[c].get<double>();
+    }
+  }
+  return state;
+}
+
+std::uint64_t FrameStats::triangles_in() const {
+  std::uint64_t sum = 0;
+  for (const OutputFrameStats& output : outputs) sum += output.render.triangles_in;
+  return sum;
+}
+
+std::uint64_t FrameStats::replicas() const {
+  std::uint64_t sum = 0;
+  for (const OutputFrameStats& output : outputs) sum += output.render.replicas;
+  return sum;
+}
+
+double FrameStats::replication_ratio() const {
+  const std::uint64_t in = triangles_in();
+  return in == 0 ? 0.0 : double(replicas()) / double(in);
+}
+
+nlohmann::json frame_stats_to_json(const FrameStats& stats) {
+  nlohmann::json outputs = nlohmann::json::array();
+  for (const OutputFrameStats& output : stats.outputs) {
+    outputs.push_back({{"name", output.name},
+                       {"rendered", output.rendered},
+                       {"triangles_in", output.render.triangles_in},
+                       {"triangles_visible", output.render.triangles_visible},
+                       {"replicas", output.render.replicas},
+                       {"facets", output.render.facets},
+                       {"reused_replication", output.render.reused_replication},
+                       {"blend_tiles", output.blend_tiles}});
+  }
+  nlohmann::json passes = nlohmann::json::object();
+  for (const PassTime& pass : stats.pass_ms) passes[pass.pass] = pass.milliseconds;
+  return {{"frame", stats.frame},
+          {"time_s", stats.time_s},
+          {"cpu_ms", stats.cpu_ms},
+          {"triangles_in", stats.triangles_in()},
+          {"replicas", stats.replicas()},
+          {"replication_ratio", stats.replication_ratio()},
+          {"pass_ms", passes},
+          {"outputs", outputs}};
+}
+
+Session::Session(SessionDisplay display, const Scene& scene)
+    : display_(std::move(display)), scene_(&scene), gpu_scene_(upload_scene(scene)) {
+  for (const SessionOutput& output : display_.outputs) {
+    const Warp& warp = output.spec.warp;
+    std::unique_ptr<RenderMethod> method = make_render_method(display_.method);
+    method->prepare(scene, gpu_scene_, std::span(&output.spec, 1), display_.settings);
+    methods_.push_back(std::move(method));
+    targets_.push_back(OutputTarget::create(warp.output_size, display_.settings.msaa_samples));
+    blends_.emplace_back(warp.output_size, output.blend, output.encoding);
+
+    // The cone around every covered direction: the axis is the mean direction, and the half angle
+    // the largest angle to a sample plus the largest angle between neighbouring samples, so no
+    // covered direction between samples falls outside.
+    constexpr int kSamples = 65;
+    std::vector<glm::dvec3> v_covered;
+    glm::dvec3 sum{0.0};
+    double spacing = 0;
+    for (int j = 0; j < kSamples; ++j) {
+      for (int i = 0; i < kSamples; ++i) {
+        const glm::dvec2 st(i / double(kSamples - 1), j / double(kSamples - 1));
+        const glm::dvec3 v = glm::normalize(warp.v_eye_from_st(st));
+        if (i > 0) {
+          const glm::dvec2 left((i - 1) / double(kSamples - 1), st.y);
+          spacing = std::max(spacing, angle_between(v, glm::normalize(warp.v_eye_from_st(left))));
+        }
+        if (j > 0) {
+          const glm::dvec2 up(st.x, (j - 1) / double(kSamples - 1));
+          spacing = std::max(spacing, angle_between(v, glm::normalize(warp.v_eye_from_st(up))));
+        }
+        if (warp.coverage_at(st) > 0) {
+          v_covered.push_back(v);
+          sum += v;
+        }
+      }
+    }
+    CoverageCone cone;
+    if (v_covered.empty()) {
+      cone.half_angle = -1;  // covers nothing
+    } else if (glm::length(sum) < 1e-6 * double(v_covered.size())) {
+      cone.half_angle = 2 * std::numbers::pi;
+    } else {
+      cone.axis = glm::normalize(sum);
+      for (const glm::dvec3& v : v_covered)
+        cone.half_angle = std::max(cone.half_angle, angle_between(cone.axis, v));
+      cone.half_angle += spacing;
+    }
+    cones_.push_back(cone);
+  }
+}
+
+Session::~Session() = default;
+
+bool Session::output_sees_scene(std::size_t index, const glm::dmat4& T_world_eye) const {
+  const CoverageCone& cone = cones_.at(index);
+  if (cone.half_angle < 0) return false;
+  if (cone.half_angle >= std::numbers::pi) return !scene_->objects.empty();
+  const glm::dmat4 T_eye_world = glm::inverse(T_world_eye);
+  constexpr double kRightAngle = std::numbers::pi / 2;
+  for (const Object& object : scene_->objects) {
+    const Aabb& box = object.bounds_world;
+    if (box.empty()) continue;
+    if (box.contains(glm::vec3(T_world_eye[3]))) return true;
+    // Seen from outside, the box lies inside the cone around the direction to its centre whose
+    // half angle is the largest angle to a corner, as long as that angle is below 90° (such a
+    // cone is convex, so the corners' hull stays inside it).
+    const glm::dvec3 centre_eye(T_eye_world * glm::dvec4(glm::dvec3(box.centre()), 1.0));
+    double box_half_angle = 0;
+    for (int corner = 0; corner < 8; ++corner) {
+      const glm::dvec3 p_world(corner & 1 ? box.p_max.x : box.p_min.x,
+                               corner & 2 ? box.p_max.y : box.p_min.y,
+                               corner & 4 ? box.p_max.z : box.p_min.z);
+      const glm::dvec3 p_eye(T_eye_world * glm::dvec4(p_world, 1.0));
+      box_half_angle = std::max(box_half_angle, angle_between(centre_eye, p_eye));
+    }
+    if (box_half_angle >= kRightAngle) return true;
+    if (angle_between(cone.axis, centre_eye) <= cone.half_angle + box_half_angle) return true;
+  }
+  return false;
+}
+
+FrameStats Session::render(const FrameState& state, bool finish) {
+  const auto start = std::chrono::steady_clock::now();
+  FrameStats stats;
+  stats.frame = state.frame;
+  stats.time_s = state.time_s;
+  const glm::dmat4 T_eye_world = glm::inverse(state.T_world_eye);
+  for (std::size_t i = 0; i < methods_.size(); ++i) {
+    OutputFrameStats output;
+    output.name = display_.outputs[i].spec.name;
+    targets_[i].clear();
+    if (output_sees_scene(i, state.T_world_eye)) {
+      output.rendered = true;
+      output.render = methods_[i]->render(T_eye_world, std::span(&targets_[i], 1), &timer_);
+    }
+    {
+      auto scope = timer_.scope("blend");
+      blends_[i].apply(targets_[i].colour());
+    }
+    output.blend_tiles = blends_[i].tiles_listed();
+    stats.outputs.push_back(std::move(output));
+  }
+  timer_.end_frame();
+  // Timer results arrive a few frames late; report the newest complete frame, summed per pass.
+  while (auto frame = timer_.poll(finish)) {
+    std::map<std::string, double> sums;
+    std::vector<PassTime> ordered;
+    for (const PassTime& pass : *frame) {
+      if (!sums.contains(pass.pass)) ordered.push_back({pass.pass, 0});
+      sums[pass.pass] += pass.milliseconds;
+    }
+    for (PassTime& pass : ordered) pass.milliseconds = sums[pass.pass];
+    last_pass_ms_ = std::move(ordered);
+  }
+  stats.pass_ms = last_pass_ms_;
+  if (finish) glFinish();
+  stats.cpu_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  return stats;
+}
+
+}  // namespace facet::driver

@@ -1,0 +1,480 @@
+#include "facet/driver/session_runner.hpp"
+
+#include <epoxy/gl.h>
+#define GLFW_INCLUDE_NONE
+#include <GLFW/glfw3.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <glm/gtc/matrix_transform.hpp>
+#include <limits>
+
+#include "facet/driver/city.hpp"
+#include "facet/driver/gl_context.hpp"
+#include "facet/driver/output_images.hpp"
+#include "facet/driver/program.hpp"
+#include "facet/projection/atomic_file.hpp"
+#include "facet/projection/errors.hpp"
+
+// stb_easy_font turns text into quads; it is a single header with internal linkage.
+#if defined(__GNUC__)
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wconversion"
+#pragma GCC diagnostic ignored "-Wsign-conversion"
+#pragma GCC diagnostic ignored "-Wshadow"
+#pragma GCC diagnostic ignored "-Wunused-function"
+#pragma GCC diagnostic ignored "-Wmissing-field-initializers"
+#endif
+#include <stb/stb_easy_font.h>
+#if defined(__GNUC__)
+#pragma GCC diagnostic pop
+#endif
+
+namespace facet::driver {
+
+namespace fs = std::filesystem;
+
+CameraPath default_camera_path(const Scene& scene, bool builtin_city) {
+  if (builtin_city) {
+    auto city_path = std::make_shared<CityCameraPath>();
+    return [city_path](double time_s) { return city_path->T_world_eye(time_s); };
+  }
+  const Aabb bounds = scene.bounds_world();
+  const glm::dvec3 centre = bounds.empty() ? glm::dvec3(0) : glm::dvec3(bounds.centre());
+  return [centre](double time_s) {
+    // One turn a minute, so a whole dome sees every side of the model.
+    const double yaw = 2 * 3.14159265358979323846 * time_s / 60.0;
+    return glm::rotate(glm::translate(glm::dmat4(1.0), centre), yaw, glm::dvec3(0, 1, 0));
+  };
+}
+
+namespace {
+
+bool holds_earlier_run_or_nothing(const fs::path& dir) {
+  if (!fs::exists(dir)) return true;
+  if (!fs::is_directory(dir)) return false;
+  return fs::is_empty(dir) || fs::exists(dir / "stats.jsonl");
+}
+
+std::string frame_file_name(std::uint64_t frame) {
+  char name[32];
+  std::snprintf(name, sizeof name, "%05llu.png", static_cast<unsigned long long>(frame));
+  return name;
+}
+
+}  // namespace
+
+HeadlessRunResult run_headless_session(Session& session, const CameraPath& path,
+                                       const HeadlessRunOptions& options) {
+  const fs::path out_dir = options.out_dir;
+  if (out_dir.empty()) throw InputError("command line", "--out", "expected an output folder");
+  if (!holds_earlier_run_or_nothing(out_dir))
+    throw InputError(out_dir.string(), "--out",
+                     "an empty folder, a folder from an earlier 'facet run', or a new path");
+  const fs::path parent = out_dir.has_parent_path() ? out_dir.parent_path() : fs::path(".");
+  fs::create_directories(parent);
+  const fs::path temporary =
+      parent / ("." + out_dir.filename().string() + ".tmp" + std::to_string(::getpid()));
+  fs::remove_all(temporary);
+
+  HeadlessRunResult result;
+  try {
+    fs::create_directories(temporary);
+    for (const SessionOutput& output : session.display().outputs)
+      fs::create_directories(temporary / output.spec.name);
+    std::ofstream stats_file(temporary / "stats.jsonl");
+    for (std::uint64_t frame = 0; frame < options.frames; ++frame) {
+      FrameState state;
+      state.frame = frame;
+      state.time_s = double(frame) * kFramePeriod_s;
+      state.T_world_eye = path(state.time_s);
+      FrameStats stats = session.render(state, options.finish_each_frame);
+      stats_file << frame_stats_to_json(stats).dump() << '\n';
+      for (std::size_t i = 0; i < session.targets().size(); ++i) {
+        const OutputTarget& target = session.targets()[i];
+        const fs::path image =
+            fs::path(session.display().outputs[i].spec.name) / frame_file_name(frame);
+        write_png_rgba8(temporary / image, target.size(), target.read_colour_rgba8());
+        result.images.push_back(out_dir / image);
+      }
+      result.frames.push_back(std::move(stats));
+    }
+    stats_file.close();
+    if (!stats_file)
+      throw std::runtime_error((out_dir / "stats.jsonl").string() + ": write failed");
+    fs::remove_all(out_dir);
+    fs::rename(temporary, out_dir);
+  } catch (...) {
+    std::error_code ignored;
+    fs::remove_all(temporary, ignored);
+    throw;
+  }
+  return result;
+}
+
+namespace {
+
+// Keyboard and mouse state shared by every window of a session.
+struct Navigation {
+  bool play_path = true;
+  bool overlay = false;
+  bool quit = false;
+  glm::dvec3 position{0.0};
+  double yaw = 0, pitch = 0;  // radians; yaw about world up, pitch about the eye's x
+  bool dragging = false;
+  glm::dvec2 last_cursor{0.0};
+  std::vector<std::string> messages;
+
+  glm::dmat4 T_world_eye() const {
+    glm::dmat4 T = glm::translate(glm::dmat4(1.0), position);
+    T = glm::rotate(T, yaw, glm::dvec3(0, 1, 0));
+    return glm::rotate(T, pitch, glm::dvec3(1, 0, 0));
+  }
+  // Takes over from the camera path at its current pose.
+  void take_over(const glm::dmat4& T_world_eye_now) {
+    if (!play_path) return;
+    play_path = false;
+    position = glm::dvec3(T_world_eye_now[3]);
+    const glm::dvec3 forward = -glm::dvec3(T_world_eye_now[2]);
+    yaw = std::atan2(-forward.x, -forward.z);
+    pitch = std::asin(std::clamp(forward.y, -1.0, 1.0));
+  }
+};
+
+Navigation* navigation_of(GLFWwindow* window) {
+  return static_cast<Navigation*>(glfwGetWindowUserPointer(window));
+}
+
+void on_key(GLFWwindow* window, int key, int, int action, int) {
+  Navigation& nav = *navigation_of(window);
+  if (action != GLFW_PRESS) return;
+  if (key == GLFW_KEY_ESCAPE) nav.quit = true;
+  if (key == GLFW_KEY_P) nav.play_path = !nav.play_path;
+  if (key == GLFW_KEY_O) nav.overlay = !nav.overlay;
+}
+
+void on_mouse_button(GLFWwindow* window, int button, int action, int) {
+  Navigation& nav = *navigation_of(window);
+  if (button != GLFW_MOUSE_BUTTON_LEFT) return;
+  nav.dragging = action == GLFW_PRESS;
+  glfwGetCursorPos(window, &nav.last_cursor.x, &nav.last_cursor.y);
+}
+
+Navigation* monitor_messages = nullptr;
+
+void on_monitor(GLFWmonitor* monitor, int event) {
+  const char* name = glfwGetMonitorName(monitor);
+  const std::string message = std::string("monitor ") + (name ? name : "?") +
+                              (event == GLFW_CONNECTED ? " connected" : " disconnected") +
+                              "; windows stay where they are";
+  std::fprintf(stderr, "facet run: %s\n", message.c_str());
+  if (monitor_messages) monitor_messages->messages.push_back(message);
+}
+
+struct Window {
+  std::unique_ptr<GlfwWindowContext> context;
+  std::vector<std::size_t> outputs;   // indices of the outputs it shows
+  std::vector<glm::ivec4> viewports;  // where each shows, framebuffer pixels (GL, from bottom)
+  std::vector<OutputPlacement> placements;
+  VertexArray vertex_array;  // per context: vertex arrays are not shared
+  Buffer overlay_vertices;
+};
+
+// Moves the eye with the held keys and the dragged mouse, scaled by the frame time.
+void steer(Navigation& nav, GLFWwindow* window, double dt, const glm::dmat4& T_world_eye_now) {
+  const double speed = 6.0, turn = 1.2;  // m/s, rad/s
+  glm::dvec3 move{0.0};
+  if (glfwGetKey(window, GLFW_KEY_W) == GLFW_PRESS) move.z -= 1;
+  if (glfwGetKey(window, GLFW_KEY_S) == GLFW_PRESS) move.z += 1;
+  if (glfwGetKey(window, GLFW_KEY_A) == GLFW_PRESS) move.x -= 1;
+  if (glfwGetKey(window, GLFW_KEY_D) == GLFW_PRESS) move.x += 1;
+  if (glfwGetKey(window, GLFW_KEY_Q) == GLFW_PRESS) move.y -= 1;
+  if (glfwGetKey(window, GLFW_KEY_E) == GLFW_PRESS) move.y += 1;
+  double yaw_rate = 0, pitch_rate = 0;
+  if (glfwGetKey(window, GLFW_KEY_LEFT) == GLFW_PRESS) yaw_rate += turn;
+  if (glfwGetKey(window, GLFW_KEY_RIGHT) == GLFW_PRESS) yaw_rate -= turn;
+  if (glfwGetKey(window, GLFW_KEY_UP) == GLFW_PRESS) pitch_rate += turn;
+  if (glfwGetKey(window, GLFW_KEY_DOWN) == GLFW_PRESS) pitch_rate -= turn;
+  glm::dvec2 drag{0.0};
+  if (nav.dragging) {
+    glm::dvec2 cursor;
+    glfwGetCursorPos(window, &cursor.x, &cursor.y);
+    drag = cursor - nav.last_cursor;
+    nav.last_cursor = cursor;
+  }
+  if (move == glm::dvec3(0.0) && yaw_rate == 0 && pitch_rate == 0 && drag == glm::dvec2(0.0))
+    return;
+  nav.take_over(T_world_eye_now);
+  nav.yaw += yaw_rate * dt - drag.x * 0.004;
+  nav.pitch = std::clamp(nav.pitch + pitch_rate * dt - drag.y * 0.004, -1.5, 1.5);
+  const glm::dmat3 R_world_eye(nav.T_world_eye());
+  nav.position += R_world_eye * move * speed * dt;
+}
+
+// Triangles (x, y in window pixels from the top left) for `text` at (x, y).
+std::vector<float> overlay_triangles(const std::string& text, float x, float y) {
+  std::vector<char> quads(text.size() * 270 + 64);
+  std::string mutable_text = text;
+  const int quad_count =
+      stb_easy_font_print(x, y, mutable_text.data(), nullptr, quads.data(), int(quads.size()));
+  std::vector<float> triangles;
+  triangles.reserve(std::size_t(quad_count) * 12);
+  auto vertex = [&](int quad, int corner) {
+    float xyz[3];
+    std::memcpy(xyz, quads.data() + (std::size_t(quad) * 4 + corner) * 16, sizeof xyz);
+    triangles.push_back(xyz[0]);
+    triangles.push_back(xyz[1]);
+  };
+  for (int q = 0; q < quad_count; ++q)
+    for (int corner : {0, 1, 2, 0, 2, 3}) vertex(q, corner);
+  return triangles;
+}
+
+}  // namespace
+
+void run_windowed_session(const SessionDisplay& display, const Scene& scene, const CameraPath& path,
+                          const WindowRunOptions& options) {
+  const std::vector<MonitorInfo> monitors = list_monitors();
+  std::vector<OutputPlacement> placements;
+  for (std::size_t i = 0; i < display.outputs.size(); ++i) {
+    placements.push_back(place_output(display.outputs[i].placement, monitors,
+                                      display.missing_monitor,
+                                      display.outputs[i].spec.warp.output_size, display.source,
+                                      "projectors[" + std::to_string(i) + "].output.monitor"));
+  }
+
+  Navigation nav;
+  nav.play_path = options.play_path;
+  nav.overlay = options.overlay;
+  monitor_messages = &nav;
+
+  std::vector<Window> windows;
+  auto open_window = [&](WindowOptions window_options) {
+    Window window;
+    window_options.share = windows.empty() ? nullptr : windows.front().context.get();
+    window_options.title = "facet";
+    window.context = std::make_unique<GlfwWindowContext>(window_options);
+    auto* native = static_cast<GLFWwindow*>(window.context->native_window());
+    glfwSetWindowUserPointer(native, &nav);
+    glfwSetKeyCallback(native, on_key);
+    glfwSetMouseButtonCallback(native, on_mouse_button);
+    return window;
+  };
+  if (options.span) {
+    glm::ivec2 low(std::numeric_limits<int>::max()), high(std::numeric_limits<int>::min());
+    for (const OutputPlacement& p : placements) {
+      low = glm::min(low, glm::ivec2(p.rect.x, p.rect.y));
+      high = glm::max(high, glm::ivec2(p.rect.x + p.rect.z, p.rect.y + p.rect.w));
+    }
+    WindowOptions spanning;
+    spanning.position = low;
+    spanning.width = high.x - low.x;
+    spanning.height = high.y - low.y;
+    spanning.decorated = false;
+    Window window = open_window(spanning);
+    for (std::size_t i = 0; i < placements.size(); ++i) {
+      const glm::ivec4& r = placements[i].rect;
+      window.outputs.push_back(i);
+      // Desktop y grows down, GL viewports up from the bottom.
+      window.viewports.emplace_back(r.x - low.x, high.y - (r.y + r.w), r.z, r.w);
+      window.placements.push_back(placements[i]);
+    }
+    windows.push_back(std::move(window));
+  } else {
+    for (std::size_t i = 0; i < placements.size(); ++i) {
+      WindowOptions one;
+      const OutputPlacement& p = placements[i];
+      if (p.kind == OutputPlacement::Kind::fullscreen) {
+        one.monitor = p.monitor;
+      } else {
+        one.position = glm::ivec2(p.rect.x, p.rect.y);
+        one.width = p.rect.z;
+        one.height = p.rect.w;
+      }
+      Window window = open_window(one);
+      const glm::ivec2 size = window.context->framebuffer_size();
+      window.outputs.push_back(i);
+      window.viewports.emplace_back(0, 0, size.x, size.y);
+      window.placements.push_back(p);
+      windows.push_back(std::move(window));
+    }
+  }
+  glfwSetMonitorCallback(on_monitor);
+  std::printf("facet run: %zu windows open:", windows.size());
+  for (std::size_t i = 0; i < placements.size(); ++i)
+    std::printf(" %s at %d,%d %dx%d (%s)", display.outputs[i].spec.name.c_str(),
+                placements[i].rect.x, placements[i].rect.y, placements[i].rect.z,
+                placements[i].rect.w, placements[i].how.c_str());
+  std::printf("\n");
+  std::fflush(stdout);
+
+  windows.front().context->make_current();
+  Session session(display, scene);
+  std::vector<Texture> raw_views;
+  for (const OutputTarget& target : session.targets())
+    raw_views.push_back(Texture::create_view(target.colour(), GL_RGBA8));
+  const Program present =
+      ProgramBuilder().shader("output/present.vert").shader("output/present.frag").link();
+  const Program overlay =
+      ProgramBuilder().shader("output/overlay.vert").shader("output/overlay.frag").link();
+  for (Window& window : windows) {
+    window.context->make_current();
+    window.vertex_array = VertexArray::create();
+  }
+
+  struct WindowReport {
+    glm::ivec2 position{0}, framebuffer{0};
+    std::vector<long long> mismatched_bytes;
+  };
+  std::vector<WindowReport> reports(windows.size());
+  double time_s = 0;
+  auto last = std::chrono::steady_clock::now();
+  double fps = 0;
+  FrameStats stats;
+  for (std::uint64_t frame = 0; !options.frames || frame < *options.frames; ++frame) {
+    glfwPollEvents();
+    bool closing = nav.quit;
+    for (const Window& window : windows) closing = closing || window.context->should_close();
+    if (closing) break;
+    const auto now = std::chrono::steady_clock::now();
+    const double dt = std::chrono::duration<double>(now - last).count();
+    last = now;
+    if (frame > 0) fps = fps == 0 ? 1 / dt : 0.9 * fps + 0.1 / dt;
+    const glm::dmat4 T_path = path(time_s);
+    steer(nav, static_cast<GLFWwindow*>(windows.front().context->native_window()), dt,
+          nav.play_path ? T_path : nav.T_world_eye());
+    if (nav.play_path) time_s += options.frames ? kFramePeriod_s : dt;
+
+    windows.front().context->make_current();
+    FrameState state{frame, time_s, nav.play_path ? T_path : nav.T_world_eye()};
+    stats = session.render(state);
+    // The other contexts read the outputs: make the rendering visible to them first.
+    GLsync rendered = glFenceSync(GL_SYNC_GPU_COMMANDS_COMPLETE, 0);
+    glFlush();
+
+    std::string overlay_text;
+    if (nav.overlay) {
+      char line[160];
+      std::snprintf(line, sizeof line, "%.1f fps   replication %.2f   frame %llu\n", fps,
+                    stats.replication_ratio(), static_cast<unsigned long long>(frame));
+      overlay_text = line;
+      for (const PassTime& pass : stats.pass_ms) {
+        std::snprintf(line, sizeof line, "%-14s %7.3f ms\n", pass.pass.c_str(), pass.milliseconds);
+        overlay_text += line;
+      }
+    }
+    const bool last_frame = options.frames && frame + 1 == *options.frames;
+    for (std::size_t w = 0; w < windows.size(); ++w) {
+      Window& window = windows[w];
+      window.context->make_current();
+      glWaitSync(rendered, 0, GL_TIMEOUT_IGNORED);
+      glBindFramebuffer(GL_FRAMEBUFFER, 0);
+      glDisable(GL_FRAMEBUFFER_SRGB);  // the views hold the encoded bytes already
+      glDisable(GL_DEPTH_TEST);
+      glDisable(GL_BLEND);
+      const glm::ivec2 size = window.context->framebuffer_size();
+      glViewport(0, 0, size.x, size.y);
+      glClearColor(0, 0, 0, 1);
+      glClear(GL_COLOR_BUFFER_BIT);
+      present.use();
+      glBindVertexArray(window.vertex_array.id());
+      for (std::size_t k = 0; k < window.outputs.size(); ++k) {
+        const glm::ivec4& v = window.viewports[k];
+        const glm::ivec2 output_size = session.targets()[window.outputs[k]].size();
+        glViewport(v.x, v.y, v.z, v.w);
+        glUniform2i(0, v.x, v.y);
+        glUniform2f(1, float(output_size.x) / float(v.z), float(output_size.y) / float(v.w));
+        raw_views[window.outputs[k]].bind_unit(0);
+        glDrawArrays(GL_TRIANGLES, 0, 3);
+      }
+      if (last_frame && options.report) {
+        // Exactly the output's bytes, as the projector would receive them?
+        WindowReport& report = reports[w];
+        glfwGetWindowPos(static_cast<GLFWwindow*>(window.context->native_window()),
+                         &report.position.x, &report.position.y);
+        report.framebuffer = size;
+        report.mismatched_bytes.clear();
+        for (std::size_t k = 0; k < window.outputs.size(); ++k) {
+          const glm::ivec4& v = window.viewports[k];
+          const OutputTarget& target = session.targets()[window.outputs[k]];
+          if (glm::ivec2(v.z, v.w) != target.size()) {
+            report.mismatched_bytes.push_back(-1);  // scaled: not comparable byte for byte
+            continue;
+          }
+          std::vector<std::uint8_t> shown(std::size_t(v.z) * v.w * 4);
+          glPixelStorei(GL_PACK_ALIGNMENT, 1);
+          glReadBuffer(GL_BACK);
+          glReadPixels(v.x, v.y, v.z, v.w, GL_RGBA, GL_UNSIGNED_BYTE, shown.data());
+          windows.front().context->make_current();
+          const std::vector<std::uint8_t> expected = target.read_colour_rgba8();
+          window.context->make_current();
+          long long mismatched = 0;
+          for (int y = 0; y < v.w; ++y)
+            for (int x = 0; x < v.z; ++x)
+              for (int c = 0; c < 3; ++c)
+                mismatched += shown[(std::size_t(v.w - 1 - y) * v.z + x) * 4 + c] !=
+                              expected[(std::size_t(y) * v.z + x) * 4 + c];
+          report.mismatched_bytes.push_back(mismatched);
+        }
+      }
+      if (!overlay_text.empty()) {
+        const std::vector<float> triangles = overlay_triangles(overlay_text, 12, 12);
+        window.overlay_vertices = Buffer::create_from(triangles);
+        glViewport(0, 0, size.x, size.y);
+        overlay.use();
+        glUniform2f(0, float(size.x), float(size.y));
+        glBindVertexArray(window.vertex_array.id());
+        window.overlay_vertices.bind_base(GL_SHADER_STORAGE_BUFFER, 0);
+        glDrawArrays(GL_TRIANGLES, 0, GLsizei(triangles.size() / 2));
+      }
+      window.context->swap_buffers();
+    }
+    windows.front().context->make_current();
+    glDeleteSync(rendered);
+  }
+
+  if (options.report) {
+    nlohmann::json windows_json = nlohmann::json::array();
+    for (std::size_t w = 0; w < windows.size(); ++w) {
+      nlohmann::json outputs_json = nlohmann::json::array();
+      for (std::size_t k = 0; k < windows[w].outputs.size(); ++k) {
+        const OutputPlacement& p = windows[w].placements[k];
+        const std::size_t index = windows[w].outputs[k];
+        outputs_json.push_back(
+            {{"name", display.outputs[index].spec.name},
+             {"placement", p.kind == OutputPlacement::Kind::fullscreen ? "fullscreen" : "window"},
+             {"how", p.how},
+             {"monitor", p.monitor >= 0 ? monitors[std::size_t(p.monitor)].name : ""},
+             {"rect", {p.rect.x, p.rect.y, p.rect.z, p.rect.w}},
+             {"mismatched_bytes",
+              k < reports[w].mismatched_bytes.size() ? reports[w].mismatched_bytes[k] : -1}});
+      }
+      windows_json.push_back({{"position", {reports[w].position.x, reports[w].position.y}},
+                              {"framebuffer", {reports[w].framebuffer.x, reports[w].framebuffer.y}},
+                              {"outputs", outputs_json}});
+    }
+    const nlohmann::json report = {{"windows", windows_json},
+                                   {"monitor_events", nav.messages},
+                                   {"last_frame", frame_stats_to_json(stats)}};
+    write_atomically(*options.report, [&](const fs::path& temporary) {
+      std::ofstream(temporary) << report.dump(2) << '\n';
+    });
+  }
+  monitor_messages = nullptr;
+  glfwSetMonitorCallback(nullptr);
+  // Vertex arrays belong to their own context: delete each with its context current.
+  for (Window& window : windows) {
+    window.context->make_current();
+    window.vertex_array.reset();
+    window.overlay_vertices.reset();
+  }
+  windows.front().context->make_current();
+  raw_views.clear();
+}
+
+}  // namespace facet::driver

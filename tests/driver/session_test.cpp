@@ -1,0 +1,216 @@
+// Sessions: the frame state as a sendable value, display loading, rendering every output with
+// its blend, skipping outputs that see nothing, and the headless runner's files.
+#include "facet/driver/session.hpp"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "facet/driver/session_runner.hpp"
+#include "facet/projection/errors.hpp"
+#include "facet/projection_io/blend_file.hpp"
+#include "facet/projection_io/warp_file.hpp"
+#include "gl_test_context.hpp"
+
+namespace facet::driver {
+namespace {
+
+namespace fs = std::filesystem;
+
+fs::path fresh_folder(const std::string& name) {
+  const fs::path folder = fs::temp_directory_path() / ("facet_session_test_" + name);
+  fs::remove_all(folder);
+  fs::create_directories(folder);
+  return folder;
+}
+
+// A 20 m square wall facing +z at z = -5 (in front of an eye at the origin looking down -z).
+Scene wall_scene() {
+  Scene scene;
+  scene.name = "wall";
+  scene.positions = {{-10, -10, -5}, {10, -10, -5}, {10, 10, -5}, {-10, 10, -5}};
+  scene.normals.assign(4, glm::vec3(0, 0, 1));
+  scene.uvs = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+  scene.indices = {0, 1, 2, 0, 2, 3};
+  scene.primitives = {{0, 6, 0}};
+  Material grey;
+  grey.base_colour = {0.5f, 0.5f, 0.5f, 1.0f};
+  scene.materials = {grey};
+  Object wall;
+  wall.name = "wall";
+  wall.first_primitive = 0;
+  wall.primitive_count = 1;
+  scene.objects = {wall};
+  scene.update_bounds();
+  return scene;
+}
+
+Warp looking(double yaw_deg, glm::ivec2 size) {
+  const double yaw = glm::radians(yaw_deg);
+  const glm::dmat3 R_eye_base(glm::dvec3(std::cos(yaw), 0, -std::sin(yaw)), glm::dvec3(0, 1, 0),
+                              glm::dvec3(std::sin(yaw), 0, std::cos(yaw)));
+  return Warp::analytic(BaseProjection::perspective(-0.5, 0.5, 0.4, -0.4), size, {2, 2},
+                        R_eye_base);
+}
+
+TEST(FrameState, RoundTripsThroughJson) {
+  FrameState state;
+  state.frame = 42;
+  state.time_s = 0.7;
+  state.T_world_eye = glm::dmat4(1.0);
+  state.T_world_eye[3] = glm::dvec4(1.5, 1.7, -3.25, 1.0);
+  state.T_world_eye[0][1] = 0.125;
+  const nlohmann::json json = frame_state_to_json(state);
+  EXPECT_EQ(frame_state_from_json(nlohmann::json::parse(json.dump()), "state"), state);
+}
+
+TEST(FrameState, RejectsMalformedValues) {
+  nlohmann::json json = frame_state_to_json(FrameState{});
+  json["T_world_eye"][2][1] = "x";
+  try {
+    frame_state_from_json(json, "broadcast");
+    FAIL() << "expected InputError";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("T_world_eye[2][1]"), std::string::npos) << e.what();
+  }
+  json = frame_state_to_json(FrameState{});
+  json.erase("time_s");
+  EXPECT_THROW(frame_state_from_json(json, "broadcast"), InputError);
+}
+
+TEST(SessionDisplay, BuiltinsGetOneWindowAndNoBlend) {
+  const SessionDisplay display = load_session_display("builtin:cylinder360", glm::ivec2(320, 240));
+  ASSERT_EQ(display.outputs.size(), 1u);
+  EXPECT_EQ(display.outputs[0].spec.warp.output_size, glm::ivec2(320, 240));
+  EXPECT_TRUE(display.outputs[0].blend.alpha.empty());
+  EXPECT_FALSE(display.outputs[0].encoding.gamma.has_value());
+  EXPECT_THROW(load_session_display("builtin:nothing"), InputError);
+}
+
+// A display.json with two projectors: "front" looks at the wall, "back" the other way.
+fs::path write_two_projector_display(const fs::path& folder, bool with_blend) {
+  const glm::ivec2 size(64, 48);
+  projection_io::DisplayConfig config;
+  config.name = "two";
+  for (const auto& [name, yaw] : {std::pair<std::string, double>{"front", 0.0}, {"back", 180.0}}) {
+    write_warp((folder / (name + ".warp.exr")).string(), looking(yaw, size));
+    projection_io::DisplayProjector projector;
+    projector.name = name;
+    projector.size = size;
+    projector.warp = name + ".warp.exr";
+    projector.output.kind = projection_io::DisplayOutput::Kind::window;
+    projector.output.window = {0, 0, size.x, size.y};
+    if (with_blend) {
+      // Left half weight 1, right half 0.5.
+      projection_io::BlendMap alpha = projection_io::BlendMap::constant(size, 1.0f);
+      for (int y = 0; y < size.y; ++y)
+        for (int x = size.x / 2; x < size.x; ++x) alpha.at(x, y) = 0.5f;
+      projection_io::write_blend_map((folder / (name + ".blend.exr")).string(), alpha);
+      projector.blend = name + ".blend.exr";
+    }
+    config.projectors.push_back(projector);
+  }
+  config.render.tolerance_px = 0.25;
+  const fs::path path = folder / "display.json";
+  projection_io::write_display_config(config, path);
+  return path;
+}
+
+TEST(Session, RendersOutputsThatSeeTheSceneAndSkipsTheOthers) {
+  test::shared_context();
+  const fs::path folder = fresh_folder("skip");
+  SessionDisplay display =
+      load_session_display(write_two_projector_display(folder, false).string());
+  const Scene scene = wall_scene();
+  Session session(display, scene);
+  EXPECT_TRUE(session.output_sees_scene(0, glm::dmat4(1.0)));
+  EXPECT_FALSE(session.output_sees_scene(1, glm::dmat4(1.0)));
+  const FrameStats stats = session.render(FrameState{}, true);
+  ASSERT_EQ(stats.outputs.size(), 2u);
+  EXPECT_TRUE(stats.outputs[0].rendered);
+  EXPECT_GT(stats.outputs[0].render.replicas, 0u);
+  EXPECT_FALSE(stats.outputs[1].rendered);
+  // The front output is all wall; the back one stays black.
+  const auto front = session.targets()[0].read_colour_rgba8();
+  const auto back = session.targets()[1].read_colour_rgba8();
+  const auto front_ids = session.targets()[0].read_ids();
+  for (std::uint32_t id : front_ids) ASSERT_NE(id, 0u);
+  for (std::size_t i = 0; i < back.size(); i += 4) ASSERT_EQ(back[i], 0);
+  // Turned around, the roles swap.
+  FrameState turned;
+  turned.T_world_eye = glm::dmat4(glm::dmat3(-1, 0, 0, 0, 1, 0, 0, 0, -1));
+  const FrameStats turned_stats = session.render(turned, true);
+  EXPECT_FALSE(turned_stats.outputs[0].rendered);
+  EXPECT_TRUE(turned_stats.outputs[1].rendered);
+}
+
+TEST(Session, BlendsInLinearLightAfterRendering) {
+  test::shared_context();
+  const fs::path plain_folder = fresh_folder("plain"), blend_folder = fresh_folder("blend");
+  const Scene scene = wall_scene();
+  Session plain(load_session_display(write_two_projector_display(plain_folder, false).string()),
+                scene);
+  Session blended(load_session_display(write_two_projector_display(blend_folder, true).string()),
+                  scene);
+  // Both displays encode with gamma 2.2 (the display.json default): the plain one has weight 1.
+  plain.render(FrameState{}, true);
+  const FrameStats stats = blended.render(FrameState{}, true);
+  EXPECT_GT(stats.outputs[0].blend_tiles, 0u);
+  const auto a = plain.targets()[0].read_colour_rgba8();
+  const auto b = blended.targets()[0].read_colour_rgba8();
+  const glm::ivec2 size = plain.targets()[0].size();
+  double worst_left = 0, worst_right = 0;
+  for (int y = 0; y < size.y; ++y) {
+    for (int x = 0; x < size.x; ++x) {
+      const std::size_t p = (std::size_t(y) * size.x + x) * 4;
+      // Decode with gamma 2.2 (the projector's encoding) and compare the light.
+      const double light_a = std::pow(a[p] / 255.0, 2.2), light_b = std::pow(b[p] / 255.0, 2.2);
+      if (x < size.x / 2)
+        worst_left = std::max(worst_left, std::abs(light_b - light_a));
+      else
+        worst_right = std::max(worst_right, std::abs(light_b - 0.5 * light_a));
+    }
+  }
+  // One 8-bit level of a mid-grey under gamma 2.2 is about 0.005 in linear light.
+  EXPECT_LE(worst_left, 0.006);
+  EXPECT_LE(worst_right, 0.006);
+}
+
+TEST(HeadlessRun, WritesFramesPerOutputAndStatistics) {
+  test::shared_context();
+  const fs::path folder = fresh_folder("headless");
+  const Scene scene = wall_scene();
+  Session session(load_session_display(write_two_projector_display(folder, false).string()), scene);
+  const fs::path out = folder / "run";
+  HeadlessRunOptions options;
+  options.frames = 3;
+  options.out_dir = out;
+  const CameraPath still = [](double) { return glm::dmat4(1.0); };
+  const HeadlessRunResult result = run_headless_session(session, still, options);
+  EXPECT_EQ(result.images.size(), 6u);
+  for (const char* file : {"front/00000.png", "front/00002.png", "back/00001.png", "stats.jsonl"})
+    EXPECT_TRUE(fs::exists(out / file)) << file;
+  std::ifstream stats(out / "stats.jsonl");
+  int lines = 0;
+  for (std::string line; std::getline(stats, line); ++lines) {
+    const nlohmann::json frame = nlohmann::json::parse(line);
+    EXPECT_EQ(frame["frame"], lines);
+    EXPECT_EQ(frame["outputs"].size(), 2u);
+    EXPECT_TRUE(frame.contains("replication_ratio"));
+  }
+  EXPECT_EQ(lines, 3);
+  // A second run replaces the first; a folder that is not a run is refused and left alone.
+  EXPECT_NO_THROW(run_headless_session(session, still, options));
+  const fs::path foreign = folder / "foreign";
+  fs::create_directories(foreign);
+  std::ofstream(foreign / "keep.txt") << "mine";
+  options.out_dir = foreign;
+  EXPECT_THROW(run_headless_session(session, still, options), InputError);
+  EXPECT_TRUE(fs::exists(foreign / "keep.txt"));
+  EXPECT_FALSE(fs::exists(foreign / "stats.jsonl"));
+}
+
+}  // namespace
+}  // namespace facet::driver

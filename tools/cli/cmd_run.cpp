@@ -1,0 +1,133 @@
+// facet run: an immersive session on a display, in windows on its projectors or headless.
+#include <cstdlib>
+#include <iostream>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "command.hpp"
+#include "display_flags.hpp"
+#include "facet/driver/city.hpp"
+#include "facet/driver/gl_context.hpp"
+#include "facet/driver/gltf_loader.hpp"
+#include "facet/driver/monitors.hpp"
+#include "facet/driver/session.hpp"
+#include "facet/driver/session_runner.hpp"
+#include "facet/projection/errors.hpp"
+
+namespace facet::cli {
+namespace {
+
+struct RunOptions {
+  std::string display = "builtin:dome180";
+  std::string scene = "builtin:city";
+  std::string size;
+  std::string method;
+  std::optional<double> tolerance;
+  bool headless = false, windowed = false;
+  std::uint64_t frames = 0;
+  std::string out = "out/session";
+  bool span = false, overlay = false, no_path = false;
+  std::string report;
+  bool monitors = false;
+};
+
+driver::Scene load_scene(const std::string& scene) {
+  if (scene == "builtin:city") return driver::build_city();
+  if (scene.starts_with("builtin:"))
+    throw InputError("command line", "--scene", "builtin:city or a .gltf/.glb file");
+  return driver::load_gltf(scene);
+}
+
+void run(const RunOptions& options) {
+  if (options.monitors) {
+    // Names and geometry to put in display.json outputs.
+    for (const driver::MonitorInfo& monitor : driver::list_monitors())
+      std::cout << monitor.name << " " << monitor.size.x << "x" << monitor.size.y << "+"
+                << monitor.position.x << "+" << monitor.position.y << " " << monitor.refresh_hz
+                << " Hz\n";
+    return;
+  }
+  std::optional<glm::ivec2> size;
+  if (!options.size.empty()) size = parse_size(options.size, "--size");
+  driver::SessionDisplay display = driver::load_session_display(options.display, size);
+  if (!options.method.empty()) display.method = options.method;
+  if (options.tolerance) {
+    if (!(*options.tolerance > 0))
+      throw InputError("command line", "--tolerance", "a positive number of output pixels");
+    display.settings.facets.layout = FacetTolerance{*options.tolerance};
+  }
+  // Check the method name before any scene work.
+  driver::make_render_method(display.method);
+  const driver::Scene scene = load_scene(options.scene);
+  const driver::CameraPath path =
+      driver::default_camera_path(scene, options.scene == "builtin:city");
+
+  const char* x_display = std::getenv("DISPLAY");
+  const char* wayland_display = std::getenv("WAYLAND_DISPLAY");
+  const bool have_display_server =
+      (x_display && *x_display) || (wayland_display && *wayland_display);
+  const bool headless = options.headless || (!options.windowed && !have_display_server);
+  if (!headless) {
+    driver::WindowRunOptions window_options;
+    if (options.frames > 0) window_options.frames = options.frames;
+    window_options.span = options.span;
+    window_options.overlay = options.overlay;
+    window_options.play_path = !options.no_path;
+    if (!options.report.empty()) window_options.report = options.report;
+    driver::run_windowed_session(display, scene, path, window_options);
+    return;
+  }
+  if (!options.headless)
+    std::cerr << "facet run: no display server (DISPLAY is not set): running headless\n";
+  auto context = driver::create_headless_context();
+  driver::Session session(display, scene);
+  driver::HeadlessRunOptions headless_options;
+  headless_options.frames = options.frames > 0 ? options.frames : 10;
+  headless_options.out_dir = options.out;
+  const driver::HeadlessRunResult result =
+      driver::run_headless_session(session, path, headless_options);
+  std::cout << "facet run: " << result.frames.size() << " frames of " << display.outputs.size()
+            << " output(s) (" << context->info().renderer << ", method " << display.method
+            << ") written to " << options.out << "/<output>/<frame>.png; statistics in "
+            << options.out << "/stats.jsonl\n";
+  if (!result.frames.empty()) {
+    const driver::FrameStats& last = result.frames.back();
+    std::cout << "facet run: last frame " << last.cpu_ms << " ms, replication ratio "
+              << last.replication_ratio() << "\n";
+  }
+}
+
+const Registration registration{
+    40, [](CLI::App& app) {
+      auto options = std::make_shared<RunOptions>();
+      auto* command = app.add_subcommand(
+          "run",
+          "Run an immersive session: a window per projector (or one spanning window), or "
+          "headless frames to files when there is no display server");
+      command->add_option("display", options->display,
+                          "builtin:dome180 (default), builtin:cylinder360, a .warp.exr or a "
+                          "display.json");
+      command->add_option("--scene", options->scene, "builtin:city (default) or a glTF 2.0 file");
+      command->add_option("--size", options->size, "Output size WxH of a built-in display");
+      command->add_option("--method", options->method,
+                          "facets, facets-gs, naive, cubemap or vertex (default: the display's)");
+      command->add_option("--tolerance", options->tolerance, "Facet tolerance in output pixels");
+      command->add_flag("--headless", options->headless, "Render through EGL to --out");
+      command->add_flag("--windowed", options->windowed, "Open windows even without DISPLAY");
+      command->add_option("--frames", options->frames,
+                          "Frames to render (headless default 10; windowed: until closed)");
+      command->add_option("--out", options->out,
+                          "Headless: folder for <output>/<frame>.png and stats.jsonl");
+      command->add_flag("--span", options->span, "One borderless window spanning every output");
+      command->add_flag("--overlay", options->overlay, "Start with the overlay shown (key O)");
+      command->add_flag("--no-path", options->no_path, "Start still instead of on the path");
+      command->add_option("--report", options->report,
+                          "Windowed: write window placement and shown-pixel checks to this JSON");
+      command->add_flag("--monitors", options->monitors,
+                        "List the connected monitors (name, size+x+y, refresh) and exit");
+      command->callback([options] { run(*options); });
+    }};
+
+}  // namespace
+}  // namespace facet::cli
