@@ -65,7 +65,7 @@ SessionDisplay load_session_display(std::string_view display, std::optional<glm:
       SessionOutput output;
       output.spec = std::move(specs.at(i));
       output.blend = blend_maps_from(config, projector);
-      output.encoding.gamma = projector.gamma;
+      output.encoding.gamma = projector.gamma;  // nullopt: sRGB
       output.placement = projector.output;
       result.outputs.push_back(std::move(output));
     }

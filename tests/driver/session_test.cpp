@@ -102,6 +102,7 @@ fs::path write_two_projector_display(const fs::path& folder, bool with_blend) {
     projector.warp = name + ".warp.exr";
     projector.output.kind = projection_io::DisplayOutput::Kind::window;
     projector.output.window = {0, 0, size.x, size.y};
+    projector.gamma = 2.2;
     if (with_blend) {
       // Left half weight 1, right half 0.5.
       projection_io::BlendMap alpha = projection_io::BlendMap::constant(size, 1.0f);
@@ -154,7 +155,7 @@ TEST(Session, BlendsInLinearLightAfterRendering) {
                 scene);
   Session blended(load_session_display(write_two_projector_display(blend_folder, true).string()),
                   scene);
-  // Both displays encode with gamma 2.2 (the display.json default): the plain one has weight 1.
+  // Both displays encode with gamma 2.2; the plain one has weight 1.
   plain.render(FrameState{}, true);
   const FrameStats stats = blended.render(FrameState{}, true);
   EXPECT_GT(stats.outputs[0].blend_tiles, 0u);

@@ -61,7 +61,7 @@ TEST(DisplayConfig, SampleFileValidatesAndRoundTrips) {
   EXPECT_EQ(config.projectors[0].output.kind, pio::DisplayOutput::Kind::monitor);
   EXPECT_EQ(config.projectors[0].output.monitor, "DP-1");
   EXPECT_EQ(config.projectors[1].output.window, glm::ivec4(1024, 0, 1024, 768));
-  EXPECT_EQ(config.projectors[1].gamma, 2.2);  // the default
+  EXPECT_FALSE(config.projectors[1].gamma.has_value());  // the default: sRGB
   EXPECT_EQ(config.missing_monitor, pio::MissingMonitor::window);
   EXPECT_EQ(config.eye, glm::dvec3(0, 1.2, 0));
 

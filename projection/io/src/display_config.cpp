@@ -229,8 +229,8 @@ void validate_display_config(const DisplayConfig& config, const std::string& sou
         projector.size.y > 65536) {
       at["size"].fail("[width, height] in output pixels, each in 1..65536");
     }
-    if (!(projector.gamma > 0) || !std::isfinite(projector.gamma)) {
-      at["gamma"].fail("a positive finite output gamma (2.2 for a usual display)");
+    if (projector.gamma && (!(*projector.gamma > 0) || !std::isfinite(*projector.gamma))) {
+      at["gamma"].fail("\"srgb\" or a positive finite output gamma (e.g. 2.2)");
     }
     auto file = [&](const std::filesystem::path& relative, const char* key) {
       if (check_files) {
@@ -298,7 +298,13 @@ DisplayConfig display_config_from_json(const json& document, const std::string& 
       projector.black = text(*black, at["black"]);
     }
     if (const json* gamma = optional_member(item, "gamma")) {
-      projector.gamma = number(*gamma, at["gamma"]);
+      if (gamma->is_string() && gamma->get<std::string>() == "srgb") {
+        projector.gamma.reset();
+      } else if (gamma->is_number()) {
+        projector.gamma = number(*gamma, at["gamma"]);
+      } else {
+        at["gamma"].fail("\"srgb\" or a positive finite output gamma (e.g. 2.2)");
+      }
     }
     projector.output = output_from_json(
         member(item, "output", at, "{\"monitor\": NAME} or {\"window\": [x, y, width, height]}"),
@@ -359,7 +365,11 @@ json display_config_to_json(const DisplayConfig& config) {
                  {"warp", projector.warp.generic_string()}};
     if (projector.blend) item["blend"] = projector.blend->generic_string();
     if (projector.black) item["black"] = projector.black->generic_string();
-    item["gamma"] = projector.gamma;
+    if (projector.gamma) {
+      item["gamma"] = *projector.gamma;
+    } else {
+      item["gamma"] = "srgb";
+    }
     item["output"] = output_to_json(projector.output);
     projectors.push_back(std::move(item));
   }

@@ -51,7 +51,10 @@ struct DisplayProjector {
   std::filesystem::path warp;                  // .warp.exr, relative to the display.json folder
   std::optional<std::filesystem::path> blend;  // .blend.exr (FORMATS.md §3), relative
   std::optional<std::filesystem::path> black;  // .black.exr black level β, relative
-  double gamma = 2.2;                          // output encoding exponent, > 0
+  // Output encoding: value = linear^(1/gamma), > 0; nullopt (JSON "srgb", the default) for the
+  // sRGB transfer function, which the GPU applies for free, so that blending touches only
+  // pixels whose weight is below 1 or whose black level is above 0.
+  std::optional<double> gamma;
   DisplayOutput output;
 
   bool operator==(const DisplayProjector&) const = default;
