@@ -1,10 +1,172 @@
+// The modern replication pipeline ("facets"): compute-shader coverage, a parallel exclusive scan,
+// a scatter of (triangle, facet) pairs with the indirect arguments, and one glDrawArraysIndirect
+// per material with vertex pulling (DESIGN.md, "The replication pipeline").
+#include <algorithm>
+#include <optional>
+
+#include "facet/driver/facet_gpu.hpp"
 #include "facet/projection/errors.hpp"
 #include "render_methods_internal.hpp"
+#include "replication_common.hpp"
 
-namespace facet::driver::detail {
-
-std::unique_ptr<RenderMethod> make_facet_pipeline() {
-  throw InputError("command line", "--method", "method 'facets' is not available in this build");
+namespace facet::driver {
+std::vector<std::vector<std::uint32_t>> gpu_triangle_coverage(
+    const Warp& warp, const RenderSettings& settings,
+    const std::vector<std::array<glm::vec3, 3>>& triangles_eye);
 }
 
+namespace facet::driver::detail {
+namespace {
+
+constexpr GLuint kLocalSize = 64;
+
+class FacetPipeline final : public FacetMethodBase {
+ public:
+  std::string_view name() const override { return "facets"; }
+
+  void prepare(const Scene& scene, const GpuScene& gpu_scene, std::span<const OutputSpec> outputs,
+               const RenderSettings& settings) override {
+    FacetMethodBase::prepare(scene, gpu_scene, outputs, settings);
+    if (!count_) {
+      count_ = link_replication_program({"replication/count.comp"});
+      scatter_ = link_replication_program({"replication/scatter.comp"});
+      args_ = build_program({"replication/draw_args.comp"}, {{"VERTICES_PER_REPLICA", "3"}});
+      draw_ = link_replication_program({"replication/draw.vert", "scene/material.frag"},
+                                       {{"WRITE_TRIANGLE_ID", "1"}});
+      scan_.prepare();
+    }
+  }
+
+  RenderStats render(const glm::dmat4& T_eye_world, std::span<OutputTarget> targets,
+                     GpuTimer* timer) override {
+    FACET_ASSERT(targets.size() == outputs_.size());
+    const bool changed = update_view(T_eye_world);
+    RenderStats stats;
+    stats.reused_replication = !outputs_.empty();
+    for (std::size_t i = 0; i < outputs_.size(); ++i) {
+      OutputState& out = outputs_[i];
+      targets[i].clear();
+      stats.facets += out.facets.mesh.facets.size();
+      stats.triangles_in += out.triangles;
+      if (out.triangles == 0 || out.facets.mesh.facets.empty()) {
+        targets[i].resolve();
+        continue;
+      }
+      if (changed || !out.replication_valid) {
+        stats.reused_replication = false;
+        replicate(i, timer);
+      }
+      stats.replicas += out.replicas;
+      stats.triangles_visible += out.visible;
+
+      TimedPass scope(timer, "pass3 draw");
+      bind_output(i);
+      targets[i].bind();
+      begin_facet_drawing(false);
+      set_list_uniforms(draw_, i);
+      draw_.use();
+      glBindVertexArray(empty_vao_.id());
+      glBindBuffer(GL_DRAW_INDIRECT_BUFFER, out.draw_args.id());
+      glMemoryBarrier(GL_COMMAND_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
+      for (std::uint32_t m = 0; m < material_count(); ++m) {
+        if (out.material_ranges[2 * m] == out.material_ranges[2 * m + 1]) continue;
+        set_material(draw_, m);
+        glDrawArraysIndirect(GL_TRIANGLES, reinterpret_cast<const void*>(std::uintptr_t(m) * 16u));
+      }
+      glBindBuffer(GL_DRAW_INDIRECT_BUFFER, 0);
+      glBindVertexArray(0);
+      end_facet_drawing();
+      targets[i].resolve();
+    }
+    if (timer) timer->end_frame();
+    return stats;
+  }
+
+ private:
+  // Passes 1 and 2 for output i: counts, scan, pairs, indirect arguments.
+  void replicate(std::size_t i, GpuTimer* timer) {
+    OutputState& out = outputs_[i];
+    const std::uint32_t n = out.triangles;
+    ensure_capacity(out.scan, (std::size_t(n) + 1) * sizeof(std::uint32_t));
+    {
+      TimedPass scope(timer, "pass1 coverage");
+      const std::uint32_t zero = 0;
+      out.stats.sub_data(0, sizeof zero, &zero);
+      bind_output(i);
+      set_list_uniforms(count_, i);
+      count_.use();
+      glDispatchCompute((n + 1 + kLocalSize - 1) / kLocalSize, 1, 1);
+    }
+    TimedPass scope(timer, "pass2 replicate");
+    scan_.run(out.scan, n + 1);
+    glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
+    // The pair count sizes the pair buffer: one small read-back per output and frame.
+    std::uint32_t total = 0, visible = 0;
+    out.scan.get_sub_data(std::size_t(n) * sizeof(std::uint32_t), sizeof total, &total);
+    out.stats.get_sub_data(0, sizeof visible, &visible);
+    out.replicas = total;
+    out.visible = visible;
+    ensure_capacity(out.pairs, std::max<std::size_t>(total, 1) * 2 * sizeof(std::uint32_t));
+    bind_output(i);
+    set_list_uniforms(scatter_, i);
+    scatter_.use();
+    glDispatchCompute((n + kLocalSize - 1) / kLocalSize, 1, 1);
+    set_list_uniforms(args_, i);
+    args_.use();
+    glDispatchCompute((material_count() + 63) / 64, 1, 1);
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_COMMAND_BARRIER_BIT);
+    out.replication_valid = true;
+  }
+
+  friend std::vector<std::vector<std::uint32_t>> facet::driver::gpu_triangle_coverage(
+      const Warp&, const RenderSettings&, const std::vector<std::array<glm::vec3, 3>>&);
+
+  Program count_, scatter_, args_, draw_;
+  PrefixScan scan_;
+};
+
+}  // namespace
+
+std::unique_ptr<RenderMethod> make_facet_pipeline() { return std::make_unique<FacetPipeline>(); }
+
 }  // namespace facet::driver::detail
+
+namespace facet::driver {
+
+std::vector<std::vector<std::uint32_t>> gpu_triangle_coverage(
+    const Warp& warp, const RenderSettings& settings,
+    const std::vector<std::array<glm::vec3, 3>>& triangles_eye) {
+  std::vector<std::vector<std::uint32_t>> result(triangles_eye.size());
+  if (triangles_eye.empty()) return result;
+  Scene scene;
+  scene.materials.push_back({});
+  for (const auto& triangle : triangles_eye) {
+    for (const glm::vec3& p : triangle) {
+      scene.indices.push_back(std::uint32_t(scene.positions.size()));
+      scene.positions.push_back(p);
+      scene.normals.push_back({0, 0, 1});
+      scene.uvs.push_back({0, 0});
+    }
+  }
+  scene.primitives.push_back({0, std::uint32_t(scene.indices.size()), 0});
+  Object object;
+  object.primitive_count = 1;
+  scene.objects.push_back(object);
+  scene.update_bounds();
+  const GpuScene gpu = upload_scene(scene);
+  detail::FacetPipeline pipeline;
+  const OutputSpec output{"coverage", warp};
+  pipeline.prepare(scene, gpu, std::span(&output, 1), settings);
+  pipeline.update_view(glm::dmat4(1.0));
+  auto& out = pipeline.outputs_[0];
+  if (out.triangles == 0 || out.facets.mesh.facets.empty()) return result;
+  pipeline.replicate(0, nullptr);
+  std::vector<std::uint32_t> pairs(2 * out.replicas);
+  if (!pairs.empty()) out.pairs.get_sub_data(0, pairs.size() * sizeof(std::uint32_t), pairs.data());
+  for (std::size_t k = 0; k < out.replicas; ++k)
+    result.at(pairs[2 * k]).push_back(pairs[2 * k + 1]);
+  for (auto& facets : result) std::sort(facets.begin(), facets.end());
+  return result;
+}
+
+}  // namespace facet::driver

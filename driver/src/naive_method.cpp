@@ -1,10 +1,93 @@
+// The naive multi-pass baseline ("naive"): for every facet, one draw of each object run whose
+// bounds may meet that facet's pyramid, with the facet's matrix and clip planes. No coverage
+// pass, no replication: the rasterizer's clipping does all the work.
+#include <glm/gtc/type_ptr.hpp>
+#include <optional>
+
 #include "facet/projection/errors.hpp"
 #include "render_methods_internal.hpp"
+#include "replication_common.hpp"
 
 namespace facet::driver::detail {
+namespace {
 
-std::unique_ptr<RenderMethod> make_naive_method() {
-  throw InputError("command line", "--method", "method 'naive' is not available in this build");
-}
+class NaiveMethod final : public FacetMethodBase {
+ public:
+  std::string_view name() const override { return "naive"; }
+
+  void prepare(const Scene& scene, const GpuScene& gpu_scene, std::span<const OutputSpec> outputs,
+               const RenderSettings& settings) override {
+    FacetMethodBase::prepare(scene, gpu_scene, outputs, settings);
+    if (!draw_) {
+      draw_ = link_replication_program({"replication/naive.vert", "scene/material.frag"},
+                                       {{"WRITE_TRIANGLE_ID", "1"}});
+    }
+  }
+
+  RenderStats render(const glm::dmat4& T_eye_world, std::span<OutputTarget> targets,
+                     GpuTimer* timer) override {
+    FACET_ASSERT(targets.size() == outputs_.size());
+    update_view(T_eye_world);
+    const Scene& scene = *scene_;
+    // Eye-frame bounding spheres of the objects, for the per-facet culling.
+    std::vector<glm::dvec3> centre(scene.objects.size());
+    std::vector<double> radius(scene.objects.size(), -1);
+    for (std::size_t o = 0; o < scene.objects.size(); ++o) {
+      const Aabb& box = scene.objects[o].bounds_world;
+      if (box.empty()) continue;
+      const glm::dvec3 p_min(box.p_min), p_max(box.p_max);
+      centre[o] = glm::dvec3(T_eye_world * glm::dvec4(0.5 * (p_min + p_max), 1.0));
+      radius[o] = 0.5 * glm::length(p_max - p_min) * 1.0001;
+    }
+    RenderStats stats;
+    TimedPass scope(timer, "draw");
+    for (std::size_t i = 0; i < outputs_.size(); ++i) {
+      OutputState& out = outputs_[i];
+      targets[i].clear();
+      stats.facets += out.facets.mesh.facets.size();
+      stats.triangles_in += out.triangles;
+      bind_output(i);
+      targets[i].bind();
+      begin_facet_drawing(settings_.cull_back_faces);
+      draw_.use();
+      glBindVertexArray(empty_vao_.id());
+      const auto& planes = out.facets.index.planes();
+      std::uint32_t bound_material = UINT32_MAX;
+      for (std::uint32_t f = 0; f < out.facets.mesh.facets.size(); ++f) {
+        glUniform1ui(44, f);
+        for (std::uint32_t m = 0; m < material_count(); ++m) {
+          for (std::uint32_t r : records_by_material_[m]) {
+            const GpuRecord& record = records_[r];
+            if (!out.object_visible[record.object]) continue;
+            if (!sphere_may_meet_cone(centre[record.object], radius[record.object],
+                                      planes[f].data(), 3)) {
+              continue;
+            }
+            if (m != bound_material) {
+              set_material(draw_, m);
+              bound_material = m;
+            }
+            glUniform1ui(45, r);
+            glDrawArrays(GL_TRIANGLES, 0, GLsizei(3 * record.triangle_count));
+            stats.replicas += record.triangle_count;
+          }
+        }
+      }
+      glBindVertexArray(0);
+      end_facet_drawing();
+      targets[i].resolve();
+    }
+    scope.end();
+    if (timer) timer->end_frame();
+    return stats;
+  }
+
+ private:
+  Program draw_;
+};
+
+}  // namespace
+
+std::unique_ptr<RenderMethod> make_naive_method() { return std::make_unique<NaiveMethod>(); }
 
 }  // namespace facet::driver::detail

@@ -13,11 +13,13 @@
 //   13 material ranges of the triangle list   14 indirect draw arguments   15 scan block sums
 #include <epoxy/gl.h>
 
+#include <array>
 #include <cstdint>
 #include <glm/glm.hpp>
 #include <vector>
 
 #include "facet/driver/gl_objects.hpp"
+#include "facet/driver/render_method.hpp"
 #include "facet/driver/scene.hpp"
 #include "facet/projection/coverage.hpp"
 #include "facet/projection/facets.hpp"
@@ -92,5 +94,12 @@ bool sphere_may_meet_cone(const glm::dvec3& centre, double radius, const glm::dv
                           int plane_count);
 // True when a sphere may meet any facet's guarded pyramid (walks the coverage hierarchy).
 bool sphere_may_meet_facets(const FacetSet& set, const glm::dvec3& centre, double radius);
+
+// Passes 1 and 2 of the "facets" pipeline on eye-frame triangles (metres, T_eye_world = identity),
+// read back: for each triangle, the facets (sorted) it is replicated into. For tests against
+// CoverageIndex::query. Needs a current context.
+std::vector<std::vector<std::uint32_t>> gpu_triangle_coverage(
+    const Warp& warp, const RenderSettings& settings,
+    const std::vector<std::array<glm::vec3, 3>>& triangles_eye);
 
 }  // namespace facet::driver

@@ -1,0 +1,223 @@
+#include "replication_common.hpp"
+
+#include <algorithm>
+#include <glm/gtc/type_ptr.hpp>
+
+#include "facet/driver/shader_library.hpp"
+#include "facet/projection/errors.hpp"
+
+namespace facet::driver::detail {
+
+Program link_replication_program(std::initializer_list<std::string_view> shaders,
+                                 const std::vector<ShaderDefine>& defines) {
+  ProgramBuilder builder;
+  for (const ShaderDefine& d : defines) builder.define(d.name, d.value);
+  const std::string_view lib_name = "replication/replication_lib.comp";
+  const std::string lib_text(embedded_shader(lib_name).text);
+  bool compute_has_lib = false;
+  for (std::string_view name : shaders) {
+    builder.shader(name);
+    const ShaderStage stage = stage_from_name(name);
+    if (stage == ShaderStage::vertex || stage == ShaderStage::geometry ||
+        (stage == ShaderStage::compute && !compute_has_lib)) {
+      builder.source(stage, std::string(lib_name), lib_text);
+      if (stage == ShaderStage::compute) compute_has_lib = true;
+    }
+  }
+  return builder.link();
+}
+
+void ensure_capacity(Buffer& buffer, std::size_t bytes) {
+  if (buffer && buffer.size() >= bytes) return;
+  std::size_t size = buffer ? buffer.size() : 256;
+  while (size < bytes) size *= 2;
+  buffer = Buffer::create(size);
+}
+
+void PrefixScan::prepare() {
+  scan_ = build_program({"replication/scan.comp"});
+  add_ = build_program({"replication/scan.comp"}, {{"SCAN_ADD", "1"}});
+  // Sized once: run_level recurses on references into this vector. Four levels of 1024-element
+  // blocks scan 2^40 values.
+  block_sums_.resize(4);
+}
+
+void PrefixScan::run(const Buffer& data, std::uint32_t count) {
+  if (count > 0) run_level(data, count, 0);
+}
+
+void PrefixScan::run_level(const Buffer& data, std::uint32_t count, std::size_t level) {
+  constexpr std::uint32_t kBlock = 4 * 256;  // scan.comp: 4 elements per thread, 256 threads
+  const std::uint32_t groups = (count + kBlock - 1) / kBlock;
+  FACET_ASSERT(level < block_sums_.size());
+  ensure_capacity(block_sums_[level], std::size_t(groups) * sizeof(std::uint32_t));
+  const auto bind = [&] {
+    data.bind_base(GL_SHADER_STORAGE_BUFFER, binding::scan);
+    block_sums_[level].bind_base(GL_SHADER_STORAGE_BUFFER, binding::block_sums);
+  };
+  bind();
+  scan_.use();
+  glUniform1ui(0, count);
+  glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+  glDispatchCompute(groups, 1, 1);
+  if (groups == 1) return;
+  run_level(block_sums_[level], groups, level + 1);
+  bind();
+  add_.use();
+  glUniform1ui(0, count);
+  glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+  glDispatchCompute(groups, 1, 1);
+  glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+}
+
+void FacetMethodBase::prepare(const Scene& scene, const GpuScene& gpu_scene,
+                              std::span<const OutputSpec> outputs, const RenderSettings& settings) {
+  if (!(settings.z_near > 0)) {
+    throw InputError("render settings", "z_near", "expected a near distance > 0 metres");
+  }
+  scene_ = &scene;
+  gpu_ = &gpu_scene;
+  settings_ = settings;
+  records_ = make_records(scene);
+  records_by_material_.assign(std::max<std::size_t>(scene.materials.size(), 1), {});
+  for (std::uint32_t r = 0; r < records_.size(); ++r) {
+    records_by_material_.at(records_[r].material).push_back(r);
+  }
+  const GpuRecord no_record{};
+  records_buffer_ = records_.empty() ? Buffer::create(sizeof no_record, &no_record)
+                                     : Buffer::create_from(records_);
+  object_frames_ =
+      Buffer::create(std::max<std::size_t>(scene.objects.size(), 1) * sizeof(GpuObjectFrame));
+  if (!empty_vao_) empty_vao_ = VertexArray::create();
+  outputs_.clear();
+  for (const OutputSpec& output : outputs) {
+    OutputState state(FacetSet::build(output.warp, settings.facets, settings.z_near));
+    state.stats = Buffer::create(sizeof(std::uint32_t));
+    state.draw_args = Buffer::create(records_by_material_.size() * 4 * sizeof(std::uint32_t));
+    outputs_.push_back(std::move(state));
+  }
+  have_view_ = false;
+}
+
+bool FacetMethodBase::update_view(const glm::dmat4& T_eye_world) {
+  if (have_view_ && T_eye_world == last_T_eye_world_) return false;
+  have_view_ = true;
+  last_T_eye_world_ = T_eye_world;
+  const Scene& scene = *scene_;
+  std::vector<GpuObjectFrame> frames(std::max<std::size_t>(scene.objects.size(), 1));
+  std::vector<glm::dvec3> centre(scene.objects.size());
+  std::vector<double> radius(scene.objects.size(), -1);
+  for (std::size_t o = 0; o < scene.objects.size(); ++o) {
+    const Object& object = scene.objects[o];
+    const glm::dmat4 T_world_object(object.T_world_object);
+    const glm::mat4 T_eye_object(T_eye_world * T_world_object);
+    std::copy_n(glm::value_ptr(T_eye_object), 16, frames[o].T_eye_object);
+    std::copy_n(glm::value_ptr(object.T_world_object), 16, frames[o].T_world_object);
+    if (object.bounds_world.empty()) continue;
+    // The box's bounding sphere; T_eye_world is rigid, so the radius carries over.
+    const glm::dvec3 p_min(object.bounds_world.p_min), p_max(object.bounds_world.p_max);
+    centre[o] = glm::dvec3(T_eye_world * glm::dvec4(0.5 * (p_min + p_max), 1.0));
+    radius[o] = 0.5 * glm::length(p_max - p_min);
+  }
+  object_frames_.sub_data(0, frames.size() * sizeof(GpuObjectFrame), frames.data());
+
+  for (OutputState& out : outputs_) {
+    out.replication_valid = false;
+    out.object_visible.assign(scene.objects.size(), 0);
+    for (std::size_t o = 0; o < scene.objects.size(); ++o) {
+      out.object_visible[o] =
+          radius[o] >= 0 && sphere_may_meet_facets(out.facets, centre[o], radius[o] * 1.0001);
+    }
+    out.list.clear();
+    out.material_ranges.clear();
+    std::uint32_t triangles = 0;
+    for (const auto& material_records : records_by_material_) {
+      out.material_ranges.push_back(triangles);
+      for (std::uint32_t r : material_records) {
+        if (!out.object_visible[records_[r].object]) continue;
+        out.list.push_back({r, triangles});
+        triangles += records_[r].triangle_count;
+      }
+      out.material_ranges.push_back(triangles);
+    }
+    out.triangles = triangles;
+    if (out.list.empty()) out.list.push_back({0, 0});  // keeps the binding valid; never read
+    ensure_capacity(out.list_buffer, out.list.size() * sizeof(ListEntry));
+    out.list_buffer.sub_data(0, out.list.size() * sizeof(ListEntry), out.list.data());
+    ensure_capacity(out.ranges_buffer, out.material_ranges.size() * sizeof(std::uint32_t));
+    out.ranges_buffer.sub_data(0, out.material_ranges.size() * sizeof(std::uint32_t),
+                               out.material_ranges.data());
+  }
+  return true;
+}
+
+void FacetMethodBase::bind_output(std::size_t i) const {
+  const GpuScene& gpu = *gpu_;
+  gpu.positions.bind_base(GL_SHADER_STORAGE_BUFFER, binding::positions);
+  gpu.normals.bind_base(GL_SHADER_STORAGE_BUFFER, binding::normals);
+  gpu.uvs.bind_base(GL_SHADER_STORAGE_BUFFER, binding::uvs);
+  gpu.indices.bind_base(GL_SHADER_STORAGE_BUFFER, binding::indices);
+  records_buffer_.bind_base(GL_SHADER_STORAGE_BUFFER, binding::records);
+  object_frames_.bind_base(GL_SHADER_STORAGE_BUFFER, binding::object_frames);
+  const OutputState& out = outputs_[i];
+  out.facets.bind();
+  out.list_buffer.bind_base(GL_SHADER_STORAGE_BUFFER, binding::list);
+  out.ranges_buffer.bind_base(GL_SHADER_STORAGE_BUFFER, binding::material_ranges);
+  out.stats.bind_base(GL_SHADER_STORAGE_BUFFER, binding::stats);
+  if (out.scan) out.scan.bind_base(GL_SHADER_STORAGE_BUFFER, binding::scan);
+  if (out.pairs) out.pairs.bind_base(GL_SHADER_STORAGE_BUFFER, binding::pairs);
+  out.draw_args.bind_base(GL_SHADER_STORAGE_BUFFER, binding::draw_args);
+}
+
+void FacetMethodBase::set_list_uniforms(const Program& program, std::size_t i) const {
+  const OutputState& out = outputs_[i];
+  // By name: a location the linker dropped from this program must not be set.
+  const std::pair<const char*, std::uint32_t> values[] = {
+      {"list_entries", std::uint32_t(out.list.size())},
+      {"cull_back_faces", settings_.cull_back_faces ? 1u : 0u},
+      {"triangle_count", out.triangles},
+      {"material_count", material_count()}};
+  for (const auto& [uniform, value] : values) {
+    const GLint location = program.uniform_location(uniform);
+    if (location >= 0) glProgramUniform1ui(program.id(), location, value);
+  }
+}
+
+void FacetMethodBase::set_material(const Program& program, std::uint32_t m) const {
+  if (m >= scene_->materials.size()) {
+    const glm::vec4 white(1.0f);
+    glProgramUniform4fv(program.id(), 8, 1, glm::value_ptr(white));
+    glProgramUniform1i(program.id(), 9, 0);
+    return;
+  }
+  const Material& material = scene_->materials[m];
+  glProgramUniform4fv(program.id(), 8, 1, glm::value_ptr(material.base_colour));
+  glProgramUniform1i(program.id(), 9, material.texture >= 0 ? 1 : 0);
+  gpu_->bind_material_texture(m, 0);
+}
+
+void FacetMethodBase::begin_facet_drawing(bool cull_back_faces) {
+  glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE);
+  glEnable(GL_DEPTH_TEST);
+  glDepthFunc(GL_GREATER);
+  glDepthMask(GL_TRUE);
+  for (int k = 0; k < 3; ++k) glEnable(GL_CLIP_DISTANCE0 + k);
+  if (cull_back_faces) {
+    glEnable(GL_CULL_FACE);
+    glCullFace(GL_BACK);
+    glFrontFace(GL_CCW);
+  } else {
+    glDisable(GL_CULL_FACE);
+  }
+}
+
+void FacetMethodBase::end_facet_drawing() {
+  for (int k = 0; k < 3; ++k) glDisable(GL_CLIP_DISTANCE0 + k);
+  glDisable(GL_CULL_FACE);
+  glDepthFunc(GL_LESS);
+  glDisable(GL_DEPTH_TEST);
+  glClipControl(GL_LOWER_LEFT, GL_NEGATIVE_ONE_TO_ONE);
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+}
+
+}  // namespace facet::driver::detail

@@ -1,0 +1,107 @@
+#pragma once
+// What the facet methods share (facets, facets-gs, naive): the scene's record table, per-frame
+// object transforms, per-output facets, object culling by bounds and the frame's triangle list
+// grouped by material; plus the GPU prefix scan of both pipelines.
+#include <cstdint>
+#include <initializer_list>
+#include <string_view>
+#include <vector>
+
+#include "facet/driver/facet_gpu.hpp"
+#include "facet/driver/gpu_timer.hpp"
+#include "facet/driver/program.hpp"
+#include "facet/driver/render_method.hpp"
+
+namespace facet::driver::detail {
+
+// Times a pass with `timer` when there is one (GpuTimer::scope needs a timer).
+class TimedPass {
+ public:
+  TimedPass(GpuTimer* timer, std::string_view pass) : timer_(timer) {
+    if (timer_) timer_->begin(pass);
+  }
+  TimedPass(const TimedPass&) = delete;
+  TimedPass& operator=(const TimedPass&) = delete;
+  ~TimedPass() { end(); }
+  void end() {
+    if (timer_) timer_->end();
+    timer_ = nullptr;
+  }
+
+ private:
+  GpuTimer* timer_;
+};
+
+// Links the embedded shaders with the replication function library (replication_lib.comp) added
+// as a second shader object to every vertex, geometry or compute stage among them.
+Program link_replication_program(std::initializer_list<std::string_view> shaders,
+                                 const std::vector<ShaderDefine>& defines = {});
+
+// Grows `buffer` (contents lost) to hold at least `bytes`, doubling to keep reallocations rare.
+void ensure_capacity(Buffer& buffer, std::size_t bytes);
+
+// Exclusive prefix sum of uint32 values in place on the GPU: scan.comp over blocks of 1024,
+// recursing on the block sums (multi-level for any count).
+class PrefixScan {
+ public:
+  void prepare();
+  // data[0, count) becomes its exclusive prefix sum. Issues memory barriers around each level.
+  void run(const Buffer& data, std::uint32_t count);
+
+ private:
+  void run_level(const Buffer& data, std::uint32_t count, std::size_t level);
+  Program scan_, add_;
+  std::vector<Buffer> block_sums_;
+};
+
+struct ListEntry {  // std430 uvec2 of replication_lib.comp's List
+  std::uint32_t record, first_triangle;
+};
+
+class FacetMethodBase : public RenderMethod {
+ public:
+  void prepare(const Scene& scene, const GpuScene& gpu_scene, std::span<const OutputSpec> outputs,
+               const RenderSettings& settings) override;
+
+ protected:
+  struct OutputState {
+    explicit OutputState(FacetSet set) : facets(std::move(set)) {}
+    FacetSet facets;
+    std::vector<std::uint8_t> object_visible;
+    std::vector<ListEntry> list;
+    std::vector<std::uint32_t> material_ranges;  // (begin, end) list triangles per material
+    std::uint32_t triangles = 0;                 // list triangles
+    Buffer list_buffer, ranges_buffer;
+    // Replication results, reused while neither view nor scene changes.
+    Buffer scan, pairs, stats, draw_args;
+    bool replication_valid = false;
+    std::uint64_t replicas = 0, visible = 0;
+  };
+
+  // Uploads the object transforms, culls objects per output and rebuilds the triangle lists when
+  // T_eye_world differs from the last frame's; returns whether it did.
+  bool update_view(const glm::dmat4& T_eye_world);
+  // Binds the scene, record and object-frame buffers, and output i's facets and triangle list.
+  void bind_output(std::size_t i) const;
+  // Sets scene/material.frag's uniforms and texture for material m on `program`.
+  void set_material(const Program& program, std::uint32_t m) const;
+  // Depth, clip-control and clip-distance state of pass 3, and its undoing.
+  static void begin_facet_drawing(bool cull_back_faces);
+  static void end_facet_drawing();
+  std::uint32_t material_count() const { return std::uint32_t(records_by_material_.size()); }
+  // Program uniforms of replication_lib.comp for output i.
+  void set_list_uniforms(const Program& program, std::size_t i) const;
+
+  const Scene* scene_ = nullptr;
+  const GpuScene* gpu_ = nullptr;
+  RenderSettings settings_;
+  std::vector<GpuRecord> records_;
+  std::vector<std::vector<std::uint32_t>> records_by_material_;
+  Buffer records_buffer_, object_frames_;
+  VertexArray empty_vao_;  // core profile draws need a vertex array; attributes are pulled
+  std::vector<OutputState> outputs_;
+  glm::dmat4 last_T_eye_world_{0.0};
+  bool have_view_ = false;
+};
+
+}  // namespace facet::driver::detail

@@ -1,0 +1,34 @@
+// Modern pipeline, pass 3: vertex pulling for glDrawArraysIndirect. Vertex 3i + c is corner c of
+// pair i = (triangle, facet); the facet's matrix and guarded clip planes place it in the output.
+// Outputs are what scene/material.frag reads, plus the triangle ID.
+layout(std430, binding = 11) readonly buffer Pairs { uvec2 pairs[]; };
+
+out vec3 v_n_world;
+out vec2 v_uv;
+flat out uint v_triangle_id;
+out float gl_ClipDistance[3];
+
+uint entry_of_triangle(uint t);
+uint vertex_of(uint e, uint t, uint c);
+uint triangle_id(uint e, uint t);
+uint object_of(uint e);
+vec3 eye_position(uint object, uint v);
+vec3 world_normal(uint object, uint v);
+vec2 vertex_uv(uint v);
+vec4 facet_clip(uint f, vec3 p_eye);
+float facet_clip_distance(uint f, int k, vec3 p_eye);
+
+void main() {
+  uvec2 pair = pairs[uint(gl_VertexID) / 3u];
+  uint corner = uint(gl_VertexID) % 3u;
+  uint t = pair.x, f = pair.y;
+  uint e = entry_of_triangle(t);
+  uint object = object_of(e);
+  uint v = vertex_of(e, t, corner);
+  vec3 p_eye = eye_position(object, v);
+  gl_Position = facet_clip(f, p_eye);
+  for (int k = 0; k < 3; ++k) gl_ClipDistance[k] = facet_clip_distance(f, k, p_eye);
+  v_n_world = world_normal(object, v);
+  v_uv = vertex_uv(v);
+  v_triangle_id = triangle_id(e, t);
+}

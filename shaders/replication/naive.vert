@@ -1,0 +1,29 @@
+// Naive multi-pass baseline: one glDrawArrays per (facet, record), pulling the record's
+// triangles; the same arithmetic as replication/draw.vert, without any coverage work.
+layout(location = 44) uniform uint facet;
+layout(location = 45) uniform uint record;
+
+out vec3 v_n_world;
+out vec2 v_uv;
+flat out uint v_triangle_id;
+out float gl_ClipDistance[3];
+
+uint record_vertex(uint r, uint i);
+uint record_object(uint r);
+uint record_first_id(uint r);
+vec3 eye_position(uint object, uint v);
+vec3 world_normal(uint object, uint v);
+vec2 vertex_uv(uint v);
+vec4 facet_clip(uint f, vec3 p_eye);
+float facet_clip_distance(uint f, int k, vec3 p_eye);
+
+void main() {
+  uint object = record_object(record);
+  uint v = record_vertex(record, uint(gl_VertexID));
+  vec3 p_eye = eye_position(object, v);
+  gl_Position = facet_clip(facet, p_eye);
+  for (int k = 0; k < 3; ++k) gl_ClipDistance[k] = facet_clip_distance(facet, k, p_eye);
+  v_n_world = world_normal(object, v);
+  v_uv = vertex_uv(v);
+  v_triangle_id = record_first_id(record) + uint(gl_VertexID) / 3u;
+}

@@ -1,0 +1,201 @@
+// Functions and buffers shared by every replication stage: the scene's triangles in the eye
+// frame, the facets' matrices and clip planes, and the coverage test (a port of
+// projection/coverage.hpp CoverageIndex::query). Not a program of its own: pipelines link it as
+// a second shader object into each stage that declares these functions (compute, vertex,
+// geometry). It is validated as a compute shader, so it uses nothing stage-specific.
+// Bindings: driver/include/facet/driver/facet_gpu.hpp.
+
+// Scene (GpuScene): tightly packed floats and uint32 indices.
+layout(std430, binding = 0) readonly buffer Positions { float positions[]; };
+layout(std430, binding = 1) readonly buffer Normals { float normals[]; };
+layout(std430, binding = 2) readonly buffer Uvs { float uvs[]; };
+layout(std430, binding = 3) readonly buffer Indices { uint indices[]; };
+
+struct Record {  // GpuRecord
+  uint first_index;
+  uint triangle_count;
+  uint object;
+  uint material;
+  uint first_id;
+  uint padding0, padding1, padding2;
+};
+layout(std430, binding = 4) readonly buffer Records { Record records[]; };
+
+struct ObjectFrame {  // GpuObjectFrame
+  mat4 T_eye_object;
+  mat4 T_world_object;
+};
+layout(std430, binding = 5) readonly buffer ObjectFrames { ObjectFrame object_frames[]; };
+
+struct Facet {  // GpuFacet
+  mat4 clip_from_eye;
+  vec4 clip_planes[3];
+};
+layout(std430, binding = 6) readonly buffer Facets { Facet facets[]; };
+
+struct Node {  // GpuCoverageNode
+  vec4 pyramid[4];
+  uint first;
+  uint count;
+  uint bounded;
+  uint padding;
+};
+layout(std430, binding = 7) readonly buffer Nodes { Node nodes[]; };
+layout(std430, binding = 8) readonly buffer Order { uint facet_order[]; };
+
+// The frame's triangle list: runs of records, each with the list position of its first triangle.
+struct ListEntry {
+  uint record;
+  uint first_triangle;
+};
+layout(std430, binding = 9) readonly buffer List { ListEntry list[]; };
+
+layout(location = 40) uniform uint list_entries;   // entries in list[]
+layout(location = 41) uniform uint cull_back_faces;  // 1: front is counter-clockwise from the eye
+
+// Rounding slack of the coverage test, radians: every plane is moved outwards by this angle so
+// that float rounding never loses a facet the double-precision reference finds.
+const float kCoverageSlack = 2e-6;
+const uint kNone = 0xffffffffu;
+
+// The list entry holding list triangle t (binary search on first_triangle).
+uint entry_of_triangle(uint t) {
+  uint lo = 0u, hi = list_entries - 1u;
+  while (lo < hi) {
+    uint mid = (lo + hi + 1u) / 2u;
+    if (list[mid].first_triangle <= t) lo = mid; else hi = mid - 1u;
+  }
+  return lo;
+}
+
+// Scene vertex index of corner c (0..2) of list triangle t in entry e.
+uint vertex_of(uint e, uint t, uint c) {
+  Record r = records[list[e].record];
+  return indices[r.first_index + 3u * (t - list[e].first_triangle) + c];
+}
+
+uint triangle_id(uint e, uint t) {
+  return records[list[e].record].first_id + (t - list[e].first_triangle);
+}
+
+// Record r's vertex for its i-th index, its object and the ID of its first triangle.
+uint record_vertex(uint r, uint i) { return indices[records[r].first_index + i]; }
+uint record_object(uint r) { return records[r].object; }
+uint record_first_id(uint r) { return records[r].first_id; }
+
+uint object_of(uint e) { return records[list[e].record].object; }
+uint material_of(uint e) { return records[list[e].record].material; }
+
+vec3 eye_position(uint object, uint v) {
+  precise vec4 p = object_frames[object].T_eye_object *
+                   vec4(positions[3u * v], positions[3u * v + 1u], positions[3u * v + 2u], 1.0);
+  return p.xyz;
+}
+
+vec3 world_normal(uint object, uint v) {
+  return mat3(object_frames[object].T_world_object) *
+         vec3(normals[3u * v], normals[3u * v + 1u], normals[3u * v + 2u]);
+}
+
+vec2 vertex_uv(uint v) { return vec2(uvs[2u * v], uvs[2u * v + 1u]); }
+
+// GL clip coordinates of an eye-frame point in facet f, and its three clip distances.
+vec4 facet_clip(uint f, vec3 p_eye) {
+  precise vec4 clip = facets[f].clip_from_eye * vec4(p_eye, 1.0);
+  return clip;
+}
+float facet_clip_distance(uint f, int k, vec3 p_eye) {
+  precise float d = dot(facets[f].clip_planes[k].xyz, p_eye);
+  return d;
+}
+
+// The three eye-frame corners of list triangle t.
+void triangle_eye(uint t, out vec3 p[3]) {
+  uint e = entry_of_triangle(t);
+  uint object = object_of(e);
+  for (uint c = 0u; c < 3u; ++c) p[c] = eye_position(object, vertex_of(e, t, c));
+}
+
+// True when the triangle meets the cone {X : planes[k]·X >= -slack·|X|, k < plane_count}:
+// Sutherland–Hodgman clipping, as triangle_meets_cone in projection/src/coverage.cpp.
+bool meets_cone(vec3 p[3], vec4 planes[4], int plane_count) {
+  vec3 poly[8];
+  vec3 next[8];
+  poly[0] = p[0];
+  poly[1] = p[1];
+  poly[2] = p[2];
+  int count = 3;
+  for (int k = 0; k < plane_count && count > 0; ++k) {
+    vec3 n = planes[k].xyz;
+    int written = 0;
+    for (int i = 0; i < count; ++i) {
+      vec3 a = poly[i];
+      vec3 b = poly[(i + 1) % count];
+      float da = dot(n, a) + kCoverageSlack * length(a);
+      float db = dot(n, b) + kCoverageSlack * length(b);
+      if (da >= 0.0 && written < 8) next[written++] = a;
+      if ((da >= 0.0) != (db >= 0.0) && written < 8) next[written++] = a + (b - a) * (da / (da - db));
+    }
+    count = written;
+    for (int i = 0; i < count; ++i) poly[i] = next[i];
+  }
+  if (count == 0) return false;
+  // What meets the cone only at the eye is seen edge-on and covers nothing.
+  float scale = max(length(p[0]), max(length(p[1]), length(p[2])));
+  for (int i = 0; i < count; ++i) {
+    if (length(poly[i]) > 1e-6 * scale) return true;
+  }
+  return false;
+}
+
+// False for triangles that are culled before any facet test: non-finite corners, degenerate or
+// edge-on triangles, and back faces when culling is on (as in CoverageIndex::query).
+bool triangle_may_cover(vec3 p[3]) {
+  for (int c = 0; c < 3; ++c) {
+    if (any(isnan(p[c])) || any(isinf(p[c]))) return false;
+  }
+  vec3 normal = cross(p[1] - p[0], p[2] - p[0]);
+  float facing = dot(normal, p[0]);
+  if (cull_back_faces != 0u && !(facing < 0.0)) return false;
+  // A triangle whose plane passes through the eye is seen edge-on and covers no pixel; the
+  // reference agrees (up to its rounding), but the slack below would list every facet it grazes.
+  float scale = max(length(p[0]), max(length(p[1]), length(p[2])));
+  return abs(facing) > 1e-6 * length(normal) * scale;
+}
+
+// Walks the facets that triangle p may cover, in the hierarchy's fixed order, and returns how
+// many there are. When pair_base != kNone, writes uvec2(t, facet) to pairs[pair_base + k] for the
+// k-th (through write_pair). When wanted != kNone, stops at the wanted-th facet and returns it in
+// wanted_facet (kNone when there are fewer).
+void write_pair(uint at, uint t, uint facet);
+uint walk_coverage(vec3 p[3], uint t, uint pair_base, uint wanted, out uint wanted_facet) {
+  wanted_facet = kNone;
+  if (!triangle_may_cover(p)) return 0u;
+  uint found = 0u;
+  uint stack[64];
+  int top = 0;
+  stack[top++] = 0u;
+  while (top > 0) {
+    Node node = nodes[stack[--top]];
+    if (node.bounded != 0u && !meets_cone(p, node.pyramid, 4)) continue;
+    if (node.count > 0u) {
+      for (uint k = node.first; k < node.first + node.count; ++k) {
+        uint f = facet_order[k];
+        vec4 planes[4] = vec4[4](facets[f].clip_planes[0], facets[f].clip_planes[1],
+                                 facets[f].clip_planes[2], vec4(0.0));
+        if (!meets_cone(p, planes, 3)) continue;
+        if (found == wanted) {
+          wanted_facet = f;
+          return found + 1u;
+        }
+        if (pair_base != kNone) write_pair(pair_base + found, t, f);
+        ++found;
+      }
+    } else if (top + 2 <= 64) {
+      // Second child pushed last is visited first, as in CoverageIndex::query.
+      stack[top++] = node.first;
+      stack[top++] = node.first + 1u;
+    }
+  }
+  return found;
+}

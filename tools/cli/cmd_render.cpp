@@ -1,0 +1,228 @@
+// facet render: renders a scene into every output of a display with one of the render methods,
+// and reports the replication ratio and timings.
+#include <OpenImageIO/imageio.h>
+
+#include <algorithm>
+#include <chrono>
+#include <filesystem>
+#include <iostream>
+#include <map>
+#include <nlohmann/json.hpp>
+
+#include "command.hpp"
+#include "display_flags.hpp"
+#include "facet/driver/city.hpp"
+#include "facet/driver/display_outputs.hpp"
+#include "facet/driver/gl_context.hpp"
+#include "facet/driver/gltf_loader.hpp"
+#include "facet/driver/gpu_scene.hpp"
+#include "facet/driver/gpu_timer.hpp"
+#include "facet/driver/render_method.hpp"
+#include "facet/projection/atomic_file.hpp"
+#include "facet/projection/errors.hpp"
+
+namespace facet::cli {
+namespace {
+
+using namespace facet::driver;
+
+// Frame k shows the city camera path at k times this step (seconds): 30 frames per second.
+constexpr double kFrameStepS = 1.0 / 30.0;
+
+struct RenderOptions {
+  std::string display, scene = "builtin:city", method = "facets", size, out;
+  LayoutFlags layout;
+  std::optional<int> face_size;
+  int frames = 1, msaa = 0;
+  bool ids = false, depth = false, reference = false, json = false;
+};
+
+double median(std::vector<double> values) {
+  if (values.empty()) return 0;
+  std::sort(values.begin(), values.end());
+  const std::size_t n = values.size();
+  return n % 2 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
+}
+
+void write_image(const std::filesystem::path& path, glm::ivec2 size, int channels,
+                 OIIO::TypeDesc type, const void* pixels) {
+  write_atomically(path, [&](const std::filesystem::path& temporary) {
+    // OpenImageIO picks the format from the extension, so the temporary keeps the final one.
+    const std::filesystem::path typed = temporary.string() + path.extension().string();
+    auto file = OIIO::ImageOutput::create(typed.string());
+    OIIO::ImageSpec spec(size.x, size.y, channels, type);
+    if (!file || !file->open(typed.string(), spec) || !file->write_image(type, pixels) ||
+        !file->close()) {
+      std::error_code ignored;
+      std::filesystem::remove(typed, ignored);
+      throw InputError(path.string(), "", "could not be written");
+    }
+    std::filesystem::rename(typed, temporary);
+  });
+}
+
+Scene load_scene(const std::string& name) {
+  if (name == "builtin:city") return build_city();
+  const std::filesystem::path path(name);
+  const std::string ext = path.extension().string();
+  if (ext != ".gltf" && ext != ".glb") {
+    throw InputError("command line", "--scene",
+                     "expected builtin:city or a .gltf/.glb file; got '" + name + "'");
+  }
+  return load_gltf(path);
+}
+
+void run(const RenderOptions& options) {
+  if (options.frames < 1) throw InputError("command line", "--frames", "expected at least 1");
+  if (options.msaa < 0) throw InputError("command line", "--msaa", "expected 0 or more samples");
+  std::optional<glm::ivec2> size;
+  if (!options.size.empty()) size = parse_size(options.size, "--size");
+  const std::vector<OutputSpec> outputs = load_display_outputs(options.display, size);
+  auto method = make_render_method(options.method);
+  RenderSettings settings;
+  settings.facets.layout = options.layout.layout();
+  if (options.face_size) {
+    if (*options.face_size < 1) {
+      throw InputError("command line", "--face-size", "expected a cube face size >= 1 pixel");
+    }
+    settings.cube_face_size = *options.face_size;
+  }
+  settings.msaa_samples = options.msaa;
+  if (options.reference) {
+    throw InputError("command line", "--reference",
+                     "the CPU reference comparison is not available in this build yet");
+  }
+  const Scene scene = load_scene(options.scene);
+
+  auto context = create_headless_context();
+  const GpuScene gpu_scene = upload_scene(scene);
+  method->prepare(scene, gpu_scene, outputs, settings);
+  std::vector<OutputTarget> targets;
+  for (const OutputSpec& output : outputs) {
+    targets.push_back(OutputTarget::create(output.warp.output_size, settings.msaa_samples));
+  }
+
+  // The view follows the city's camera path; for other scenes it starts from the bounds' centre.
+  const CityCameraPath path;
+  const bool city = options.scene == "builtin:city";
+  const glm::dvec3 centre(scene.bounds_world().empty() ? glm::vec3(0)
+                                                       : scene.bounds_world().centre());
+  GpuTimer timer;
+  std::vector<double> frame_ms;
+  std::vector<RenderStats> stats;
+  for (int k = 0; k < options.frames; ++k) {
+    glm::dmat4 T_world_eye = city ? path.T_world_eye(k * kFrameStepS) : glm::dmat4(1.0);
+    if (!city) T_world_eye[3] = glm::dvec4(centre, 1.0);
+    const auto start = std::chrono::steady_clock::now();
+    stats.push_back(method->render(glm::inverse(T_world_eye), targets, &timer));
+    glFinish();
+    frame_ms.push_back(
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+            .count());
+  }
+  std::map<std::string, std::vector<double>> pass_times;
+  while (auto frame = timer.poll(true)) {
+    std::map<std::string, double> sums;
+    for (const PassTime& pass : *frame) sums[pass.pass] += pass.milliseconds;
+    for (const auto& [pass, ms] : sums) pass_times[pass].push_back(ms);
+  }
+
+  if (!options.out.empty()) {
+    const std::filesystem::path folder(options.out);
+    std::error_code error;
+    std::filesystem::create_directories(folder, error);
+    if (error || !std::filesystem::is_directory(folder)) {
+      throw InputError(options.out, "--out", "expected a folder that can be created");
+    }
+    for (std::size_t i = 0; i < outputs.size(); ++i) {
+      const glm::ivec2 s = targets[i].size();
+      const auto colour = targets[i].read_colour_rgba8();
+      write_image(folder / (outputs[i].name + ".png"), s, 4, OIIO::TypeDesc::UINT8, colour.data());
+      if (options.ids) {
+        const auto ids = targets[i].read_ids();
+        write_image(folder / (outputs[i].name + ".ids.exr"), s, 1, OIIO::TypeDesc::UINT,
+                    ids.data());
+      }
+      if (options.depth) {
+        const auto depth = targets[i].read_depth();
+        write_image(folder / (outputs[i].name + ".depth.exr"), s, 1, OIIO::TypeDesc::FLOAT,
+                    depth.data());
+      }
+    }
+  }
+
+  const RenderStats& last = stats.back();
+  double ratio_sum = 0;
+  int reused = 0;
+  for (const RenderStats& s : stats) {
+    ratio_sum += s.replication_ratio();
+    reused += s.reused_replication;
+  }
+  nlohmann::json pass_ms = nlohmann::json::object();
+  for (const auto& [pass, times] : pass_times) pass_ms[pass] = median(times);
+  nlohmann::json names = nlohmann::json::array();
+  for (const OutputSpec& output : outputs) names.push_back(output.name);
+  const nlohmann::json report = {{"display", options.display},
+                                 {"scene", options.scene},
+                                 {"method", method->name()},
+                                 {"outputs", names},
+                                 {"renderer", context->info().renderer},
+                                 {"frames", options.frames},
+                                 {"facets", last.facets},
+                                 {"triangles_scene", scene.triangle_count()},
+                                 {"triangles_in", last.triangles_in},
+                                 {"triangles_visible", last.triangles_visible},
+                                 {"replicas", last.replicas},
+                                 {"replication_ratio", last.replication_ratio()},
+                                 {"replication_ratio_mean", ratio_sum / options.frames},
+                                 {"reused_frames", reused},
+                                 {"frame_ms", median(frame_ms)},
+                                 {"pass_ms", pass_ms}};
+  if (options.json) {
+    std::cout << report.dump(2) << "\n";
+  } else {
+    std::printf(
+        "%s, %s, %s: %llu facets, %llu triangles in, %llu replicas, ratio %.3f, "
+        "%.2f ms/frame (median of %d)\n",
+        options.display.c_str(), options.scene.c_str(), options.method.c_str(),
+        static_cast<unsigned long long>(last.facets),
+        static_cast<unsigned long long>(last.triangles_in),
+        static_cast<unsigned long long>(last.replicas), last.replication_ratio(), median(frame_ms),
+        options.frames);
+    for (const auto& [pass, times] : pass_times) {
+      std::printf("  %-16s %8.3f ms (GPU, median)\n", pass.c_str(), median(times));
+    }
+  }
+}
+
+const Registration registration{
+    30, [](CLI::App& app) {
+      auto* command =
+          app.add_subcommand("render", "Render a scene into a display's outputs with one method");
+      auto options = std::make_shared<RenderOptions>();
+      command
+          ->add_option("--display", options->display,
+                       "builtin:cylinder360 | builtin:dome180 | FILE.warp.exr | display.json")
+          ->required();
+      command->add_option("--scene", options->scene, "builtin:city | FILE.gltf")
+          ->capture_default_str();
+      command
+          ->add_option("--method", options->method, "facets | facets-gs | cubemap | naive | vertex")
+          ->capture_default_str();
+      options->layout.add_to(*command);
+      command->add_option("--face-size", options->face_size, "Cube-map face size in pixels");
+      command->add_option("--size", options->size, "Output size WxH (built-in displays)");
+      command->add_option("--frames", options->frames, "Frames to render (median timings)")
+          ->capture_default_str();
+      command->add_option("--msaa", options->msaa, "Colour samples per pixel (0: none)");
+      command->add_option("--out", options->out, "Folder for <output>.png (and IDs, depth)");
+      command->add_flag("--ids", options->ids, "Also write <output>.ids.exr (needs --out)");
+      command->add_flag("--depth", options->depth, "Also write <output>.depth.exr (needs --out)");
+      command->add_flag("--reference", options->reference,
+                        "Compare the IDs with the CPU ray-cast reference");
+      command->add_flag("--json", options->json, "Print one JSON object");
+      command->callback([options] { run(*options); });
+    }};
+
+}  // namespace
+}  // namespace facet::cli
