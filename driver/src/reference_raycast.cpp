@@ -176,7 +176,8 @@ std::vector<std::uint32_t> reference_ids(const Scene& scene, const Warp& warp,
 }
 
 IdComparison compare_ids(const std::vector<std::uint32_t>& reference,
-                         const std::vector<std::uint32_t>& tested, glm::ivec2 size) {
+                         const std::vector<std::uint32_t>& tested, glm::ivec2 size,
+                         const IdCompareOptions& options) {
   const std::size_t pixels = std::size_t(std::max(size.x, 0)) * std::max(size.y, 0);
   if (reference.size() != pixels) {
     throw InputError("reference ID image", "size",
@@ -190,6 +191,16 @@ IdComparison compare_ids(const std::vector<std::uint32_t>& reference,
   }
   auto at = [&](const std::vector<std::uint32_t>& image, int x, int y) {
     return image[std::size_t(y) * size.x + x];
+  };
+  // Column x on the image, or -1 beyond its edge; with wrap_x every column is on it.
+  auto column = [&](int x) {
+    if (options.wrap_x) return ((x % size.x) + size.x) % size.x;
+    return x < 0 || x >= size.x ? -1 : x;
+  };
+  // Horizontal distance, the short way round with wrap_x.
+  auto x_distance = [&](long dx) {
+    dx = std::abs(dx);
+    return options.wrap_x ? std::min(dx, long(size.x) - dx) : dx;
   };
 
   // Where each ID lies in the reference, for edge distances beyond the local search.
@@ -208,8 +219,8 @@ IdComparison compare_ids(const std::vector<std::uint32_t>& reference,
       bool near_edge = false;
       for (int dy = -1; dy <= 1 && !near_edge; ++dy) {
         for (int dx = -1; dx <= 1 && !near_edge; ++dx) {
-          const int nx = x + dx, ny = y + dy;
-          if (nx < 0 || ny < 0 || nx >= size.x || ny >= size.y) continue;
+          const int nx = column(x + dx), ny = y + dy;
+          if (nx < 0 || ny < 0 || ny >= size.y) continue;
           near_edge = at(reference, nx, ny) != expected;
         }
       }
@@ -224,6 +235,10 @@ IdComparison compare_ids(const std::vector<std::uint32_t>& reference,
         ++result.absent_id_pixels;
         continue;
       }
+      if (list->second.size() < options.min_reference_pixels) {
+        ++result.sparse_id_pixels;
+        continue;
+      }
       // Every pixel on Chebyshev ring r is at least r away, so the search ends once r² passes
       // the best squared distance.
       long best = std::numeric_limits<long>::max();
@@ -233,15 +248,15 @@ IdComparison compare_ids(const std::vector<std::uint32_t>& reference,
           if (ny < 0 || ny >= size.y) continue;
           const int step = (dy == -r || dy == r) ? 1 : 2 * r;
           for (int dx = -r; dx <= r; dx += step) {
-            const int nx = x + dx;
-            if (nx < 0 || nx >= size.x || at(reference, nx, ny) != id) continue;
+            const int nx = column(x + dx);
+            if (nx < 0 || at(reference, nx, ny) != id) continue;
             best = std::min(best, long(dx) * dx + long(dy) * dy);
           }
         }
       }
       if (best > long(kLocalRadius) * kLocalRadius) {
         for (const glm::ivec2& p : list->second) {
-          const long dx = p.x - x, dy = p.y - y;
+          const long dx = x_distance(p.x - x), dy = p.y - y;
           best = std::min(best, dx * dx + dy * dy);
         }
       }

@@ -190,8 +190,57 @@ TEST(CompareIds, ShiftedEdgeFarBlobAndAbsentId) {
   diagonal[10 * 100 + 10] = 1;
   auto tested_diagonal = diagonal;
   tested_diagonal[12 * 100 + 12] = 1;
+  // The reference shows ID 1 at one pixel only: too sparse for an edge distance by default,
+  // measured when every triangle counts.
   c = compare_ids(diagonal, tested_diagonal, {100, 40});
+  EXPECT_EQ(c.max_edge_px, 0.0);
+  EXPECT_EQ(c.sparse_id_pixels, 1u);
+  c = compare_ids(diagonal, tested_diagonal, {100, 40}, {.min_reference_pixels = 1});
   EXPECT_DOUBLE_EQ(c.max_edge_px, std::sqrt(8.0));
+  EXPECT_EQ(c.sparse_id_pixels, 0u);
+}
+
+// A sliver: the reference hits ID 3 at two pixel centres 30 px apart along a row (a thin
+// triangle lying between the centres elsewhere); the tested image hits it at the centre between
+// them, 15 px from both. Its distance measures sampling, not an edge shift: left out below
+// min_reference_pixels, and counted.
+TEST(CompareIds, SparseTrianglesAreCountedNotMeasured) {
+  auto reference = two_halves();
+  reference[10 * 100 + 60] = 3;
+  reference[10 * 100 + 90] = 3;
+  auto tested = reference;
+  tested[10 * 100 + 75] = 3;
+  IdComparison c = compare_ids(reference, tested, {100, 40});
+  EXPECT_EQ(c.differing_pixels, 1u);
+  EXPECT_EQ(c.sparse_id_pixels, 1u);
+  EXPECT_EQ(c.absent_id_pixels, 0u);
+  EXPECT_EQ(c.max_edge_px, 0.0);
+  // Still a mismatch away from edges: the comparison does not hide it.
+  EXPECT_EQ(c.mismatched_pixels, 1u);
+  c = compare_ids(reference, tested, {100, 40}, {.min_reference_pixels = 2});
+  EXPECT_DOUBLE_EQ(c.max_edge_px, 15.0);
+  EXPECT_EQ(c.sparse_id_pixels, 0u);
+}
+
+// A 360° panorama: column 0 and column 99 are neighbours with wrap_x.
+TEST(CompareIds, WrapXJoinsTheLeftAndRightColumns) {
+  // ID 1 only in column 99, ID 2 elsewhere; the tested image shows ID 1 in column 1 as well:
+  // 2 px round the seam, 98 px across the image.
+  std::vector<std::uint32_t> edge_ref(100 * 40, 2);
+  for (int y = 0; y < 40; ++y) edge_ref[std::size_t(y) * 100 + 99] = 1;
+  auto edge_tested = edge_ref;
+  for (int y = 0; y < 40; ++y) edge_tested[std::size_t(y) * 100 + 1] = 1;
+  const IdComparison across = compare_ids(edge_ref, edge_tested, {100, 40});
+  const IdComparison round = compare_ids(edge_ref, edge_tested, {100, 40}, {.wrap_x = true});
+  EXPECT_DOUBLE_EQ(across.max_edge_px, 98.0);
+  EXPECT_DOUBLE_EQ(round.max_edge_px, 2.0);
+  // Column 0 touches column 99's ID 1 only round the seam: one column more near an edge.
+  EXPECT_EQ(across.compared_pixels, 100u * 40u - 2u * 40u);
+  EXPECT_EQ(round.compared_pixels, 100u * 40u - 3u * 40u);
+  // Column 1 was compared without wrap_x and is a mismatch there; with wrap_x it still is (its
+  // neighbours 0 and 2 are both ID 2).
+  EXPECT_EQ(across.mismatched_pixels, 40u);
+  EXPECT_EQ(round.mismatched_pixels, 40u);
 }
 
 TEST(CompareIds, WrongSizesAreInputErrors) {

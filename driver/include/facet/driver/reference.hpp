@@ -71,9 +71,22 @@ std::vector<std::uint32_t> reference_ids(const Scene& scene, const Warp& warp,
 // - For every tested pixel whose ID differs from the reference (edge pixels included), its edge
 //   distance is the Euclidean distance, centre to centre in output pixels, to the nearest
 //   reference pixel showing the tested ID. A perfect image has none; an edge drawn one pixel off
-//   gives 1. max_edge_px is the largest, p99_edge_px the 99th percentile. Tested IDs that
-//   appear nowhere in the reference (a triangle the reference hits at no pixel centre, or a
-//   wrong ID) have no distance: they are counted in absent_id_pixels and left out of both.
+//   gives 1. max_edge_px is the largest, p99_edge_px the 99th percentile (nearest rank).
+// - Only well-sampled triangles take part in the edge distance: a triangle that holds fewer than
+//   IdCompareOptions::min_reference_pixels pixel centres in the reference (a sliver, or a small
+//   or distant triangle) is hit at a few scattered centres, and the distance to the nearest of
+//   them says how sparse the sampling is, not how far an edge moved: a sliver shifted by a tenth
+//   of a pixel lights centres tens of pixels away from the reference's ones. Such pixels are
+//   counted in sparse_id_pixels; tested IDs that appear nowhere in the reference (a triangle the
+//   reference hits at no pixel centre, or a wrong ID) in absent_id_pixels. Both are left out of
+//   max_edge_px and p99_edge_px but not out of id_mismatch: read the three together.
+// - wrap_x: the image's left and right columns are neighbours (a 360° panorama, see
+//   BaseProjection::wraps_horizontally), for the edge test and for distances.
+struct IdCompareOptions {
+  bool wrap_x = false;
+  std::size_t min_reference_pixels = 16;
+};
+
 struct IdComparison {
   double id_mismatch = 0;
   double max_edge_px = 0;
@@ -82,10 +95,12 @@ struct IdComparison {
   std::size_t mismatched_pixels = 0;  // of those, the ones whose ID differs
   std::size_t differing_pixels = 0;   // every pixel whose ID differs, edges included
   std::size_t absent_id_pixels = 0;   // differing pixels whose ID is nowhere in the reference
+  std::size_t sparse_id_pixels = 0;   // differing pixels whose ID has too few reference pixels
 };
 
 // InputError when either image is not size.x · size.y pixels.
 IdComparison compare_ids(const std::vector<std::uint32_t>& reference,
-                         const std::vector<std::uint32_t>& tested, glm::ivec2 size);
+                         const std::vector<std::uint32_t>& tested, glm::ivec2 size,
+                         const IdCompareOptions& options = {});
 
 }  // namespace facet::driver
