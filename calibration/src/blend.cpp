@@ -3,12 +3,19 @@
 #include <algorithm>
 #include <cmath>
 #include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "facet/projection/errors.hpp"
 #include "facet/projection/warp_inverse.hpp"
 
 namespace facet::calibration {
 namespace {
+
+// An uncovered pixel of one projector counts as an edge to fade towards when another projector
+// covers its direction at least this far (output pixels) inside its own covered region. Covered
+// regions that end at the same place on the screen (where the camera's view ends) do so along
+// node-sized steps of each warp; the margin keeps those steps from counting as overlaps.
+constexpr double kOverlapMarginPx = 16;
 
 template <typename Body>
 void parallel_rows(int rows, const Body& body) {
@@ -20,15 +27,61 @@ void parallel_rows(int rows, const Body& body) {
       std::max(1.0, rows / 8.0));
 }
 
-// Distance from a projector's image edge to its position of v, as an angle: pixels times the
-// local angle per pixel (the square root of the area ratio of direction and output Jacobians).
-// 0 where the projector does not cover v.
-double edge_distance_rad(const Warp& warp, glm::dvec3 v_eye) {
+// The covered pixel centres of a warp, padded by one pixel on every side: 1 covered, 0 not
+// (the padding stands for the image edge). CV_8U, (W + 2) × (H + 2).
+cv::Mat padded_covered(const std::vector<glm::dvec2>& st_of_pixel, glm::ivec2 size) {
+  cv::Mat covered(size.y + 2, size.x + 2, CV_8U, cv::Scalar(0));
+  for (int y = 0; y < size.y; ++y) {
+    for (int x = 0; x < size.x; ++x) {
+      if (!std::isnan(st_of_pixel[std::size_t(y) * size.x + x].x)) {
+        covered.at<std::uint8_t>(y + 1, x + 1) = 1;
+      }
+    }
+  }
+  return covered;
+}
+
+// Distance in output pixels from each pixel centre to the nearest 0 of a padded mask, as the
+// distance to that pixel's edge (a pixel centre next to it lies 0.5 px away). CV_32F, W × H.
+cv::Mat distance_px(const cv::Mat& padded) {
+  cv::Mat distance;
+  cv::distanceTransform(padded, distance, cv::DIST_L2, cv::DIST_MASK_PRECISE, CV_32F);
+  cv::Mat inner = distance(cv::Rect(1, 1, padded.cols - 2, padded.rows - 2)) - 0.5f;
+  return cv::max(inner, 0.0f);
+}
+
+// A CV_32F map read bilinearly between pixel centres at output position q, clamped at the edge.
+double bilinear(const cv::Mat& map, glm::dvec2 q) {
+  const double fx = std::clamp(q.x - 0.5, 0.0, double(map.cols - 1));
+  const double fy = std::clamp(q.y - 0.5, 0.0, double(map.rows - 1));
+  const int x0 = std::min(int(fx), std::max(0, map.cols - 2));
+  const int y0 = std::min(int(fy), std::max(0, map.rows - 2));
+  const int x1 = std::min(x0 + 1, map.cols - 1), y1 = std::min(y0 + 1, map.rows - 1);
+  const double ax = fx - x0, ay = fy - y0;
+  return (1 - ay) * ((1 - ax) * map.at<float>(y0, x0) + ax * map.at<float>(y0, x1)) +
+         ay * ((1 - ax) * map.at<float>(y1, x0) + ax * map.at<float>(y1, x1));
+}
+
+// How far inside its covered region projector k's position of v lies, in output pixels; 0 where
+// k does not cover v.
+double covered_depth_px(const Warp& warp, const cv::Mat& depth_px, glm::dvec3 v_eye) {
   const auto projected = warp.project(v_eye);
   if (!projected || !projected->covered) return 0;
   const glm::dvec2 q = projected->q;
-  const double d_px =
-      std::min(std::min(q.x, warp.output_size.x - q.x), std::min(q.y, warp.output_size.y - q.y));
+  if (!(q.x > 0 && q.y > 0 && q.x < warp.output_size.x && q.y < warp.output_size.y)) return 0;
+  return bilinear(depth_px, q);
+}
+
+// The distance of v from the part of projector k's covered edge that matters for blending, as
+// an angle: the feather distance map at k's position of v (bilinear between pixel centres), times
+// the local angle per output pixel (the square root of the area ratio of direction and output
+// Jacobians). 0 where k does not cover v.
+double edge_distance_rad(const Warp& warp, const cv::Mat& distance, glm::dvec3 v_eye) {
+  const auto projected = warp.project(v_eye);
+  if (!projected || !projected->covered) return 0;
+  const glm::dvec2 q = projected->q;
+  if (!(q.x > 0 && q.y > 0 && q.x < warp.output_size.x && q.y < warp.output_size.y)) return 0;
+  const double d_px = bilinear(distance, q);
   if (!(d_px > 0)) return 0;
   constexpr double h = 1e-4;
   const glm::dvec2 st = glm::clamp(projected->st, glm::dvec2(h), glm::dvec2(1 - h));
@@ -61,6 +114,40 @@ BlendResult compute_blend(std::span<const Warp> warps, const BlendOptions& optio
   for (const Warp& warp : warps) {
     st_of_pixel.push_back(WarpInverse(warp).st_at_pixel_centres());
   }
+  // A projector fades out towards the edges of its covered region that lie well inside another
+  // projector's, and only those: where covered regions end together (the display's outer edge, or
+  // where the camera's view ended for both), fading both would make the weights the ratio of two
+  // vanishing numbers, which changes within a pixel.
+  std::vector<cv::Mat> depth_px, feather_px;
+  for (std::size_t k = 0; k < warps.size(); ++k) {
+    depth_px.push_back(distance_px(padded_covered(st_of_pixel[k], warps[k].output_size)));
+  }
+  for (std::size_t k = 0; k < warps.size(); ++k) {
+    const glm::ivec2 size = warps[k].output_size;
+    cv::Mat seeds = padded_covered(st_of_pixel[k], size);
+    // Directions of uncovered pixels (and of the ring just outside the image) from the warp's
+    // extrapolated offsets.
+    Warp extended = warps[k];
+    std::fill(extended.coverage.begin(), extended.coverage.end(), 1.0f);
+    const WarpInverse inverse(std::move(extended));
+    parallel_rows(size.y + 2, [&](int y) {
+      auto* row = seeds.ptr<std::uint8_t>(y);
+      for (int x = 0; x < size.x + 2; ++x) {
+        if (row[x] != 0) continue;
+        row[x] = 1;
+        const auto inverted = inverse.invert({x - 0.5, y - 0.5});
+        if (!inverted) continue;
+        for (std::size_t j = 0; j < warps.size(); ++j) {
+          if (j != k &&
+              covered_depth_px(warps[j], depth_px[j], inverted->v_eye) >= kOverlapMarginPx) {
+            row[x] = 0;
+            break;
+          }
+        }
+      }
+    });
+    feather_px.push_back(distance_px(seeds));
+  }
   // How many projectors overlap at most, for the black-level target.
   std::vector<cv::Mat> overlap_count;
   for (std::size_t p = 0; p < warps.size(); ++p) {
@@ -75,7 +162,8 @@ BlendResult compute_blend(std::span<const Warp> warps, const BlendOptions& optio
         double own = 0, sum = 0;
         int covering = 0;
         for (std::size_t k = 0; k < warps.size(); ++k) {
-          const double raw = smoothstep(edge_distance_rad(warps[k], v) / options.feather_rad);
+          const double raw =
+              smoothstep(edge_distance_rad(warps[k], feather_px[k], v) / options.feather_rad);
           if (raw > 0) ++covering;
           sum += raw;
           if (k == p) own = raw;
@@ -118,8 +206,15 @@ BlendCheck check_blend(std::span<const Warp> warps, std::span<const projection_i
                        int stride, double border_px) {
   FACET_ASSERT(warps.size() == alpha.size() && stride >= 1);
   BlendCheck check;
+  std::vector<WarpInverse> inverses;
+  std::vector<cv::Mat> depth_px;
+  for (const Warp& warp : warps) {
+    inverses.emplace_back(warp);
+    depth_px.push_back(
+        distance_px(padded_covered(inverses.back().st_at_pixel_centres(), warp.output_size)));
+  }
   for (std::size_t p = 0; p < warps.size(); ++p) {
-    const WarpInverse inverse(warps[p]);
+    const WarpInverse& inverse = inverses[p];
     const glm::ivec2 size = warps[p].output_size;
     std::vector<double> row_error(std::size_t(size.y), 0.0);
     std::vector<std::size_t> row_count(std::size_t(size.y), 0);
@@ -136,10 +231,7 @@ BlendCheck check_blend(std::span<const Warp> warps, std::span<const projection_i
           const auto projected = warps[k].project(inverted->v_eye);
           if (!projected || !projected->covered) continue;
           const glm::dvec2 q = projected->q;
-          if (q.x < border_px || q.y < border_px || q.x > warps[k].output_size.x - border_px ||
-              q.y > warps[k].output_size.y - border_px) {
-            near_edge = true;
-          }
+          if (!(bilinear(depth_px[k], q) >= border_px)) near_edge = true;
           sum += alpha[k].sample(q);
           ++covering;
         }

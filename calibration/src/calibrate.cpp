@@ -95,6 +95,7 @@ nlohmann::json CalibrationReport::to_json() const {
                            {"residual_p50_px", p.fit.residual_p50_px},
                            {"residual_p99_px", p.fit.residual_p99_px},
                            {"outlier_fraction", p.fit.outlier_fraction},
+                           {"filled", p.fit.filled},
                            {"holes", p.fit.holes},
                            {"folds", p.fit.folds}};
     if (p.accuracy) {

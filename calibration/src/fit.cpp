@@ -283,6 +283,12 @@ WarpFit fit_warp(std::span<const FitSample> samples, glm::ivec2 output_size,
     const std::size_t end = std::min(samples.size(), std::size_t(block + 1) * 4096);
     for (std::size_t k = std::size_t(block) * 4096; k < end; ++k) {
       const auto value = cover.base.st_from_direction(R_base_eye * samples[k].v_eye, 0.5);
+      const glm::dvec2 q = samples[k].q;
+      const double guard = options.edge_guard_px;
+      if (q.x < guard || q.y < guard || q.x > output_size.x - guard ||
+          q.y > output_size.y - guard) {
+        continue;
+      }
       if (value && value->x >= 0 && value->x <= 1 && value->y >= 0 && value->y <= 1) {
         st[k] = *value;
       }
@@ -428,6 +434,7 @@ WarpFit fit_warp(std::span<const FitSample> samples, glm::ivec2 output_size,
   const glm::dvec2 step{double(output_size.x) / cells.x, double(output_size.y) / cells.y};
   std::vector<glm::dvec2> offset(nodes.size(), glm::dvec2(kNaN));
   std::vector<char> known(nodes.size(), 0);
+  std::vector<int> ring(nodes.size(), 0);  // 0 supported, n filled in the n-th pass
   for (int j = 0; j < grid.y; ++j) {
     for (int i = 0; i < grid.x; ++i) {
       const std::size_t k = std::size_t(j) * grid.x + i;
@@ -444,8 +451,8 @@ WarpFit fit_warp(std::span<const FitSample> samples, glm::ivec2 output_size,
                          std::to_string(grid.x) + "x" + std::to_string(grid.y) +
                          " grid has enough samples around it");
   }
-  for (bool changed = true; changed;) {
-    changed = false;
+  for (int pass = 1, changed = 1; changed; ++pass) {
+    changed = 0;
     std::vector<std::size_t> filled;
     std::vector<glm::dvec2> values;
     for (int j = 0; j < grid.y; ++j) {
@@ -477,12 +484,16 @@ WarpFit fit_warp(std::span<const FitSample> samples, glm::ivec2 output_size,
     for (std::size_t n = 0; n < filled.size(); ++n) {
       offset[filled[n]] = values[n];
       known[filled[n]] = 1;
-      changed = true;
+      ring[filled[n]] = pass;
+      changed = 1;
     }
   }
 
   // Coverage: a ramp across one node spacing centred on the image edge, so that A = 0.5 (the
   // covered boundary after bilinear interpolation) falls close to where q leaves the image.
+  // Filled nodes are extrapolations: the first `extrapolate_rings` rings around the supported
+  // nodes stay covered (A at most 0.5, so the covered region ends at them), the rest of the
+  // image, which the camera never saw well enough, is left uncovered rather than guessed.
   const double spacing_px = 0.5 * (step.x + step.y);
   warp.offset_px.resize(nodes.size());
   warp.coverage.resize(nodes.size());
@@ -493,8 +504,13 @@ WarpFit fit_warp(std::span<const FitSample> samples, glm::ivec2 output_size,
       const double inside =
           std::min(std::min(q.x, output_size.x - q.x), std::min(q.y, output_size.y - q.y));
       warp.offset_px[k] = glm::vec2(offset[k]);
-      warp.coverage[k] = float(std::clamp(0.5 + inside / spacing_px, 0.0, 1.0));
-      if (!nodes[k].supported && inside > 0) ++result.report.holes;
+      double coverage = std::clamp(0.5 + inside / spacing_px, 0.0, 1.0);
+      if (ring[k] > 0)
+        coverage = ring[k] <= options.extrapolate_rings ? std::min(coverage, 0.5) : 0;
+      warp.coverage[k] = float(coverage);
+      if (ring[k] > 0 && inside > 0) {
+        ++(ring[k] > options.extrapolate_rings ? result.report.holes : result.report.filled);
+      }
     }
   }
 

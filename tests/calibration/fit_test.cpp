@@ -142,16 +142,30 @@ TEST(FitWarp, CoverageEndsAtTheProjectorEdge) {
   EXPECT_EQ(wrong, 0) << "of " << checked << " directions 6 px outside the image";
 }
 
-// A hole the camera never saw is filled, reported, and stays accurate enough to draw.
-TEST(FitWarp, ReportsHoles) {
+// A small gap in the samples is filled by extrapolation and stays covered; a large part of the
+// image the camera never saw is reported as holes and left uncovered rather than guessed.
+TEST(FitWarp, FillsSmallGapsAndReportsHoles) {
   const TruthProjector truth;
-  auto samples = make_samples(truth, 0.5, 0.3, false, 0.0, 4);
-  std::erase_if(samples, [](const fc::FitSample& s) {
-    return glm::length(s.q - glm::dvec2(160, 120)) < 30;  // 3.75 node spacings across
-  });
-  const fc::WarpFit fit = fc::fit_warp(samples, truth.size);
-  EXPECT_GT(fit.report.holes, 0u);
-  EXPECT_EQ(fit.report.folds, 0u);
+  const glm::dvec2 centre(160, 120);
+  for (const double radius : {20.0, 60.0}) {
+    auto samples = make_samples(truth, 0.5, 0.3, false, 0.0, 4);
+    std::erase_if(samples,
+                  [&](const fc::FitSample& s) { return glm::length(s.q - centre) < radius; });
+    const fc::WarpFit fit = fc::fit_warp(samples, truth.size);
+    EXPECT_EQ(fit.report.folds, 0u);
+    const auto projected = fit.warp.project(truth.v_eye(centre));
+    ASSERT_TRUE(projected.has_value());
+    if (radius < 30) {
+      EXPECT_GT(fit.report.filled, 0u);
+      EXPECT_EQ(fit.report.holes, 0u);
+      EXPECT_TRUE(projected->covered);
+      // Extrapolated over about 1.5 node spacings from each side with 0.3 px noise.
+      EXPECT_LT(glm::length(projected->q - centre), 0.5);
+    } else {
+      EXPECT_GT(fit.report.holes, 0u);
+      EXPECT_FALSE(projected->covered);
+    }
+  }
 }
 
 TEST(FitWarp, TooFewSamplesIsAnInputError) {

@@ -31,8 +31,10 @@ struct BlendResult {
 // Weights for the projectors of one display. Each warp's output pixel centre is turned into an
 // eye direction with WarpInverse; pixels no direction maps to get α = 0. The raw weight of
 // projector k at direction v is smoothstep(d_k(v) / feather_rad), where d_k is the distance in
-// output pixels from k's position of v to k's image edge, times k's local angle per pixel; 0 where
-// k does not cover v. α is the raw weight over the sum of raw weights.
+// output pixels from k's position of v to the nearest edge of k's covered region that lies inside
+// another projector's covered region (by at least 16 px), times k's local angle per pixel; 0
+// where k does not cover v. Edges no other projector covers beyond (the display's outer edge)
+// need no fading. α is the raw weight over the sum of raw weights.
 BlendResult compute_blend(std::span<const Warp> warps, const BlendOptions& options = {});
 
 struct BlendCheck {
@@ -43,9 +45,10 @@ struct BlendCheck {
 };
 
 // Measures the blend independently of how it was made: directions at every `stride`-th output
-// pixel centre of every projector (excluding pixels within `border_px` of the edge), and at each
-// one every covering projector's α, interpolated bilinearly at its own position of the
-// direction, summed.
+// pixel centre of every projector, and at each one every covering projector's α, interpolated
+// bilinearly at its own position of the direction, summed. Directions that some covering
+// projector places within `border_px` of the edge of its covered region (the image edge, or where
+// its warp stops covering) are left out: there α meets the 0 beyond the edge between two pixels.
 BlendCheck check_blend(std::span<const Warp> warps, std::span<const projection_io::BlendMap> alpha,
                        int stride = 3, double border_px = 1.0);
 

@@ -46,10 +46,20 @@ struct FitOptions {
   // Noise gain of the fitted value, [N⁻¹]₀₀·Σw: 1 for a plain mean, a few for a centred
   // quadratic, large when the node lies beyond the samples and the fit would extrapolate.
   double max_gain = 40;
+  // Unsupported nodes are filled by extrapolating outwards, ring by ring; this many rings around
+  // the supported nodes stay covered (enough for the image edges, where the last node lies
+  // beyond the samples), the rest are left uncovered.
+  int extrapolate_rings = 1;
   int irls_iterations = 3;
   // Tukey biweight cut-off: max(tukey_sigmas · robust σ, min_cutoff_px).
   double tukey_sigmas = 4.685;
   double min_cutoff_px = 0.75;
+  // Samples decoded within this many output pixels of the image edge are left out: projector
+  // defocus and camera blur mix the edge with the dark beyond it, which pulls the positions
+  // decoded there inwards (up to 1 px error within 5 px of the edge on the simulated rigs, with
+  // 1 px projector defocus and 0.5 camera pixel blur). The fit extrapolates the last few pixels
+  // smoothly instead.
+  double edge_guard_px = 5;
   // Residuals above this count as outliers in the report (output pixels).
   double outlier_px = 2.0;
   // Base projection: a perspective lined up with the projector (its axis and rows, from a
@@ -64,7 +74,8 @@ struct FitReport {
   std::size_t samples = 0;      // correspondences given
   glm::ivec2 grid{0, 0};        // node grid chosen
   std::size_t supported = 0;    // nodes with a well-posed fit
-  std::size_t holes = 0;        // unsupported nodes whose filled position lies inside the image
+  std::size_t filled = 0;       // unsupported nodes inside the image, extrapolated and kept covered
+  std::size_t holes = 0;        // unsupported nodes inside the image left uncovered
   std::size_t folds = 0;        // nodes uncovered because their cell folded
   double residual_rms_px = 0;   // RMS |warp(v) − q| over samples the warp covers
   double residual_p50_px = 0;   // median of the same
