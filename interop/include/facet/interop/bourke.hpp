@@ -1,0 +1,55 @@
+#pragma once
+// Paul Bourke warp meshes (`.data`), as used for spherical-mirror and dome projection.
+//
+// Line 1: the mesh type (2: rectangular). Line 2: "nx ny". Then nx·ny lines "x y u v i", x
+// varying fastest, rows from the bottom of the output image to its top:
+// - (x, y): the node's output position, x in [−aspect, aspect] left to right, y in [−1, 1]
+//   bottom to top, on a regular grid;
+// - (u, v): the source-image position the node shows, in [0,1], v upwards (OpenGL texture
+//   convention); a negative u or v marks a node that shows nothing;
+// - i: an intensity multiplier in [0,1], applied to the encoded output value.
+//
+// facet reads this as an inverse map (interop/inverse_grid.hpp) over a base projection chosen for
+// the source image: for a dome or a spherical mirror, a fisheye master whose image is the (u, v)
+// square (st = (u, 1 − v)).
+#include <glm/glm.hpp>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "facet/interop/display_folder.hpp"
+#include "facet/projection/base_projection.hpp"
+
+namespace facet::interop {
+
+struct BourkeNode {
+  double x = 0, y = 0, u = 0, v = 0, intensity = 1;
+};
+
+struct BourkeMesh {
+  int mesh_type = 2;
+  glm::ivec2 grid_size{0, 0};     // nx, ny
+  std::vector<BourkeNode> nodes;  // file order: x fastest, bottom row first
+  double aspect = 1;              // the largest |x|
+};
+
+// Throws InputError(source, "line N", expected) for a bad header, a wrong node count, a node
+// with too few or non-numeric columns, non-finite values, nodes off the regular grid, or more
+// than 4096 nodes on a side.
+BourkeMesh parse_bourke(std::string_view text, const std::string& source);
+
+struct BourkeImportOptions {
+  glm::ivec2 output_size{1920, 1080};  // must match the mesh's aspect within 1%
+  BaseProjection base = BaseProjection::fisheye(180);
+  glm::dmat3 R_eye_base{1.0};
+  glm::ivec2 warp_grid{0, 0};  // 0: the mesh's own node counts
+  // The intensity multiplies encoded values; linear α = intensity^gamma.
+  double intensity_gamma = 2.2;
+};
+
+// One projector: the warp and the blend map (linear α from the intensity column, bilinear between
+// nodes, 0 where the mesh shows nothing).
+ImportedProjector import_bourke(const BourkeMesh& mesh, const BourkeImportOptions& options,
+                                const std::string& source, const std::string& name);
+
+}  // namespace facet::interop

@@ -1,0 +1,37 @@
+#pragma once
+// Writing an imported display: a folder holding display.json (FORMATS.md §4) with one
+// `.warp.exr` per projector and its optional blend and black-level maps.
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "facet/projection/warp.hpp"
+#include "facet/projection_io/blend_file.hpp"
+#include "facet/projection_io/display_config.hpp"
+
+namespace facet::interop {
+
+struct ImportedProjector {
+  std::string name;  // a display.json projector name: letters, digits, '_', '-', '.'
+  Warp warp;
+  std::optional<projection_io::BlendMap> blend;  // α at the output size
+  std::optional<projection_io::BlendMap> black;  // β at the output size
+  projection_io::DisplayOutput output;           // where the image goes
+};
+
+struct ImportedDisplay {
+  std::string name;
+  std::vector<ImportedProjector> projectors;
+};
+
+// Turns any text into a projector name display.json accepts ("" becomes "projector").
+std::string sanitize_name(const std::string& text);
+
+// Writes DIR/display.json, DIR/<name>.warp.exr and, where present, DIR/<name>.blend.exr and
+// DIR/<name>.black.exr. Everything is written into a temporary folder next to `folder`, which is
+// renamed onto `folder` only when complete, so a failure leaves nothing behind. `folder` must not
+// exist or be empty (InputError naming it otherwise).
+void write_display_folder(const ImportedDisplay& display, const std::filesystem::path& folder);
+
+}  // namespace facet::interop

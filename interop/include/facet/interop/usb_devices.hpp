@@ -1,0 +1,64 @@
+#pragma once
+// USB devices for capture and projector control, through libusb. Enumeration (list_usb_devices,
+// UsbWatcher) is kept apart from classification, stable identities and formatting, which are
+// plain functions of UsbDevice values and testable without hardware.
+#include <chrono>
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace facet::interop {
+
+struct UsbDevice {
+  std::uint16_t vendor_id = 0, product_id = 0;
+  std::uint8_t bus = 0;
+  std::vector<std::uint8_t> ports;  // port numbers from the root hub down
+  std::uint8_t device_class = 0;
+  std::vector<std::uint8_t> interface_classes;
+  std::string serial, manufacturer, product;  // empty when the device has none or denies access
+
+  bool operator==(const UsbDevice&) const = default;
+};
+
+enum class UsbRole { camera, projector_control, other };
+const char* to_string(UsbRole role);
+
+// A camera: a video-class (0x0E) interface, or a machine-vision vendor (USB3 Vision devices use a
+// vendor-specific class). Projector control: USB–serial adapters (FTDI, Prolific, Silicon Labs,
+// WCH) as used for RS-232 projector control, and communications-class (0x02) devices.
+UsbRole classify(const UsbDevice& device);
+
+// "BUS-P1.P2…", the Linux sysfs name of the port: stable while the cabling stays the same.
+std::string bus_path(const UsbDevice& device);
+// "VVVV:PPPP" in lower-case hex.
+std::string vid_pid(const UsbDevice& device);
+
+// The identity a config names a device by: "usb:VVVV:PPPP:SERIAL" when the device reports a
+// serial number (it survives re-plugging into another port), else "usb:VVVV:PPPP@BUS-PATH".
+std::string stable_id(const UsbDevice& device);
+// Whether `id` (a stable_id, or just "usb:VVVV:PPPP" for any such device) names `device`.
+bool matches(const std::string& id, const UsbDevice& device);
+// The devices `id` names; several only for the bare VID:PID form.
+std::vector<UsbDevice> find_devices(const std::string& id, const std::vector<UsbDevice>& devices);
+
+// One line per device: VID:PID, role, serial, bus path, stable id, product; or
+// "no USB devices" for an empty list.
+std::string format_devices(const std::vector<UsbDevice>& devices);
+
+struct UsbListing {
+  std::vector<UsbDevice> devices;
+  std::string problem;  // non-empty when libusb could not look (no USB subsystem, permissions)
+};
+// Enumerates the devices now, sorted by bus path.
+UsbListing list_usb_devices();
+
+// Follows hotplug: calls `on_change(arrived, device)` for every device that arrives or leaves,
+// until `keep_going()` returns false (checked every `poll`), by comparing listings every `poll`
+// (which works where libusb has no hotplug support, as in containers).
+void watch_usb_devices(const std::function<void(bool arrived, const UsbDevice& device)>& on_change,
+                       const std::function<bool()>& keep_going,
+                       std::chrono::milliseconds poll = std::chrono::milliseconds(500));
+
+}  // namespace facet::interop

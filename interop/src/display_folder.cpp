@@ -1,0 +1,76 @@
+#include "facet/interop/display_folder.hpp"
+
+#include <unistd.h>
+
+#include <atomic>
+#include <set>
+#include <system_error>
+
+#include "facet/projection/errors.hpp"
+#include "facet/projection_io/warp_file.hpp"
+
+namespace facet::interop {
+
+std::string sanitize_name(const std::string& text) {
+  std::string name;
+  for (char c : text) {
+    const bool ok = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') ||
+                    c == '_' || c == '-' || c == '.';
+    name += ok ? c : '_';
+  }
+  return name.empty() ? "projector" : name;
+}
+
+void write_display_folder(const ImportedDisplay& display, const std::filesystem::path& folder) {
+  namespace fs = std::filesystem;
+  std::error_code error;
+  if (fs::exists(folder, error) && !(fs::is_directory(folder) && fs::is_empty(folder))) {
+    throw InputError(folder.string(), "--out", "expected a folder that does not exist or is empty");
+  }
+  projection_io::DisplayConfig config;
+  config.name = display.name.empty() ? "imported" : display.name;
+  config.missing_monitor = projection_io::MissingMonitor::window;
+  std::set<std::string> names;
+  for (const ImportedProjector& projector : display.projectors) {
+    std::string name = sanitize_name(projector.name);
+    for (int n = 2; names.count(name); ++n)
+      name = sanitize_name(projector.name) + "-" + std::to_string(n);
+    names.insert(name);
+    projection_io::DisplayProjector entry;
+    entry.name = name;
+    entry.size = projector.warp.output_size;
+    entry.warp = name + ".warp.exr";
+    if (projector.blend) entry.blend = name + ".blend.exr";
+    if (projector.black) entry.black = name + ".black.exr";
+    entry.output = projector.output;
+    config.projectors.push_back(entry);
+  }
+  projection_io::validate_display_config(config, folder.string() + "/display.json", false);
+
+  static std::atomic<unsigned> counter{0};
+  fs::path parent = folder.parent_path();
+  if (parent.empty()) parent = ".";
+  const fs::path temporary =
+      parent / ("." + folder.filename().string() + ".tmp" + std::to_string(::getpid()) + "-" +
+                std::to_string(counter++));
+  try {
+    fs::create_directories(temporary);
+    for (std::size_t p = 0; p < display.projectors.size(); ++p) {
+      const ImportedProjector& projector = display.projectors[p];
+      const projection_io::DisplayProjector& entry = config.projectors[p];
+      write_warp((temporary / entry.warp).string(), projector.warp);
+      if (projector.blend)
+        projection_io::write_blend_map((temporary / *entry.blend).string(), *projector.blend);
+      if (projector.black)
+        projection_io::write_blend_map((temporary / *entry.black).string(), *projector.black);
+    }
+    projection_io::write_display_config(config, temporary / "display.json");
+    if (fs::exists(folder)) fs::remove(folder);  // empty, checked above
+    fs::rename(temporary, folder);
+  } catch (...) {
+    fs::remove_all(temporary, error);
+    throw;
+  }
+}
+
+}  // namespace facet::interop

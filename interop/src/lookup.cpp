@@ -1,0 +1,73 @@
+#include "facet/interop/lookup.hpp"
+
+#include <OpenImageIO/imageio.h>
+
+#include <cmath>
+#include <nlohmann/json.hpp>
+
+#include "facet/projection/atomic_file.hpp"
+#include "facet/projection/errors.hpp"
+#include "facet/projection/warp_inverse.hpp"
+
+namespace facet::interop {
+
+void write_lookup(const Warp& warp, const std::filesystem::path& path) {
+  const WarpInverse inverse(warp);
+  const std::vector<glm::dvec2> st = inverse.st_at_pixel_centres();
+  const int w = warp.output_size.x, h = warp.output_size.y;
+  constexpr int kChannels = 7;
+  std::vector<float> pixels(std::size_t(w) * h * kChannels);
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  for (std::size_t k = 0; k < st.size(); ++k) {
+    float* p = &pixels[k * kChannels];
+    const bool covered = std::isfinite(st[k].x) && std::isfinite(st[k].y);
+    const glm::dvec3 v = covered ? warp.v_eye_from_st(st[k]) : glm::dvec3(nan);
+    p[0] = float(st[k].x);
+    p[1] = float(st[k].y);
+    p[2] = 0.0f;
+    p[3] = covered ? 1.0f : 0.0f;
+    p[4] = float(v.x);
+    p[5] = float(v.y);
+    p[6] = float(v.z);
+  }
+  nlohmann::json base = {{"base", to_string(warp.base.kind)}};
+  switch (warp.base.kind) {
+    case BaseKind::perspective:
+      base["tan_extent"] = warp.base.tan_extent;
+      break;
+    case BaseKind::fisheye:
+      base["fov"] = warp.base.fov_deg;
+      break;
+    case BaseKind::cylindrical:
+      base["azimuth"] = warp.base.azimuth_deg;
+      base["tan_elevation"] = warp.base.tan_elevation;
+      break;
+    case BaseKind::equirectangular:
+      base["azimuth"] = warp.base.azimuth_deg;
+      base["elevation"] = warp.base.elevation_deg;
+      break;
+  }
+  nlohmann::json rotation = nlohmann::json::array();
+  for (int r = 0; r < 3; ++r) {
+    rotation.push_back({warp.R_eye_base[0][r], warp.R_eye_base[1][r], warp.R_eye_base[2][r]});
+  }
+  base["rotation"] = rotation;
+  base["output_size"] = {w, h};
+  const nlohmann::json header = {{"format", "facet-lookup/1"}, {"warp", base}};
+
+  write_atomically(path, [&](const std::filesystem::path& temporary) {
+    OIIO::ImageSpec spec(w, h, kChannels, OIIO::TypeDesc::FLOAT);
+    spec.channelnames = {"R", "G", "B", "A", "X", "Y", "Z"};
+    spec.alpha_channel = 3;
+    spec.attribute("compression", "zip");
+    spec.attribute("facet:lookup", header.dump());
+    auto out = OIIO::ImageOutput::create(temporary.string());
+    if (!out || !out->open(temporary.string(), spec) ||
+        !out->write_image(OIIO::TypeDesc::FLOAT, pixels.data()) || !out->close()) {
+      const std::string reason = out ? out->geterror() : OIIO::geterror();
+      throw InputError(path.string(), "", "cannot write the lookup image: " + reason);
+    }
+  });
+}
+
+}  // namespace facet::interop

@@ -1,0 +1,450 @@
+// MPCDI containers: zip members, import into facet warps and blend maps, export.
+#include "facet/interop/mpcdi.hpp"
+
+#include <OpenImageIO/filesystem.h>
+#include <OpenImageIO/imageio.h>
+#include <zip.h>
+
+#include <cmath>
+#include <fstream>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "facet/interop/inverse_grid.hpp"
+#include "facet/interop/pfm.hpp"
+#include "facet/projection/atomic_file.hpp"
+#include "facet/projection/errors.hpp"
+#include "facet/projection/footprint.hpp"
+#include "facet/projection/warp_inverse.hpp"
+#include "facet/projection_io/warp_file.hpp"
+
+namespace facet::interop {
+namespace {
+
+constexpr std::uint64_t kMaxMemberBytes = std::uint64_t(256) << 20;
+
+struct ZipCloser {
+  void operator()(zip_t* archive) const { zip_discard(archive); }
+};
+
+// ---- reading -----------------------------------------------------------------------------------
+
+const std::string& member(const MpcdiFiles& files, const std::string& name,
+                          const std::string& source, const std::string& field) {
+  if (auto found = files.find(name); found != files.end()) return found->second;
+  // Some writers store members in a folder but name them without it (or the other way round).
+  const std::string base = std::filesystem::path(name).filename().string();
+  for (const auto& [path, bytes] : files) {
+    if (std::filesystem::path(path).filename().string() == base) return bytes;
+  }
+  throw InputError(source, field, "expected a member named \"" + name + "\" in the container");
+}
+
+// Decodes a PNG (or any image OpenImageIO reads) to `size` by bilinear resampling at output pixel
+// centres; each value becomes value^gamma_embedded, clamped to [0,1].
+projection_io::BlendMap decode_map(const std::string& bytes, const MpcdiMap& map, glm::ivec2 size,
+                                   const std::string& source) {
+  OIIO::Filesystem::IOMemReader reader(bytes.data(), bytes.size());
+  auto input = OIIO::ImageInput::open(map.path, nullptr, &reader);
+  if (!input) {
+    (void)OIIO::geterror();
+    throw InputError(source, map.path, "expected a PNG image");
+  }
+  const OIIO::ImageSpec spec = input->spec();
+  if (spec.width < 1 || spec.height < 1 || spec.nchannels < 1 ||
+      std::size_t(spec.width) * std::size_t(spec.height) > (std::size_t(1) << 26)) {
+    throw InputError(source, map.path, "expected an image of at most 2^26 pixels");
+  }
+  std::vector<float> pixels(std::size_t(spec.width) * spec.height * spec.nchannels);
+  if (!input->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, pixels.data())) {
+    (void)input->geterror();
+    throw InputError(source, map.path, "expected a readable PNG image");
+  }
+  const int channels = spec.nchannels >= 3 ? 3 : 1;
+  projection_io::BlendMap result;
+  result.size = size;
+  result.channels = channels;
+  result.values.resize(std::size_t(size.x) * size.y * channels);
+  const auto texel = [&](int x, int y, int c) {
+    x = std::clamp(x, 0, spec.width - 1);
+    y = std::clamp(y, 0, spec.height - 1);
+    return double(pixels[(std::size_t(y) * spec.width + x) * spec.nchannels + c]);
+  };
+  for (int y = 0; y < size.y; ++y) {
+    for (int x = 0; x < size.x; ++x) {
+      const double u = (x + 0.5) / size.x * spec.width - 0.5;
+      const double v = (y + 0.5) / size.y * spec.height - 0.5;
+      const int x0 = int(std::floor(u)), y0 = int(std::floor(v));
+      const double fx = u - x0, fy = v - y0;
+      for (int c = 0; c < channels; ++c) {
+        double value = (texel(x0, y0, c) * (1 - fx) + texel(x0 + 1, y0, c) * fx) * (1 - fy) +
+                       (texel(x0, y0 + 1, c) * (1 - fx) + texel(x0 + 1, y0 + 1, c) * fx) * fy;
+        value = std::pow(std::clamp(value, 0.0, 1.0), map.gamma_embedded);
+        result.at(x, y, c) = float(std::isfinite(value) ? value : 0.0);
+      }
+    }
+  }
+  return result;
+}
+
+// Fraction of complete cells of a node grid whose image keeps the grid's orientation with a
+// non-negligible area: 1 for a good map, near 0 for a mirrored or collapsed one.
+double orientation_score(const std::vector<glm::dvec2>& positions, glm::ivec2 size) {
+  int good = 0, complete = 0;
+  const double min_area = 1e-3 / (double(size.x - 1) * double(size.y - 1));
+  for (int j = 0; j + 1 < size.y; ++j) {
+    for (int i = 0; i + 1 < size.x; ++i) {
+      const glm::dvec2 a = positions[std::size_t(j) * size.x + i];
+      const glm::dvec2 b = positions[std::size_t(j) * size.x + i + 1];
+      const glm::dvec2 c = positions[std::size_t(j + 1) * size.x + i];
+      const glm::dvec2 d = positions[std::size_t(j + 1) * size.x + i + 1];
+      if (!std::isfinite(a.x + a.y + b.x + b.y + c.x + c.y + d.x + d.y)) continue;
+      ++complete;
+      const auto cross = [](glm::dvec2 u, glm::dvec2 v) { return u.x * v.y - u.y * v.x; };
+      if (cross(b - a, c - a) > min_area && cross(c - d, b - d) > min_area) ++good;
+    }
+  }
+  return complete ? double(good) / complete : 0.0;
+}
+
+struct RegionWarpInput {
+  const PfmImage* pfm;
+  BaseProjection base;
+  glm::dmat3 R{1.0};
+  glm::ivec2 output_size;
+  glm::ivec2 warp_grid;
+};
+
+Warp region_warp(const RegionWarpInput& in, MpcdiWarpValues values, const std::string& source) {
+  const PfmImage& pfm = *in.pfm;
+  const glm::ivec2 size{pfm.width, pfm.height};
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  std::vector<glm::dvec2> absolute(std::size_t(size.x) * size.y), offset_output(absolute.size());
+  for (int j = 0; j < size.y; ++j) {
+    for (int i = 0; i < size.x; ++i) {
+      const std::size_t k = std::size_t(j) * size.x + i;
+      const double x = pfm.at(i, j, 0), y = pfm.at(i, j, 1);
+      const bool ok = std::isfinite(x) && std::isfinite(y);
+      const glm::dvec2 node{double(i) / (size.x - 1), double(j) / (size.y - 1)};
+      absolute[k] = ok ? glm::dvec2(x, y) : glm::dvec2(nan);
+      // The offset form adds (dx, dy) to the node's position with y up.
+      offset_output[k] = ok ? node + glm::dvec2(x, -y) : glm::dvec2(nan);
+    }
+  }
+  if (values == MpcdiWarpValues::automatic) {
+    const double absolute_score = orientation_score(absolute, size);
+    const double offset_score = orientation_score(offset_output, size);
+    const bool absolute_ok = absolute_score >= 0.9, offset_ok = offset_score >= 0.9;
+    if (absolute_ok == offset_ok) {
+      throw InputError(source, "warp values",
+                       "expected a warp that reads as either absolute positions or offsets "
+                       "(cells keeping their orientation: absolute " +
+                           std::to_string(absolute_score) + ", offset " +
+                           std::to_string(offset_score) + "); say which with --warp-values");
+    }
+    values = absolute_ok ? MpcdiWarpValues::absolute : MpcdiWarpValues::offset;
+  }
+  if (values == MpcdiWarpValues::absolute) {
+    InverseGrid grid;
+    grid.grid_size = size;
+    grid.st = std::move(absolute);
+    return warp_from_inverse_grid(grid, in.base, in.R, in.output_size, in.warp_grid, source);
+  }
+  // Offset form: the PFM grid is already a forward map over the base image.
+  std::vector<glm::dvec2> offsets(offset_output.size());
+  for (int j = 0; j < size.y; ++j) {
+    for (int i = 0; i < size.x; ++i) {
+      const std::size_t k = std::size_t(j) * size.x + i;
+      const glm::dvec2 node{double(i) / (size.x - 1), double(j) / (size.y - 1)};
+      offsets[k] = (offset_output[k] - node) * glm::dvec2(in.output_size);
+    }
+  }
+  const std::vector<bool> covered = fill_missing(offsets, size, source);
+  Warp warp;
+  warp.base = in.base;
+  warp.R_eye_base = in.R;
+  warp.output_size = in.output_size;
+  warp.grid_size = size;
+  for (std::size_t k = 0; k < offsets.size(); ++k) {
+    warp.offset_px.push_back(glm::vec2(offsets[k]));
+    warp.coverage.push_back(covered[k] ? 1.0f : 0.0f);
+  }
+  warp.validate(source);
+  return warp;
+}
+
+// ---- writing -----------------------------------------------------------------------------------
+
+std::string encode_png16(const projection_io::BlendMap& map) {
+  std::vector<unsigned char> buffer;
+  OIIO::Filesystem::IOVecOutput output(buffer);
+  auto out = OIIO::ImageOutput::create("map.png", &output);
+  FACET_ASSERT(out);
+  OIIO::ImageSpec spec(map.size.x, map.size.y, map.channels, OIIO::TypeDesc::UINT16);
+  if (!out->open("map.png", spec) || !out->write_image(OIIO::TypeDesc::FLOAT, map.values.data()) ||
+      !out->close()) {
+    throw std::runtime_error("PNG encoding failed: " + out->geterror());
+  }
+  return std::string(buffer.begin(), buffer.end());
+}
+
+}  // namespace
+
+MpcdiFiles read_zip(std::string_view bytes, const std::string& source) {
+  zip_error_t error;
+  zip_error_init(&error);
+  zip_source_t* zip_source = zip_source_buffer_create(bytes.data(), bytes.size(), 0, &error);
+  if (!zip_source) {
+    zip_error_fini(&error);
+    throw InputError(source, "", "cannot read the container");
+  }
+  std::unique_ptr<zip_t, ZipCloser> archive(zip_open_from_source(zip_source, ZIP_RDONLY, &error));
+  if (!archive) {
+    zip_source_free(zip_source);
+    const std::string reason = zip_error_strerror(&error);
+    zip_error_fini(&error);
+    throw InputError(source, "", "expected a zip container (MPCDI): " + reason);
+  }
+  zip_error_fini(&error);
+  MpcdiFiles files;
+  const zip_int64_t count = zip_get_num_entries(archive.get(), 0);
+  for (zip_int64_t index = 0; index < count; ++index) {
+    zip_stat_t stat;
+    if (zip_stat_index(archive.get(), zip_uint64_t(index), 0, &stat) != 0 ||
+        !(stat.valid & ZIP_STAT_NAME) || !(stat.valid & ZIP_STAT_SIZE)) {
+      throw InputError(source, "member " + std::to_string(index), "expected a readable zip entry");
+    }
+    const std::string name = stat.name;
+    if (!name.empty() && name.back() == '/') continue;  // a folder
+    if (stat.size > kMaxMemberBytes) {
+      throw InputError(source, name, "expected a member of at most 256 MiB");
+    }
+    zip_file_t* file = zip_fopen_index(archive.get(), zip_uint64_t(index), 0);
+    if (!file)
+      throw InputError(
+          source, name,
+          "expected a member that can be opened (unsupported compression or encryption?)");
+    std::string data(std::size_t(stat.size), '\0');
+    const zip_int64_t read = zip_fread(file, data.data(), stat.size);
+    zip_fclose(file);
+    if (read < 0 || zip_uint64_t(read) != stat.size) {
+      throw InputError(source, name, "expected a member that decompresses to its recorded size");
+    }
+    files[name] = std::move(data);
+  }
+  return files;
+}
+
+MpcdiFiles read_zip_file(const std::filesystem::path& path) {
+  std::ifstream stream(path, std::ios::binary);
+  if (!stream) throw InputError(path.string(), "", "cannot open the file");
+  std::ostringstream bytes;
+  bytes << stream.rdbuf();
+  return read_zip(bytes.str(), path.string());
+}
+
+void write_zip_file(const std::filesystem::path& path, const MpcdiFiles& files) {
+  write_atomically(path, [&](const std::filesystem::path& temporary) {
+    int code = 0;
+    zip_t* archive = zip_open(temporary.c_str(), ZIP_CREATE | ZIP_TRUNCATE, &code);
+    if (!archive) throw InputError(path.string(), "", "cannot create the file");
+    for (const auto& [name, bytes] : files) {
+      zip_source_t* data = zip_source_buffer(archive, bytes.data(), bytes.size(), 0);
+      if (!data ||
+          zip_file_add(archive, name.c_str(), data, ZIP_FL_OVERWRITE | ZIP_FL_ENC_UTF_8) < 0) {
+        if (data) zip_source_free(data);
+        zip_discard(archive);
+        throw InputError(path.string(), name, "cannot add this member");
+      }
+    }
+    if (zip_close(archive) != 0) {
+      const std::string reason = zip_strerror(archive);
+      zip_discard(archive);
+      throw InputError(path.string(), "", "cannot write the file: " + reason);
+    }
+  });
+}
+
+ImportedDisplay import_mpcdi(const MpcdiFiles& files, const std::string& source,
+                             const MpcdiImportOptions& options) {
+  // The description: mpcdi.xml, else the only .xml member.
+  std::string xml_name;
+  if (files.count("mpcdi.xml")) {
+    xml_name = "mpcdi.xml";
+  } else {
+    for (const auto& [name, bytes] : files) {
+      if (name.size() > 4 && name.compare(name.size() - 4, 4, ".xml") == 0) {
+        if (!xml_name.empty()) {
+          throw InputError(source, "mpcdi.xml",
+                           "expected mpcdi.xml, or a single .xml member (found several)");
+        }
+        xml_name = name;
+      }
+    }
+  }
+  if (xml_name.empty()) throw InputError(source, "mpcdi.xml", "expected this member");
+  const std::string xml_source = source + ":" + xml_name;
+  const MpcdiDocument document = parse_mpcdi_xml(files.at(xml_name), xml_source);
+  if (document.profile == MpcdiProfile::advanced_3d) {
+    throw InputError(xml_source, "MPCDI@profile",
+                     "expected profile 2d or 3d (a3, warps as 3D screen points, is not supported)");
+  }
+  // The sampling facet's own export recorded, if this container came from facet.
+  nlohmann::json hints;
+  if (auto found = files.find("facet.json"); found != files.end()) {
+    hints = nlohmann::json::parse(found->second, nullptr, false);
+    if (hints.is_discarded() || !hints.is_object()) hints = nlohmann::json::object();
+  }
+
+  ImportedDisplay display;
+  display.name = std::filesystem::path(source).stem().string();
+  for (const MpcdiRegion& region : document.regions) {
+    const std::string field = "files/fileset[region=" + region.id + "]";
+    const std::string& pfm_bytes =
+        member(files, region.warp_path, xml_source, field + "/geometryWarpFile/path");
+    const std::string pfm_source = source + ":" + region.warp_path;
+    const PfmImage pfm = parse_pfm(pfm_bytes, pfm_source);
+    if (pfm.channels != 3 || pfm.width < 2 || pfm.height < 2) {
+      throw InputError(pfm_source, "header", "expected a three-channel PFM of at least 2×2 nodes");
+    }
+    RegionWarpInput in;
+    in.pfm = &pfm;
+    in.output_size = region.resolution;
+    if (document.profile == MpcdiProfile::three_d) {
+      in.base = frustum_base(*region.frustum);
+      in.R = R_eye_frustum(*region.frustum);
+    } else {
+      const double aspect = double(region.buffer_resolution.x) / region.buffer_resolution.y;
+      in.base = BaseProjection::perspective(-aspect, aspect, 1, -1);
+    }
+    in.warp_grid = {pfm.width, pfm.height};
+    const nlohmann::json* hint = nullptr;
+    if (hints.contains("regions") && hints["regions"].is_object() &&
+        hints["regions"].contains(region.id)) {
+      hint = &hints["regions"][region.id];
+    }
+    if (options.warp_grid) {
+      in.warp_grid = *options.warp_grid;
+    } else if (hint && hint->contains("warp_grid") && (*hint)["warp_grid"].is_array() &&
+               (*hint)["warp_grid"].size() == 2 && (*hint)["warp_grid"][0].is_number_integer() &&
+               (*hint)["warp_grid"][1].is_number_integer()) {
+      const int gx = (*hint)["warp_grid"][0], gy = (*hint)["warp_grid"][1];
+      if (gx >= 2 && gy >= 2 && gx <= 4096 && gy <= 4096) in.warp_grid = {gx, gy};
+    }
+
+    ImportedProjector projector;
+    projector.name = sanitize_name(region.id);
+    projector.warp = region_warp(in, options.values, pfm_source);
+    if (region.alpha) {
+      projector.blend =
+          decode_map(member(files, region.alpha->path, xml_source, field + "/alphaMap/path"),
+                     *region.alpha, region.resolution, source + ":" + region.alpha->path);
+    }
+    if (region.beta) {
+      projector.black =
+          decode_map(member(files, region.beta->path, xml_source, field + "/betaMap/path"),
+                     *region.beta, region.resolution, source + ":" + region.beta->path);
+    }
+    // Buffers sit left to right on the desktop, regions inside them by their extents.
+    int x0 = 0;
+    std::vector<int> widths;
+    for (const MpcdiRegion& other : document.regions) {
+      if (int(widths.size()) <= other.buffer_index) widths.resize(other.buffer_index + 1, 0);
+      widths[other.buffer_index] = other.buffer_resolution.x;
+    }
+    for (int b = 0; b < region.buffer_index; ++b) x0 += widths[b];
+    projector.output.kind = projection_io::DisplayOutput::Kind::window;
+    projector.output.window = {x0 + int(std::lround(region.extent.x * region.buffer_resolution.x)),
+                               int(std::lround(region.extent.y * region.buffer_resolution.y)),
+                               region.resolution.x, region.resolution.y};
+    display.projectors.push_back(std::move(projector));
+  }
+  return display;
+}
+
+MpcdiFiles export_mpcdi(const projection_io::DisplayConfig& display,
+                        const MpcdiExportOptions& options) {
+  FACET_ASSERT(options.node_spacing_px > 0);
+  MpcdiDocument document;
+  MpcdiFiles files;
+  nlohmann::json hints = {{"format", "facet-mpcdi/1"}, {"regions", nlohmann::json::object()}};
+  int buffer = 0;
+  for (const projection_io::DisplayProjector& projector : display.projectors) {
+    const std::string warp_path = display.resolve(projector.warp).string();
+    const Warp warp = read_warp(warp_path);
+    MpcdiRegion region;
+    region.id = projector.name;
+    region.buffer_index = buffer++;
+    region.buffer_resolution = warp.output_size;
+    region.resolution = warp.output_size;
+    MpcdiFrustum frustum;
+    if (warp.base.kind == BaseKind::perspective) {
+      frustum = frustum_from_base(warp.base, warp.R_eye_base);
+    } else {
+      // A perspective frustum around everything the projector shows: directions of the output
+      // image's border and interior, found by exact inversion.
+      const WarpInverse inverse(warp);
+      std::vector<glm::dvec3> directions;
+      const int n = 64;
+      for (int j = 0; j <= n; ++j) {
+        for (int i = 0; i <= n; ++i) {
+          const glm::dvec2 q{double(i) / n * warp.output_size.x,
+                             double(j) / n * warp.output_size.y};
+          if (auto inverted = inverse.invert(q)) directions.push_back(inverted->v_eye);
+        }
+      }
+      if (directions.empty())
+        throw InputError(warp_path, "coverage", "expected a warp that covers some output pixels");
+      CoverOptions cover;
+      cover.max_perspective_half_angle_rad = glm::radians(80.0);
+      cover.up_eye = warp.R_eye_base * glm::dvec3(0, 1, 0);
+      const BaseCover covered = cover_directions(directions, cover);
+      if (covered.base.kind != BaseKind::perspective) {
+        throw InputError(warp_path, "base",
+                         "expected a projector footprint within 80° of its centre, so that one "
+                         "MPCDI frustum holds it");
+      }
+      frustum = frustum_from_base(covered.base, covered.R_eye_base);
+    }
+    region.frustum = frustum;
+    const BaseProjection base = frustum_base(frustum);
+    const glm::dmat3 R_frustum_eye = glm::transpose(R_eye_frustum(frustum));
+    const glm::ivec2 nodes{int(std::ceil(warp.output_size.x / options.node_spacing_px)) + 1,
+                           int(std::ceil(warp.output_size.y / options.node_spacing_px)) + 1};
+    const InverseGrid grid = inverse_grid_from_warp(warp, nodes, [&](const glm::dvec3& v_eye) {
+      return base.st_from_direction(R_frustum_eye * v_eye);
+    });
+    PfmImage pfm;
+    pfm.width = nodes.x;
+    pfm.height = nodes.y;
+    pfm.channels = 3;
+    for (const glm::dvec2& st : grid.st) {
+      pfm.values.push_back(float(st.x));
+      pfm.values.push_back(float(st.y));
+      pfm.values.push_back(std::isfinite(st.x) ? 0.0f : std::numeric_limits<float>::quiet_NaN());
+    }
+    region.warp_path = projector.name + ".pfm";
+    files[region.warp_path] = format_pfm(pfm);
+    if (projector.blend) {
+      const auto map = projection_io::read_blend_map(display.resolve(*projector.blend).string(),
+                                                     warp.output_size);
+      region.alpha = MpcdiMap{projector.name + "_alpha.png", 1.0, map.channels};
+      files[region.alpha->path] = encode_png16(map);
+    }
+    if (projector.black) {
+      const auto map = projection_io::read_blend_map(display.resolve(*projector.black).string(),
+                                                     warp.output_size);
+      region.beta = MpcdiMap{projector.name + "_beta.png", 1.0, map.channels};
+      files[region.beta->path] = encode_png16(map);
+    }
+    hints["regions"][region.id] = {{"warp_grid", {warp.grid_size.x, warp.grid_size.y}},
+                                   {"pfm_nodes", {nodes.x, nodes.y}}};
+    document.regions.push_back(region);
+  }
+  files["mpcdi.xml"] = format_mpcdi_xml(document);
+  files["facet.json"] = hints.dump(2);
+  return files;
+}
+
+}  // namespace facet::interop

@@ -1,0 +1,207 @@
+#include "facet/interop/usb_devices.hpp"
+
+#include <libusb.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <map>
+#include <set>
+#include <thread>
+#include <tuple>
+
+namespace facet::interop {
+namespace {
+
+std::string hex4(std::uint16_t value) {
+  char text[8];
+  std::snprintf(text, sizeof text, "%04x", value);
+  return text;
+}
+
+std::string descriptor_string(libusb_device_handle* handle, std::uint8_t index) {
+  if (!handle || index == 0) return {};
+  unsigned char text[256];
+  const int length = libusb_get_string_descriptor_ascii(handle, index, text, sizeof text);
+  if (length <= 0) return {};
+  std::string result(reinterpret_cast<const char*>(text), std::size_t(length));
+  // Serials go into configs and tables: keep them printable.
+  for (char& c : result) {
+    if (c < 0x21 || c > 0x7e) c = '_';
+  }
+  return result;
+}
+
+UsbDevice describe(libusb_device* device) {
+  UsbDevice result;
+  libusb_device_descriptor descriptor{};
+  if (libusb_get_device_descriptor(device, &descriptor) != 0) return result;
+  result.vendor_id = descriptor.idVendor;
+  result.product_id = descriptor.idProduct;
+  result.device_class = descriptor.bDeviceClass;
+  result.bus = libusb_get_bus_number(device);
+  std::uint8_t ports[8];
+  const int depth = libusb_get_port_numbers(device, ports, 8);
+  for (int k = 0; k < depth; ++k) result.ports.push_back(ports[k]);
+  libusb_config_descriptor* config = nullptr;
+  if (libusb_get_active_config_descriptor(device, &config) == 0 && config) {
+    for (int i = 0; i < config->bNumInterfaces; ++i) {
+      for (int a = 0; a < config->interface[i].num_altsetting; ++a) {
+        result.interface_classes.push_back(config->interface[i].altsetting[a].bInterfaceClass);
+      }
+    }
+    libusb_free_config_descriptor(config);
+  }
+  // Strings need the device opened, which permissions may deny: then they stay empty.
+  libusb_device_handle* handle = nullptr;
+  if (libusb_open(device, &handle) == 0) {
+    result.serial = descriptor_string(handle, descriptor.iSerialNumber);
+    result.manufacturer = descriptor_string(handle, descriptor.iManufacturer);
+    result.product = descriptor_string(handle, descriptor.iProduct);
+    libusb_close(handle);
+  }
+  return result;
+}
+
+void sort_devices(std::vector<UsbDevice>& devices) {
+  std::sort(devices.begin(), devices.end(), [](const UsbDevice& a, const UsbDevice& b) {
+    return std::tie(a.bus, a.ports, a.vendor_id, a.product_id) <
+           std::tie(b.bus, b.ports, b.vendor_id, b.product_id);
+  });
+}
+
+}  // namespace
+
+const char* to_string(UsbRole role) {
+  switch (role) {
+    case UsbRole::camera:
+      return "camera";
+    case UsbRole::projector_control:
+      return "projector-control";
+    case UsbRole::other:
+      break;
+  }
+  return "other";
+}
+
+UsbRole classify(const UsbDevice& device) {
+  constexpr std::uint8_t kVideo = 0x0e, kCommunications = 0x02;
+  const auto has_class = [&](std::uint8_t c) {
+    return device.device_class == c ||
+           std::find(device.interface_classes.begin(), device.interface_classes.end(), c) !=
+               device.interface_classes.end();
+  };
+  if (has_class(kVideo)) return UsbRole::camera;
+  // Machine-vision cameras (USB3 Vision uses a vendor-specific class): FLIR/Point Grey, Basler,
+  // IDS, Allied Vision, XIMEA, The Imaging Source.
+  static const std::set<std::uint16_t> camera_vendors{0x1e10, 0x2676, 0x1409,
+                                                      0x1ab2, 0x20f7, 0x199e};
+  if (camera_vendors.count(device.vendor_id)) return UsbRole::camera;
+  // USB–serial bridges that drive projectors' RS-232 control ports: FTDI, Prolific,
+  // Silicon Labs, WCH.
+  static const std::set<std::uint16_t> serial_vendors{0x0403, 0x067b, 0x10c4, 0x1a86};
+  if (serial_vendors.count(device.vendor_id) || has_class(kCommunications)) {
+    return UsbRole::projector_control;
+  }
+  return UsbRole::other;
+}
+
+std::string bus_path(const UsbDevice& device) {
+  std::string path = std::to_string(device.bus);
+  if (device.ports.empty()) return path + "-0";
+  for (std::size_t k = 0; k < device.ports.size(); ++k) {
+    path += (k == 0 ? "-" : ".") + std::to_string(device.ports[k]);
+  }
+  return path;
+}
+
+std::string vid_pid(const UsbDevice& device) {
+  return hex4(device.vendor_id) + ":" + hex4(device.product_id);
+}
+
+std::string stable_id(const UsbDevice& device) {
+  if (!device.serial.empty()) return "usb:" + vid_pid(device) + ":" + device.serial;
+  return "usb:" + vid_pid(device) + "@" + bus_path(device);
+}
+
+bool matches(const std::string& id, const UsbDevice& device) {
+  const std::string prefix = "usb:" + vid_pid(device);
+  std::string lower = id;
+  // VID:PID is hex and may be written in capitals; the serial and bus path stay as written.
+  for (std::size_t k = 0; k < std::min<std::size_t>(lower.size(), prefix.size()); ++k) {
+    lower[k] = char(std::tolower(static_cast<unsigned char>(lower[k])));
+  }
+  if (lower.compare(0, prefix.size(), prefix) != 0) return false;
+  if (lower.size() == prefix.size()) return true;
+  return lower == stable_id(device) ||
+         (lower[prefix.size()] == '@' && lower.substr(prefix.size() + 1) == bus_path(device));
+}
+
+std::vector<UsbDevice> find_devices(const std::string& id, const std::vector<UsbDevice>& devices) {
+  std::vector<UsbDevice> found;
+  for (const UsbDevice& device : devices) {
+    if (matches(id, device)) found.push_back(device);
+  }
+  return found;
+}
+
+std::string format_devices(const std::vector<UsbDevice>& devices) {
+  if (devices.empty()) return "no USB devices\n";
+  std::string out;
+  char line[512];
+  std::snprintf(line, sizeof line, "%-10s %-18s %-12s %-20s %-32s %s\n", "VID:PID", "role",
+                "bus path", "serial", "stable id", "product");
+  out += line;
+  for (const UsbDevice& device : devices) {
+    const std::string product =
+        device.manufacturer.empty() ? device.product : device.manufacturer + " " + device.product;
+    std::snprintf(line, sizeof line, "%-10s %-18s %-12s %-20s %-32s %s\n", vid_pid(device).c_str(),
+                  to_string(classify(device)), bus_path(device).c_str(),
+                  device.serial.empty() ? "-" : device.serial.c_str(), stable_id(device).c_str(),
+                  product.empty() ? "-" : product.c_str());
+    out += line;
+  }
+  return out;
+}
+
+UsbListing list_usb_devices() {
+  UsbListing listing;
+  libusb_context* context = nullptr;
+  if (const int code = libusb_init(&context); code != 0) {
+    listing.problem = std::string("libusb cannot start: ") + libusb_strerror(code);
+    return listing;
+  }
+  libusb_device** list = nullptr;
+  const ssize_t count = libusb_get_device_list(context, &list);
+  if (count < 0) {
+    listing.problem = std::string("libusb cannot list devices: ") + libusb_strerror(int(count));
+  } else {
+    for (ssize_t k = 0; k < count; ++k) listing.devices.push_back(describe(list[k]));
+    libusb_free_device_list(list, 1);
+  }
+  libusb_exit(context);
+  sort_devices(listing.devices);
+  return listing;
+}
+
+void watch_usb_devices(const std::function<void(bool arrived, const UsbDevice& device)>& on_change,
+                       const std::function<bool()>& keep_going, std::chrono::milliseconds poll) {
+  // Comparing listings works on every platform and needs no callback threading; libusb's
+  // hotplug events would only shorten the delay below `poll`.
+  const auto key = [](const UsbDevice& d) { return bus_path(d) + " " + vid_pid(d); };
+  std::map<std::string, UsbDevice> known;
+  for (const UsbDevice& device : list_usb_devices().devices) known[key(device)] = device;
+  while (keep_going()) {
+    std::this_thread::sleep_for(poll);
+    std::map<std::string, UsbDevice> now;
+    for (const UsbDevice& device : list_usb_devices().devices) now[key(device)] = device;
+    for (const auto& [k, device] : known) {
+      if (!now.count(k)) on_change(false, device);
+    }
+    for (const auto& [k, device] : now) {
+      if (!known.count(k)) on_change(true, device);
+    }
+    known = std::move(now);
+  }
+}
+
+}  // namespace facet::interop

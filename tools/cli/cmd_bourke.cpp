@@ -1,0 +1,72 @@
+// facet bourke: Paul Bourke warp meshes (.data) into a display folder.
+#include <fstream>
+#include <iostream>
+#include <sstream>
+
+#include "command.hpp"
+#include "display_flags.hpp"
+#include "facet/interop/bourke.hpp"
+#include "facet/projection/errors.hpp"
+
+namespace facet::cli {
+namespace {
+
+const Registration registration{
+    61, [](CLI::App& app) {
+      auto* command = app.add_subcommand("bourke", "Import Paul Bourke warp meshes (.data)");
+      command->require_subcommand(1);
+      struct Options {
+        std::string file, out, size = "1920x1080", grid;
+        double fov = 180, gamma = 2.2;
+      };
+      auto options = std::make_shared<Options>();
+      auto* import_command = command->add_subcommand(
+          "import",
+          "Read a mesh into DIR/display.json: an offset map over a fisheye master and a blend "
+          "map from the intensity column");
+      import_command->add_option("file", options->file, "The .data mesh")->required();
+      import_command->add_option("--out", options->out, "The folder to create")->required();
+      import_command->add_option("--size", options->size,
+                                 "Projector resolution WxH; its aspect must match the mesh's "
+                                 "(default 1920x1080)");
+      import_command->add_option(
+          "--fov", options->fov,
+          "Field of view of the fisheye source image, degrees (default 180)");
+      import_command->add_option("--grid", options->grid,
+                                 "Node count GXxGY of the warp (default: the mesh's)");
+      import_command->add_option("--intensity-gamma", options->gamma,
+                                 "Linear blend = intensity^gamma (default 2.2)");
+      import_command->callback([options] {
+        std::ifstream stream(options->file, std::ios::binary);
+        if (!stream) throw InputError(options->file, "", "cannot open the file");
+        std::ostringstream text;
+        text << stream.rdbuf();
+        const interop::BourkeMesh mesh = interop::parse_bourke(text.str(), options->file);
+        interop::BourkeImportOptions import;
+        import.output_size = parse_size(options->size, "--size");
+        if (!(options->fov > 0 && options->fov <= 360)) {
+          throw InputError("--fov", "", "expected degrees in (0, 360]");
+        }
+        if (!(options->gamma > 0 && options->gamma <= 10)) {
+          throw InputError("--intensity-gamma", "", "expected a gamma in (0, 10]");
+        }
+        import.base = BaseProjection::fisheye(options->fov);
+        import.intensity_gamma = options->gamma;
+        if (!options->grid.empty()) {
+          import.warp_grid = parse_size(options->grid, "--grid");
+          if (import.warp_grid.x < 2 || import.warp_grid.y < 2 || import.warp_grid.x > 4096 ||
+              import.warp_grid.y > 4096) {
+            throw InputError("--grid", "", "expected GXxGY with each count in [2, 4096]");
+          }
+        }
+        interop::ImportedDisplay display;
+        display.name = std::filesystem::path(options->file).stem().string();
+        display.projectors.push_back(interop::import_bourke(mesh, import, options->file,
+                                                            interop::sanitize_name(display.name)));
+        interop::write_display_folder(display, options->out);
+        std::cout << "wrote " << options->out << "/display.json\n";
+      });
+    }};
+
+}  // namespace
+}  // namespace facet::cli

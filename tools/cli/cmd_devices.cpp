@@ -1,0 +1,64 @@
+// facet devices: USB cameras and projector controllers, and their stable identities.
+#include <atomic>
+#include <chrono>
+#include <csignal>
+#include <iostream>
+
+#include "command.hpp"
+#include "facet/interop/usb_devices.hpp"
+#include "facet/projection/errors.hpp"
+
+namespace facet::cli {
+namespace {
+
+std::atomic<bool> interrupted{false};
+
+const Registration registration{
+    70, [](CLI::App& app) {
+      auto* command = app.add_subcommand(
+          "devices",
+          "List USB devices (VID:PID, role, serial, bus path, stable id); --watch follows hotplug");
+      struct Options {
+        bool watch = false;
+        double seconds = 0;
+        std::string find;
+      };
+      auto options = std::make_shared<Options>();
+      command->add_flag("--watch", options->watch, "Keep running and report arrivals and removals");
+      command->add_option("--for", options->seconds,
+                          "With --watch: stop after this many seconds (default: until Ctrl-C)");
+      command->add_option("--find", options->find,
+                          "Only the devices a stable id (usb:VVVV:PPPP[:SERIAL|@BUS-PATH]) names");
+      command->callback([options] {
+        if (options->seconds < 0) throw InputError("--for", "", "expected seconds >= 0");
+        const interop::UsbListing listing = interop::list_usb_devices();
+        if (!listing.problem.empty()) std::cerr << "facet: note: " << listing.problem << "\n";
+        std::vector<interop::UsbDevice> devices = listing.devices;
+        if (!options->find.empty()) {
+          if (options->find.rfind("usb:", 0) != 0) {
+            throw InputError("--find", "", "expected usb:VVVV:PPPP[:SERIAL|@BUS-PATH]");
+          }
+          devices = interop::find_devices(options->find, devices);
+        }
+        std::cout << interop::format_devices(devices) << std::flush;
+        if (!options->watch) return;
+        std::signal(SIGINT, [](int) { interrupted = true; });
+        const auto start = std::chrono::steady_clock::now();
+        const double limit = options->seconds;
+        interop::watch_usb_devices(
+            [](bool arrived, const interop::UsbDevice& device) {
+              std::cout << (arrived ? "+ " : "- ") << interop::vid_pid(device) << " "
+                        << interop::to_string(interop::classify(device)) << " "
+                        << interop::bus_path(device) << " " << interop::stable_id(device)
+                        << std::endl;
+            },
+            [start, limit] {
+              const double elapsed =
+                  std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+              return !interrupted && (limit <= 0 || elapsed < limit);
+            });
+      });
+    }};
+
+}  // namespace
+}  // namespace facet::cli

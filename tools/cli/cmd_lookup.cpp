@@ -1,0 +1,52 @@
+// facet lookup: per-pixel source coordinates for tools that only resample.
+#include <iostream>
+
+#include "command.hpp"
+#include "facet/interop/lookup.hpp"
+#include "facet/projection/errors.hpp"
+#include "facet/projection_io/display_config.hpp"
+#include "facet/projection_io/warp_file.hpp"
+
+namespace facet::cli {
+namespace {
+
+const Registration registration{
+    62, [](CLI::App& app) {
+      auto* command = app.add_subcommand(
+          "lookup",
+          "Write an EXR holding, for every output pixel, the base st (R, G) and eye direction "
+          "(X, Y, Z) it shows");
+      struct Options {
+        std::string warp, display, out;
+      };
+      auto options = std::make_shared<Options>();
+      auto* warp = command->add_option("--warp", options->warp, "A .warp.exr");
+      auto* display = command->add_option("--display", options->display,
+                                          "A display.json: one <projector>.lookup.exr each");
+      warp->excludes(display);
+      command
+          ->add_option("--out", options->out,
+                       "The .exr to write (with --display: the folder to write into)")
+          ->required();
+      command->callback([options] {
+        if (!options->warp.empty()) {
+          interop::write_lookup(read_warp(options->warp), options->out);
+          std::cout << "wrote " << options->out << "\n";
+          return;
+        }
+        if (options->display.empty()) {
+          throw InputError("--warp, --display", "", "expected one of them");
+        }
+        const auto config = projection_io::read_display_config(options->display);
+        std::filesystem::create_directories(options->out);
+        for (const auto& projector : config.projectors) {
+          const std::filesystem::path path =
+              std::filesystem::path(options->out) / (projector.name + ".lookup.exr");
+          interop::write_lookup(read_warp(config.resolve(projector.warp).string()), path);
+          std::cout << "wrote " << path.string() << "\n";
+        }
+      });
+    }};
+
+}  // namespace
+}  // namespace facet::cli
