@@ -1,0 +1,128 @@
+// facet run from the command line: a headless session renders the same pixels as facet render,
+// writes non-empty frames for every sample display, and rejects bad displays with exit status 2.
+#include <OpenImageIO/imageio.h>
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+namespace facet {
+namespace {
+
+namespace fs = std::filesystem;
+
+int run(const std::string& arguments, const fs::path& log) {
+  const std::string command =
+      std::string(FACET_CLI) + " " + arguments + " > " + log.string() + " 2>&1";
+  const int status = std::system(command.c_str());
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+std::string slurp(const fs::path& path) {
+  std::ifstream in(path);
+  return {std::istreambuf_iterator<char>(in), {}};
+}
+
+struct Png {
+  int width = 0, height = 0, channels = 0;
+  std::vector<unsigned char> pixels;
+};
+
+Png read_png(const fs::path& path) {
+  Png png;
+  auto in = OIIO::ImageInput::open(path.string());
+  if (!in) return png;
+  const OIIO::ImageSpec& spec = in->spec();
+  png.width = spec.width;
+  png.height = spec.height;
+  png.channels = spec.nchannels;
+  png.pixels.resize(std::size_t(spec.width) * spec.height * spec.nchannels);
+  in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::UINT8, png.pixels.data());
+  return png;
+}
+
+fs::path fresh_folder(const std::string& name) {
+  const fs::path folder = fs::temp_directory_path() / ("facet_run_cli_" + name);
+  fs::remove_all(folder);
+  fs::create_directories(folder);
+  return folder;
+}
+
+TEST(RunCli, HeadlessSessionRendersTheSamePixelsAsRender) {
+  const fs::path folder = fresh_folder("same");
+  const std::string common =
+      "--size 160x120 --scene builtin:city --method facets --tolerance 0.25 --frames 1";
+  ASSERT_EQ(run("run builtin:cylinder360 --headless " + common + " --out " +
+                    (folder / "session").string(),
+                folder / "run.log"),
+            0)
+      << slurp(folder / "run.log");
+  ASSERT_EQ(run("render --display builtin:cylinder360 " + common + " --out " +
+                    (folder / "render").string(),
+                folder / "render.log"),
+            0)
+      << slurp(folder / "render.log");
+  const Png session = read_png(folder / "session" / "cylinder360" / "00000.png");
+  const Png render = read_png(folder / "render" / "cylinder360.png");
+  ASSERT_EQ(session.width, 160);
+  ASSERT_EQ(session.height, 120);
+  ASSERT_EQ(render.width, session.width);
+  ASSERT_EQ(render.height, session.height);
+  ASSERT_EQ(render.channels, session.channels);
+  std::size_t differing = 0;
+  for (std::size_t i = 0; i < session.pixels.size(); ++i)
+    differing += session.pixels[i] != render.pixels[i];
+  EXPECT_EQ(differing, 0u) << "the session and facet render disagree on " << differing << " bytes";
+  // Not a blank image: the city covers the view.
+  std::size_t lit = 0;
+  for (std::size_t i = 0; i < session.pixels.size(); i += std::size_t(session.channels))
+    lit += session.pixels[i] > 0 || session.pixels[i + 1] > 0 || session.pixels[i + 2] > 0;
+  EXPECT_GT(lit, session.pixels.size() / std::size_t(session.channels) / 2);
+}
+
+TEST(RunCli, BadDisplaysExitWithStatusTwoNamingTheProblem) {
+  const fs::path folder = fresh_folder("bad");
+  struct Case {
+    std::string name, json, expected;
+  };
+  const std::vector<Case> cases = {
+      {"missing_warp",
+       R"({"format": "facet-display/1", "name": "d", "eye": [0, 0, 0], "projectors": [{"name": "p", "size": [64, 48],
+          "warp": "nowhere.warp.exr", "output": {"window": [0, 0, 64, 48]}}]})",
+       "nowhere.warp.exr"},
+      {"wrong_type",
+       R"({"format": "facet-display/1", "name": "d", "eye": [0, 0, 0], "projectors": [{"name": "p", "size": "64x48",
+          "warp": "p.warp.exr", "output": {"window": [0, 0, 64, 48]}}]})",
+       "projectors[0].size"},
+      {"nan", R"({"format": "facet-display/1", "name": "d", "eye": [0, NaN, 0], "projectors": []})",
+       "expected valid JSON"},
+      {"infinite",
+       R"({"format": "facet-display/1", "name": "d", "eye": [0, 1e999, 0], "projectors": []})",
+       "1e999"},
+      {"bad_gamma",
+       R"({"format": "facet-display/1", "name": "d", "eye": [0, 0, 0], "projectors": [{"name": "p", "size": [64, 48],
+          "warp": "p.warp.exr", "gamma": "linear", "output": {"window": [0, 0, 64, 48]}}]})",
+       "gamma"},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.name);
+    const fs::path dir = folder / c.name;
+    fs::create_directories(dir);
+    std::ofstream(dir / "display.json") << c.json;
+    const fs::path out = dir / "frames";
+    EXPECT_EQ(run("run " + (dir / "display.json").string() + " --headless --frames 1 --out " +
+                      out.string(),
+                  dir / "log"),
+              2);
+    const std::string log = slurp(dir / "log");
+    EXPECT_NE(log.find(c.expected), std::string::npos) << log;
+    EXPECT_FALSE(fs::exists(out)) << "a failed run left output behind";
+  }
+}
+
+}  // namespace
+}  // namespace facet
