@@ -78,7 +78,8 @@ void run(const RenderOptions& options) {
   std::optional<glm::ivec2> size;
   if (!options.size.empty()) size = parse_size(options.size, "--size");
   const std::vector<OutputSpec> outputs = load_display_outputs(options.display, size);
-  auto method = make_render_method(options.method);
+  // Checked before any GL work; made again once the context exists, which must outlive it.
+  make_render_method(options.method);
   RenderSettings settings;
   settings.facets.layout = options.layout.layout();
   if (options.face_size) {
@@ -95,6 +96,7 @@ void run(const RenderOptions& options) {
   const Scene scene = load_scene(options.scene);
 
   auto context = create_headless_context();
+  auto method = make_render_method(options.method);
   const GpuScene gpu_scene = upload_scene(scene);
   method->prepare(scene, gpu_scene, outputs, settings);
   std::vector<OutputTarget> targets;
