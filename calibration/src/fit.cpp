@@ -170,6 +170,8 @@ std::optional<BaseCover> projector_cover(std::span<const FitSample> samples, glm
 struct NodeFit {
   glm::dvec2 q{kNaN};
   bool supported = false;
+  // Second-order terms of the fit in node units: x·du², x·dv², y·du², y·dv².
+  cv::Vec4d curvature{0, 0, 0, 0};
 };
 
 using Basis = cv::Vec<double, 6>;
@@ -296,8 +298,8 @@ WarpFit fit_warp(std::span<const FitSample> samples, glm::ivec2 output_size,
   });
 
   // Grid: from the average scale of output pixels per unit of s and t (a linear fit q ~ st).
-  glm::ivec2 grid = options.grid;
-  if (grid.x == 0 || grid.y == 0) {
+  double px_per_s = output_size.x, px_per_t = output_size.y;
+  {
     cv::Matx33d normal = cv::Matx33d::zeros();
     cv::Matx<double, 3, 2> rhs = cv::Matx<double, 3, 2>::zeros();
     for (std::size_t k = 0; k < samples.size(); k += stride) {
@@ -308,125 +310,181 @@ WarpFit fit_warp(std::span<const FitSample> samples, glm::ivec2 output_size,
     }
     cv::Matx<double, 3, 2> solution;
     cv::solve(normal, rhs, solution, cv::DECOMP_SVD);
-    const double px_per_s = std::hypot(solution(1, 0), solution(1, 1));
-    const double px_per_t = std::hypot(solution(2, 0), solution(2, 1));
-    auto nodes = [&](double px) {
-      return std::clamp(int(std::ceil(px / options.node_spacing_px)) + 1, 4, 1024);
-    };
-    grid = {nodes(std::isfinite(px_per_s) ? px_per_s : output_size.x),
-            nodes(std::isfinite(px_per_t) ? px_per_t : output_size.y)};
+    const double s_scale = std::hypot(solution(1, 0), solution(1, 1));
+    const double t_scale = std::hypot(solution(2, 0), solution(2, 1));
+    if (std::isfinite(s_scale) && s_scale > 0) px_per_s = s_scale;
+    if (std::isfinite(t_scale) && t_scale > 0) px_per_t = t_scale;
   }
-  FACET_ASSERT(grid.x >= 2 && grid.y >= 2);
+  auto grid_for = [&](double spacing_px) {
+    auto count = [&](double px) {
+      return std::clamp(int(std::ceil(px / spacing_px)) + 1, 4, 1024);
+    };
+    return glm::ivec2(count(px_per_s), count(px_per_t));
+  };
+  const bool chosen_grid = options.grid.x == 0 || options.grid.y == 0;
+  glm::ivec2 grid_nodes = chosen_grid ? grid_for(options.node_spacing_px) : options.grid;
+
+  auto fit_nodes = [&](const glm::ivec2 grid) {
+    FACET_ASSERT(grid.x >= 2 && grid.y >= 2);
+    const glm::ivec2 cells = grid - 1;
+
+    // Bin samples by the cell that holds them (counting sort).
+    std::vector<std::uint32_t> start(std::size_t(cells.x) * cells.y + 1, 0);
+    std::vector<std::int32_t> cell_of(samples.size(), -1);
+    for (std::size_t k = 0; k < samples.size(); ++k) {
+      if (std::isnan(st[k].x)) continue;
+      const int i = std::min(int(st[k].x * cells.x), cells.x - 1);
+      const int j = std::min(int(st[k].y * cells.y), cells.y - 1);
+      cell_of[k] = j * cells.x + i;
+      ++start[std::size_t(cell_of[k]) + 1];
+    }
+    for (std::size_t c = 1; c < start.size(); ++c) start[c] += start[c - 1];
+    std::vector<std::uint32_t> order(start.back());
+    {
+      std::vector<std::uint32_t> fill(start.begin(), start.end() - 1);
+      for (std::size_t k = 0; k < samples.size(); ++k) {
+        if (cell_of[k] >= 0) order[fill[std::size_t(cell_of[k])]++] = std::uint32_t(k);
+      }
+    }
+
+    // Per-node robust local fits.
+    std::vector<NodeFit> nodes(std::size_t(grid.x) * grid.y);
+    const double radius = options.radius_nodes;
+    parallel_range(grid.y, [&](int j) {
+      std::vector<std::uint32_t> near;
+      std::vector<double> kernel, robust, du, dv, residual;
+      for (int i = 0; i < grid.x; ++i) {
+        near.clear();
+        kernel.clear();
+        du.clear();
+        dv.clear();
+        const int i0 = std::max(0, int(std::floor(i - radius))),
+                  i1 = std::min(cells.x - 1, int(std::ceil(i + radius)) - 1);
+        const int j0 = std::max(0, int(std::floor(j - radius))),
+                  j1 = std::min(cells.y - 1, int(std::ceil(j + radius)) - 1);
+        double kernel_sum = 0;
+        for (int cj = j0; cj <= j1; ++cj) {
+          for (int ci = i0; ci <= i1; ++ci) {
+            const std::size_t cell = std::size_t(cj) * cells.x + ci;
+            for (std::uint32_t n = start[cell]; n < start[cell + 1]; ++n) {
+              const std::uint32_t k = order[n];
+              const double a = st[k].x * cells.x - i, b = st[k].y * cells.y - j;
+              const double d = std::sqrt(a * a + b * b) / radius;
+              if (d >= 1) continue;
+              const double tricube = std::pow(1 - d * d * d, 3);
+              const double w = tricube * samples[k].weight;
+              near.push_back(k);
+              kernel.push_back(w);
+              du.push_back(a);
+              dv.push_back(b);
+              kernel_sum += tricube;
+            }
+          }
+        }
+        NodeFit& node = nodes[std::size_t(j) * grid.x + i];
+        if (kernel_sum < options.min_samples) continue;
+        robust.assign(near.size(), 1.0);
+        residual.assign(near.size(), 0.0);
+        for (int iteration = 0; iteration <= options.irls_iterations; ++iteration) {
+          cv::Matx66d normal = cv::Matx66d::zeros();
+          Basis rhs_x = Basis::all(0), rhs_y = Basis::all(0);
+          double weight_sum = 0;
+          for (std::size_t n = 0; n < near.size(); ++n) {
+            const double w = kernel[n] * robust[n];
+            if (w <= 0) continue;
+            const Basis basis = quadratic_basis(du[n], dv[n]);
+            for (int r = 0; r < 6; ++r) {
+              const double wb = w * basis[r];
+              for (int c = r; c < 6; ++c) normal(r, c) += wb * basis[c];
+              rhs_x[r] += wb * samples[near[n]].q.x;
+              rhs_y[r] += wb * samples[near[n]].q.y;
+            }
+            weight_sum += w;
+          }
+          for (int r = 0; r < 6; ++r) {
+            for (int c = 0; c < r; ++c) normal(r, c) = normal(c, r);
+          }
+          cv::Matx66d inverse;
+          if (cv::invert(normal, inverse, cv::DECOMP_CHOLESKY) == 0) {
+            node.supported = false;
+            break;
+          }
+          // The noise gain of the value at the node: large when the node lies outside the samples.
+          const double gain = inverse(0, 0) * weight_sum;
+          if (!(gain <= options.max_gain)) {
+            node.supported = false;
+            break;
+          }
+          const Basis coefficient_x = inverse * rhs_x, coefficient_y = inverse * rhs_y;
+          node.q = {coefficient_x[0], coefficient_y[0]};
+          node.supported = true;
+          // Bilinear error of the quadratic terms (node units) at the worst point of a cell.
+          node.curvature = {coefficient_x[3], coefficient_x[5], coefficient_y[3], coefficient_y[5]};
+          if (iteration == options.irls_iterations) break;
+          for (std::size_t n = 0; n < near.size(); ++n) {
+            const Basis basis = quadratic_basis(du[n], dv[n]);
+            residual[n] = std::hypot(coefficient_x.dot(basis) - samples[near[n]].q.x,
+                                     coefficient_y.dot(basis) - samples[near[n]].q.y);
+          }
+          std::vector<double> sorted = residual;
+          const double sigma = 1.4826 * percentile(std::move(sorted), 0.5);
+          const double cutoff = std::max(options.tukey_sigmas * sigma, options.min_cutoff_px);
+          for (std::size_t n = 0; n < near.size(); ++n) {
+            const double u = residual[n] / cutoff;
+            robust[n] = u < 1 ? (1 - u * u) * (1 - u * u) : 0.0;
+          }
+        }
+      }
+    });
+    return nodes;
+  };
+
+  std::vector<NodeFit> nodes = fit_nodes(grid_nodes);
+  if (chosen_grid && options.max_interpolation_error_px > 0) {
+    // Bilinear interpolation between nodes misses the curvature of the map: from the quadratic
+    // terms of the node fits, the error at cell centres and edge midpoints. A smaller spacing
+    // cuts it with the square of the spacing (at the price of fewer samples per node).
+    // Each node's terms are noisy; averaged over the 5×5 nodes around it, the noise drops
+    // five-fold while the map's curvature, smooth over such distances, stays.
+    std::vector<double> curvature;
+    const glm::ivec2 g = grid_nodes;
+    for (int j = 0; j < g.y; ++j) {
+      for (int i = 0; i < g.x; ++i) {
+        cv::Vec4d sum(0, 0, 0, 0);
+        int count = 0;
+        for (int b = std::max(0, j - 2); b <= std::min(g.y - 1, j + 2); ++b) {
+          for (int a = std::max(0, i - 2); a <= std::min(g.x - 1, i + 2); ++a) {
+            const NodeFit& node = nodes[std::size_t(b) * g.x + a];
+            if (!node.supported) continue;
+            sum += node.curvature;
+            ++count;
+          }
+        }
+        if (count < 13) continue;
+        const cv::Vec4d c = sum / double(count);
+        // Bilinear error of a·du² + b·dv² (node units) at cell centres and edge midpoints.
+        auto worst = [](double a, double b) {
+          return std::max({std::abs(a), std::abs(b), std::abs(a + b)}) / 4;
+        };
+        curvature.push_back(std::hypot(worst(c[0], c[1]), worst(c[2], c[3])));
+      }
+    }
+    const double error = percentile(std::move(curvature), 0.9);
+    if (error > options.max_interpolation_error_px) {
+      const double spacing =
+          std::max(options.min_node_spacing_px,
+                   options.node_spacing_px * std::sqrt(options.max_interpolation_error_px / error));
+      const glm::ivec2 finer = grid_for(spacing);
+      if (finer.x > grid_nodes.x || finer.y > grid_nodes.y) {
+        grid_nodes = glm::max(grid_nodes, finer);
+        nodes = fit_nodes(grid_nodes);
+      }
+    }
+  }
+  const glm::ivec2 grid = grid_nodes;
   warp.grid_size = grid;
   result.report.grid = grid;
   const glm::ivec2 cells = grid - 1;
-
-  // Bin samples by the cell that holds them (counting sort).
-  std::vector<std::uint32_t> start(std::size_t(cells.x) * cells.y + 1, 0);
-  std::vector<std::int32_t> cell_of(samples.size(), -1);
-  for (std::size_t k = 0; k < samples.size(); ++k) {
-    if (std::isnan(st[k].x)) continue;
-    const int i = std::min(int(st[k].x * cells.x), cells.x - 1);
-    const int j = std::min(int(st[k].y * cells.y), cells.y - 1);
-    cell_of[k] = j * cells.x + i;
-    ++start[std::size_t(cell_of[k]) + 1];
-  }
-  for (std::size_t c = 1; c < start.size(); ++c) start[c] += start[c - 1];
-  std::vector<std::uint32_t> order(start.back());
-  {
-    std::vector<std::uint32_t> fill(start.begin(), start.end() - 1);
-    for (std::size_t k = 0; k < samples.size(); ++k) {
-      if (cell_of[k] >= 0) order[fill[std::size_t(cell_of[k])]++] = std::uint32_t(k);
-    }
-  }
-
-  // Per-node robust local fits.
-  std::vector<NodeFit> nodes(std::size_t(grid.x) * grid.y);
-  const double radius = options.radius_nodes;
-  parallel_range(grid.y, [&](int j) {
-    std::vector<std::uint32_t> near;
-    std::vector<double> kernel, robust, du, dv, residual;
-    for (int i = 0; i < grid.x; ++i) {
-      near.clear();
-      kernel.clear();
-      du.clear();
-      dv.clear();
-      const int i0 = std::max(0, int(std::floor(i - radius))),
-                i1 = std::min(cells.x - 1, int(std::ceil(i + radius)) - 1);
-      const int j0 = std::max(0, int(std::floor(j - radius))),
-                j1 = std::min(cells.y - 1, int(std::ceil(j + radius)) - 1);
-      double kernel_sum = 0;
-      for (int cj = j0; cj <= j1; ++cj) {
-        for (int ci = i0; ci <= i1; ++ci) {
-          const std::size_t cell = std::size_t(cj) * cells.x + ci;
-          for (std::uint32_t n = start[cell]; n < start[cell + 1]; ++n) {
-            const std::uint32_t k = order[n];
-            const double a = st[k].x * cells.x - i, b = st[k].y * cells.y - j;
-            const double d = std::sqrt(a * a + b * b) / radius;
-            if (d >= 1) continue;
-            const double tricube = std::pow(1 - d * d * d, 3);
-            const double w = tricube * samples[k].weight;
-            near.push_back(k);
-            kernel.push_back(w);
-            du.push_back(a);
-            dv.push_back(b);
-            kernel_sum += tricube;
-          }
-        }
-      }
-      NodeFit& node = nodes[std::size_t(j) * grid.x + i];
-      if (kernel_sum < options.min_samples) continue;
-      robust.assign(near.size(), 1.0);
-      residual.assign(near.size(), 0.0);
-      for (int iteration = 0; iteration <= options.irls_iterations; ++iteration) {
-        cv::Matx66d normal = cv::Matx66d::zeros();
-        Basis rhs_x = Basis::all(0), rhs_y = Basis::all(0);
-        double weight_sum = 0;
-        for (std::size_t n = 0; n < near.size(); ++n) {
-          const double w = kernel[n] * robust[n];
-          if (w <= 0) continue;
-          const Basis basis = quadratic_basis(du[n], dv[n]);
-          for (int r = 0; r < 6; ++r) {
-            const double wb = w * basis[r];
-            for (int c = r; c < 6; ++c) normal(r, c) += wb * basis[c];
-            rhs_x[r] += wb * samples[near[n]].q.x;
-            rhs_y[r] += wb * samples[near[n]].q.y;
-          }
-          weight_sum += w;
-        }
-        for (int r = 0; r < 6; ++r) {
-          for (int c = 0; c < r; ++c) normal(r, c) = normal(c, r);
-        }
-        cv::Matx66d inverse;
-        if (cv::invert(normal, inverse, cv::DECOMP_CHOLESKY) == 0) {
-          node.supported = false;
-          break;
-        }
-        // The noise gain of the value at the node: large when the node lies outside the samples.
-        const double gain = inverse(0, 0) * weight_sum;
-        if (!(gain <= options.max_gain)) {
-          node.supported = false;
-          break;
-        }
-        const Basis coefficient_x = inverse * rhs_x, coefficient_y = inverse * rhs_y;
-        node.q = {coefficient_x[0], coefficient_y[0]};
-        node.supported = true;
-        if (iteration == options.irls_iterations) break;
-        for (std::size_t n = 0; n < near.size(); ++n) {
-          const Basis basis = quadratic_basis(du[n], dv[n]);
-          residual[n] = std::hypot(coefficient_x.dot(basis) - samples[near[n]].q.x,
-                                   coefficient_y.dot(basis) - samples[near[n]].q.y);
-        }
-        std::vector<double> sorted = residual;
-        const double sigma = 1.4826 * percentile(std::move(sorted), 0.5);
-        const double cutoff = std::max(options.tukey_sigmas * sigma, options.min_cutoff_px);
-        for (std::size_t n = 0; n < near.size(); ++n) {
-          const double u = residual[n] / cutoff;
-          robust[n] = u < 1 ? (1 - u * u) * (1 - u * u) : 0.0;
-        }
-      }
-    }
-  });
 
   // Offsets of supported nodes; the rest are filled outwards from them, each unsupported node
   // taking the mean of the linear extrapolations (or, failing those, the values) of its
@@ -491,10 +549,11 @@ WarpFit fit_warp(std::span<const FitSample> samples, glm::ivec2 output_size,
 
   // Coverage: a ramp across one node spacing centred on the image edge, so that A = 0.5 (the
   // covered boundary after bilinear interpolation) falls close to where q leaves the image.
-  // Filled nodes are extrapolations: the first `extrapolate_rings` rings around the supported
+  // Filled nodes are extrapolations: the rings around the supported nodes within extrapolate_px
   // nodes stay covered (A at most 0.5, so the covered region ends at them), the rest of the
   // image, which the camera never saw well enough, is left uncovered rather than guessed.
   const double spacing_px = 0.5 * (step.x + step.y);
+  const int extrapolate_rings = std::max(1, int(std::ceil(options.extrapolate_px / spacing_px)));
   warp.offset_px.resize(nodes.size());
   warp.coverage.resize(nodes.size());
   for (int j = 0; j < grid.y; ++j) {
@@ -505,11 +564,10 @@ WarpFit fit_warp(std::span<const FitSample> samples, glm::ivec2 output_size,
           std::min(std::min(q.x, output_size.x - q.x), std::min(q.y, output_size.y - q.y));
       warp.offset_px[k] = glm::vec2(offset[k]);
       double coverage = std::clamp(0.5 + inside / spacing_px, 0.0, 1.0);
-      if (ring[k] > 0)
-        coverage = ring[k] <= options.extrapolate_rings ? std::min(coverage, 0.5) : 0;
+      if (ring[k] > 0) coverage = ring[k] <= extrapolate_rings ? std::min(coverage, 0.5) : 0;
       warp.coverage[k] = float(coverage);
       if (ring[k] > 0 && inside > 0) {
-        ++(ring[k] > options.extrapolate_rings ? result.report.holes : result.report.filled);
+        ++(ring[k] > extrapolate_rings ? result.report.holes : result.report.filled);
       }
     }
   }

@@ -30,11 +30,13 @@ struct BlendResult {
 
 // Weights for the projectors of one display. Each warp's output pixel centre is turned into an
 // eye direction with WarpInverse; pixels no direction maps to get α = 0. The raw weight of
-// projector k at direction v is smoothstep(d_k(v) / feather_rad), where d_k is the distance in
-// output pixels from k's position of v to the nearest edge of k's covered region that lies inside
-// another projector's covered region (by at least 16 px), times k's local angle per pixel; 0
-// where k does not cover v. Edges no other projector covers beyond (the display's outer edge)
-// need no fading. α is the raw weight over the sum of raw weights.
+// projector k at direction v is smoothstep(d_k(v) / feather_rad): d_k is the distance in output
+// pixels from k's position of v to the edges of k's covered region that another projector covers
+// (each edge point raised by 4× how far short of 1.25 node spacings inside the other projector
+// it lies, so an edge that projector barely reaches hardly counts), lightly smoothed (Gaussian,
+// σ = 3 px), times k's local angle per pixel; 0 where k does not cover v. Edges no other
+// projector covers beyond (the display's outer edge) need no fading. α is the raw weight over
+// the sum of raw weights, so the weights sum to 1 at every pixel centre.
 BlendResult compute_blend(std::span<const Warp> warps, const BlendOptions& options = {});
 
 struct BlendCheck {

@@ -37,6 +37,12 @@ struct FitOptions {
   // Node grid (Gw, Gh); {0, 0} picks one node about every node_spacing_px output pixels.
   glm::ivec2 grid{0, 0};
   double node_spacing_px = 16;
+  // With the grid chosen from node_spacing_px: when the bilinear interpolation between nodes
+  // would miss the fitted map's curvature by more than this (90th percentile over the nodes,
+  // estimated from the quadratic terms of their fits), the grid is refined once, down to
+  // min_node_spacing_px. 0 keeps the spacing.
+  double max_interpolation_error_px = 0.02;
+  double min_node_spacing_px = 4;
   // Radius of a node's neighbourhood, in node spacings. Larger averages more noise and bends
   // less with the warp's curvature; the quadratic model keeps the bias small either way.
   double radius_nodes = 1.6;
@@ -46,10 +52,10 @@ struct FitOptions {
   // Noise gain of the fitted value, [N⁻¹]₀₀·Σw: 1 for a plain mean, a few for a centred
   // quadratic, large when the node lies beyond the samples and the fit would extrapolate.
   double max_gain = 40;
-  // Unsupported nodes are filled by extrapolating outwards, ring by ring; this many rings around
-  // the supported nodes stay covered (enough for the image edges, where the last node lies
-  // beyond the samples), the rest are left uncovered.
-  int extrapolate_rings = 1;
+  // Unsupported nodes are filled by extrapolating outwards, ring by ring; the rings within this
+  // many output pixels of the supported nodes (at least one ring) stay covered, enough for the
+  // image edges, where the last nodes lie beyond the samples; the rest are left uncovered.
+  double extrapolate_px = 8;
   int irls_iterations = 3;
   // Tukey biweight cut-off: max(tukey_sigmas · robust σ, min_cutoff_px).
   double tukey_sigmas = 4.685;
