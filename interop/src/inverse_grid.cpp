@@ -1,5 +1,6 @@
 #include "facet/interop/inverse_grid.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "facet/projection/errors.hpp"
@@ -73,25 +74,48 @@ Warp warp_from_inverse_grid(const InverseGrid& grid, const BaseProjection& base,
   FACET_ASSERT(grid.st.size() == std::size_t(grid.grid_size.x) * grid.grid_size.y);
   FACET_ASSERT(warp_grid.x >= 2 && warp_grid.y >= 2);
   // The inverse grid as a Warp of its own: its base image is the output (normalised), its
-  // "output" the base image of the result scaled by kAuxiliaryScale. Inverting that warp
-  // answers "which output position shows st".
-  std::vector<glm::dvec2> st = grid.st;
-  const std::vector<bool> valid = fill_missing(st, grid.grid_size, source);
-  Warp auxiliary;
-  auxiliary.output_size = {kAuxiliaryScale, kAuxiliaryScale};
-  auxiliary.grid_size = grid.grid_size;
-  auxiliary.offset_px.resize(st.size());
-  auxiliary.coverage.resize(st.size());
+  // "output" the base image of the result scaled by kAuxiliaryScale. Inverting that warp answers
+  // "which output position shows st". The grid is padded by extrapolated nodes on every side, so
+  // that base positions landing just outside the output image still get accurate offsets (they
+  // are uncovered, but bilinear interpolation towards them must stay smooth).
+  const glm::ivec2 pad{std::max(2, grid.grid_size.x / 8), std::max(2, grid.grid_size.y / 8)};
+  const glm::ivec2 padded = grid.grid_size + 2 * pad;
+  std::vector<glm::dvec2> st(std::size_t(padded.x) * padded.y,
+                             glm::dvec2(std::numeric_limits<double>::quiet_NaN()));
   for (int j = 0; j < grid.grid_size.y; ++j) {
     for (int i = 0; i < grid.grid_size.x; ++i) {
+      st[std::size_t(j + pad.y) * padded.x + i + pad.x] =
+          grid.st[std::size_t(j) * grid.grid_size.x + i];
+    }
+  }
+  const std::vector<bool> valid = fill_missing(st, padded, source);
+  Warp auxiliary;
+  auxiliary.output_size = {kAuxiliaryScale, kAuxiliaryScale};
+  auxiliary.grid_size = padded;
+  auxiliary.offset_px.resize(st.size());
+  auxiliary.coverage.assign(st.size(), 1.0f);
+  // Auxiliary base position (a, b) in [0,1]² ↔ normalised output position
+  // ((a·(Pw−1) − pad)/(Gw−1), ...).
+  const glm::dvec2 cells_in_grid = glm::dvec2(grid.grid_size - 1);
+  const glm::dvec2 cells_padded = glm::dvec2(padded - 1);
+  for (int j = 0; j < padded.y; ++j) {
+    for (int i = 0; i < padded.x; ++i) {
       const std::size_t k = auxiliary.node_index(i, j);
-      const glm::dvec2 q_output{double(i) / (grid.grid_size.x - 1),
-                                double(j) / (grid.grid_size.y - 1)};
-      auxiliary.offset_px[k] = glm::vec2((st[k] - q_output) * double(kAuxiliaryScale));
-      auxiliary.coverage[k] = valid[k] ? 1.0f : 0.0f;
+      const glm::dvec2 a{double(i) / (padded.x - 1), double(j) / (padded.y - 1)};
+      auxiliary.offset_px[k] = glm::vec2((st[k] - a) * double(kAuxiliaryScale));
     }
   }
   const WarpInverse inverse(std::move(auxiliary));
+  // Bilinear mask of the nodes that were valid, at a normalised output position.
+  const auto valid_at = [&](glm::dvec2 output) {
+    const glm::dvec2 g = output * cells_in_grid + glm::dvec2(pad);
+    const int i = std::clamp(int(std::floor(g.x)), 0, padded.x - 2);
+    const int j = std::clamp(int(std::floor(g.y)), 0, padded.y - 2);
+    const double fx = g.x - i, fy = g.y - j;
+    const auto v = [&](int a, int b) { return valid[std::size_t(b) * padded.x + a] ? 1.0 : 0.0; };
+    return (v(i, j) * (1 - fx) + v(i + 1, j) * fx) * (1 - fy) +
+           (v(i, j + 1) * (1 - fx) + v(i + 1, j + 1) * fx) * fy;
+  };
 
   Warp warp;
   warp.base = base;
@@ -100,16 +124,21 @@ Warp warp_from_inverse_grid(const InverseGrid& grid, const BaseProjection& base,
   warp.grid_size = warp_grid;
   std::vector<glm::dvec2> offsets(std::size_t(warp_grid.x) * warp_grid.y,
                                   glm::dvec2(std::numeric_limits<double>::quiet_NaN()));
+  std::vector<bool> covered(offsets.size(), false);
   for (int j = 0; j < warp_grid.y; ++j) {
     for (int i = 0; i < warp_grid.x; ++i) {
       const glm::dvec2 st_node{double(i) / (warp_grid.x - 1), double(j) / (warp_grid.y - 1)};
-      if (auto output = inverse.st_from_q(st_node * double(kAuxiliaryScale))) {
-        const glm::dvec2 q = *output * glm::dvec2(output_size);
-        offsets[warp.node_index(i, j)] = q - st_node * glm::dvec2(output_size);
+      if (auto a = inverse.st_from_q(st_node * double(kAuxiliaryScale))) {
+        const glm::dvec2 output = (*a * cells_padded - glm::dvec2(pad)) / cells_in_grid;
+        const std::size_t k = warp.node_index(i, j);
+        offsets[k] = output * glm::dvec2(output_size) - st_node * glm::dvec2(output_size);
+        covered[k] = output.x >= 0 && output.y >= 0 && output.x <= 1 && output.y <= 1 &&
+                     valid_at(output) >= 0.5;
       }
     }
   }
-  const std::vector<bool> covered = fill_missing(offsets, warp_grid, source);
+  fill_missing(offsets, warp_grid, source);
+
   warp.offset_px.resize(offsets.size());
   warp.coverage.resize(offsets.size());
   for (std::size_t k = 0; k < offsets.size(); ++k) {

@@ -135,7 +135,12 @@ Warp region_warp(const RegionWarpInput& in, MpcdiWarpValues values, const std::s
   if (values == MpcdiWarpValues::automatic) {
     const double absolute_score = orientation_score(absolute, size);
     const double offset_score = orientation_score(offset_output, size);
-    const bool absolute_ok = absolute_score >= 0.9, offset_ok = offset_score >= 0.9;
+    // A clean map keeps the orientation of (nearly) every cell under one reading only; when
+    // both readings pass, the clearly better one wins.
+    const bool absolute_ok =
+        absolute_score >= 0.9 && absolute_score > offset_score + 0.05 - (offset_score < 0.9);
+    const bool offset_ok =
+        offset_score >= 0.9 && offset_score > absolute_score + 0.05 - (absolute_score < 0.9);
     if (absolute_ok == offset_ok) {
       throw InputError(source, "warp values",
                        "expected a warp that reads as either absolute positions or offsets "
@@ -333,9 +338,14 @@ ImportedDisplay import_mpcdi(const MpcdiFiles& files, const std::string& source,
       if (gx >= 2 && gy >= 2 && gx <= 4096 && gy <= 4096) in.warp_grid = {gx, gy};
     }
 
+    MpcdiWarpValues values = options.values;
+    if (values == MpcdiWarpValues::automatic && hint && hint->contains("warp_values") &&
+        (*hint)["warp_values"] == "absolute") {
+      values = MpcdiWarpValues::absolute;
+    }
     ImportedProjector projector;
     projector.name = sanitize_name(region.id);
-    projector.warp = region_warp(in, options.values, pfm_source);
+    projector.warp = region_warp(in, values, pfm_source);
     if (region.alpha) {
       projector.blend =
           decode_map(member(files, region.alpha->path, xml_source, field + "/alphaMap/path"),
@@ -439,6 +449,7 @@ MpcdiFiles export_mpcdi(const projection_io::DisplayConfig& display,
       files[region.beta->path] = encode_png16(map);
     }
     hints["regions"][region.id] = {{"warp_grid", {warp.grid_size.x, warp.grid_size.y}},
+                                   {"warp_values", "absolute"},
                                    {"pfm_nodes", {nodes.x, nodes.y}}};
     document.regions.push_back(region);
   }

@@ -1,0 +1,178 @@
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+
+#include "facet/interop/mpcdi.hpp"
+#include "facet/interop/pfm.hpp"
+#include "facet/projection_io/display_config.hpp"
+#include "facet/projection_io/warp_file.hpp"
+#include "test_util.hpp"
+
+namespace facet::interop {
+namespace {
+
+namespace fs = std::filesystem;
+const std::string kWarps = std::string(FACET_SHARED_DATA_DIR) + "/warps/";
+
+struct CliRun {
+  int status;
+  std::string output;
+};
+
+CliRun run(const std::string& arguments, const fs::path& scratch) {
+  const fs::path log = scratch / "cli.log";
+  const std::string command =
+      std::string(FACET_CLI) + " " + arguments + " > " + log.string() + " 2>&1";
+  const int raw = std::system(command.c_str());
+  std::ifstream stream(log);
+  std::ostringstream text;
+  text << stream.rdbuf();
+  return {WIFEXITED(raw) ? WEXITSTATUS(raw) : -1, text.str()};
+}
+
+void write_file(const fs::path& path, const std::string& bytes) {
+  std::ofstream(path, std::ios::binary) << bytes;
+}
+
+TEST(InteropCli, RealFilesFromOtherToolsImportToReadableDisplays) {
+  test::ScratchFolder scratch("cli-real");
+  for (const char* name : {"correction_mesh", "zero_distortion_mesh"}) {
+    const fs::path out = scratch.path / name;
+    const CliRun r =
+        run("mpcdi import " + kWarps + "sgct-mpcdi/" + name + ".mpcdi --out " + out.string(),
+            scratch.path);
+    ASSERT_EQ(r.status, 0) << r.output;
+    const auto display = projection_io::read_display_config(out / "display.json");
+    ASSERT_EQ(display.projectors.size(), 1u);
+    EXPECT_NO_THROW(read_warp(display.resolve(display.projectors[0].warp).string()));
+    // The imported warp feeds `facet error --warp`.
+    const CliRun error =
+        run("error --warp " + display.resolve(display.projectors[0].warp).string() +
+                " --tolerance 0.25 --json",
+            scratch.path);
+    EXPECT_EQ(error.status, 0) << error.output;
+  }
+  const fs::path mirror = scratch.path / "mirror";
+  const CliRun r =
+      run("bourke import " + kWarps + "sgct-mesh/standard_16x9.data --out " + mirror.string(),
+          scratch.path);
+  ASSERT_EQ(r.status, 0) << r.output;
+  const auto display = projection_io::read_display_config(mirror / "display.json");
+  EXPECT_NO_THROW(read_warp(display.resolve(display.projectors[0].warp).string()));
+  ASSERT_TRUE(display.projectors[0].blend);
+  // A Bourke mesh's warp with a uniform facet grid (the tolerance builder cannot follow the
+  // mirror's edge; see interop/README.md).
+  const CliRun error = run("error --warp " + display.resolve(display.projectors[0].warp).string() +
+                               " --grid 64x64 --json",
+                           scratch.path);
+  EXPECT_EQ(error.status, 0) << error.output;
+}
+
+TEST(InteropCli, ExportImportRoundTripThroughTheCommands) {
+  test::ScratchFolder scratch("cli-roundtrip");
+  const Warp warp = test::calibrated_like_warp({320, 200}, {17, 11});
+  write_warp((scratch.path / "p0.warp.exr").string(), warp);
+  write_file(scratch.path / "display.json",
+             R"({"format": "facet-display/1", "name": "t", "eye": [0, 0, 0],
+                 "projectors": [{"name": "p0", "size": [320, 200], "warp": "p0.warp.exr",
+                                 "output": {"window": [0, 0, 320, 200]}}]})");
+  // Nodes every 2 px: the error of the PFM's bilinear interpolation shrinks with the square of
+  // the spacing, and this small image bends faster per pixel than a full-size projector's.
+  CliRun r = run("mpcdi export --node-spacing 2 " + (scratch.path / "display.json").string() +
+                     " --out " + (scratch.path / "d.mpcdi").string(),
+                 scratch.path);
+  ASSERT_EQ(r.status, 0) << r.output;
+  r = run("mpcdi import " + (scratch.path / "d.mpcdi").string() + " --out " +
+              (scratch.path / "back").string(),
+          scratch.path);
+  ASSERT_EQ(r.status, 0) << r.output;
+  const Warp back = read_warp((scratch.path / "back" / "p0.warp.exr").string());
+  double worst = 0;
+  for (int j = 0; j <= 50; ++j) {
+    for (int i = 0; i <= 50; ++i) {
+      const glm::dvec2 st{i / 50.0, j / 50.0};
+      if (back.coverage_at(st) < 0.5) continue;
+      worst = std::max(worst, glm::length(warp.q_from_st(st) - back.q_from_st(st)));
+    }
+  }
+  EXPECT_LT(worst, 0.01);
+  // Importing into a folder that holds files is refused.
+  r = run("mpcdi import " + (scratch.path / "d.mpcdi").string() + " --out " +
+              (scratch.path / "back").string(),
+          scratch.path);
+  EXPECT_EQ(r.status, 2) << r.output;
+}
+
+TEST(InteropCli, BadFilesExitWithStatus2AndLeaveNothingBehind) {
+  test::ScratchFolder scratch("cli-bad");
+  write_file(scratch.path / "text.mpcdi", "not a zip at all");
+  write_file(scratch.path / "bad.data", "2\n3 2\n-1.5 -1 0 0 1\n");
+  PfmImage pfm;
+  pfm.width = pfm.height = 2;
+  pfm.values.assign(12, std::numeric_limits<float>::quiet_NaN());
+  MpcdiFiles files{{"mpcdi.xml",
+                    "<MPCDI profile=\"3d\"><display><buffer xResolution=\"8\" yResolution=\"8\">"
+                    "<region id=\"r\" x=\"0\" y=\"0\" xSize=\"1\" ySize=\"1\" xResolution=\"8\" "
+                    "yResolution=\"8\"><frustum><yaw>0</yaw><pitch>0</pitch><roll>0</roll>"
+                    "<rightAngle>10</rightAngle><leftAngle>-10</leftAngle><upAngle>10</upAngle>"
+                    "<downAngle>-10</downAngle></frustum></region></buffer></display><files>"
+                    "<fileset region=\"r\"><geometryWarpFile><path>w.pfm</path>"
+                    "</geometryWarpFile></fileset></files></MPCDI>"},
+                   {"w.pfm", format_pfm(pfm)}};  // every node NaN: a warp that shows nothing
+  write_zip_file(scratch.path / "collapsed.mpcdi", files);
+  const std::vector<std::string> commands{
+      "mpcdi import " + (scratch.path / "text.mpcdi").string(),
+      "mpcdi import " + (scratch.path / "collapsed.mpcdi").string(),
+      "mpcdi import " + (scratch.path / "missing.mpcdi").string(),
+      "bourke import " + (scratch.path / "bad.data").string(),
+      "bourke import " + kWarps + "sgct-mesh/standard_16x9.data --size 1000x1000",
+  };
+  for (const std::string& command : commands) {
+    const fs::path out = scratch.path / "out";
+    const CliRun r = run(command + " --out " + out.string(), scratch.path);
+    EXPECT_EQ(r.status, 2) << command << "\n" << r.output;
+    EXPECT_NE(r.output.find("facet: error:"), std::string::npos) << r.output;
+    EXPECT_FALSE(fs::exists(out)) << command;
+  }
+  // Nothing but the inputs and the log: no temporary folders left over.
+  int entries = 0;
+  for (const auto& entry : fs::directory_iterator(scratch.path)) {
+    (void)entry;
+    ++entries;
+  }
+  EXPECT_EQ(entries, 4);
+  const CliRun lookup = run("lookup --warp " + (scratch.path / "none.warp.exr").string() +
+                                " --out " + (scratch.path / "l.exr").string(),
+                            scratch.path);
+  EXPECT_EQ(lookup.status, 2) << lookup.output;
+  EXPECT_FALSE(fs::exists(scratch.path / "l.exr"));
+}
+
+TEST(InteropCli, LookupOfAWarp) {
+  test::ScratchFolder scratch("cli-lookup");
+  write_warp((scratch.path / "w.warp.exr").string(), test::calibrated_like_warp({64, 40}, {5, 5}));
+  const CliRun r = run("lookup --warp " + (scratch.path / "w.warp.exr").string() + " --out " +
+                           (scratch.path / "l.exr").string(),
+                       scratch.path);
+  EXPECT_EQ(r.status, 0) << r.output;
+  EXPECT_TRUE(fs::exists(scratch.path / "l.exr"));
+}
+
+TEST(InteropCli, DevicesListsOrSaysThereAreNone) {
+  test::ScratchFolder scratch("cli-devices");
+  CliRun r = run("devices", scratch.path);
+  EXPECT_EQ(r.status, 0) << r.output;
+  EXPECT_TRUE(r.output.find("no USB devices") != std::string::npos ||
+              r.output.find("VID:PID") != std::string::npos)
+      << r.output;
+  r = run("devices --watch --for 1", scratch.path);
+  EXPECT_EQ(r.status, 0) << r.output;
+  r = run("devices --find camera0", scratch.path);
+  EXPECT_EQ(r.status, 2) << r.output;
+}
+
+}  // namespace
+}  // namespace facet::interop

@@ -1,0 +1,78 @@
+#include <gtest/gtest.h>
+
+#include "facet/interop/usb_devices.hpp"
+
+namespace facet::interop {
+namespace {
+
+UsbDevice camera() {
+  UsbDevice d;
+  d.vendor_id = 0x046d;
+  d.product_id = 0x085c;
+  d.bus = 3;
+  d.ports = {2, 1};
+  d.interface_classes = {0x0e, 0x0e, 0x01};
+  d.serial = "A1B2C3";
+  d.product = "C922 Pro Stream Webcam";
+  return d;
+}
+
+UsbDevice serial_adapter() {
+  UsbDevice d;
+  d.vendor_id = 0x0403;
+  d.product_id = 0x6001;
+  d.bus = 1;
+  d.ports = {4};
+  d.interface_classes = {0xff};
+  return d;
+}
+
+TEST(UsbDevices, RolesFromClassAndVendor) {
+  EXPECT_EQ(classify(camera()), UsbRole::camera);
+  EXPECT_EQ(classify(serial_adapter()), UsbRole::projector_control);
+  UsbDevice vision;
+  vision.vendor_id = 0x2676;  // Basler, USB3 Vision with a vendor-specific class
+  vision.interface_classes = {0xef};
+  EXPECT_EQ(classify(vision), UsbRole::camera);
+  UsbDevice hub;
+  hub.vendor_id = 0x1d6b;
+  hub.device_class = 0x09;
+  EXPECT_EQ(classify(hub), UsbRole::other);
+}
+
+TEST(UsbDevices, StableIdentityPrefersTheSerialAndFallsBackToThePort) {
+  EXPECT_EQ(bus_path(camera()), "3-2.1");
+  EXPECT_EQ(stable_id(camera()), "usb:046d:085c:A1B2C3");
+  EXPECT_EQ(stable_id(serial_adapter()), "usb:0403:6001@1-4");
+  // The serial identity survives moving the camera to another port; the port identity does not.
+  UsbDevice moved = camera();
+  moved.ports = {5};
+  EXPECT_TRUE(matches(stable_id(camera()), moved));
+  UsbDevice moved_adapter = serial_adapter();
+  moved_adapter.ports = {3};
+  EXPECT_FALSE(matches(stable_id(serial_adapter()), moved_adapter));
+  EXPECT_TRUE(matches("USB:046D:085C", camera()));
+  EXPECT_FALSE(matches("usb:046d:085c:OTHER", camera()));
+  EXPECT_FALSE(matches("usb:046d:085d", camera()));
+  const std::vector<UsbDevice> all{camera(), serial_adapter(), moved};
+  EXPECT_EQ(find_devices("usb:046d:085c", all).size(), 2u);
+  EXPECT_EQ(find_devices("usb:0403:6001@1-4", all).size(), 1u);
+}
+
+TEST(UsbDevices, Formatting) {
+  EXPECT_EQ(format_devices({}), "no USB devices\n");
+  const std::string table = format_devices({camera(), serial_adapter()});
+  EXPECT_NE(table.find("046d:085c"), std::string::npos);
+  EXPECT_NE(table.find("camera"), std::string::npos);
+  EXPECT_NE(table.find("projector-control"), std::string::npos);
+  EXPECT_NE(table.find("usb:0403:6001@1-4"), std::string::npos);
+}
+
+TEST(UsbDevices, ListingRunsWhereverItIs) {
+  // No USB devices may exist here; the call must return either way.
+  const UsbListing listing = list_usb_devices();
+  for (const UsbDevice& device : listing.devices) EXPECT_FALSE(bus_path(device).empty());
+}
+
+}  // namespace
+}  // namespace facet::interop

@@ -1,0 +1,52 @@
+#pragma once
+// Shared helpers of the interop tests: scratch folders and small synthetic warps.
+#include <unistd.h>
+
+#include <cmath>
+#include <filesystem>
+#include <glm/glm.hpp>
+#include <string>
+
+#include "facet/projection/warp.hpp"
+
+namespace facet::interop::test {
+
+// A fresh folder under the system temp folder, removed when the object goes.
+struct ScratchFolder {
+  std::filesystem::path path;
+  explicit ScratchFolder(const std::string& name) {
+    path = std::filesystem::temp_directory_path() /
+           ("facet-interop-" + name + "-" + std::to_string(::getpid()));
+    std::filesystem::remove_all(path);
+    std::filesystem::create_directories(path);
+  }
+  ~ScratchFolder() {
+    std::error_code ignored;
+    std::filesystem::remove_all(path, ignored);
+  }
+};
+
+// A warp like a calibrated one: a perspective base lined up with the projector (asymmetric
+// extents, turned by yaw, pitch and roll) plus smooth offsets of up to about 12 px.
+inline Warp calibrated_like_warp(glm::ivec2 output_size = {640, 400}, glm::ivec2 grid = {33, 21}) {
+  Warp warp =
+      Warp::analytic(BaseProjection::perspective(-0.7, 0.9, 0.55, -0.45), output_size, grid);
+  const double yaw = glm::radians(-35.0), pitch = glm::radians(20.0), roll = glm::radians(7.0);
+  const glm::dmat3 Ry{std::cos(yaw), 0, -std::sin(yaw), 0, 1, 0, std::sin(yaw), 0, std::cos(yaw)};
+  const glm::dmat3 Rx{
+      1, 0, 0, 0, std::cos(pitch), std::sin(pitch), 0, -std::sin(pitch), std::cos(pitch)};
+  const glm::dmat3 Rz{
+      std::cos(roll), std::sin(roll), 0, -std::sin(roll), std::cos(roll), 0, 0, 0, 1};
+  warp.R_eye_base = Ry * Rx * Rz;
+  for (int j = 0; j < grid.y; ++j) {
+    for (int i = 0; i < grid.x; ++i) {
+      const double s = double(i) / (grid.x - 1), t = double(j) / (grid.y - 1);
+      warp.offset_px[warp.node_index(i, j)] =
+          glm::vec2(float(8 * std::sin(2.1 * s + 0.4) * std::cos(1.3 * t) + 3 * s * t),
+                    float(-6 * std::cos(1.7 * s) * std::sin(2.4 * t + 0.2) + 4 * s));
+    }
+  }
+  return warp;
+}
+
+}  // namespace facet::interop::test
