@@ -37,9 +37,9 @@ std::string joined_names() {
 
 std::span<const std::string_view> render_method_names() { return kNames; }
 
-std::unique_ptr<RenderMethod> make_render_method(std::string_view name) {
+void check_render_method(std::string_view name) {
   for (const auto& [known, factory] : kFactories) {
-    if (known == name) return factory();
+    if (known == name) return;
   }
   for (std::string_view known : kNames) {
     if (known == name) {
@@ -49,6 +49,15 @@ std::unique_ptr<RenderMethod> make_render_method(std::string_view name) {
   }
   throw InputError("command line", "--method",
                    "expected one of " + joined_names() + "; got '" + std::string(name) + "'");
+}
+
+std::unique_ptr<RenderMethod> make_render_method(std::string_view name) {
+  check_render_method(name);
+  for (const auto& [known, factory] : kFactories) {
+    if (known == name) return factory();
+  }
+  FACET_ASSERT(false);
+  return nullptr;
 }
 
 std::vector<std::uint32_t> scene_triangle_base(const Scene& scene) {

@@ -158,7 +158,6 @@ EndSection
       config.projectors.push_back(projector);
     }
     config.render.tolerance_px = 0.5;
-    config.render.method = "cubemap";
     const fs::path path = dir / "display.json";
     projection_io::write_display_config(config, path);
     return path;

@@ -79,7 +79,7 @@ void run(const RenderOptions& options) {
   if (!options.size.empty()) size = parse_size(options.size, "--size");
   const std::vector<OutputSpec> outputs = load_display_outputs(options.display, size);
   // Checked before any GL work; made again once the context exists, which must outlive it.
-  make_render_method(options.method);
+  check_render_method(options.method);
   RenderSettings settings;
   settings.facets.layout = options.layout.layout();
   if (options.face_size) {

@@ -58,7 +58,7 @@ void run(const RunOptions& options) {
     display.settings.facets.layout = FacetTolerance{*options.tolerance};
   }
   // Check the method name before any scene work.
-  driver::make_render_method(display.method);
+  driver::check_render_method(display.method);
   const driver::Scene scene = load_scene(options.scene);
   const driver::CameraPath path =
       driver::default_camera_path(scene, options.scene == "builtin:city");
