@@ -211,10 +211,25 @@ BlendResult compute_blend(std::span<const Warp> warps, const BlendOptions& optio
     // Every uncovered pixel of k (and the ring just outside the image) whose direction another
     // projector j covers is an edge to fade towards, raised by how little j covers it: by
     // kRaiseGain · (margin − depth_j), so an edge deep inside j counts fully and one j barely
-    // reaches hardly at all. Directions from the warp's extrapolated offsets.
+    // reaches hardly at all. Directions from the warp's extrapolated offsets, over the nodes with
+    // any coverage (the ramp past the image edge, the rings kept around the seen part) and their
+    // neighbours: the nodes filled farther out are guesses that may fold over the image.
     cv::Mat height(size.y + 2, size.x + 2, CV_64F, cv::Scalar(kFar));
     Warp extended = warps[k];
-    std::fill(extended.coverage.begin(), extended.coverage.end(), 1.0f);
+    {
+      const glm::ivec2 g = extended.grid_size;
+      for (int j = 0; j < g.y; ++j) {
+        for (int i = 0; i < g.x; ++i) {
+          bool near = false;
+          for (int b = std::max(0, j - 1); b <= std::min(g.y - 1, j + 1); ++b) {
+            for (int a = std::max(0, i - 1); a <= std::min(g.x - 1, i + 1); ++a) {
+              near = near || warps[k].coverage[warps[k].node_index(a, b)] > 0;
+            }
+          }
+          extended.coverage[extended.node_index(i, j)] = near ? 1.0f : 0.0f;
+        }
+      }
+    }
     const WarpInverse inverse(std::move(extended));
     parallel_rows(size.y + 2, [&](int y) {
       const auto* inside = covered.ptr<std::uint8_t>(y);

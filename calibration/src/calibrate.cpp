@@ -200,20 +200,7 @@ CalibrationReport calibrate(const fs::path& capture_path, const fs::path& out,
   display.name = options.display_name.empty() ? fs::absolute(capture.folder).filename().string()
                                               : options.display_name;
   if (display.name.empty()) display.name = "display";
-  if (capture.screen) {
-    const Screen& screen = *capture.screen;
-    projection_io::DisplayScreen converted;
-    converted.type =
-        screen.type == Screen::Type::sphere     ? projection_io::DisplayScreen::Type::sphere
-        : screen.type == Screen::Type::cylinder ? projection_io::DisplayScreen::Type::cylinder
-                                                : projection_io::DisplayScreen::Type::plane;
-    converted.center = screen.center;
-    converted.axis = screen.axis;
-    converted.radius = screen.radius;
-    converted.point = screen.point;
-    converted.normal = screen.normal;
-    display.screen = converted;
-  }
+  display.screen = capture.screen;
   int x = 0;
   for (std::size_t p = 0; p < warps.size(); ++p) {
     const CaptureProjector& projector = capture.projectors[p];

@@ -99,8 +99,9 @@ double homography_residual(const cv::Matx33d& H, const FitSample& sample) {
 // is close to a pinhole, so in this base q is nearly affine in st and the offsets are small and
 // smooth: bilinear interpolation between nodes then costs little. Samples far from the
 // homography (wrong codes, stray light) are left out of the fit and of the extents; the warp fit
-// ignores samples outside the base image. nullopt when the fit is ill-posed, mirrored, or a
-// consistent sample lies more than max_half_angle_rad off the axis.
+// ignores samples outside the base image. nullopt when the fit is ill-posed, mirrored, or the
+// consistent samples reach more than max_half_angle_rad off the axis horizontally or vertically
+// (margin included).
 std::optional<BaseCover> projector_cover(std::span<const FitSample> samples, glm::ivec2 output_size,
                                          double margin_rad, double max_half_angle_rad) {
   std::vector<char> use(samples.size(), 0);
@@ -146,13 +147,12 @@ std::optional<BaseCover> projector_cover(std::span<const FitSample> samples, glm
   BaseCover cover;
   // Base: x right, y up, looking down −z; projector: x right, y down, z forward.
   cover.R_eye_base = glm::dmat3(x_projector, -y_projector, -z_projector);
-  const double min_cos = std::cos(max_half_angle_rad);
   double left = 1e300, right = -1e300, top = -1e300, bottom = 1e300;
   for (std::size_t k = 0; k < samples.size(); ++k) {
     if (!(residual[k] <= threshold)) continue;
     const glm::dvec3& v = samples[k].v_eye;
     const double z = glm::dot(v, z_projector);
-    if (!(z >= min_cos * glm::length(v))) return std::nullopt;
+    if (!(z > 0)) return std::nullopt;
     const double x = std::atan2(glm::dot(v, x_projector), z);
     const double y = std::atan2(-glm::dot(v, y_projector), z);
     left = std::min(left, x);
@@ -160,10 +160,13 @@ std::optional<BaseCover> projector_cover(std::span<const FitSample> samples, glm
     top = std::max(top, y);
     bottom = std::min(bottom, y);
   }
+  // Far off the axis a perspective base stretches: its nodes crowd into the middle of the image
+  // and the few at the sides see few samples each.
   const double limit = max_half_angle_rad;
-  cover.base = BaseProjection::perspective(
-      std::tan(std::max(left - margin_rad, -limit)), std::tan(std::min(right + margin_rad, limit)),
-      std::tan(std::min(top + margin_rad, limit)), std::tan(std::max(bottom - margin_rad, -limit)));
+  if (std::max({-left, right, top, -bottom}) + margin_rad > limit) return std::nullopt;
+  cover.base =
+      BaseProjection::perspective(std::tan(left - margin_rad), std::tan(right + margin_rad),
+                                  std::tan(top + margin_rad), std::tan(bottom - margin_rad));
   return cover;
 }
 
@@ -550,8 +553,10 @@ WarpFit fit_warp(std::span<const FitSample> samples, glm::ivec2 output_size,
   // Coverage: a ramp across one node spacing centred on the image edge, so that A = 0.5 (the
   // covered boundary after bilinear interpolation) falls close to where q leaves the image.
   // Filled nodes are extrapolations: the rings around the supported nodes within extrapolate_px
-  // nodes stay covered (A at most 0.5, so the covered region ends at them), the rest of the
-  // image, which the camera never saw well enough, is left uncovered rather than guessed.
+  // keep the ramp (the image edge's last nodes lie beyond the samples); farther ones are
+  // uncovered, so inside the image the covered region ends half a node past the last kept ring.
+  // The rest of the image, which the camera never saw well enough, is left uncovered rather than
+  // guessed.
   const double spacing_px = 0.5 * (step.x + step.y);
   const int extrapolate_rings = std::max(1, int(std::ceil(options.extrapolate_px / spacing_px)));
   warp.offset_px.resize(nodes.size());
@@ -564,7 +569,7 @@ WarpFit fit_warp(std::span<const FitSample> samples, glm::ivec2 output_size,
           std::min(std::min(q.x, output_size.x - q.x), std::min(q.y, output_size.y - q.y));
       warp.offset_px[k] = glm::vec2(offset[k]);
       double coverage = std::clamp(0.5 + inside / spacing_px, 0.0, 1.0);
-      if (ring[k] > 0) coverage = ring[k] <= extrapolate_rings ? std::min(coverage, 0.5) : 0;
+      if (ring[k] > extrapolate_rings) coverage = 0;
       warp.coverage[k] = float(coverage);
       if (ring[k] > 0 && inside > 0) {
         ++(ring[k] > extrapolate_rings ? result.report.holes : result.report.filled);

@@ -28,6 +28,7 @@
 #include "facet/calibration/image_io.hpp"
 #include "facet/calibration/simulate.hpp"
 #include "facet/projection/errors.hpp"
+#include "facet/projection_io/blend_file.hpp"
 #include "test_folder.hpp"
 
 namespace facet::calibration {
@@ -147,6 +148,18 @@ TEST(Replay, BlendWeightsSumToOneWhereProjectorsOverlap) {
     // every third pixel of both projectors).
     EXPECT_GT(report.blend_overlap_directions, 200u);
     EXPECT_LE(report.blend_sum_max_err, 0.005) << report.blend_worst;
+  }
+  // The weights fade towards an edge that lies inside the other projector, and not towards the
+  // display's outer edge: the left projector's right edge falls inside the right projector's
+  // image, its left edge is the display's edge.
+  const fs::path display = replay(true).folder->path() / "display";
+  const projection_io::BlendMap left =
+      projection_io::read_blend_map((display / "left.blend.exr").string());
+  for (const int y : {24, 48, 72}) {
+    EXPECT_GT(left.at(0, y), 0.999f) << "row " << y;
+    EXPECT_LT(left.at(127, y), 0.05f) << "row " << y;
+    EXPECT_GT(left.at(100, y), 0.05f) << "row " << y;
+    EXPECT_LT(left.at(100, y), 0.95f) << "row " << y;
   }
 }
 

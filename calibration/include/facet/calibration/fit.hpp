@@ -69,10 +69,11 @@ struct FitOptions {
   // Residuals above this count as outliers in the report (output pixels).
   double outlier_px = 2.0;
   // Base projection: a perspective lined up with the projector (its axis and rows, from a
-  // homography fitted to the samples) when every sample lies within max_aligned_half_angle_rad of
-  // its axis; otherwise, or when disabled, cover_directions with `cover`.
+  // homography fitted to the samples) when the samples stay within max_aligned_half_angle_rad of
+  // its axis horizontally and vertically (margin included); otherwise, or when disabled,
+  // cover_directions with `cover`.
   bool projector_aligned_base = true;
-  double max_aligned_half_angle_rad = 1.40;  // about 80°
+  double max_aligned_half_angle_rad = 1.22;  // about 70°
   CoverOptions cover;
 };
 

@@ -13,22 +13,15 @@
 #include <string>
 #include <vector>
 
+#include "facet/projection/screen.hpp"
+
 namespace facet::projection_io {
 
 inline constexpr const char* kDisplayFormat = "facet-display/1";
 
-// The display surface, in the same JSON shape as capture.json's `screen` (FORMATS.md §1).
-struct DisplayScreen {
-  enum class Type { sphere, cylinder, plane };
-  Type type = Type::sphere;
-  glm::dvec3 center{0.0};            // sphere, cylinder: a point on the axis
-  glm::dvec3 axis{0.0, 1.0, 0.0};    // cylinder: unit direction of the axis
-  double radius = 1;                 // sphere, cylinder: > 0
-  glm::dvec3 point{0.0};             // plane: a point on it
-  glm::dvec3 normal{0.0, 0.0, 1.0};  // plane: unit normal
-
-  bool operator==(const DisplayScreen&) const = default;
-};
+// The display surface, in the same JSON shape as capture.json's `screen` (FORMATS.md §1): the
+// projection core's Screen, so that a display's screen meets rays with facet::intersect_screen.
+using DisplayScreen = facet::Screen;
 
 // Where a projector's image goes. A monitor name (EDID/connector name as the window system
 // reports it) survives a reboot; `position`/`size` say where that monitor sat on the desktop and
