@@ -46,9 +46,10 @@ const facet::cli::Registration registration{
       cmd->add_option("--out", args->out, "output folder (must not exist, or be empty)")
           ->required();
       cmd->add_flag("--json", args->json,
-                    "print the report as JSON: per projector coverage, decoded pixels, fit "
-                    "residual and, with truth/, rms_px, p99_px and max_px; blend_sum_max_err; "
-                    "seconds");
+                    "print the report as JSON: per projector coverage, decoded pixels, grid, "
+                    "fit residual, filled and holes (nodes extrapolated and kept, or left "
+                    "uncovered) and folds, and with truth/ rms_px, p99_px, max_px, max_at_px and "
+                    "uncovered_fraction; blend_sum_max_err and where (blend_worst); seconds");
       cmd->add_option("--grid", args->grid,
                       "offset-map nodes GWxGH for every projector (default: one node about "
                       "every 16 output pixels)");
