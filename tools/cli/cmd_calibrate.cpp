@@ -52,7 +52,7 @@ const facet::cli::Registration registration{
                     "uncovered_fraction; blend_sum_max_err and where (blend_worst); seconds");
       cmd->add_option("--grid", args->grid,
                       "offset-map nodes GWxGH for every projector (default: one node about "
-                      "every 16 output pixels)");
+                      "every 16 output pixels, refined once where the map curves)");
       cmd->add_option("--node-spacing", args->node_spacing_px,
                       "node spacing in output pixels when --grid is not given");
       cmd->add_option("--black-level", args->black_level,
