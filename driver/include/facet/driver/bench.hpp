@@ -1,0 +1,124 @@
+#pragma once
+// `facet bench`: every render method over a sweep of settings, side by side in one run, on the
+// scenarios of the seed paper (a 360° cylinder, a view deformation through camera textures, a dome
+// master and a multi-projector dome), with median frame times, GPU pass times and accuracy
+// against the Embree reference.
+//
+// Timing. Methods are interleaved within every frame (frame k renders every setting once, in an
+// order that rotates with k), so that load from other processes hits them alike; wall time is
+// measured around render() + glFinish(). Frame k (k = 1..N) looks from the city camera path at
+// k · kBenchFrameStepS seconds, so every frame has a new view and the facet pipelines rerun
+// passes 1 and 2. On a software rasterizer (llvmpipe) only ratios from one run mean anything.
+//
+// Accuracy comes from one extra frame at t = 0 (also the warm-up): the ID image of every output
+// against the ray-cast reference (compare_ids, wrap_x on 360° outputs), plus a geometric error
+// in output pixels whose source depends on the method (BenchRow::geometric_source).
+#include <filesystem>
+#include <functional>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "facet/driver/render_method.hpp"
+
+namespace facet::driver {
+
+inline constexpr double kBenchFrameStepS = 0.25;
+
+struct BenchOptions {
+  // Any of "cylinder", "deformation", "dome"; empty means all three.
+  std::vector<std::string> scenarios;
+  int frames = 5;           // timed frames per setting (>= 1)
+  double size_scale = 1.0;  // multiplies every output size (and the rig's projector sizes)
+  // Small sizes (size_scale · 1/8 unless set otherwise), fewer settings; for tests.
+  bool quick = false;
+  // The multi-projector dome rig of the dome scenario (facet-rig/1 JSON).
+  std::filesystem::path dome_rig = "configs/rigs/dome4.json";
+};
+
+// One method at one setting on one scenario.
+struct BenchSetting {
+  std::string method;  // a render_method_names() entry
+  std::string label;   // e.g. "pieces=160", "grid=80x60", "tol=0.25px", "face=1024", "tess=4"
+  RenderSettings settings;
+  // facets-gs: the label of the facets setting whose IDs it must reproduce exactly.
+  std::string same_ids_as;
+};
+
+struct BenchScenario {
+  std::string name;         // "cylinder", "deformation-80x60", "dome", "dome4", ...
+  std::string description;  // one line
+  std::vector<OutputSpec> outputs;
+  std::vector<BenchSetting> settings;
+};
+
+struct BenchRow {
+  std::string scenario, method, setting;
+  std::string error;  // non-empty when the setting could not be prepared (then nothing else)
+  int outputs = 0;
+  std::string output_size;  // "WxH" of the first output
+  int frames = 0;
+  double frame_ms = 0;  // median wall time of a frame, render + glFinish
+  double frame_ms_min = 0, frame_ms_max = 0;
+  std::map<std::string, double> pass_ms;  // median GPU ms per pass, summed over outputs
+  double gpu_ms = 0;                      // median of the per-frame sum of every pass
+  // Facet pipelines only (else nullopt). Passes 1+2's share of the frame:
+  // 1 − pass3_only_ms / frame_ms, where pass3_only_ms is the median wall time of a second render
+  // of each timed frame's view, which reuses passes 1 and 2 (RenderStats::reused_replication).
+  // Wall clock, so it also holds where GPU timer queries cannot attribute time to passes (llvmpipe
+  // runs compute work lazily, at the next synchronising call).
+  std::optional<double> passes12_share, pass3_only_ms;
+  // The same share from the GPU timer: median over frames of (pass1 + pass2) / all passes.
+  std::optional<double> passes12_share_gpu;
+  std::uint64_t facets = 0, triangles_in = 0, triangles_visible = 0, replicas = 0;
+  double replication_ratio = 0;  // mean of replicas / triangles_in over the timed frames
+  // Reference comparison on the accuracy frame, pooled over outputs: id_mismatch is
+  // Σ mismatched / Σ compared, max_edge_px the largest, p99_edge_px the largest output's p99.
+  double id_mismatch = 0, max_edge_px = 0, p99_edge_px = 0;
+  // Geometric error in output pixels: max (worst case) and RMS; see geometric_source.
+  double geometric_max_px = 0, geometric_rms_px = 0;
+  // "facet error" (evaluate_facet_error of the facets against the exact warp), "cube texel"
+  // (nearest-texel displacement: half a face texel diagonally, mapped into output pixels at
+  // every sampled output pixel) or "reference edges" (vertex: its error is the straight chords
+  // between projected vertices and depends on the scene, so max/p99 of the reference edge
+  // distances stand in for max/RMS).
+  std::string geometric_source;
+  // facets-gs: pixels whose ID differs from same_ids_as' image on the accuracy frame.
+  std::optional<std::uint64_t> id_pixels_differing_from_facets;
+};
+
+struct BenchReport {
+  std::string renderer;  // GL_RENDERER
+  int frames = 0;
+  double size_scale = 1;
+  bool quick = false;
+  std::vector<BenchRow> rows;
+  std::vector<std::string> notes;  // the closing note: ratios at matched error, shares, ratios
+};
+
+// The scenarios of `options`, with their outputs and settings. Throws InputError for an unknown
+// scenario name or a bad rig file.
+std::vector<BenchScenario> make_bench_scenarios(const BenchOptions& options);
+
+// Runs every scenario. Needs a current GL context. `progress` (may be empty) gets one line per
+// step.
+BenchReport run_bench(const BenchOptions& options, const std::string& renderer,
+                      const std::function<void(const std::string&)>& progress = {});
+
+// The closing note of a report's rows (also stored in BenchReport::notes by run_bench).
+std::vector<std::string> bench_notes(const std::vector<BenchRow>& rows,
+                                     const std::string& renderer);
+
+// Writes folder/bench.json, folder/bench.csv and folder/bench.png (median frame time against
+// id_mismatch and against geometric error, one series per method, one row of panels per
+// scenario). The files are written to a temporary folder beside `folder` and moved into it, so a
+// failure leaves none of them half-written. InputError naming the folder if it cannot be made.
+void write_bench_files(const BenchReport& report, const std::filesystem::path& folder);
+
+// The CSV columns, in order (bench.csv's header).
+std::vector<std::string> bench_csv_columns();
+
+double median(std::vector<double> values);
+
+}  // namespace facet::driver

@@ -1,0 +1,505 @@
+#include "facet/driver/bench.hpp"
+
+#include <epoxy/gl.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <numbers>
+#include <set>
+
+#include "facet/driver/city.hpp"
+#include "facet/driver/display_outputs.hpp"
+#include "facet/driver/gpu_scene.hpp"
+#include "facet/driver/gpu_timer.hpp"
+#include "facet/driver/reference.hpp"
+#include "facet/projection/errors.hpp"
+#include "facet/projection/facet_error.hpp"
+#include "facet/projection/rig.hpp"
+#include "facet/projection/warp_inverse.hpp"
+#include "facet/projection_io/rig_file.hpp"
+
+namespace facet::driver {
+namespace {
+
+std::string format(const char* pattern, auto... values) {
+  char text[256];
+  std::snprintf(text, sizeof text, pattern, values...);
+  return text;
+}
+
+std::string size_text(glm::ivec2 size) { return format("%dx%d", size.x, size.y); }
+
+glm::ivec2 scaled(glm::ivec2 size, double scale) {
+  return {std::max(16, int(std::lround(size.x * scale))),
+          std::max(16, int(std::lround(size.y * scale)))};
+}
+
+// The view deformation of the seed paper's camera textures: a perspective base (90° × 73.7°,
+// 4:3) and a smooth offset map of a few output-pixel-scaled waves, about 3% of the width at most,
+// far from folding (the map's derivative stays below a third of the base's).
+Warp deformation_warp(glm::ivec2 output_size, glm::ivec2 texture_cells) {
+  Warp warp = Warp::analytic(BaseProjection::perspective(-1, 1, 0.75, -0.75), output_size,
+                             texture_cells + 1);
+  const double two_pi = 2 * std::numbers::pi;
+  for (int j = 0; j < warp.grid_size.y; ++j) {
+    for (int i = 0; i < warp.grid_size.x; ++i) {
+      const double s = double(i) / (warp.grid_size.x - 1), t = double(j) / (warp.grid_size.y - 1);
+      const double dx = 0.03 * std::sin(two_pi * (1.5 * s + 0.1)) * std::cos(two_pi * t) +
+                        0.02 * (s - 0.5) * (t - 0.5);
+      const double dy = 0.025 * std::sin(two_pi * (t + 0.2)) * std::cos(two_pi * 0.75 * s) +
+                        0.015 * std::sin(two_pi * (s + t));
+      warp.offset_px[warp.node_index(i, j)] =
+          glm::vec2(float(dx * output_size.x), float(dy * output_size.y));
+    }
+  }
+  warp.validate("builtin view deformation");
+  return warp;
+}
+
+// The rig's projectors scaled by `scale` (sizes, focal lengths, principal points), so that the
+// quick run and --size-scale shrink the dome rig as they shrink the other outputs.
+std::vector<OutputSpec> rig_outputs(const std::filesystem::path& path, double scale) {
+  Rig rig = read_rig(path);
+  for (ProjectorModel& projector : rig.projectors) {
+    const glm::ivec2 size = scaled(projector.size, scale);
+    const glm::dvec2 ratio = glm::dvec2(size) / glm::dvec2(projector.size);
+    projector.size = size;
+    projector.focal_px *= ratio;
+    projector.principal_px *= ratio;
+  }
+  std::vector<OutputSpec> outputs;
+  TrueWarpOptions options;
+  // 0.01 px, FORMATS.md's bound: the warp is the display here, not a simulation's ground truth.
+  options.max_error_px = 0.01;
+  for (std::size_t k = 0; k < rig.projectors.size(); ++k) {
+    outputs.push_back({rig.projectors[k].name, true_warp(rig, k, options)});
+  }
+  return outputs;
+}
+
+std::string layout_label(const FacetLayout& layout) {
+  if (const auto* strips = std::get_if<FacetStrips>(&layout)) {
+    return format("pieces=%d", strips->count);
+  }
+  if (const auto* grid = std::get_if<FacetGrid>(&layout)) {
+    return format("grid=%dx%d", grid->columns, grid->rows);
+  }
+  return format("tol=%gpx", std::get<FacetTolerance>(layout).px);
+}
+
+// The settings of one scenario: facets over `layouts`, facets-gs at `gs_layout` (the
+// geometry-shader form loops over facets per triangle, far slower on a software rasterizer than
+// the compute form, so it gets a small layout), naive over
+// `naive_layouts` (naive issues one draw per facet and object run, so layouts of thousands of
+// facets make it draw-call bound and are left out), cube faces of the given edge lengths, vertex
+// with the given tessellation caps.
+std::vector<BenchSetting> sweep(const std::vector<FacetLayout>& layouts,
+                                const FacetLayout& gs_layout,
+                                const std::vector<FacetLayout>& naive_layouts,
+                                const std::vector<int>& faces,
+                                const std::vector<int>& tessellation) {
+  std::vector<BenchSetting> settings;
+  for (const FacetLayout& layout : layouts) {
+    BenchSetting s{"facets", layout_label(layout), {}, {}};
+    s.settings.facets.layout = layout;
+    settings.push_back(s);
+  }
+  {
+    const std::string label = layout_label(gs_layout);
+    BenchSetting s{"facets-gs", label, {}, label};
+    s.settings.facets.layout = gs_layout;
+    settings.push_back(s);
+  }
+  for (const FacetLayout& layout : naive_layouts) {
+    BenchSetting s{"naive", layout_label(layout), {}, {}};
+    s.settings.facets.layout = layout;
+    settings.push_back(s);
+  }
+  for (int face : faces) {
+    BenchSetting s{"cubemap", format("face=%d", face), {}, {}};
+    s.settings.cube_face_size = face;
+    settings.push_back(s);
+  }
+  for (int cap : tessellation) {
+    BenchSetting s{"vertex", format("tess=%d", cap), {}, {}};
+    s.settings.max_tessellation = cap;
+    settings.push_back(s);
+  }
+  return settings;
+}
+
+// Largest displacement, in output pixels, that a nearest-texel lookup in a cube map of face edge
+// `face` can cause, sampled over the output pixels (the half-diagonal of the texel holding each
+// pixel's exact direction, mapped through the warp). Faces are the eye frame's axes, as in the
+// cube-map method.
+std::pair<double, double> cube_texel_error(const Warp& warp, const WarpInverse& inverse, int face) {
+  const glm::ivec2 size = warp.output_size;
+  const int stride = std::max(1, int(std::sqrt(double(size.x) * size.y / 65536.0)));
+  const double half_texel = 1.0 / face;  // face coordinates span [-1, 1]
+  double max_px = 0, sum_sq = 0;
+  std::size_t n = 0;
+  for (int y = stride / 2; y < size.y; y += stride) {
+    for (int x = stride / 2; x < size.x; x += stride) {
+      const glm::dvec2 q(x + 0.5, y + 0.5);
+      const auto inverted = inverse.invert(q);
+      if (!inverted) continue;
+      const glm::dvec3 v = inverted->v_eye;
+      int m = 0;
+      for (int k = 1; k < 3; ++k) {
+        if (std::abs(v[k]) > std::abs(v[m])) m = k;
+      }
+      const int a = (m + 1) % 3, b = (m + 2) % 3;
+      const glm::dvec3 on_face = v / std::abs(v[m]);
+      double worst = 0;
+      for (const double sb : {-1.0, 1.0}) {
+        glm::dvec3 moved = on_face;
+        moved[a] += half_texel;
+        moved[b] += sb * half_texel;
+        const auto projected = warp.project(moved, inverted->st.x);
+        if (projected) worst = std::max(worst, glm::length(projected->q - q));
+      }
+      max_px = std::max(max_px, worst);
+      sum_sq += worst * worst;
+      ++n;
+    }
+  }
+  return {max_px, n ? std::sqrt(sum_sq / double(n)) : 0.0};
+}
+
+struct Runner {
+  BenchSetting setting;
+  std::unique_ptr<RenderMethod> method;
+  GpuTimer timer;
+  std::vector<double> frame_ms;
+  std::vector<double> reused_ms;  // facet pipelines: frames that skip passes 1 and 2
+  std::vector<RenderStats> stats;
+  BenchRow row;
+};
+
+double wall_ms_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+      .count();
+}
+
+}  // namespace
+
+double median(std::vector<double> values) {
+  if (values.empty()) return 0;
+  std::sort(values.begin(), values.end());
+  const std::size_t n = values.size();
+  return n % 2 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
+}
+
+std::vector<BenchScenario> make_bench_scenarios(const BenchOptions& options) {
+  static const std::set<std::string> known = {"cylinder", "deformation", "dome"};
+  std::vector<std::string> names = options.scenarios;
+  if (names.empty()) names = {"cylinder", "deformation", "dome"};
+  for (const std::string& name : names) {
+    if (!known.contains(name)) {
+      throw InputError("command line", "--scenario",
+                       "expected cylinder, deformation, dome or all; got '" + name + "'");
+    }
+  }
+  if (!(options.size_scale > 0) || options.size_scale > 4) {
+    throw InputError("command line", "--size-scale", "expected a scale in (0, 4]");
+  }
+  if (options.frames < 1) throw InputError("command line", "--frames", "expected at least 1");
+  const double scale = options.size_scale * (options.quick ? 0.125 : 1.0);
+  const bool quick = options.quick;
+  auto faces = [&](std::vector<int> edges) {
+    for (int& e : edges) e = std::max(8, int(std::lround(e * scale)));
+    return edges;
+  };
+  const std::vector<int> tess = quick ? std::vector<int>{1, 16} : std::vector<int>{1, 4, 16};
+
+  const std::vector<int> faces_sweep =
+      faces(quick ? std::vector<int>{256, 1024} : std::vector<int>{256, 512, 1024, 2048});
+  std::vector<BenchScenario> scenarios;
+  for (const std::string& name : names) {
+    if (name == "cylinder") {
+      BenchScenario s;
+      s.name = "cylinder";
+      s.outputs = load_display_outputs("builtin:cylinder360", scaled({1600, 1200}, scale));
+      s.description = "the seed's 360x90 cylinder at " + size_text(s.outputs[0].warp.output_size) +
+                      ", the city";
+      if (quick) {
+        s.settings = sweep({FacetStrips{16}, FacetTolerance{1}}, FacetStrips{16}, {FacetStrips{16}},
+                           faces_sweep, tess);
+      } else {
+        s.settings =
+            sweep({FacetStrips{160}, FacetStrips{40}, FacetStrips{80}, FacetTolerance{1},
+                   FacetTolerance{0.25}, FacetTolerance{0.1}},
+                  FacetStrips{160},
+                  {FacetStrips{160}, FacetStrips{40}, FacetTolerance{1}, FacetTolerance{0.25}},
+                  faces_sweep, tess);
+      }
+      scenarios.push_back(std::move(s));
+    } else if (name == "deformation") {
+      for (const glm::ivec2 cells : {glm::ivec2(80, 60), glm::ivec2(128, 128)}) {
+        if (quick && cells.x == 128) continue;
+        BenchScenario s;
+        s.name = "deformation-" + size_text(cells);
+        const glm::ivec2 size = scaled({1024, 768}, scale);
+        s.outputs.push_back({"deformation", deformation_warp(size, cells)});
+        s.description = "view deformation: perspective base, built-in smooth offset map on a " +
+                        size_text(cells) + " camera texture, " + size_text(size);
+        if (quick) {
+          s.settings = sweep({FacetGrid{8, 6}, FacetTolerance{1}}, FacetGrid{8, 6},
+                             {FacetGrid{8, 6}}, faces_sweep, tess);
+        } else {
+          // The seed's facets are the camera texture's cells.
+          const FacetGrid quarter{cells.x / 4, cells.y / 4};
+          s.settings = sweep({FacetGrid{cells.x, cells.y}, quarter, FacetTolerance{1}}, quarter,
+                             {quarter, FacetTolerance{1}}, faces_sweep, tess);
+        }
+        scenarios.push_back(std::move(s));
+      }
+    } else {
+      {
+        BenchScenario s;
+        s.name = "dome";
+        s.outputs = load_display_outputs("builtin:dome180", scaled({2048, 2048}, scale));
+        s.description =
+            "180-degree dome master at " + size_text(s.outputs[0].warp.output_size) + ", the city";
+        if (quick) {
+          s.settings = sweep({FacetTolerance{1}, FacetGrid{4, 4}}, FacetGrid{4, 4},
+                             {FacetGrid{4, 4}}, faces_sweep, tess);
+        } else {
+          s.settings = sweep(
+              {FacetTolerance{0.25}, FacetGrid{16, 16}, FacetTolerance{1}, FacetTolerance{0.1}},
+              FacetGrid{16, 16}, {FacetGrid{16, 16}, FacetTolerance{1}}, faces_sweep, tess);
+        }
+        scenarios.push_back(std::move(s));
+      }
+      {
+        BenchScenario s;
+        s.name = "dome4";
+        s.outputs = rig_outputs(options.dome_rig, scale);
+        s.description = "multi-projector dome rig " + options.dome_rig.filename().string() + ": " +
+                        std::to_string(s.outputs.size()) + " projectors at " +
+                        size_text(s.outputs[0].warp.output_size) + ", true warps";
+        if (quick) {
+          s.settings =
+              sweep({FacetTolerance{1}}, FacetTolerance{1}, {FacetTolerance{1}}, faces_sweep, tess);
+        } else {
+          s.settings = sweep({FacetTolerance{0.25}, FacetTolerance{1}, FacetTolerance{0.1}},
+                             FacetTolerance{1}, {FacetTolerance{1}, FacetTolerance{0.25}},
+                             faces_sweep, tess);
+        }
+        scenarios.push_back(std::move(s));
+      }
+    }
+  }
+  return scenarios;
+}
+
+BenchReport run_bench(const BenchOptions& options, const std::string& renderer,
+                      const std::function<void(const std::string&)>& progress) {
+  auto say = [&](const std::string& line) {
+    if (progress) progress(line);
+  };
+  const std::vector<BenchScenario> scenarios = make_bench_scenarios(options);
+  BenchReport report;
+  report.renderer = renderer;
+  report.frames = options.frames;
+  report.size_scale = options.size_scale;
+  report.quick = options.quick;
+
+  const Scene scene = build_city();
+  const GpuScene gpu_scene = upload_scene(scene);
+  const ReferenceRaycaster raycaster(scene);
+  const CityCameraPath path;
+  auto T_eye_world_at = [&](double t) { return glm::inverse(path.T_world_eye(t)); };
+
+  for (const BenchScenario& scenario : scenarios) {
+    say("scenario " + scenario.name + ": " + scenario.description);
+    const bool wrap_x = scenario.outputs[0].warp.base.wraps_horizontally();
+    std::vector<WarpInverse> inverses;
+    std::vector<std::vector<std::uint32_t>> reference;
+    const glm::dmat4 T0 = T_eye_world_at(0);
+    for (const OutputSpec& output : scenario.outputs) {
+      inverses.emplace_back(output.warp);
+      reference.push_back(raycaster.ids(inverses.back(), T0));
+    }
+    std::vector<OutputTarget> targets;
+    for (const OutputSpec& output : scenario.outputs) {
+      targets.push_back(OutputTarget::create(output.warp.output_size));
+    }
+
+    // Geometric errors that depend only on the outputs and the layout, shared by the facet
+    // methods at one layout.
+    std::map<std::string, std::pair<double, double>> facet_errors;
+    auto facet_error_of = [&](const BenchSetting& setting) {
+      auto found = facet_errors.find(setting.label);
+      if (found != facet_errors.end()) return found->second;
+      double max_px = 0, sum_sq = 0;
+      std::size_t n = 0;
+      for (const OutputSpec& output : scenario.outputs) {
+        const FacetMesh mesh = build_facets(output.warp, setting.settings.facets);
+        const FacetError error = evaluate_facet_error(output.warp, mesh);
+        max_px = std::max(max_px, error.max_px);
+        sum_sq += error.rms_px * error.rms_px * double(error.samples);
+        n += error.samples;
+      }
+      const std::pair<double, double> result{max_px, n ? std::sqrt(sum_sq / double(n)) : 0.0};
+      facet_errors.emplace(setting.label, result);
+      return result;
+    };
+
+    std::vector<Runner> runners;
+    std::map<std::string, std::vector<std::vector<std::uint32_t>>> facet_ids;
+    for (const BenchSetting& setting : scenario.settings) {
+      Runner runner;
+      runner.setting = setting;
+      BenchRow& row = runner.row;
+      row.scenario = scenario.name;
+      row.method = setting.method;
+      row.setting = setting.label;
+      row.outputs = int(scenario.outputs.size());
+      row.output_size = size_text(scenario.outputs[0].warp.output_size);
+      row.frames = options.frames;
+      const auto start = std::chrono::steady_clock::now();
+      try {
+        runner.method = make_render_method(setting.method);
+        runner.method->prepare(scene, gpu_scene, scenario.outputs, setting.settings);
+      } catch (const InputError& error) {
+        row.error = error.what();
+        say("  " + setting.method + " " + setting.label + ": not run: " + row.error);
+        runner.method.reset();
+        runners.push_back(std::move(runner));
+        continue;
+      }
+      const double prepare_ms = wall_ms_since(start);
+
+      // The accuracy frame, which is also the warm-up.
+      runner.method->render(T0, targets);
+      glFinish();
+      IdComparison pooled;
+      std::vector<std::vector<std::uint32_t>> ids;
+      for (std::size_t i = 0; i < targets.size(); ++i) {
+        ids.push_back(targets[i].read_ids());
+        const IdComparison c =
+            compare_ids(reference[i], ids.back(), targets[i].size(), {.wrap_x = wrap_x});
+        pooled.compared_pixels += c.compared_pixels;
+        pooled.mismatched_pixels += c.mismatched_pixels;
+        pooled.max_edge_px = std::max(pooled.max_edge_px, c.max_edge_px);
+        pooled.p99_edge_px = std::max(pooled.p99_edge_px, c.p99_edge_px);
+      }
+      row.id_mismatch = pooled.compared_pixels
+                            ? double(pooled.mismatched_pixels) / double(pooled.compared_pixels)
+                            : 0.0;
+      row.max_edge_px = pooled.max_edge_px;
+      row.p99_edge_px = pooled.p99_edge_px;
+      if (setting.method == "facets") facet_ids[setting.label] = ids;
+      if (!setting.same_ids_as.empty()) {
+        const auto match = facet_ids.find(setting.same_ids_as);
+        if (match != facet_ids.end()) {
+          std::uint64_t differing = 0;
+          for (std::size_t i = 0; i < ids.size(); ++i) {
+            for (std::size_t p = 0; p < ids[i].size(); ++p) {
+              differing += ids[i][p] != match->second[i][p];
+            }
+          }
+          row.id_pixels_differing_from_facets = differing;
+        }
+      }
+      if (setting.method == "facets" || setting.method == "facets-gs" ||
+          setting.method == "naive") {
+        std::tie(row.geometric_max_px, row.geometric_rms_px) = facet_error_of(setting);
+        row.geometric_source = "facet error";
+      } else if (setting.method == "cubemap") {
+        double max_px = 0, sum_sq = 0;
+        for (std::size_t i = 0; i < scenario.outputs.size(); ++i) {
+          const auto [m, rms] = cube_texel_error(scenario.outputs[i].warp, inverses[i],
+                                                 setting.settings.cube_face_size);
+          max_px = std::max(max_px, m);
+          sum_sq += rms * rms;
+        }
+        row.geometric_max_px = max_px;
+        row.geometric_rms_px = std::sqrt(sum_sq / double(scenario.outputs.size()));
+        row.geometric_source = "cube texel";
+      } else {
+        row.geometric_max_px = row.max_edge_px;
+        row.geometric_rms_px = row.p99_edge_px;
+        row.geometric_source = "reference edges";
+      }
+      say(
+          format("  %-9s %-12s prepared in %7.0f ms: id_mismatch %.5f, edges max %.2f px p99 "
+                 "%.2f px, geometric max %.3f px",
+                 setting.method.c_str(), setting.label.c_str(), prepare_ms, row.id_mismatch,
+                 row.max_edge_px, row.p99_edge_px, row.geometric_max_px));
+      runners.push_back(std::move(runner));
+    }
+
+    // Timed frames, interleaved: every setting once per frame, the starting setting rotating.
+    for (int k = 1; k <= options.frames; ++k) {
+      const glm::dmat4 T = T_eye_world_at(k * kBenchFrameStepS);
+      for (std::size_t j = 0; j < runners.size(); ++j) {
+        Runner& runner = runners[(j + std::size_t(k)) % runners.size()];
+        if (!runner.method) continue;
+        const auto start = std::chrono::steady_clock::now();
+        runner.stats.push_back(runner.method->render(T, targets, &runner.timer));
+        glFinish();
+        runner.frame_ms.push_back(wall_ms_since(start));
+        if (runner.setting.method == "facets" || runner.setting.method == "facets-gs") {
+          // The same view again: the pipeline keeps passes 1 and 2 and draws only.
+          const auto again = std::chrono::steady_clock::now();
+          const RenderStats reused = runner.method->render(T, targets);
+          glFinish();
+          if (reused.reused_replication) runner.reused_ms.push_back(wall_ms_since(again));
+        }
+      }
+    }
+
+    for (Runner& runner : runners) {
+      BenchRow& row = runner.row;
+      if (!runner.method) {
+        report.rows.push_back(row);
+        continue;
+      }
+      row.frame_ms = median(runner.frame_ms);
+      row.frame_ms_min = *std::min_element(runner.frame_ms.begin(), runner.frame_ms.end());
+      row.frame_ms_max = *std::max_element(runner.frame_ms.begin(), runner.frame_ms.end());
+      std::map<std::string, std::vector<double>> passes;
+      std::vector<double> totals, shares;
+      while (auto frame = runner.timer.poll(true)) {
+        std::map<std::string, double> sums;
+        double total = 0;
+        for (const PassTime& pass : *frame) {
+          sums[pass.pass] += pass.milliseconds;
+          total += pass.milliseconds;
+        }
+        for (const auto& [pass, ms] : sums) passes[pass].push_back(ms);
+        totals.push_back(total);
+        if (sums.contains("pass1 coverage") && total > 0) {
+          shares.push_back((sums["pass1 coverage"] + sums["pass2 replicate"]) / total);
+        }
+      }
+      for (const auto& [pass, times] : passes) row.pass_ms[pass] = median(times);
+      row.gpu_ms = median(totals);
+      if (!shares.empty()) row.passes12_share_gpu = median(shares);
+      if (!runner.reused_ms.empty() && row.frame_ms > 0) {
+        row.pass3_only_ms = median(runner.reused_ms);
+        row.passes12_share = std::max(0.0, 1.0 - *row.pass3_only_ms / row.frame_ms);
+      }
+      double ratio_sum = 0;
+      for (const RenderStats& s : runner.stats) ratio_sum += s.replication_ratio();
+      row.replication_ratio = ratio_sum / double(runner.stats.size());
+      const RenderStats& last = runner.stats.back();
+      row.facets = last.facets;
+      row.triangles_in = last.triangles_in;
+      row.triangles_visible = last.triangles_visible;
+      row.replicas = last.replicas;
+      say(format("  %-9s %-12s %9.2f ms/frame (median of %d), GPU %8.2f ms, ratio %.3f",
+                 row.method.c_str(), row.setting.c_str(), row.frame_ms, options.frames, row.gpu_ms,
+                 row.replication_ratio));
+      report.rows.push_back(row);
+    }
+  }
+  report.notes = bench_notes(report.rows, renderer);
+  return report;
+}
+
+}  // namespace facet::driver

@@ -1,0 +1,469 @@
+// bench.json, bench.csv, bench.png and the closing note of `facet bench`.
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <set>
+
+#include "facet/driver/bench.hpp"
+#include "facet/projection/errors.hpp"
+
+namespace facet::driver {
+namespace {
+
+std::string format(const char* pattern, auto... values) {
+  char text[512];
+  std::snprintf(text, sizeof text, pattern, values...);
+  return text;
+}
+
+std::vector<const BenchRow*> rows_of(const std::vector<BenchRow>& rows, const std::string& scenario,
+                                     const std::string& method) {
+  std::vector<const BenchRow*> found;
+  for (const BenchRow& row : rows) {
+    if (row.scenario == scenario && row.method == method && row.error.empty()) {
+      found.push_back(&row);
+    }
+  }
+  return found;
+}
+
+const BenchRow* row_of(const std::vector<BenchRow>& rows, const std::string& scenario,
+                       const std::string& method, const std::string& setting) {
+  for (const BenchRow* row : rows_of(rows, scenario, method)) {
+    if (row->setting == setting) return row;
+  }
+  return nullptr;
+}
+
+std::vector<std::string> scenarios_of(const std::vector<BenchRow>& rows) {
+  std::vector<std::string> names;
+  for (const BenchRow& row : rows) {
+    if (std::find(names.begin(), names.end(), row.scenario) == names.end()) {
+      names.push_back(row.scenario);
+    }
+  }
+  return names;
+}
+
+std::string csv_field(const std::string& text) {
+  if (text.find_first_of(",\"\n") == std::string::npos) return text;
+  std::string quoted = "\"";
+  for (char c : text) {
+    if (c == '"') quoted += '"';
+    quoted += c;
+  }
+  return quoted + "\"";
+}
+
+nlohmann::json optional_json(const std::optional<double>& value) {
+  return value ? nlohmann::json(*value) : nlohmann::json(nullptr);
+}
+
+nlohmann::json row_json(const BenchRow& row) {
+  nlohmann::json j = {{"scenario", row.scenario},
+                      {"method", row.method},
+                      {"setting", row.setting},
+                      {"outputs", row.outputs},
+                      {"output_size", row.output_size}};
+  if (!row.error.empty()) {
+    j["error"] = row.error;
+    return j;
+  }
+  j.update({{"frames", row.frames},
+            {"frame_ms", row.frame_ms},
+            {"frame_ms_min", row.frame_ms_min},
+            {"frame_ms_max", row.frame_ms_max},
+            {"gpu_ms", row.gpu_ms},
+            {"pass_ms", row.pass_ms},
+            {"passes12_share", optional_json(row.passes12_share)},
+            {"pass3_only_ms", optional_json(row.pass3_only_ms)},
+            {"passes12_share_gpu", optional_json(row.passes12_share_gpu)},
+            {"facets", row.facets},
+            {"triangles_in", row.triangles_in},
+            {"triangles_visible", row.triangles_visible},
+            {"replicas", row.replicas},
+            {"replication_ratio", row.replication_ratio},
+            {"id_mismatch", row.id_mismatch},
+            {"max_edge_px", row.max_edge_px},
+            {"p99_edge_px", row.p99_edge_px},
+            {"geometric_max_px", row.geometric_max_px},
+            {"geometric_rms_px", row.geometric_rms_px},
+            {"geometric_source", row.geometric_source}});
+  if (row.id_pixels_differing_from_facets) {
+    j["id_pixels_differing_from_facets"] = *row.id_pixels_differing_from_facets;
+  }
+  return j;
+}
+
+std::string csv_text(const BenchReport& report) {
+  std::string text;
+  const std::vector<std::string> columns = bench_csv_columns();
+  for (std::size_t k = 0; k < columns.size(); ++k) text += (k ? "," : "") + columns[k];
+  text += "\n";
+  for (const BenchRow& row : report.rows) {
+    std::string passes;
+    for (const auto& [pass, ms] : row.pass_ms) {
+      passes += (passes.empty() ? "" : ";") + pass + "=" + format("%.4f", ms);
+    }
+    const bool ok = row.error.empty();
+    auto number = [&](double value) { return ok ? format("%.6g", value) : std::string(); };
+    auto count = [&](std::uint64_t value) { return ok ? std::to_string(value) : std::string(); };
+    const std::vector<std::string> fields = {
+        row.scenario,
+        row.method,
+        row.setting,
+        std::to_string(row.outputs),
+        row.output_size,
+        ok ? std::to_string(row.frames) : "",
+        number(row.frame_ms),
+        number(row.frame_ms_min),
+        number(row.frame_ms_max),
+        number(row.gpu_ms),
+        row.passes12_share ? format("%.6g", *row.passes12_share) : "",
+        row.pass3_only_ms ? format("%.6g", *row.pass3_only_ms) : "",
+        row.passes12_share_gpu ? format("%.6g", *row.passes12_share_gpu) : "",
+        passes,
+        count(row.facets),
+        count(row.triangles_in),
+        count(row.triangles_visible),
+        count(row.replicas),
+        number(row.replication_ratio),
+        number(row.id_mismatch),
+        number(row.max_edge_px),
+        number(row.p99_edge_px),
+        number(row.geometric_max_px),
+        number(row.geometric_rms_px),
+        row.geometric_source,
+        row.id_pixels_differing_from_facets ? std::to_string(*row.id_pixels_differing_from_facets)
+                                            : "",
+        row.error};
+    for (std::size_t k = 0; k < fields.size(); ++k) text += (k ? "," : "") + csv_field(fields[k]);
+    text += "\n";
+  }
+  return text;
+}
+
+// --- The plot -----------------------------------------------------------------------------------
+
+const cv::Scalar kInk(40, 40, 40), kGrid(225, 225, 225);
+
+cv::Scalar method_colour(const std::string& method) {  // BGR
+  if (method == "facets") return {40, 40, 220};
+  if (method == "facets-gs") return {0, 150, 250};
+  if (method == "naive") return {200, 90, 30};
+  if (method == "cubemap") return {60, 160, 40};
+  return {160, 50, 150};
+}
+
+// Log-scale axis over [lo, hi], widened to whole decades.
+struct LogAxis {
+  double lo_exp = 0, hi_exp = 1;
+  LogAxis(double lo, double hi) {
+    lo_exp = std::floor(std::log10(lo));
+    hi_exp = std::ceil(std::log10(hi));
+    if (hi_exp <= lo_exp) hi_exp = lo_exp + 1;
+  }
+  double fraction(double value) const { return (std::log10(value) - lo_exp) / (hi_exp - lo_exp); }
+};
+
+void put_text(cv::Mat& image, const std::string& text, cv::Point at, double scale = 0.42,
+              const cv::Scalar& colour = kInk) {
+  cv::putText(image, text, at, cv::FONT_HERSHEY_SIMPLEX, scale, colour, 1, cv::LINE_AA);
+}
+
+std::string decade_label(double exponent) {
+  if (exponent >= 0 && exponent <= 3) return format("%g", std::pow(10.0, exponent));
+  if (exponent < 0 && exponent >= -2) return format("%g", std::pow(10.0, exponent));
+  return format("1e%d", int(exponent));
+}
+
+// One panel: x = error (log), y = median frame ms (log), one polyline per method through its
+// settings in order of error. Values below x_floor are drawn at x_floor (labelled "<=").
+void draw_panel(cv::Mat& image, cv::Rect box, const std::vector<const BenchRow*>& rows,
+                double (*error_of)(const BenchRow&), double x_floor, const std::string& title,
+                const std::string& x_name) {
+  double x_lo = 1e300, x_hi = 0, y_lo = 1e300, y_hi = 0;
+  for (const BenchRow* row : rows) {
+    const double x = std::max(error_of(*row), x_floor);
+    x_lo = std::min(x_lo, x);
+    x_hi = std::max(x_hi, x);
+    y_lo = std::min(y_lo, std::max(row->frame_ms, 1e-3));
+    y_hi = std::max(y_hi, std::max(row->frame_ms, 1e-3));
+  }
+  const cv::Rect plot(box.x + 60, box.y + 30, box.width - 80, box.height - 75);
+  cv::rectangle(image, plot, kInk, 1);
+  put_text(image, title, {box.x + 60, box.y + 20}, 0.5);
+  put_text(image, x_name, {plot.x + plot.width / 2 - 60, plot.y + plot.height + 38});
+  put_text(image, "ms", {box.x + 10, plot.y + plot.height / 2});
+  if (rows.empty()) return;
+  const LogAxis ax(x_lo, x_hi), ay(y_lo, y_hi);
+  auto to_pixel = [&](double x, double y) {
+    return cv::Point(
+        plot.x + int(std::lround(ax.fraction(std::max(x, x_floor)) * plot.width)),
+        plot.y + plot.height - int(std::lround(ay.fraction(std::max(y, 1e-3)) * plot.height)));
+  };
+  for (double e = ax.lo_exp; e <= ax.hi_exp; ++e) {
+    const int px = to_pixel(std::pow(10.0, e), std::pow(10.0, ay.lo_exp)).x;
+    cv::line(image, {px, plot.y + 1}, {px, plot.y + plot.height - 1}, kGrid, 1);
+    std::string label = decade_label(e);
+    if (e == ax.lo_exp && std::pow(10.0, e) <= x_floor) label = "<=" + label;
+    put_text(image, label, {px - 12, plot.y + plot.height + 18}, 0.38);
+  }
+  for (double e = ay.lo_exp; e <= ay.hi_exp; ++e) {
+    const int py = to_pixel(std::pow(10.0, ax.lo_exp), std::pow(10.0, e)).y;
+    cv::line(image, {plot.x + 1, py}, {plot.x + plot.width - 1, py}, kGrid, 1);
+    put_text(image, decade_label(e), {box.x + 22, py + 5}, 0.38);
+  }
+  std::vector<std::string> methods;
+  for (const BenchRow* row : rows) {
+    if (std::find(methods.begin(), methods.end(), row->method) == methods.end()) {
+      methods.push_back(row->method);
+    }
+  }
+  for (std::size_t m = 0; m < methods.size(); ++m) {
+    std::vector<const BenchRow*> series;
+    for (const BenchRow* row : rows) {
+      if (row->method == methods[m]) series.push_back(row);
+    }
+    std::sort(series.begin(), series.end(),
+              [&](const BenchRow* a, const BenchRow* b) { return error_of(*a) < error_of(*b); });
+    const cv::Scalar colour = method_colour(methods[m]);
+    for (std::size_t k = 0; k < series.size(); ++k) {
+      const cv::Point p = to_pixel(error_of(*series[k]), series[k]->frame_ms);
+      if (k > 0) {
+        cv::line(image, to_pixel(error_of(*series[k - 1]), series[k - 1]->frame_ms), p, colour, 1,
+                 cv::LINE_AA);
+      }
+      cv::circle(image, p, 4, colour, cv::FILLED, cv::LINE_AA);
+    }
+    const cv::Point legend(plot.x + plot.width - 95, plot.y + 16 + 16 * int(m));
+    cv::circle(image, legend, 4, colour, cv::FILLED, cv::LINE_AA);
+    put_text(image, methods[m], {legend.x + 10, legend.y + 5}, 0.4, colour);
+  }
+}
+
+double id_mismatch_of(const BenchRow& row) { return row.id_mismatch; }
+double geometric_of(const BenchRow& row) { return row.geometric_max_px; }
+
+cv::Mat plot_image(const BenchReport& report) {
+  const std::vector<std::string> scenarios = scenarios_of(report.rows);
+  const int panel_w = 560, panel_h = 380, header = 50;
+  cv::Mat image(header + panel_h * std::max<int>(1, int(scenarios.size())), 2 * panel_w, CV_8UC3,
+                cv::Scalar(255, 255, 255));
+  put_text(image,
+           format("facet bench: median frame time against error, %d frames, %s", report.frames,
+                  report.renderer.c_str()),
+           {12, 20}, 0.5);
+  put_text(image,
+           "Software rasterizer times are meaningful only as ratios within this run. Geometric "
+           "error: facet max (facet methods), cube texel (cubemap), reference edge max (vertex).",
+           {12, 40}, 0.38);
+  for (std::size_t s = 0; s < scenarios.size(); ++s) {
+    std::vector<const BenchRow*> rows;
+    for (const BenchRow& row : report.rows) {
+      if (row.scenario == scenarios[s] && row.error.empty()) rows.push_back(&row);
+    }
+    const int y = header + int(s) * panel_h;
+    draw_panel(image, {0, y, panel_w, panel_h}, rows, &id_mismatch_of, 1e-5,
+               scenarios[s] + ": time against ID mismatch", "id_mismatch (fraction of pixels)");
+    draw_panel(image, {panel_w, y, panel_w, panel_h}, rows, &geometric_of, 1e-3,
+               scenarios[s] + ": time against geometric error", "geometric max error (output px)");
+  }
+  return image;
+}
+
+void write_text(const std::filesystem::path& path, const std::string& text) {
+  std::ofstream out(path, std::ios::binary);
+  out << text;
+  out.close();
+  if (!out) throw InputError(path.string(), "", "could not be written");
+}
+
+}  // namespace
+
+std::vector<std::string> bench_csv_columns() {
+  return {"scenario",
+          "method",
+          "setting",
+          "outputs",
+          "output_size",
+          "frames",
+          "frame_ms",
+          "frame_ms_min",
+          "frame_ms_max",
+          "gpu_ms",
+          "passes12_share",
+          "pass3_only_ms",
+          "passes12_share_gpu",
+          "pass_ms",
+          "facets",
+          "triangles_in",
+          "triangles_visible",
+          "replicas",
+          "replication_ratio",
+          "id_mismatch",
+          "max_edge_px",
+          "p99_edge_px",
+          "geometric_max_px",
+          "geometric_rms_px",
+          "geometric_source",
+          "id_pixels_differing_from_facets",
+          "error"};
+}
+
+std::vector<std::string> bench_notes(const std::vector<BenchRow>& rows,
+                                     const std::string& renderer) {
+  std::vector<std::string> notes;
+  int frames = 0;
+  for (const BenchRow& row : rows) frames = std::max(frames, row.frames);
+  notes.push_back(format(
+      "Times are medians over %d frames with every method interleaved in each frame, on %s. On a "
+      "software rasterizer such as llvmpipe (shared CPU cores) only the ratios within one run "
+      "mean anything; absolute times count only on a GPU.",
+      frames, renderer.c_str()));
+  for (const std::string& scenario : scenarios_of(rows)) {
+    const auto facets = rows_of(rows, scenario, "facets");
+    // facets / naive at the same facets (the same error by construction).
+    std::string line;
+    for (const BenchRow* naive : rows_of(rows, scenario, "naive")) {
+      if (const BenchRow* f = row_of(rows, scenario, "facets", naive->setting)) {
+        line += format(" %s %.3f (%.1f/%.1f ms);", naive->setting.c_str(),
+                       f->frame_ms / naive->frame_ms, f->frame_ms, naive->frame_ms);
+      }
+    }
+    if (!line.empty()) {
+      notes.push_back(scenario + ": time facets/naive at the same facets (same error):" + line);
+    }
+    // facets / cubemap at matched geometric error: the fastest facets setting whose geometric
+    // max error is at most the cube map's.
+    line.clear();
+    for (const BenchRow* cube : rows_of(rows, scenario, "cubemap")) {
+      const BenchRow* best = nullptr;
+      for (const BenchRow* f : facets) {
+        if (f->geometric_max_px <= cube->geometric_max_px &&
+            (!best || f->frame_ms < best->frame_ms)) {
+          best = f;
+        }
+      }
+      if (best) {
+        line += format(
+            " %s (%.3f px, id_mismatch %.2g) vs facets %s (%.3f px, id_mismatch %.2g): %.3f;",
+            cube->setting.c_str(), cube->geometric_max_px, cube->id_mismatch, best->setting.c_str(),
+            best->geometric_max_px, best->id_mismatch, best->frame_ms / cube->frame_ms);
+      } else {
+        line += format(" %s (%.3f px): no facets setting this accurate was run;",
+                       cube->setting.c_str(), cube->geometric_max_px);
+      }
+    }
+    if (!line.empty()) {
+      notes.push_back(scenario +
+                      ": time facets/cubemap at matched geometric error (fastest facets with "
+                      "max error <= the cube map's):" +
+                      line);
+    }
+    line.clear();
+    for (const BenchRow* f : facets) {
+      if (f->passes12_share) {
+        const std::string gpu =
+            f->passes12_share_gpu ? format("%.1f%%", 100 * *f->passes12_share_gpu) : "n/a";
+        line += format(" %s %.1f%% (%.1f of %.1f ms; GPU timer %s; %llu facets, ratio %.3f);",
+                       f->setting.c_str(), 100 * *f->passes12_share,
+                       f->frame_ms - f->pass3_only_ms.value_or(0), f->frame_ms, gpu.c_str(),
+                       static_cast<unsigned long long>(f->facets), f->replication_ratio);
+      }
+    }
+    if (!line.empty()) {
+      notes.push_back(
+          scenario +
+          ": share of passes 1+2 in the facets frame (wall clock: frame minus a render that "
+          "reuses them; paper: under 10%):" +
+          line);
+    }
+    for (const BenchRow* gs : rows_of(rows, scenario, "facets-gs")) {
+      if (gs->id_pixels_differing_from_facets) {
+        notes.push_back(
+            format("%s: facets-gs at %s: %llu ID pixels differ from facets (%s)", scenario.c_str(),
+                   gs->setting.c_str(),
+                   static_cast<unsigned long long>(*gs->id_pixels_differing_from_facets),
+                   *gs->id_pixels_differing_from_facets == 0 ? "identical" : "NOT identical"));
+      }
+    }
+  }
+  // The paper's replication ratios.
+  if (const BenchRow* p160 = row_of(rows, "cylinder", "facets", "pieces=160")) {
+    std::string line =
+        format("seed setup (cylinder, city) replication ratio: %.3f at 160 pieces (paper: 1.96)",
+               p160->replication_ratio);
+    if (const BenchRow* tol = row_of(rows, "cylinder", "facets", "tol=0.25px")) {
+      line += format(", %.3f at the facet count for 0.25 px (%llu facets)", tol->replication_ratio,
+                     static_cast<unsigned long long>(tol->facets));
+    }
+    notes.push_back(line);
+  }
+  for (const char* scenario : {"deformation-80x60", "deformation-128x128"}) {
+    std::string line;
+    for (const BenchRow* f : rows_of(rows, scenario, "facets")) {
+      line += format(" %s %.3f (%llu facets);", f->setting.c_str(), f->replication_ratio,
+                     static_cast<unsigned long long>(f->facets));
+    }
+    if (!line.empty()) {
+      notes.push_back(std::string(scenario) +
+                      ": view-deformation replication ratio (paper: 10.17 at 80x60):" + line);
+    }
+  }
+  return notes;
+}
+
+void write_bench_files(const BenchReport& report, const std::filesystem::path& folder) {
+  namespace fs = std::filesystem;
+  std::error_code error;
+  const fs::path parent = folder.has_parent_path() ? folder.parent_path() : fs::path(".");
+  fs::create_directories(parent, error);
+  const fs::path temporary =
+      parent / ("." + folder.filename().string() + ".partial-" + std::to_string(::getpid()));
+  fs::remove_all(temporary, error);
+  if (!fs::create_directories(temporary, error) || error) {
+    throw InputError(folder.string(), "--out", "expected a folder that can be created");
+  }
+  try {
+    nlohmann::json rows = nlohmann::json::array();
+    std::set<std::string> methods;
+    for (const BenchRow& row : report.rows) {
+      rows.push_back(row_json(row));
+      methods.insert(row.method);
+    }
+    const nlohmann::json json = {{"renderer", report.renderer},
+                                 {"frames", report.frames},
+                                 {"size_scale", report.size_scale},
+                                 {"quick", report.quick},
+                                 {"frame_step_s", kBenchFrameStepS},
+                                 {"methods", methods},
+                                 {"rows", rows},
+                                 {"notes", report.notes}};
+    write_text(temporary / "bench.json", json.dump(2) + "\n");
+    write_text(temporary / "bench.csv", csv_text(report));
+    if (!cv::imwrite((temporary / "bench.png").string(), plot_image(report))) {
+      throw InputError((folder / "bench.png").string(), "", "could not be written");
+    }
+    fs::create_directories(folder, error);
+    if (!fs::is_directory(folder)) {
+      throw InputError(folder.string(), "--out", "expected a folder that can be created");
+    }
+    for (const char* name : {"bench.json", "bench.csv", "bench.png"}) {
+      fs::rename(temporary / name, folder / name, error);
+      if (error) throw InputError((folder / name).string(), "--out", "a file that can be replaced");
+    }
+    fs::remove_all(temporary, error);
+  } catch (...) {
+    fs::remove_all(temporary, error);
+    throw;
+  }
+}
+
+}  // namespace facet::driver

@@ -1,0 +1,170 @@
+// facet bench from the command line: --quick writes bench.json, bench.csv and bench.png with every
+// render method, the same rows in JSON and CSV, a readable plot, and facets-gs IDs identical to
+// facets. Bad flags exit 2 and write nothing. No timing assertions: times only have to exist.
+#include <OpenImageIO/imageio.h>
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace facet {
+namespace {
+
+namespace fs = std::filesystem;
+
+int run(const std::string& arguments, const fs::path& log) {
+  const std::string command =
+      std::string(FACET_CLI) + " " + arguments + " > " + log.string() + " 2>&1";
+  const int status = std::system(command.c_str());
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+std::string slurp(const fs::path& path) {
+  std::ifstream in(path);
+  return {std::istreambuf_iterator<char>(in), {}};
+}
+
+fs::path fresh_folder(const std::string& name) {
+  const fs::path folder = fs::temp_directory_path() / ("facet_bench_cli_" + name);
+  fs::remove_all(folder);
+  fs::create_directories(folder);
+  return folder;
+}
+
+// RFC 4180 fields: quoted fields may hold commas and doubled quotes.
+std::vector<std::string> split_csv_line(const std::string& line) {
+  std::vector<std::string> fields(1);
+  bool quoted = false;
+  for (std::size_t k = 0; k < line.size(); ++k) {
+    const char c = line[k];
+    if (quoted) {
+      if (c == '"' && k + 1 < line.size() && line[k + 1] == '"') {
+        fields.back() += '"';
+        ++k;
+      } else if (c == '"') {
+        quoted = false;
+      } else {
+        fields.back() += c;
+      }
+    } else if (c == '"') {
+      quoted = true;
+    } else if (c == ',') {
+      fields.emplace_back();
+    } else {
+      fields.back() += c;
+    }
+  }
+  return fields;
+}
+
+TEST(BenchCli, QuickWritesJsonCsvAndPlotWithEveryMethod) {
+  const fs::path folder = fresh_folder("quick");
+  const fs::path out = folder / "bench";
+  ASSERT_EQ(
+      run("bench --quick --scenario cylinder --frames 1 --out " + out.string(), folder / "log.txt"),
+      0)
+      << slurp(folder / "log.txt");
+
+  const nlohmann::json json = nlohmann::json::parse(slurp(out / "bench.json"));
+  ASSERT_TRUE(json.contains("rows"));
+  ASSERT_TRUE(json.contains("notes"));
+  EXPECT_FALSE(json["notes"].empty());
+  const std::vector<std::string> methods = {"facets", "facets-gs", "cubemap", "naive", "vertex"};
+  std::set<std::string> seen;
+  for (const auto& row : json["rows"]) {
+    ASSERT_FALSE(row.contains("error")) << row.dump();
+    seen.insert(row["method"].get<std::string>());
+    for (const char* field :
+         {"scenario", "setting", "frames", "frame_ms", "gpu_ms", "pass_ms", "facets",
+          "triangles_in", "replicas", "replication_ratio", "id_mismatch", "max_edge_px",
+          "p99_edge_px", "geometric_max_px", "geometric_rms_px", "geometric_source"}) {
+      EXPECT_TRUE(row.contains(field)) << field << " missing in " << row.dump();
+    }
+    EXPECT_GT(row["frame_ms"].get<double>(), 0.0);
+    const double mismatch = row["id_mismatch"].get<double>();
+    EXPECT_GE(mismatch, 0.0);
+    EXPECT_LE(mismatch, 1.0);
+    if (row["method"] == "facets") {
+      EXPECT_GT(row["facets"].get<int>(), 0);
+      EXPECT_TRUE(row["passes12_share"].is_number()) << row.dump();
+      // Facets built to 1 px (or 16 strips of a 200-px cylinder, 1.44 px): the geometric error
+      // must be the facet error, within a few px, and the image close to the reference.
+      EXPECT_EQ(row["geometric_source"], "facet error");
+      EXPECT_LT(row["geometric_max_px"].get<double>(), 2.0);
+      EXPECT_LT(mismatch, 0.01);
+    }
+    if (row["method"] == "facets-gs") {
+      ASSERT_TRUE(row.contains("id_pixels_differing_from_facets"));
+      EXPECT_EQ(row["id_pixels_differing_from_facets"].get<int>(), 0);
+    }
+  }
+  for (const std::string& method : methods) EXPECT_TRUE(seen.contains(method)) << method;
+
+  // The CSV: the header, then the JSON's rows in the same order.
+  std::istringstream csv(slurp(out / "bench.csv"));
+  std::string line;
+  ASSERT_TRUE(std::getline(csv, line));
+  const std::vector<std::string> header = split_csv_line(line);
+  auto column = [&](const std::string& name) {
+    for (std::size_t k = 0; k < header.size(); ++k) {
+      if (header[k] == name) return k;
+    }
+    ADD_FAILURE() << "no column " << name;
+    return std::size_t(0);
+  };
+  const std::size_t c_method = column("method"), c_setting = column("setting"),
+                    c_frame = column("frame_ms"), c_mismatch = column("id_mismatch");
+  std::size_t rows = 0;
+  while (std::getline(csv, line)) {
+    const std::vector<std::string> fields = split_csv_line(line);
+    ASSERT_EQ(fields.size(), header.size()) << line;
+    ASSERT_LT(rows, json["rows"].size());
+    const auto& row = json["rows"][rows];
+    EXPECT_EQ(fields[c_method], row["method"].get<std::string>());
+    EXPECT_EQ(fields[c_setting], row["setting"].get<std::string>());
+    EXPECT_NEAR(std::stod(fields[c_frame]), row["frame_ms"].get<double>(),
+                1e-5 * row["frame_ms"].get<double>());
+    EXPECT_NEAR(std::stod(fields[c_mismatch]), row["id_mismatch"].get<double>(), 1e-6);
+    ++rows;
+  }
+  EXPECT_EQ(rows, json["rows"].size());
+
+  // The plot: a PNG that decodes, two panels wide, not blank.
+  auto png = OIIO::ImageInput::open((out / "bench.png").string());
+  ASSERT_TRUE(png) << OIIO::geterror();
+  const OIIO::ImageSpec spec = png->spec();
+  EXPECT_GE(spec.width, 800);
+  EXPECT_GE(spec.height, 300);
+  std::vector<unsigned char> pixels(std::size_t(spec.width) * spec.height * spec.nchannels);
+  ASSERT_TRUE(png->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::UINT8, pixels.data()));
+  std::size_t dark = 0;
+  for (unsigned char v : pixels) dark += v < 128;
+  EXPECT_GT(dark, pixels.size() / 1000);
+  // No temporary folder is left beside the output.
+  for (const auto& entry : fs::directory_iterator(folder)) {
+    EXPECT_EQ(entry.path().filename().string().find(".partial"), std::string::npos) << entry.path();
+  }
+}
+
+TEST(BenchCli, BadFlagsExitTwoAndWriteNothing) {
+  const fs::path folder = fresh_folder("bad");
+  for (const std::string& flags :
+       {std::string("--scenario moon"), std::string("--frames 0"), std::string("--size-scale -1"),
+        std::string("--scenario dome --rig /nonexistent.json")}) {
+    const fs::path out = folder / "bench";
+    EXPECT_EQ(run("bench --quick " + flags + " --out " + out.string(), folder / "log.txt"), 2)
+        << flags << ": " << slurp(folder / "log.txt");
+    EXPECT_FALSE(fs::exists(out)) << flags;
+  }
+}
+
+}  // namespace
+}  // namespace facet
