@@ -193,13 +193,18 @@ double median(std::vector<double> values) {
 }
 
 std::vector<BenchScenario> make_bench_scenarios(const BenchOptions& options) {
-  static const std::set<std::string> known = {"cylinder", "deformation", "dome"};
+  // "deformation" and "dome" are groups; their parts can be run alone.
+  static const std::set<std::string> known = {
+      "cylinder",    "deformation", "deformation-80x60", "deformation-128x128", "dome",
+      "dome-master", "dome4"};
   std::vector<std::string> names = options.scenarios;
   if (names.empty()) names = {"cylinder", "deformation", "dome"};
   for (const std::string& name : names) {
     if (!known.contains(name)) {
       throw InputError("command line", "--scenario",
-                       "expected cylinder, deformation, dome or all; got '" + name + "'");
+                       "expected cylinder, deformation, deformation-80x60, deformation-128x128, "
+                       "dome, dome-master, dome4 or all; got '" +
+                           name + "'");
     }
   }
   if (!(options.size_scale > 0) || options.size_scale > 4) {
@@ -236,9 +241,10 @@ std::vector<BenchScenario> make_bench_scenarios(const BenchOptions& options) {
                   faces_sweep, tess);
       }
       scenarios.push_back(std::move(s));
-    } else if (name == "deformation") {
+    } else if (name.starts_with("deformation")) {
       for (const glm::ivec2 cells : {glm::ivec2(80, 60), glm::ivec2(128, 128)}) {
         if (quick && cells.x == 128) continue;
+        if (name != "deformation" && name != "deformation-" + size_text(cells)) continue;
         BenchScenario s;
         s.name = "deformation-" + size_text(cells);
         const glm::ivec2 size = scaled({1024, 768}, scale);
@@ -257,7 +263,7 @@ std::vector<BenchScenario> make_bench_scenarios(const BenchOptions& options) {
         scenarios.push_back(std::move(s));
       }
     } else {
-      {
+      if (name != "dome4") {
         BenchScenario s;
         s.name = "dome";
         s.outputs = load_display_outputs("builtin:dome180", scaled({2048, 2048}, scale));
@@ -273,7 +279,7 @@ std::vector<BenchScenario> make_bench_scenarios(const BenchOptions& options) {
         }
         scenarios.push_back(std::move(s));
       }
-      {
+      if (name != "dome-master") {
         BenchScenario s;
         s.name = "dome4";
         s.outputs = rig_outputs(options.dome_rig, scale);

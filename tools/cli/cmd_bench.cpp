@@ -53,7 +53,9 @@ const Registration registration{
       auto* command = app.add_subcommand(
           "bench", "Time against error for every render method, side by side in one run");
       auto options = std::make_shared<BenchCommandOptions>();
-      command->add_option("--scenario", options->scenario, "cylinder | deformation | dome | all")
+      command
+          ->add_option("--scenario", options->scenario,
+                       "cylinder | deformation[-80x60|-128x128] | dome | dome-master | dome4 | all")
           ->capture_default_str();
       command
           ->add_option("--frames", options->frames,
