@@ -32,6 +32,20 @@ std::vector<OutputSpec> load_display_outputs(std::string_view display,
     outputs.push_back({"dome180", Warp::analytic(BaseProjection::fisheye(180),
                                                  size.value_or(glm::ivec2(2048, 2048)),
                                                  glm::ivec2(2, 2), R_eye_base)});
+  } else if (display == "builtin:wall2x2") {
+    // A flat wall 2 m in front of the eye, 6.4 m × 4 m (tan x in [-1.6, 1.6], tan y in [-1, 1]),
+    // tiled by 2 × 2 projectors that overlap across tan x in [-0.16, 0.16] and tan y in
+    // [-0.1, 0.1] (see wall2x2_blend in session.cpp for their weights).
+    const glm::ivec2 tile_size = size.value_or(glm::ivec2(1280, 800));
+    const double x_edges[2][2] = {{-1.6, 0.16}, {-0.16, 1.6}};
+    const double y_edges[2][2] = {{1.0, -0.1}, {0.1, -1.0}};  // top, bottom of each row
+    for (int row = 0; row < 2; ++row)
+      for (int column = 0; column < 2; ++column)
+        outputs.push_back(
+            {"wall_r" + std::to_string(row) + "c" + std::to_string(column),
+             Warp::analytic(BaseProjection::perspective(x_edges[column][0], x_edges[column][1],
+                                                        y_edges[row][0], y_edges[row][1]),
+                            tile_size)});
   } else if (ends_with(display, ".warp.exr")) {
     const std::string path(display);
     Warp warp = read_warp(path);
@@ -59,10 +73,11 @@ std::vector<OutputSpec> load_display_outputs(std::string_view display,
       outputs.push_back({projector.name, std::move(warp)});
     }
   } else {
-    throw InputError("command line", "--display",
-                     "expected builtin:cylinder360, builtin:dome180, a .warp.exr file or a "
-                     "display.json; got '" +
-                         std::string(display) + "'");
+    throw InputError(
+        "command line", "--display",
+        "expected builtin:cylinder360, builtin:dome180, builtin:wall2x2, a .warp.exr file or a "
+        "display.json; got '" +
+            std::string(display) + "'");
   }
   return outputs;
 }

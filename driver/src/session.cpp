@@ -10,6 +10,7 @@
 #include "facet/driver/display_outputs.hpp"
 #include "facet/projection/errors.hpp"
 #include "facet/projection_io/blend_file.hpp"
+#include "facet/projection_io/warp_file.hpp"
 
 namespace facet::driver {
 
@@ -48,6 +49,29 @@ double angle_between(const glm::dvec3& a, const glm::dvec3& b) {
   return std::atan2(glm::length(glm::cross(a, b)), glm::dot(a, b));
 }
 
+// Weights of builtin:wall2x2: across each overlap band a smoothstep from one projector to the
+// other, so that the weights of the projectors lighting a point sum to 1.
+BlendMaps wall2x2_blend(const Warp& warp, int row, int column) {
+  auto smoothstep = [](double edge0, double edge1, double x) {
+    const double t = std::clamp((x - edge0) / (edge1 - edge0), 0.0, 1.0);
+    return t * t * (3 - 2 * t);
+  };
+  BlendMaps maps;
+  maps.size = warp.output_size;
+  maps.alpha.resize(std::size_t(maps.size.x) * maps.size.y);
+  for (int y = 0; y < maps.size.y; ++y) {
+    for (int x = 0; x < maps.size.x; ++x) {
+      const glm::dvec2 st((x + 0.5) / maps.size.x, (y + 0.5) / maps.size.y);
+      const glm::dvec3 v = warp.base.direction(st);
+      const double tan_x = v.x / -v.z, tan_y = v.y / -v.z;
+      const double right = smoothstep(-0.16, 0.16, tan_x), top = smoothstep(-0.1, 0.1, tan_y);
+      maps.alpha[std::size_t(y) * maps.size.x + x] =
+          float((column == 0 ? 1 - right : right) * (row == 0 ? top : 1 - top));
+    }
+  }
+  return maps;
+}
+
 }  // namespace
 
 SessionDisplay load_session_display(std::string_view display, std::optional<glm::ivec2> size) {
@@ -72,14 +96,106 @@ SessionDisplay load_session_display(std::string_view display, std::optional<glm:
     return result;
   }
   result.settings.facets.layout = FacetTolerance{0.25};
-  for (OutputSpec& spec : specs) {
+  int x = 0;
+  for (std::size_t i = 0; i < specs.size(); ++i) {
     SessionOutput output;
+    const glm::ivec2 output_size = specs[i].warp.output_size;
     output.placement.kind = projection_io::DisplayOutput::Kind::window;
-    output.placement.window = {0, 0, spec.warp.output_size.x, spec.warp.output_size.y};
-    output.spec = std::move(spec);
+    output.placement.window = {x, 0, output_size.x, output_size.y};
+    x += output_size.x;
+    if (display == "builtin:wall2x2")
+      output.blend = wall2x2_blend(specs[i].warp, int(i) / 2, int(i) % 2);
+    output.spec = std::move(specs[i]);
     result.outputs.push_back(std::move(output));
   }
   return result;
+}
+
+void scale_session_display(SessionDisplay& display, double factor) {
+  if (!(factor > 0 && factor <= 1))
+    throw InputError("command line", "--scale", "a factor in (0, 1]");
+  for (SessionOutput& output : display.outputs) {
+    Warp& warp = output.spec.warp;
+    const glm::ivec2 old_size = warp.output_size;
+    const glm::ivec2 new_size =
+        glm::max(glm::ivec2(1), glm::ivec2(glm::round(glm::dvec2(old_size) * factor)));
+    const glm::dvec2 ratio = glm::dvec2(new_size) / glm::dvec2(old_size);
+    for (glm::vec2& offset : warp.offset_px) offset *= glm::vec2(ratio);
+    warp.output_size = new_size;
+    auto resample = [&](const std::vector<float>& values) {
+      if (values.empty()) return values;
+      const int channels = output.blend.channels;
+      std::vector<float> result(std::size_t(new_size.x) * new_size.y * channels);
+      for (int y = 0; y < new_size.y; ++y) {
+        const int from_y = std::min(old_size.y - 1, int((y + 0.5) / ratio.y));
+        for (int x = 0; x < new_size.x; ++x) {
+          const int from_x = std::min(old_size.x - 1, int((x + 0.5) / ratio.x));
+          for (int c = 0; c < channels; ++c)
+            result[(std::size_t(y) * new_size.x + x) * channels + c] =
+                values[(std::size_t(from_y) * old_size.x + from_x) * channels + c];
+        }
+      }
+      return result;
+    };
+    output.blend.alpha = resample(output.blend.alpha);
+    output.blend.black = resample(output.blend.black);
+    if (!output.blend.alpha.empty() || !output.blend.black.empty()) output.blend.size = new_size;
+    if (output.placement.kind == projection_io::DisplayOutput::Kind::window)
+      output.placement.window =
+          glm::ivec4(glm::dvec4(output.placement.window) * glm::dvec4(ratio, ratio));
+  }
+}
+
+void write_session_display(const SessionDisplay& display, const std::string& name,
+                           const std::filesystem::path& folder) {
+  namespace fs = std::filesystem;
+  if (fs::exists(folder))
+    throw InputError(folder.string(), "--out", "a folder that does not exist yet");
+  const fs::path parent = folder.has_parent_path() ? folder.parent_path() : fs::path(".");
+  fs::create_directories(parent);
+  const fs::path temporary = parent / ("." + folder.filename().string() + ".tmp");
+  fs::remove_all(temporary);
+  try {
+    fs::create_directories(temporary);
+    projection_io::DisplayConfig config;
+    config.name = name;
+    config.render.method = display.method;
+    if (const auto* tolerance = std::get_if<FacetTolerance>(&display.settings.facets.layout))
+      config.render.tolerance_px = tolerance->px;
+    config.render.z_near = display.settings.z_near;
+    config.missing_monitor = display.missing_monitor;
+    for (const SessionOutput& output : display.outputs) {
+      projection_io::DisplayProjector projector;
+      projector.name = output.spec.name;
+      projector.size = output.spec.warp.output_size;
+      projector.warp = output.spec.name + ".warp.exr";
+      write_warp((temporary / projector.warp).string(), output.spec.warp);
+      auto write_map = [&](const std::vector<float>& values, const std::string& file) {
+        projection_io::BlendMap map;
+        map.size = output.blend.size;
+        map.channels = output.blend.channels;
+        map.values = values;
+        projection_io::write_blend_map((temporary / file).string(), map);
+      };
+      if (!output.blend.alpha.empty()) {
+        projector.blend = output.spec.name + ".blend.exr";
+        write_map(output.blend.alpha, projector.blend->string());
+      }
+      if (!output.blend.black.empty()) {
+        projector.black = output.spec.name + ".black.exr";
+        write_map(output.blend.black, projector.black->string());
+      }
+      projector.gamma = output.encoding.gamma;
+      projector.output = output.placement;
+      config.projectors.push_back(std::move(projector));
+    }
+    projection_io::write_display_config(config, temporary / "display.json");
+    fs::rename(temporary, folder);
+  } catch (...) {
+    std::error_code ignored;
+    fs::remove_all(temporary, ignored);
+    throw;
+  }
 }
 
 nlohmann::json frame_state_to_json(const FrameState& state) {

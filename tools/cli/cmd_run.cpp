@@ -24,6 +24,7 @@ struct RunOptions {
   std::string size;
   std::string method;
   std::optional<double> tolerance;
+  std::optional<double> scale;
   bool headless = false, windowed = false;
   std::uint64_t frames = 0;
   std::string out = "out/session";
@@ -51,6 +52,7 @@ void run(const RunOptions& options) {
   std::optional<glm::ivec2> size;
   if (!options.size.empty()) size = parse_size(options.size, "--size");
   driver::SessionDisplay display = driver::load_session_display(options.display, size);
+  if (options.scale) driver::scale_session_display(display, *options.scale);
   if (!options.method.empty()) display.method = options.method;
   if (options.tolerance) {
     if (!(*options.tolerance > 0))
@@ -113,6 +115,8 @@ const Registration registration{
       command->add_option("--method", options->method,
                           "facets, facets-gs, naive, cubemap or vertex (default: the display's)");
       command->add_option("--tolerance", options->tolerance, "Facet tolerance in output pixels");
+      command->add_option("--scale", options->scale,
+                          "Preview at this fraction of every output's resolution (0, 1]");
       command->add_flag("--headless", options->headless, "Render through EGL to --out");
       command->add_flag("--windowed", options->windowed, "Open windows even without DISPLAY");
       command->add_option("--frames", options->frames,

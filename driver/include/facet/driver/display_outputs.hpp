@@ -15,6 +15,9 @@ namespace facet::driver {
 //   builtin:dome180      a 180° fisheye dome master, default 2048x2048, looking straight up: the
 //                        image centre is eye +y (up), the bottom edge of the image is eye -z
 //                        (the viewer's front), its top edge +z (behind), its right edge +x.
+//   builtin:wall2x2      a flat wall 2 m ahead (tan x in [-1.6, 1.6], tan y in [-1, 1]) tiled by
+//                        2 × 2 overlapping perspective projectors wall_r<row>c<column>, default
+//                        1280x800 each; sessions blend them (load_session_display).
 //   FILE.warp.exr        one projector's offset map (FORMATS.md §2); the output is named after the
 //                        file.
 //   FILE.json            a display.json (FORMATS.md §4): one output per projector, named and

@@ -6,6 +6,7 @@
 // Cluster-ready: everything a frame depends on is the small value FrameState, so one node can
 // broadcast it and every node render its own outputs from it.
 #include <cstdint>
+#include <filesystem>
 #include <glm/glm.hpp>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -42,10 +43,21 @@ struct SessionDisplay {
 
 // Loads a display the way `facet render` names it (see load_display_outputs): a built-in, a
 // .warp.exr, or a display.json, whose blend and black maps, gammas, outputs, render method and
-// tolerance are used too. Built-ins and warp files get one window each, sRGB encoding and no
-// blend. `size` overrides a built-in's output size. Throws InputError for bad input.
+// tolerance are used too. Built-ins and warp files get one window each, side by side, and sRGB
+// encoding; builtin:wall2x2 blends its overlaps, the others have no blend. `size` overrides a
+// built-in's output size. Throws InputError for bad input.
 SessionDisplay load_session_display(std::string_view display,
                                     std::optional<glm::ivec2> size = std::nullopt);
+
+// A preview at a fraction of the resolution: every output's size and warp offsets scaled by
+// `factor` (0 < factor <= 1; sizes rounded, at least 1 pixel), blend and black maps sampled at the
+// nearest pixel. The geometry stays exact up to the rounding of the output size.
+void scale_session_display(SessionDisplay& display, double factor);
+
+// Writes `display` as a display.json folder (warps, blends, black levels, display.json) under a
+// temporary name, renamed to `folder` when complete; `folder` must not exist yet (InputError).
+void write_session_display(const SessionDisplay& display, const std::string& name,
+                           const std::filesystem::path& folder);
 
 // The whole state one frame depends on.
 struct FrameState {

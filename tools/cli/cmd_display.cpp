@@ -1,0 +1,46 @@
+// facet display: writes a display (a built-in, a warp file or a display.json) as a display.json
+// folder with its warps and blends, ready to edit (monitor names) and to run.
+#include <iostream>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "command.hpp"
+#include "display_flags.hpp"
+#include "facet/driver/session.hpp"
+
+namespace facet::cli {
+namespace {
+
+struct DisplayOptions {
+  std::string display;
+  std::string size;
+  std::string name;
+  std::string out;
+};
+
+const Registration registration{
+    45, [](CLI::App& app) {
+      auto options = std::make_shared<DisplayOptions>();
+      auto* command = app.add_subcommand(
+          "display",
+          "Write a display (builtin:cylinder360, builtin:dome180, builtin:wall2x2, a .warp.exr or "
+          "a display.json) as a folder holding display.json, the warps and the blends");
+      command->add_option("display", options->display, "The display to write")->required();
+      command->add_option("--size", options->size, "Output size WxH of a built-in display");
+      command->add_option("--name", options->name, "Name in display.json (default: the folder's)");
+      command->add_option("--out", options->out, "Folder to create")->required();
+      command->callback([options] {
+        std::optional<glm::ivec2> size;
+        if (!options->size.empty()) size = parse_size(options->size, "--size");
+        const driver::SessionDisplay display = driver::load_session_display(options->display, size);
+        const std::filesystem::path out(options->out);
+        const std::string name = options->name.empty() ? out.filename().string() : options->name;
+        driver::write_session_display(display, name, out);
+        std::cout << "facet display: " << display.outputs.size() << " output(s) written to "
+                  << (out / "display.json").string() << "\n";
+      });
+    }};
+
+}  // namespace
+}  // namespace facet::cli
