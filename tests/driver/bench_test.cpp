@@ -1,6 +1,8 @@
 // facet bench from the command line: --quick writes bench.json, bench.csv and bench.png with every
 // render method, the same rows in JSON and CSV, a readable plot, and facets-gs IDs identical to
 // facets. Bad flags exit 2 and write nothing. No timing assertions: times only have to exist.
+#include "facet/driver/bench.hpp"
+
 #include <OpenImageIO/imageio.h>
 #include <gtest/gtest.h>
 #include <sys/wait.h>
@@ -14,6 +16,8 @@
 #include <sstream>
 #include <string>
 #include <vector>
+
+#include "facet/projection/errors.hpp"
 
 namespace facet {
 namespace {
@@ -164,6 +168,52 @@ TEST(BenchCli, BadFlagsExitTwoAndWriteNothing) {
         << flags << ": " << slurp(folder / "log.txt");
     EXPECT_FALSE(fs::exists(out)) << flags;
   }
+}
+
+// Every scenario's outputs and settings, without rendering: the quick and the full sweeps name
+// every method, the built-in view deformation is a valid warp that does not fold, and the dome rig
+// gives one output per projector.
+TEST(BenchScenarios, EveryScenarioHasValidOutputsAndEveryMethod) {
+  for (const bool quick : {true, false}) {
+    driver::BenchOptions options;
+    options.quick = quick;
+    options.size_scale = 0.125;
+    options.dome_rig = std::string(FACET_SOURCE_DIR) + "/configs/rigs/dome4.json";
+    const auto scenarios = driver::make_bench_scenarios(options);
+    std::set<std::string> names;
+    for (const auto& scenario : scenarios) {
+      names.insert(scenario.name);
+      ASSERT_FALSE(scenario.outputs.empty()) << scenario.name;
+      for (const auto& output : scenario.outputs) {
+        EXPECT_NO_THROW(output.warp.validate(scenario.name)) << scenario.name;
+        EXPECT_FALSE(output.warp.find_fold()) << scenario.name;
+      }
+      std::set<std::string> methods;
+      for (const auto& setting : scenario.settings) methods.insert(setting.method);
+      EXPECT_EQ(methods,
+                (std::set<std::string>{"facets", "facets-gs", "cubemap", "naive", "vertex"}))
+          << scenario.name;
+    }
+    EXPECT_TRUE(names.contains("cylinder"));
+    EXPECT_TRUE(names.contains("deformation-80x60"));
+    EXPECT_EQ(names.contains("deformation-128x128"), !quick);
+    EXPECT_TRUE(names.contains("dome"));
+    EXPECT_TRUE(names.contains("dome4"));
+  }
+  driver::BenchOptions options;
+  options.scenarios = {"deformation-80x60"};
+  const auto deformation = driver::make_bench_scenarios(options);
+  ASSERT_EQ(deformation.size(), 1u);
+  const Warp& warp = deformation[0].outputs.at(0).warp;
+  EXPECT_EQ(warp.grid_size, glm::ivec2(81, 61));
+  EXPECT_EQ(warp.output_size, glm::ivec2(1024, 768));
+  // A real deformation: offsets of tens of pixels, at most about 3.5% of the width.
+  double largest = 0;
+  for (const glm::vec2& d : warp.offset_px) largest = std::max(largest, double(glm::length(d)));
+  EXPECT_GT(largest, 10.0);
+  EXPECT_LT(largest, 0.05 * 1024);
+  options.scenarios = {"moon"};
+  EXPECT_THROW(driver::make_bench_scenarios(options), InputError);
 }
 
 }  // namespace
