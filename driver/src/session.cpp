@@ -16,10 +16,6 @@ namespace facet::driver {
 
 namespace {
 
-bool ends_with(std::string_view text, std::string_view suffix) {
-  return text.size() >= suffix.size() && text.substr(text.size() - suffix.size()) == suffix;
-}
-
 BlendMaps blend_maps_from(const projection_io::DisplayConfig& config,
                           const projection_io::DisplayProjector& projector) {
   BlendMaps maps;
@@ -78,7 +74,7 @@ SessionDisplay load_session_display(std::string_view display, std::optional<glm:
   SessionDisplay result;
   result.source = std::string(display);
   std::vector<OutputSpec> specs = load_display_outputs(display, size);
-  if (ends_with(display, ".json")) {
+  if (display.ends_with(".json")) {
     const auto config = projection_io::read_display_config(std::filesystem::path(display));
     result.method = config.render.method;
     result.settings.facets.layout = FacetTolerance{config.render.tolerance_px};
