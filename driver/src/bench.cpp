@@ -457,6 +457,7 @@ BenchReport run_bench(const BenchOptions& options, const std::string& renderer,
           if (reused.reused_replication) runner.reused_ms.push_back(wall_ms_since(again));
         }
       }
+      say(format("  timed frame %d of %d done", k, options.frames));
     }
 
     for (Runner& runner : runners) {
