@@ -95,14 +95,14 @@ TEST(RunCli, EverySampleDisplayRunsHeadlessWithNonEmptyFrames) {
     const std::string name = entry.path().filename().string();
     SCOPED_TRACE(name);
     const fs::path out = folder / name;
-    // An eighth of the resolution and the cube-map method keep llvmpipe quick (facet rendering of
+    // A sixteenth of the resolution and the cube-map method keep llvmpipe quick (facet rendering of
     // the dome is slow on llvmpipe's rasterizer); the displays' geometry, blends and sessions are
     // what this checks. The facet pipelines have their own tests.
-    ASSERT_EQ(run("run " + display.string() +
-                      " --headless --frames 1 --scale 0.125 --method cubemap --out " +
-                      out.string(),
-                  folder / (name + ".log")),
-              0)
+    ASSERT_EQ(
+        run("run " + display.string() +
+                " --headless --frames 1 --scale 0.0625 --method cubemap --out " + out.string(),
+            folder / (name + ".log")),
+        0)
         << slurp(folder / (name + ".log"));
     int images = 0;
     for (const auto& output : fs::directory_iterator(out)) {
