@@ -8,13 +8,6 @@
 #include "facet/projection_io/warp_file.hpp"
 
 namespace facet::driver {
-namespace {
-
-bool ends_with(std::string_view text, std::string_view suffix) {
-  return text.size() >= suffix.size() && text.substr(text.size() - suffix.size()) == suffix;
-}
-
-}  // namespace
 
 std::vector<OutputSpec> load_display_outputs(std::string_view display,
                                              std::optional<glm::ivec2> size) {
@@ -46,7 +39,7 @@ std::vector<OutputSpec> load_display_outputs(std::string_view display,
              Warp::analytic(BaseProjection::perspective(x_edges[column][0], x_edges[column][1],
                                                         y_edges[row][0], y_edges[row][1]),
                             tile_size)});
-  } else if (ends_with(display, ".warp.exr")) {
+  } else if (display.ends_with(".warp.exr")) {
     const std::string path(display);
     Warp warp = read_warp(path);
     if (size && *size != warp.output_size) {
@@ -57,7 +50,7 @@ std::vector<OutputSpec> load_display_outputs(std::string_view display,
     std::string name = std::filesystem::path(path).filename().string();
     name = name.substr(0, name.size() - std::string_view(".warp.exr").size());
     outputs.push_back({name.empty() ? "output" : name, std::move(warp)});
-  } else if (ends_with(display, ".json")) {
+  } else if (display.ends_with(".json")) {
     const auto config = projection_io::read_display_config(std::filesystem::path(display));
     if (size) {
       throw InputError("command line", "--size",

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "facet/projection/atomic_file.hpp"
+#include "facet/projection/errors.hpp"
 
 namespace facet::driver {
 
@@ -17,7 +18,7 @@ void write_image(const std::filesystem::path& path, const OIIO::ImageSpec& spec,
     auto out = OIIO::ImageOutput::create(path.string());
     if (!out || !out->open(temporary.string(), spec) || !out->write_image(spec.format, pixels)) {
       const std::string reason = out ? out->geterror() : OIIO::geterror();
-      throw std::runtime_error(path.string() + ": cannot write image: " + reason);
+      throw InputError(path.string(), "", "a writable image file (" + reason + ")");
     }
     out->close();
   });

@@ -1,6 +1,5 @@
 // facet render: renders a scene into every output of a display with one of the render methods,
 // and reports the replication ratio and timings.
-#include <OpenImageIO/imageio.h>
 
 #include <algorithm>
 #include <chrono>
@@ -17,8 +16,8 @@
 #include "facet/driver/gltf_loader.hpp"
 #include "facet/driver/gpu_scene.hpp"
 #include "facet/driver/gpu_timer.hpp"
+#include "facet/driver/output_images.hpp"
 #include "facet/driver/render_method.hpp"
-#include "facet/projection/atomic_file.hpp"
 #include "facet/projection/errors.hpp"
 
 namespace facet::cli {
@@ -42,23 +41,6 @@ double median(std::vector<double> values) {
   std::sort(values.begin(), values.end());
   const std::size_t n = values.size();
   return n % 2 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
-}
-
-void write_image(const std::filesystem::path& path, glm::ivec2 size, int channels,
-                 OIIO::TypeDesc type, const void* pixels) {
-  write_atomically(path, [&](const std::filesystem::path& temporary) {
-    // OpenImageIO picks the format from the extension, so the temporary keeps the final one.
-    const std::filesystem::path typed = temporary.string() + path.extension().string();
-    auto file = OIIO::ImageOutput::create(typed.string());
-    OIIO::ImageSpec spec(size.x, size.y, channels, type);
-    if (!file || !file->open(typed.string(), spec) || !file->write_image(type, pixels) ||
-        !file->close()) {
-      std::error_code ignored;
-      std::filesystem::remove(typed, ignored);
-      throw InputError(path.string(), "", "could not be written");
-    }
-    std::filesystem::rename(typed, temporary);
-  });
 }
 
 Scene load_scene(const std::string& name) {
@@ -139,16 +121,14 @@ void run(const RenderOptions& options) {
     for (std::size_t i = 0; i < outputs.size(); ++i) {
       const glm::ivec2 s = targets[i].size();
       const auto colour = targets[i].read_colour_rgba8();
-      write_image(folder / (outputs[i].name + ".png"), s, 4, OIIO::TypeDesc::UINT8, colour.data());
+      write_png_rgba8(folder / (outputs[i].name + ".png"), s, colour);
       if (options.ids) {
         const auto ids = targets[i].read_ids();
-        write_image(folder / (outputs[i].name + ".ids.exr"), s, 1, OIIO::TypeDesc::UINT,
-                    ids.data());
+        write_ids_exr(folder / (outputs[i].name + ".ids.exr"), s, ids);
       }
       if (options.depth) {
         const auto depth = targets[i].read_depth();
-        write_image(folder / (outputs[i].name + ".depth.exr"), s, 1, OIIO::TypeDesc::FLOAT,
-                    depth.data());
+        write_depth_exr(folder / (outputs[i].name + ".depth.exr"), s, depth);
       }
     }
   }

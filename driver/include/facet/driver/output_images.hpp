@@ -9,7 +9,8 @@
 
 namespace facet::driver {
 
-// `rgba` holds size.x * size.y * 4 bytes. Throws std::runtime_error naming the file on failure.
+// `rgba` holds size.x * size.y * 4 bytes. Throws InputError naming the file when it cannot be
+// written.
 void write_png_rgba8(const std::filesystem::path& path, glm::ivec2 size,
                      std::span<const std::uint8_t> rgba);
 // IDs as a UINT channel "id" (exact for every 32-bit value).
