@@ -4,6 +4,7 @@
 #include <bit>
 #include <cstring>
 #include <glm/gtc/type_ptr.hpp>
+#include <string_view>
 
 #include "facet/projection/errors.hpp"
 
@@ -19,7 +20,27 @@ void GpuScene::bind_material_texture(std::uint32_t m, GLuint unit) const {
   (material_repeat[m] ? repeat_sampler : clamp_sampler).bind_unit(unit);
 }
 
-GpuScene upload_scene(const Scene& scene) {
+bool is_software_renderer() {
+  const auto* renderer = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
+  if (renderer == nullptr) return false;
+  const std::string_view name(renderer);
+  return name.starts_with("llvmpipe") || name.starts_with("softpipe") ||
+         name.find("SwiftShader") != std::string_view::npos;
+}
+
+float resolve_anisotropy(float requested) {
+  // Core since GL 4.6; on 4.5 drivers it is the ARB/EXT extension with the same enum value.
+  const bool anisotropic = epoxy_gl_version() >= 46 ||
+                           epoxy_has_gl_extension("GL_ARB_texture_filter_anisotropic") ||
+                           epoxy_has_gl_extension("GL_EXT_texture_filter_anisotropic");
+  if (!anisotropic) return 1.0f;
+  float max_anisotropy = 1.0f;
+  glGetFloatv(GL_MAX_TEXTURE_MAX_ANISOTROPY, &max_anisotropy);
+  if (requested == kAutomaticAnisotropy) requested = is_software_renderer() ? 1.0f : 8.0f;
+  return std::clamp(requested, 1.0f, std::max(1.0f, max_anisotropy));
+}
+
+GpuScene upload_scene(const Scene& scene, float max_anisotropy) {
   FACET_ASSERT(scene.normals.size() == scene.positions.size());
   FACET_ASSERT(scene.uvs.size() == scene.positions.size());
   GpuScene gpu;
@@ -65,12 +86,7 @@ GpuScene upload_scene(const Scene& scene) {
   }
   glVertexArrayElementBuffer(vao, gpu.indices.id());
 
-  float max_anisotropy = 1.0f;
-  // Core since GL 4.6; on 4.5 drivers it is the ARB/EXT extension with the same enum value.
-  const bool anisotropic = epoxy_gl_version() >= 46 ||
-                           epoxy_has_gl_extension("GL_ARB_texture_filter_anisotropic") ||
-                           epoxy_has_gl_extension("GL_EXT_texture_filter_anisotropic");
-  if (anisotropic) glGetFloatv(GL_MAX_TEXTURE_MAX_ANISOTROPY, &max_anisotropy);
+  gpu.max_anisotropy = resolve_anisotropy(max_anisotropy);
   for (const auto& image : scene.images) {
     FACET_ASSERT(image.rgba.size() == static_cast<std::size_t>(image.width) *
                                           static_cast<std::size_t>(image.height) * 4u);
@@ -95,8 +111,8 @@ GpuScene upload_scene(const Scene& scene) {
     glSamplerParameteri(sampler->id(), GL_TEXTURE_WRAP_T, static_cast<GLint>(wrap));
     glSamplerParameteri(sampler->id(), GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
     glSamplerParameteri(sampler->id(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-    if (anisotropic)
-      glSamplerParameterf(sampler->id(), GL_TEXTURE_MAX_ANISOTROPY, std::min(8.0f, max_anisotropy));
+    if (gpu.max_anisotropy > 1.0f)
+      glSamplerParameterf(sampler->id(), GL_TEXTURE_MAX_ANISOTROPY, gpu.max_anisotropy);
   }
   return gpu;
 }

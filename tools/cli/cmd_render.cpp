@@ -17,6 +17,7 @@
 #include "facet/driver/gpu_scene.hpp"
 #include "facet/driver/gpu_timer.hpp"
 #include "facet/driver/output_images.hpp"
+#include "facet/driver/reference.hpp"
 #include "facet/driver/render_method.hpp"
 #include "facet/projection/errors.hpp"
 
@@ -33,6 +34,7 @@ struct RenderOptions {
   LayoutFlags layout;
   std::optional<int> face_size;
   int frames = 1, msaa = 0;
+  float anisotropy = kAutomaticAnisotropy;
   bool ids = false, depth = false, reference = false, json = false;
 };
 
@@ -54,6 +56,41 @@ Scene load_scene(const std::string& name) {
   return load_gltf(path);
 }
 
+// The last frame's IDs against the Embree ray cast of the same view, pooled over the outputs
+// (ratios of pooled pixel counts; edge distances are the worst output's).
+nlohmann::json compare_with_reference(const Scene& scene, const std::vector<OutputSpec>& outputs,
+                                      const std::vector<OutputTarget>& targets,
+                                      const glm::dmat4& T_eye_world) {
+  const ReferenceRaycaster raycaster(scene);
+  IdComparison pooled;
+  nlohmann::json per_output = nlohmann::json::array();
+  for (std::size_t i = 0; i < outputs.size(); ++i) {
+    const WarpInverse inverse(outputs[i].warp);
+    const IdCompareOptions compare{.wrap_x = outputs[i].warp.base.wraps_horizontally()};
+    const IdComparison c = compare_ids(raycaster.ids(inverse, T_eye_world), targets[i].read_ids(),
+                                       targets[i].size(), compare);
+    per_output.push_back({{"name", outputs[i].name},
+                          {"id_mismatch", c.id_mismatch},
+                          {"max_edge_px", c.max_edge_px},
+                          {"p99_edge_px", c.p99_edge_px}});
+    pooled.compared_pixels += c.compared_pixels;
+    pooled.mismatched_pixels += c.mismatched_pixels;
+    pooled.differing_pixels += c.differing_pixels;
+    pooled.max_edge_px = std::max(pooled.max_edge_px, c.max_edge_px);
+    pooled.p99_edge_px = std::max(pooled.p99_edge_px, c.p99_edge_px);
+  }
+  const double mismatch = pooled.compared_pixels
+                              ? double(pooled.mismatched_pixels) / double(pooled.compared_pixels)
+                              : 0.0;
+  return {{"id_mismatch", mismatch},
+          {"max_edge_px", pooled.max_edge_px},
+          {"p99_edge_px", pooled.p99_edge_px},
+          {"compared_pixels", pooled.compared_pixels},
+          {"mismatched_pixels", pooled.mismatched_pixels},
+          {"differing_pixels", pooled.differing_pixels},
+          {"outputs", per_output}};
+}
+
 void run(const RenderOptions& options) {
   if (options.frames < 1) throw InputError("command line", "--frames", "expected at least 1");
   if (options.msaa < 0) throw InputError("command line", "--msaa", "expected 0 or more samples");
@@ -71,15 +108,14 @@ void run(const RenderOptions& options) {
     settings.cube_face_size = *options.face_size;
   }
   settings.msaa_samples = options.msaa;
-  if (options.reference) {
-    throw InputError("command line", "--reference",
-                     "the CPU reference comparison is not available in this build yet");
+  if (options.anisotropy != kAutomaticAnisotropy && !(options.anisotropy >= 1.0f)) {
+    throw InputError("command line", "--anisotropy", "expected 0 (automatic) or a level >= 1");
   }
   const Scene scene = load_scene(options.scene);
 
   auto context = create_headless_context();
   auto method = make_render_method(options.method);
-  const GpuScene gpu_scene = upload_scene(scene);
+  const GpuScene gpu_scene = upload_scene(scene, options.anisotropy);
   method->prepare(scene, gpu_scene, outputs, settings);
   std::vector<OutputTarget> targets;
   for (const OutputSpec& output : outputs) {
@@ -94,11 +130,13 @@ void run(const RenderOptions& options) {
   GpuTimer timer;
   std::vector<double> frame_ms;
   std::vector<RenderStats> stats;
+  glm::dmat4 T_eye_world(1.0);
   for (int k = 0; k < options.frames; ++k) {
     glm::dmat4 T_world_eye = city ? path.T_world_eye(k * kFrameStepS) : glm::dmat4(1.0);
     if (!city) T_world_eye[3] = glm::dvec4(centre, 1.0);
+    T_eye_world = glm::inverse(T_world_eye);
     const auto start = std::chrono::steady_clock::now();
-    stats.push_back(method->render(glm::inverse(T_world_eye), targets, &timer));
+    stats.push_back(method->render(T_eye_world, targets, &timer));
     glFinish();
     frame_ms.push_back(
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
@@ -144,22 +182,25 @@ void run(const RenderOptions& options) {
   for (const auto& [pass, times] : pass_times) pass_ms[pass] = median(times);
   nlohmann::json names = nlohmann::json::array();
   for (const OutputSpec& output : outputs) names.push_back(output.name);
-  const nlohmann::json report = {{"display", options.display},
-                                 {"scene", options.scene},
-                                 {"method", method->name()},
-                                 {"outputs", names},
-                                 {"renderer", context->info().renderer},
-                                 {"frames", options.frames},
-                                 {"facets", last.facets},
-                                 {"triangles_scene", scene.triangle_count()},
-                                 {"triangles_in", last.triangles_in},
-                                 {"triangles_visible", last.triangles_visible},
-                                 {"replicas", last.replicas},
-                                 {"replication_ratio", last.replication_ratio()},
-                                 {"replication_ratio_mean", ratio_sum / options.frames},
-                                 {"reused_frames", reused},
-                                 {"frame_ms", median(frame_ms)},
-                                 {"pass_ms", pass_ms}};
+  nlohmann::json report = {{"display", options.display},
+                           {"scene", options.scene},
+                           {"method", method->name()},
+                           {"outputs", names},
+                           {"renderer", context->info().renderer},
+                           {"frames", options.frames},
+                           {"facets", last.facets},
+                           {"triangles_scene", scene.triangle_count()},
+                           {"triangles_in", last.triangles_in},
+                           {"triangles_visible", last.triangles_visible},
+                           {"replicas", last.replicas},
+                           {"replication_ratio", last.replication_ratio()},
+                           {"replication_ratio_mean", ratio_sum / options.frames},
+                           {"reused_frames", reused},
+                           {"frame_ms", median(frame_ms)},
+                           {"pass_ms", pass_ms},
+                           {"texture_anisotropy", gpu_scene.max_anisotropy}};
+  if (options.reference)
+    report["reference"] = compare_with_reference(scene, outputs, targets, T_eye_world);
   if (options.json) {
     std::cout << report.dump(2) << "\n";
   } else {
@@ -173,6 +214,12 @@ void run(const RenderOptions& options) {
         options.frames);
     for (const auto& [pass, times] : pass_times) {
       std::printf("  %-16s %8.3f ms (GPU, median)\n", pass.c_str(), median(times));
+    }
+    if (options.reference) {
+      const nlohmann::json& r = report["reference"];
+      std::printf("  reference: id_mismatch %.6f, max_edge_px %.3f, p99_edge_px %.3f\n",
+                  r["id_mismatch"].get<double>(), r["max_edge_px"].get<double>(),
+                  r["p99_edge_px"].get<double>());
     }
   }
 }
@@ -202,6 +249,8 @@ const Registration registration{
       command->add_flag("--depth", options->depth, "Also write <output>.depth.exr (needs --out)");
       command->add_flag("--reference", options->reference,
                         "Compare the IDs with the CPU ray-cast reference");
+      command->add_option("--anisotropy", options->anisotropy,
+                          "Texture anisotropy level (0: automatic, 8 on GPUs, off on llvmpipe)");
       command->add_flag("--json", options->json, "Print one JSON object");
       command->callback([options] { run(*options); });
     }};

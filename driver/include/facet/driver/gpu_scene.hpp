@@ -39,20 +39,36 @@ struct GpuScene {
   Buffer objects;    // GpuObject per Scene::objects entry
   // Attribute 0: position (vec3), 1: normal (vec3), 2: uv (vec2); element buffer = indices.
   VertexArray vertex_array;
-  // One SRGB8_ALPHA8 texture per Scene::images entry, mipmapped, trilinear + 8x anisotropic
-  // where available; wrap mode comes from the samplers below.
+  // One SRGB8_ALPHA8 texture per Scene::images entry, mipmapped, trilinear, with anisotropic
+  // filtering up to `max_anisotropy`; wrap mode comes from the samplers below.
   std::vector<Texture> textures;
   Texture white;  // 1x1 white, bound for materials with no texture
   Sampler repeat_sampler, clamp_sampler;
   std::vector<std::int32_t> material_texture;  // Scene::materials[i].texture, kept for binding
   std::vector<bool> material_repeat;
+  float max_anisotropy = 1.0f;  // as applied to both samplers; 1: anisotropic filtering off
 
   // Binds material `m`'s texture (or `white`) and sampler to texture unit `unit`.
   void bind_material_texture(std::uint32_t m, GLuint unit) const;
 };
 
+// Requests the driver's choice of anisotropic filtering: 8 on GPUs, off (1) on software
+// rasterizers. llvmpipe's anisotropic sampler walks the texel footprint, whose length has no
+// useful bound where a facet squashes the scene (a fisheye's rim, looking along the ground):
+// the 180° dome at 64×64 took 17.6 s a frame with 8x and 0.25 s without.
+inline constexpr float kAutomaticAnisotropy = 0.0f;
+
+// The anisotropy `requested` resolves to on the current context: kAutomaticAnisotropy as above,
+// otherwise `requested` clamped to [1, GL_MAX_TEXTURE_MAX_ANISOTROPY] (1 where the context has
+// no anisotropic filtering).
+float resolve_anisotropy(float requested);
+
+// True when the current context's GL_RENDERER is a CPU rasterizer (llvmpipe, softpipe,
+// SwiftShader).
+bool is_software_renderer();
+
 // Uploads the scene. Needs a current GL context; the GpuScene must be destroyed while a context
 // of the same share group is current.
-GpuScene upload_scene(const Scene& scene);
+GpuScene upload_scene(const Scene& scene, float max_anisotropy = kAutomaticAnisotropy);
 
 }  // namespace facet::driver
