@@ -30,6 +30,7 @@ void write_display_folder(const ImportedDisplay& display, const std::filesystem:
   projection_io::DisplayConfig config;
   config.name = display.name.empty() ? "imported" : display.name;
   config.missing_monitor = projection_io::MissingMonitor::window;
+  config.eye = display.eye;
   std::set<std::string> names;
   for (const ImportedProjector& projector : display.projectors) {
     std::string name = sanitize_name(projector.name);

@@ -16,6 +16,43 @@ bool finite(glm::dvec2 v) { return std::isfinite(v.x) && std::isfinite(v.y); }
 // side; queries are solved exactly by Newton whatever the table's resolution.
 constexpr int kAuxiliaryScale = 1024;
 
+// Nodes found only among filled-in nodes of the inverse grid may come from a fold of that
+// extrapolation rather than from the map. A suspect node is kept when it continues its trusted
+// neighbours: it lies within `tolerance_px` of the line through two trusted nodes next to it
+// (in any of the four directions), checked ring by ring outwards from the trusted nodes. The rest
+// become NaN, to be extrapolated from the forward grid instead.
+void drop_inconsistent(std::vector<glm::dvec2>& offsets, const std::vector<bool>& suspect,
+                       glm::ivec2 grid_size, double tolerance_px) {
+  const int w = grid_size.x, h = grid_size.y;
+  std::vector<bool> trusted(offsets.size());
+  for (std::size_t k = 0; k < offsets.size(); ++k) trusted[k] = !suspect[k] && finite(offsets[k]);
+  const int di[4] = {1, -1, 0, 0}, dj[4] = {0, 0, 1, -1};
+  for (bool changed = true; changed;) {
+    changed = false;
+    std::vector<std::size_t> accepted;
+    for (int j = 0; j < h; ++j) {
+      for (int i = 0; i < w; ++i) {
+        const std::size_t k = std::size_t(j) * w + i;
+        if (trusted[k] || !suspect[k] || !finite(offsets[k])) continue;
+        for (int d = 0; d < 4; ++d) {
+          const int i1 = i + di[d], j1 = j + dj[d], i2 = i + 2 * di[d], j2 = j + 2 * dj[d];
+          if (i2 < 0 || j2 < 0 || i2 >= w || j2 >= h) continue;
+          const std::size_t k1 = std::size_t(j1) * w + i1, k2 = std::size_t(j2) * w + i2;
+          if (!trusted[k1] || !trusted[k2]) continue;
+          if (glm::length(offsets[k] - (2.0 * offsets[k1] - offsets[k2])) <= tolerance_px) {
+            accepted.push_back(k);
+            break;
+          }
+        }
+      }
+    }
+    for (std::size_t k : accepted) trusted[k] = changed = true;
+  }
+  for (std::size_t k = 0; k < offsets.size(); ++k) {
+    if (!trusted[k]) offsets[k] = glm::dvec2(std::numeric_limits<double>::quiet_NaN());
+  }
+}
+
 }  // namespace
 
 std::vector<bool> fill_missing(std::vector<glm::dvec2>& values, glm::ivec2 grid_size,
@@ -93,6 +130,11 @@ Warp warp_from_inverse_grid(const InverseGrid& grid, const BaseProjection& base,
   auxiliary.output_size = {kAuxiliaryScale, kAuxiliaryScale};
   auxiliary.grid_size = padded;
   auxiliary.offset_px.resize(st.size());
+  // Two inverses of the same nodes. `inside` counts only the nodes that were valid as covered:
+  // where filled-in nodes fold over valid ones (large NaN areas, extrapolated front by front, can),
+  // it still finds the valid preimage of a base position that the output shows. `anywhere` also
+  // covers the filled-in and padding nodes, for the accurate offsets of base positions that land
+  // just outside the output image.
   auxiliary.coverage.assign(st.size(), 1.0f);
   // Auxiliary base position (a, b) in [0,1]² ↔ normalised output position
   // ((a·(Pw−1) − pad)/(Gw−1), ...).
@@ -105,7 +147,9 @@ Warp warp_from_inverse_grid(const InverseGrid& grid, const BaseProjection& base,
       auxiliary.offset_px[k] = glm::vec2((st[k] - a) * double(kAuxiliaryScale));
     }
   }
-  const WarpInverse inverse(std::move(auxiliary));
+  const WarpInverse anywhere(auxiliary);
+  for (std::size_t k = 0; k < st.size(); ++k) auxiliary.coverage[k] = valid[k] ? 1.0f : 0.0f;
+  const WarpInverse inside(std::move(auxiliary));
   // Bilinear mask of the nodes that were valid, at a normalised output position.
   const auto valid_at = [&](glm::dvec2 output) {
     const glm::dvec2 g = output * cells_in_grid + glm::dvec2(pad);
@@ -124,11 +168,16 @@ Warp warp_from_inverse_grid(const InverseGrid& grid, const BaseProjection& base,
   warp.grid_size = warp_grid;
   std::vector<glm::dvec2> offsets(std::size_t(warp_grid.x) * warp_grid.y,
                                   glm::dvec2(std::numeric_limits<double>::quiet_NaN()));
-  std::vector<bool> covered(offsets.size(), false);
+  std::vector<bool> covered(offsets.size(), false), from_anywhere(offsets.size(), false);
   for (int j = 0; j < warp_grid.y; ++j) {
     for (int i = 0; i < warp_grid.x; ++i) {
       const glm::dvec2 st_node{double(i) / (warp_grid.x - 1), double(j) / (warp_grid.y - 1)};
-      if (auto a = inverse.st_from_q(st_node * double(kAuxiliaryScale))) {
+      const glm::dvec2 q_auxiliary = st_node * double(kAuxiliaryScale);
+      std::optional<glm::dvec2> a = inside.st_from_q(q_auxiliary);
+      const bool from_inside = a.has_value();
+      if (!a) a = anywhere.st_from_q(q_auxiliary);
+      from_anywhere[warp.node_index(i, j)] = a && !from_inside;
+      if (a) {
         const glm::dvec2 output = (*a * cells_padded - glm::dvec2(pad)) / cells_in_grid;
         const std::size_t k = warp.node_index(i, j);
         offsets[k] = output * glm::dvec2(output_size) - st_node * glm::dvec2(output_size);
@@ -137,6 +186,10 @@ Warp warp_from_inverse_grid(const InverseGrid& grid, const BaseProjection& base,
       }
     }
   }
+  // A smooth map bends by a small part of a cell from one node to the next.
+  const double cell_px = glm::length(glm::dvec2(output_size) / glm::dvec2(warp_grid - 1));
+  drop_inconsistent(offsets, from_anywhere, warp_grid, std::max(1.0, 0.1 * cell_px));
+  for (std::size_t k = 0; k < offsets.size(); ++k) covered[k] = covered[k] && finite(offsets[k]);
   fill_missing(offsets, warp_grid, source);
 
   warp.offset_px.resize(offsets.size());

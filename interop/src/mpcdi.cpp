@@ -16,6 +16,7 @@
 #include "facet/projection/atomic_file.hpp"
 #include "facet/projection/errors.hpp"
 #include "facet/projection/footprint.hpp"
+#include "facet/projection/screen.hpp"
 #include "facet/projection/warp_inverse.hpp"
 #include "facet/projection_io/warp_file.hpp"
 
@@ -194,6 +195,139 @@ std::string encode_png16(const projection_io::BlendMap& map) {
   return std::string(buffer.begin(), buffer.end());
 }
 
+// ---- profile a3
+// ----------------------------------------------------------------------------------
+
+// facet.json's record of a warp's base and rotation, so that an a3 round trip lands on the same
+// base image (the a3 PFM itself only holds screen points).
+nlohmann::json base_hint(const BaseProjection& base, const glm::dmat3& R_eye_base) {
+  nlohmann::json hint = {{"kind", to_string(base.kind)}};
+  switch (base.kind) {
+    case BaseKind::perspective:
+      hint["tan_extent"] = base.tan_extent;
+      break;
+    case BaseKind::fisheye:
+      hint["fov"] = base.fov_deg;
+      break;
+    case BaseKind::cylindrical:
+      hint["azimuth"] = base.azimuth_deg;
+      hint["tan_elevation"] = base.tan_elevation;
+      break;
+    case BaseKind::equirectangular:
+      hint["azimuth"] = base.azimuth_deg;
+      hint["elevation"] = base.elevation_deg;
+      break;
+  }
+  nlohmann::json rotation = nlohmann::json::array();
+  for (int c = 0; c < 3; ++c)
+    rotation.push_back({R_eye_base[c].x, R_eye_base[c].y, R_eye_base[c].z});
+  hint["rotation_columns"] = rotation;
+  return hint;
+}
+
+// The base a facet.json hint records, or nullopt when it is missing or not usable (the import then
+// chooses its own base; facet.json is advisory and never an error).
+std::optional<BaseCover> base_from_hint(const nlohmann::json* hint) {
+  if (!hint || !hint->contains("base") || !(*hint)["base"].is_object()) return std::nullopt;
+  const nlohmann::json& json = (*hint)["base"];
+  try {
+    BaseCover cover;
+    cover.base.kind = base_kind_from_string(json.at("kind").get<std::string>());
+    switch (cover.base.kind) {
+      case BaseKind::perspective:
+        cover.base.tan_extent = json.at("tan_extent").get<std::array<double, 4>>();
+        break;
+      case BaseKind::fisheye:
+        cover.base.fov_deg = json.at("fov").get<double>();
+        break;
+      case BaseKind::cylindrical:
+        cover.base.azimuth_deg = json.at("azimuth").get<std::array<double, 2>>();
+        cover.base.tan_elevation = json.at("tan_elevation").get<std::array<double, 2>>();
+        break;
+      case BaseKind::equirectangular:
+        cover.base.azimuth_deg = json.at("azimuth").get<std::array<double, 2>>();
+        cover.base.elevation_deg = json.at("elevation").get<std::array<double, 2>>();
+        break;
+    }
+    cover.base.validate();
+    const auto columns = json.at("rotation_columns").get<std::array<std::array<double, 3>, 3>>();
+    for (int c = 0; c < 3; ++c) cover.R_eye_base[c] = {columns[c][0], columns[c][1], columns[c][2]};
+    // Only a proper rotation is worth trusting.
+    const glm::dmat3 should_be_identity = glm::transpose(cover.R_eye_base) * cover.R_eye_base;
+    for (int c = 0; c < 3; ++c) {
+      if (!(glm::length(should_be_identity[c] - glm::dmat3(1.0)[c]) < 1e-6)) return std::nullopt;
+    }
+    if (!(glm::determinant(cover.R_eye_base) > 0)) return std::nullopt;
+    return cover;
+  } catch (const std::exception&) {
+    return std::nullopt;
+  }
+}
+
+// An a3 region's warp: every node's direction from the eye, expressed in a base covering them.
+Warp region_warp_a3(const PfmImage& pfm, glm::dvec3 eye_file, glm::ivec2 output_size,
+                    glm::ivec2 warp_grid, const nlohmann::json* hint, const std::string& source) {
+  const glm::ivec2 size{pfm.width, pfm.height};
+  const glm::dmat3 R_eye_file = R_eye_mpcdi3d();
+  std::vector<glm::dvec3> v_eye(std::size_t(size.x) * size.y, glm::dvec3(0.0));
+  std::vector<glm::dvec3> valid_directions;
+  double longest = 0;
+  for (int j = 0; j < size.y; ++j) {
+    for (int i = 0; i < size.x; ++i) {
+      const glm::dvec3 p{pfm.at(i, j, 0), pfm.at(i, j, 1), pfm.at(i, j, 2)};
+      if (!std::isfinite(p.x + p.y + p.z) || p == glm::dvec3(0.0)) continue;
+      const glm::dvec3 v = R_eye_file * (p - eye_file);
+      longest = std::max(longest, glm::length(v));
+      v_eye[std::size_t(j) * size.x + i] = v;
+    }
+  }
+  // A point at the eye has no direction; "at" is relative to the size of the screen.
+  for (glm::dvec3& v : v_eye) {
+    if (!(glm::length(v) > 1e-9 * longest)) {
+      v = glm::dvec3(0.0);
+    } else {
+      v = glm::normalize(v);
+      valid_directions.push_back(v);
+    }
+  }
+  if (valid_directions.empty()) {
+    throw InputError(source, "nodes",
+                     "expected at least one 3D point that is not NaN, (0, 0, 0) or the eye point");
+  }
+  std::optional<BaseCover> cover = base_from_hint(hint);
+  if (!cover) {
+    // Keep the projector's up (its image's top edge) towards t = 0, so that offsets stay small.
+    glm::dvec3 up{0.0};
+    for (int i = 0; i < size.x; ++i) {
+      const glm::dvec3 top = v_eye[std::size_t(i)];
+      const glm::dvec3 bottom = v_eye[std::size_t(size.y - 1) * size.x + i];
+      if (top != glm::dvec3(0.0) && bottom != glm::dvec3(0.0)) up += top - bottom;
+    }
+    CoverOptions options;
+    if (glm::length(up) > 1e-9) options.up_eye = glm::normalize(up);
+    cover = cover_directions(valid_directions, options);
+  }
+  const glm::dmat3 R_base_eye = glm::transpose(cover->R_eye_base);
+  InverseGrid grid;
+  grid.grid_size = size;
+  grid.st.assign(v_eye.size(), glm::dvec2(std::numeric_limits<double>::quiet_NaN()));
+  for (int j = 0; j < size.y; ++j) {
+    // Wrapping bases pick the branch next to the row's previous node, so that rows stay
+    // continuous across the seam.
+    double s_hint = std::numeric_limits<double>::quiet_NaN();
+    for (int i = 0; i < size.x; ++i) {
+      const std::size_t k = std::size_t(j) * size.x + i;
+      if (v_eye[k] == glm::dvec3(0.0)) continue;
+      if (auto st = cover->base.st_from_direction(R_base_eye * v_eye[k], s_hint)) {
+        grid.st[k] = *st;
+        s_hint = st->x;
+      }
+    }
+  }
+  return warp_from_inverse_grid(grid, cover->base, cover->R_eye_base, output_size, warp_grid,
+                                source);
+}
+
 }  // namespace
 
 MpcdiFiles read_zip(std::string_view bytes, const std::string& source) {
@@ -291,10 +425,6 @@ ImportedDisplay import_mpcdi(const MpcdiFiles& files, const std::string& source,
   if (xml_name.empty()) throw InputError(source, "mpcdi.xml", "expected this member");
   const std::string xml_source = source + ":" + xml_name;
   const MpcdiDocument document = parse_mpcdi_xml(files.at(xml_name), xml_source);
-  if (document.profile == MpcdiProfile::advanced_3d) {
-    throw InputError(xml_source, "MPCDI@profile",
-                     "expected profile 2d or 3d (a3, warps as 3D screen points, is not supported)");
-  }
   // The sampling facet's own export recorded, if this container came from facet.
   nlohmann::json hints;
   if (auto found = files.find("facet.json"); found != files.end()) {
@@ -304,6 +434,35 @@ ImportedDisplay import_mpcdi(const MpcdiFiles& files, const std::string& source,
 
   ImportedDisplay display;
   display.name = std::filesystem::path(source).stem().string();
+  if (document.profile == MpcdiProfile::advanced_3d) {
+    const MpcdiRegion& first = document.regions.front();
+    const glm::dvec3 eye_file = options.eye.value_or(glm::dvec3(0.0));
+    const std::optional<double> metres = metres_per_unit(first.unit);
+    display.eye = R_eye_mpcdi3d() * eye_file * metres.value_or(1.0);
+    if (!options.eye && first.origin != MpcdiOrigin::ideal_eye_point) {
+      display.notes.push_back(std::string("profile a3 with originOf3DData ") +
+                              to_string(first.origin) +
+                              ": the eye is taken at the origin of the file's frame; give the "
+                              "real eye point with --eye x,y,z (file frame, geometricUnit)");
+    }
+    if (!metres && eye_file != glm::dvec3(0.0)) {
+      display.notes.push_back(
+          "geometricUnit unknown: display.json's eye is the --eye point read as metres");
+    }
+    for (const MpcdiRegion& region : document.regions) {
+      if (region.unit != first.unit) {
+        throw InputError(
+            xml_source, "files/fileset[region=" + region.id + "]/geometryWarpFile/geometricUnit",
+            std::string("expected the same unit in every region (") + to_string(first.unit) + ")");
+      }
+      if (region.origin != first.origin) {
+        throw InputError(xml_source,
+                         "files/fileset[region=" + region.id + "]/geometryWarpFile/originOf3DData",
+                         std::string("expected the same origin in every region (") +
+                             to_string(first.origin) + ")");
+      }
+    }
+  }
   for (const MpcdiRegion& region : document.regions) {
     const std::string field = "files/fileset[region=" + region.id + "]";
     const std::string& pfm_bytes =
@@ -345,7 +504,13 @@ ImportedDisplay import_mpcdi(const MpcdiFiles& files, const std::string& source,
     }
     ImportedProjector projector;
     projector.name = sanitize_name(region.id);
-    projector.warp = region_warp(in, values, pfm_source);
+    if (document.profile == MpcdiProfile::advanced_3d) {
+      projector.warp = region_warp_a3(pfm, options.eye.value_or(glm::dvec3(0.0)), region.resolution,
+                                      in.warp_grid, hint, pfm_source);
+      if (display.eye != glm::dvec3(0.0)) projector.warp.eye = display.eye;
+    } else {
+      projector.warp = region_warp(in, values, pfm_source);
+    }
     if (region.alpha) {
       projector.blend =
           decode_map(member(files, region.alpha->path, xml_source, field + "/alphaMap/path"),
@@ -376,7 +541,10 @@ ImportedDisplay import_mpcdi(const MpcdiFiles& files, const std::string& source,
 MpcdiFiles export_mpcdi(const projection_io::DisplayConfig& display,
                         const MpcdiExportOptions& options) {
   FACET_ASSERT(options.node_spacing_px > 0);
+  FACET_ASSERT(options.profile != MpcdiProfile::two_d);
+  const bool a3 = options.profile == MpcdiProfile::advanced_3d;
   MpcdiDocument document;
+  document.profile = options.profile;
   MpcdiFiles files;
   nlohmann::json hints = {{"format", "facet-mpcdi/1"}, {"regions", nlohmann::json::object()}};
   int buffer = 0;
@@ -388,8 +556,42 @@ MpcdiFiles export_mpcdi(const projection_io::DisplayConfig& display,
     region.buffer_index = buffer++;
     region.buffer_resolution = warp.output_size;
     region.resolution = warp.output_size;
+    const glm::ivec2 nodes{int(std::ceil(warp.output_size.x / options.node_spacing_px)) + 1,
+                           int(std::ceil(warp.output_size.y / options.node_spacing_px)) + 1};
+    PfmImage pfm;
+    pfm.width = nodes.x;
+    pfm.height = nodes.y;
+    pfm.channels = 3;
+    nlohmann::json& hint = hints["regions"][projector.name];
+    hint = {{"warp_grid", {warp.grid_size.x, warp.grid_size.y}}, {"pfm_nodes", {nodes.x, nodes.y}}};
+    if (a3) {
+      region.unit = MpcdiUnit::m;
+      region.origin = MpcdiOrigin::ideal_eye_point;
+      const WarpInverse inverse(warp);
+      const glm::dmat3 R_file_eye = glm::transpose(R_eye_mpcdi3d());
+      const float nan = std::numeric_limits<float>::quiet_NaN();
+      for (int j = 0; j < nodes.y; ++j) {
+        for (int i = 0; i < nodes.x; ++i) {
+          const glm::dvec2 q{double(i) / (nodes.x - 1) * warp.output_size.x,
+                             double(j) / (nodes.y - 1) * warp.output_size.y};
+          std::optional<glm::dvec3> p_eye;
+          if (auto inverted = inverse.invert(q)) {
+            if (!display.screen) {
+              p_eye = inverted->v_eye;
+            } else if (auto hit = screen_hit(*display.screen, display.eye, inverted->v_eye)) {
+              p_eye = *hit - display.eye;
+            }
+          }
+          const glm::dvec3 p = p_eye ? R_file_eye * *p_eye : glm::dvec3(nan);
+          pfm.values.insert(pfm.values.end(), {float(p.x), float(p.y), float(p.z)});
+        }
+      }
+      hint["base"] = base_hint(warp.base, warp.R_eye_base);
+    }
     MpcdiFrustum frustum;
-    if (warp.base.kind == BaseKind::perspective) {
+    if (a3) {
+      // No frustum: the points say everything.
+    } else if (warp.base.kind == BaseKind::perspective) {
       frustum = frustum_from_base(warp.base, warp.R_eye_base);
     } else {
       // A perspective frustum around everything the projector shows: directions of the output
@@ -417,22 +619,19 @@ MpcdiFiles export_mpcdi(const projection_io::DisplayConfig& display,
       }
       frustum = frustum_from_base(covered.base, covered.R_eye_base);
     }
-    region.frustum = frustum;
-    const BaseProjection base = frustum_base(frustum);
-    const glm::dmat3 R_frustum_eye = glm::transpose(R_eye_frustum(frustum));
-    const glm::ivec2 nodes{int(std::ceil(warp.output_size.x / options.node_spacing_px)) + 1,
-                           int(std::ceil(warp.output_size.y / options.node_spacing_px)) + 1};
-    const InverseGrid grid = inverse_grid_from_warp(warp, nodes, [&](const glm::dvec3& v_eye) {
-      return base.st_from_direction(R_frustum_eye * v_eye);
-    });
-    PfmImage pfm;
-    pfm.width = nodes.x;
-    pfm.height = nodes.y;
-    pfm.channels = 3;
-    for (const glm::dvec2& st : grid.st) {
-      pfm.values.push_back(float(st.x));
-      pfm.values.push_back(float(st.y));
-      pfm.values.push_back(std::isfinite(st.x) ? 0.0f : std::numeric_limits<float>::quiet_NaN());
+    if (!a3) {
+      region.frustum = frustum;
+      const BaseProjection base = frustum_base(frustum);
+      const glm::dmat3 R_frustum_eye = glm::transpose(R_eye_frustum(frustum));
+      const InverseGrid grid = inverse_grid_from_warp(warp, nodes, [&](const glm::dvec3& v_eye) {
+        return base.st_from_direction(R_frustum_eye * v_eye);
+      });
+      for (const glm::dvec2& st : grid.st) {
+        pfm.values.push_back(float(st.x));
+        pfm.values.push_back(float(st.y));
+        pfm.values.push_back(std::isfinite(st.x) ? 0.0f : std::numeric_limits<float>::quiet_NaN());
+      }
+      hint["warp_values"] = "absolute";
     }
     region.warp_path = projector.name + ".pfm";
     files[region.warp_path] = format_pfm(pfm);
@@ -448,9 +647,6 @@ MpcdiFiles export_mpcdi(const projection_io::DisplayConfig& display,
       region.beta = MpcdiMap{projector.name + "_beta.png", 1.0, map.channels};
       files[region.beta->path] = encode_png16(map);
     }
-    hints["regions"][region.id] = {{"warp_grid", {warp.grid_size.x, warp.grid_size.y}},
-                                   {"warp_values", "absolute"},
-                                   {"pfm_nodes", {nodes.x, nodes.y}}};
     document.regions.push_back(region);
   }
   files["mpcdi.xml"] = format_mpcdi_xml(document);

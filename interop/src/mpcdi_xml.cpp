@@ -75,7 +75,73 @@ std::string format_number(double value) {
   return text;
 }
 
+// The standard's names. The reference MPCDI library writes "unkown"; it reads as unknown too.
+constexpr std::pair<const char*, MpcdiUnit> kUnits[] = {
+    {"mm", MpcdiUnit::mm}, {"cm", MpcdiUnit::cm},          {"dm", MpcdiUnit::dm},
+    {"m", MpcdiUnit::m},   {"in", MpcdiUnit::in},          {"ft", MpcdiUnit::ft},
+    {"yd", MpcdiUnit::yd}, {"unknown", MpcdiUnit::unknown}};
+constexpr std::pair<const char*, MpcdiOrigin> kOrigins[] = {
+    {"centerOfMass", MpcdiOrigin::center_of_mass},
+    {"idealEyePoint", MpcdiOrigin::ideal_eye_point},
+    {"floorCenter", MpcdiOrigin::floor_center},
+    {"unknown", MpcdiOrigin::unknown}};
+
+template <typename Enum, std::size_t N>
+Enum enum_child(const pugi::xml_node& node, const char* name,
+                const std::pair<const char*, Enum> (&names)[N], Enum unknown,
+                const std::string& source, const std::string& path) {
+  const pugi::xml_node child = node.child(name);
+  if (!child) return unknown;
+  std::string text = child.text().get();
+  const auto blank = [](char c) { return c == ' ' || c == '\t' || c == '\n' || c == '\r'; };
+  while (!text.empty() && blank(text.back())) text.pop_back();
+  while (!text.empty() && blank(text.front())) text.erase(text.begin());
+  if (text == "unkown") return unknown;
+  std::string expected;
+  for (const auto& [word, value] : names) {
+    if (text == word) return value;
+    expected += std::string(expected.empty() ? "" : ", ") + word;
+  }
+  throw InputError(source, path + "/" + name,
+                   "expected one of " + expected + ", found \"" + text.substr(0, 40) + "\"");
+}
+
+template <typename Enum, std::size_t N>
+const char* enum_name(Enum value, const std::pair<const char*, Enum> (&names)[N]) {
+  for (const auto& [word, entry] : names) {
+    if (entry == value) return word;
+  }
+  return "unknown";
+}
+
 }  // namespace
+
+std::optional<double> metres_per_unit(MpcdiUnit unit) {
+  switch (unit) {
+    case MpcdiUnit::mm:
+      return 0.001;
+    case MpcdiUnit::cm:
+      return 0.01;
+    case MpcdiUnit::dm:
+      return 0.1;
+    case MpcdiUnit::m:
+      return 1.0;
+    case MpcdiUnit::in:
+      return 0.0254;
+    case MpcdiUnit::ft:
+      return 0.3048;
+    case MpcdiUnit::yd:
+      return 0.9144;
+    case MpcdiUnit::unknown:
+      break;
+  }
+  return std::nullopt;
+}
+
+const char* to_string(MpcdiUnit unit) { return enum_name(unit, kUnits); }
+const char* to_string(MpcdiOrigin origin) { return enum_name(origin, kOrigins); }
+
+glm::dmat3 R_eye_mpcdi3d() { return glm::dmat3(-1, 0, 0, 0, 1, 0, 0, 0, -1); }
 
 glm::dmat3 R_eye_frustum(const MpcdiFrustum& f) {
   return rotation_about({0, 1, 0}, -f.yaw_deg) * rotation_about({1, 0, 0}, f.pitch_deg) *
@@ -207,8 +273,16 @@ MpcdiDocument parse_mpcdi_xml(std::string_view xml, const std::string& source) {
                        "expected the id of a region, found \"" + id.substr(0, 40) + "\"");
     }
     MpcdiRegion& region = result.regions[found->second];
-    const std::string warp = fileset.child("geometryWarpFile").child("path").text().get();
+    const pugi::xml_node warp_node = fileset.child("geometryWarpFile");
+    const std::string warp = warp_node.child("path").text().get();
     if (!warp.empty()) region.warp_path = warp;
+    if (result.profile == MpcdiProfile::advanced_3d) {
+      const std::string warp_path = "files/fileset[region=" + id + "]/geometryWarpFile";
+      region.unit =
+          enum_child(warp_node, "geometricUnit", kUnits, MpcdiUnit::unknown, source, warp_path);
+      region.origin = enum_child(warp_node, "originOf3DData", kOrigins, MpcdiOrigin::unknown,
+                                 source, warp_path);
+    }
     if (auto alpha = read_map(fileset, "alphaMap", source, path)) region.alpha = alpha;
     if (auto beta = read_map(fileset, "betaMap", source, path)) region.beta = beta;
   }
@@ -270,7 +344,13 @@ std::string format_mpcdi_xml(const MpcdiDocument& document) {
     fileset.append_attribute("region") = region.id.c_str();
     pugi::xml_node warp = fileset.append_child("geometryWarpFile");
     warp.append_child("path").text().set(region.warp_path.c_str());
+    if (document.profile == MpcdiProfile::advanced_3d) {
+      warp.append_child("geometricUnit").text().set(to_string(region.unit));
+    }
     warp.append_child("interpolation").text().set("linear");
+    if (document.profile == MpcdiProfile::advanced_3d) {
+      warp.append_child("originOf3DData").text().set(to_string(region.origin));
+    }
     const auto put_map = [&](const char* name, const std::optional<MpcdiMap>& map) {
       if (!map) return;
       pugi::xml_node node_map = fileset.append_child(name);

@@ -23,6 +23,10 @@ struct ImportedProjector {
 struct ImportedDisplay {
   std::string name;
   std::vector<ImportedProjector> projectors;
+  glm::dvec3 eye{0.0};  // display.json `eye`: world frame (facet's eye axes), metres
+  // What an importer wants the user to know (a guessed eye point, masked folds): one sentence
+  // each, for the CLI to print.
+  std::vector<std::string> notes;
 };
 
 // Turns any text into a projector name display.json accepts ("" becomes "projector").
