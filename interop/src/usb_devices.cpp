@@ -183,25 +183,91 @@ UsbListing list_usb_devices() {
   return listing;
 }
 
-void watch_usb_devices(const std::function<void(bool arrived, const UsbDevice& device)>& on_change,
-                       const std::function<bool()>& keep_going, std::chrono::milliseconds poll) {
-  // Comparing listings works on every platform and needs no callback threading; libusb's
-  // hotplug events would only shorten the delay below `poll`.
-  const auto key = [](const UsbDevice& d) { return bus_path(d) + " " + vid_pid(d); };
-  std::map<std::string, UsbDevice> known;
-  for (const UsbDevice& device : list_usb_devices().devices) known[key(device)] = device;
-  while (keep_going()) {
-    std::this_thread::sleep_for(poll);
-    std::map<std::string, UsbDevice> now;
-    for (const UsbDevice& device : list_usb_devices().devices) now[key(device)] = device;
-    for (const auto& [k, device] : known) {
-      if (!now.count(k)) on_change(false, device);
-    }
-    for (const auto& [k, device] : now) {
-      if (!known.count(k)) on_change(true, device);
-    }
-    known = std::move(now);
+std::vector<UsbChange> diff_devices(const std::vector<UsbDevice>& before,
+                                    const std::vector<UsbDevice>& after) {
+  const auto key = [](const UsbDevice& d) { return std::make_tuple(d.bus, d.ports, vid_pid(d)); };
+  std::map<decltype(key(UsbDevice{})), const UsbDevice*> old_devices, new_devices;
+  for (const UsbDevice& device : before) old_devices[key(device)] = &device;
+  for (const UsbDevice& device : after) new_devices[key(device)] = &device;
+  std::vector<UsbChange> changes;
+  for (const auto& [k, device] : old_devices) {
+    if (!new_devices.count(k)) changes.push_back({false, *device});
   }
+  for (const auto& [k, device] : new_devices) {
+    if (!old_devices.count(k)) changes.push_back({true, *device});
+  }
+  return changes;
+}
+
+std::string format_change(const UsbChange& change) {
+  return std::string(change.arrived ? "+ " : "- ") + vid_pid(change.device) + " " +
+         to_string(classify(change.device)) + " " + bus_path(change.device) + " " +
+         stable_id(change.device);
+}
+
+const char* to_string(UsbWatchMethod method) {
+  return method == UsbWatchMethod::hotplug ? "libusb hotplug events" : "polling";
+}
+
+UsbWatchMethod usb_watch_method() {
+  libusb_context* context = nullptr;
+  if (libusb_init(&context) != 0) return UsbWatchMethod::polling;
+  const bool hotplug = libusb_has_capability(LIBUSB_CAP_HAS_HOTPLUG) != 0;
+  libusb_exit(context);
+  return hotplug ? UsbWatchMethod::hotplug : UsbWatchMethod::polling;
+}
+
+namespace {
+
+int LIBUSB_CALL on_hotplug(libusb_context*, libusb_device*, libusb_hotplug_event, void* flag) {
+  // Device descriptors may not be opened inside the callback: note the event, list afterwards.
+  *static_cast<bool*>(flag) = true;
+  return 0;  // stay registered
+}
+
+}  // namespace
+
+UsbWatchMethod watch_usb_devices(const std::function<void(const UsbChange& change)>& on_change,
+                                 const std::function<bool()>& keep_going,
+                                 std::chrono::milliseconds poll) {
+  std::vector<UsbDevice> known = list_usb_devices().devices;
+  const auto relist = [&] {
+    std::vector<UsbDevice> now = list_usb_devices().devices;
+    for (const UsbChange& change : diff_devices(known, now)) on_change(change);
+    known = std::move(now);
+  };
+  libusb_context* context = nullptr;
+  libusb_hotplug_callback_handle handle = 0;
+  bool event = false;
+  const bool hotplug =
+      libusb_init(&context) == 0 && libusb_has_capability(LIBUSB_CAP_HAS_HOTPLUG) &&
+      libusb_hotplug_register_callback(context,
+                                       libusb_hotplug_event(LIBUSB_HOTPLUG_EVENT_DEVICE_ARRIVED |
+                                                            LIBUSB_HOTPLUG_EVENT_DEVICE_LEFT),
+                                       libusb_hotplug_flag(0), LIBUSB_HOTPLUG_MATCH_ANY,
+                                       LIBUSB_HOTPLUG_MATCH_ANY, LIBUSB_HOTPLUG_MATCH_ANY,
+                                       on_hotplug, &event, &handle) == LIBUSB_SUCCESS;
+  if (!hotplug) {
+    if (context) libusb_exit(context);
+    while (keep_going()) {
+      std::this_thread::sleep_for(poll);
+      relist();
+    }
+    return UsbWatchMethod::polling;
+  }
+  const auto seconds = std::chrono::duration_cast<std::chrono::microseconds>(poll).count();
+  while (keep_going()) {
+    timeval timeout{static_cast<decltype(timeval::tv_sec)>(seconds / 1000000),
+                    static_cast<decltype(timeval::tv_usec)>(seconds % 1000000)};
+    libusb_handle_events_timeout_completed(context, &timeout, nullptr);
+    if (event) {
+      event = false;
+      relist();
+    }
+  }
+  libusb_hotplug_deregister_callback(context, handle);
+  libusb_exit(context);
+  return UsbWatchMethod::hotplug;
 }
 
 }  // namespace facet::interop

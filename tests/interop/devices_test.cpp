@@ -68,6 +68,42 @@ TEST(UsbDevices, Formatting) {
   EXPECT_NE(table.find("usb:0403:6001@1-4"), std::string::npos);
 }
 
+TEST(UsbDevices, WatchReportsRemovalsThenArrivalsFromTwoListings) {
+  // A camera moves to another port, the serial adapter leaves, a second camera arrives.
+  UsbDevice moved = camera();
+  moved.ports = {5};
+  UsbDevice second = camera();
+  second.serial = "ZZ";
+  second.ports = {2, 3};
+  const std::vector<UsbChange> changes =
+      diff_devices({camera(), serial_adapter()}, {moved, second, camera()});
+  ASSERT_EQ(changes.size(), 3u);
+  EXPECT_FALSE(changes[0].arrived);
+  EXPECT_EQ(changes[0].device, serial_adapter());
+  EXPECT_TRUE(changes[1].arrived);
+  EXPECT_EQ(changes[1].device, second);  // bus 3, ports 2.3 sort before 5
+  EXPECT_TRUE(changes[2].arrived);
+  EXPECT_EQ(changes[2].device, moved);
+  EXPECT_EQ(format_change(changes[0]), "- 0403:6001 projector-control 1-4 usb:0403:6001@1-4");
+  EXPECT_EQ(format_change(changes[1]), "+ 046d:085c camera 3-2.3 usb:046d:085c:ZZ");
+  // Same devices, any order: nothing to report.
+  EXPECT_TRUE(diff_devices({camera(), serial_adapter()}, {serial_adapter(), camera()}).empty());
+  EXPECT_TRUE(diff_devices({}, {}).empty());
+  EXPECT_EQ(diff_devices({}, {camera()}).size(), 1u);
+}
+
+TEST(UsbDevices, WatchStopsWhenAsked) {
+  // Whichever method this machine has, the watch returns once keep_going says so and reports
+  // nothing when nothing changes (no device is expected to come or go during the test).
+  int calls = 0, changes = 0;
+  const UsbWatchMethod method =
+      watch_usb_devices([&](const UsbChange&) { ++changes; }, [&] { return ++calls <= 3; },
+                        std::chrono::milliseconds(20));
+  EXPECT_EQ(method, usb_watch_method());
+  EXPECT_EQ(calls, 4);
+  EXPECT_EQ(changes, 0);
+}
+
 TEST(UsbDevices, ListingRunsWhereverItIs) {
   // No USB devices may exist here; the call must return either way.
   const UsbListing listing = list_usb_devices();

@@ -165,7 +165,7 @@ TEST(MpcdiA3, FisheyeAndCylindricalBasesGoThroughAsTheyAre) {
   }
 }
 
-TEST(MpcdiA3, SampleDomeRoundTripsWithin001Px) {
+TEST(MpcdiA3, SampleDomeRoundTripsWithinFiveHundredthsOfAPixel) {
   // The calibrated sample display: four projectors, a 5 m dome screen, so the PFM holds points on
   // the dome rather than on the unit sphere.
   const auto config = projection_io::read_display_config(std::string(FACET_SOURCE_DIR) +

@@ -45,12 +45,12 @@ const Registration registration{
         std::signal(SIGINT, [](int) { interrupted = true; });
         const auto start = std::chrono::steady_clock::now();
         const double limit = options->seconds;
+        std::cout << "watching for arrivals and removals ("
+                  << interop::to_string(interop::usb_watch_method()) << "); Ctrl-C stops"
+                  << std::endl;
         interop::watch_usb_devices(
-            [](bool arrived, const interop::UsbDevice& device) {
-              std::cout << (arrived ? "+ " : "- ") << interop::vid_pid(device) << " "
-                        << interop::to_string(interop::classify(device)) << " "
-                        << interop::bus_path(device) << " " << interop::stable_id(device)
-                        << std::endl;
+            [](const interop::UsbChange& change) {
+              std::cout << interop::format_change(change) << std::endl;
             },
             [start, limit] {
               const double elapsed =

@@ -1,4 +1,6 @@
 // facet mpcdi: MPCDI containers in and out (interop/README.md documents the conventions).
+#include <cmath>
+#include <cstdio>
 #include <iostream>
 
 #include "command.hpp"
@@ -15,17 +17,22 @@ const Registration registration{
       command->require_subcommand(1);
 
       struct ExportOptions {
-        std::string display, out;
+        std::string display, out, profile = "3d";
         double spacing = 4.0;
       };
       auto exporting = std::make_shared<ExportOptions>();
       auto* export_command = command->add_subcommand(
-          "export", "Write a display.json's warps and blends as an MPCDI container (profile 3d)");
+          "export",
+          "Write a display.json's warps and blends as an MPCDI container (profile 3d or a3)");
       export_command->add_option("display", exporting->display, "display.json (or its folder)")
           ->required();
       export_command->add_option("--out", exporting->out, "The .mpcdi file to write")->required();
       export_command->add_option("--node-spacing", exporting->spacing,
                                  "Spacing of the PFM warp nodes in output pixels (default 4)");
+      export_command->add_option("--profile", exporting->profile,
+                                 "3d (default: a frustum and source positions per node) or a3 "
+                                 "(3D screen points per node: on display.json's screen, else on "
+                                 "the unit sphere around the eye)");
       export_command->callback([exporting] {
         if (!(exporting->spacing >= 0.5 && exporting->spacing <= 1024)) {
           throw InputError("--node-spacing", "", "expected a spacing in [0.5, 1024] pixels");
@@ -33,13 +40,18 @@ const Registration registration{
         const auto display = projection_io::read_display_config(exporting->display);
         interop::MpcdiExportOptions options;
         options.node_spacing_px = exporting->spacing;
+        if (exporting->profile == "a3") {
+          options.profile = interop::MpcdiProfile::advanced_3d;
+        } else if (exporting->profile != "3d") {
+          throw InputError("--profile", "", "expected 3d or a3");
+        }
         interop::write_zip_file(exporting->out, interop::export_mpcdi(display, options));
         std::cout << "wrote " << exporting->out << " (" << display.projectors.size()
                   << " regions)\n";
       });
 
       struct ImportOptions {
-        std::string file, out, values = "auto", grid;
+        std::string file, out, values = "auto", grid, eye;
       };
       auto importing = std::make_shared<ImportOptions>();
       auto* import_command = command->add_subcommand(
@@ -54,6 +66,9 @@ const Registration registration{
       import_command->add_option("--grid", importing->grid,
                                  "Node count GXxGY of the imported warps (default: as recorded "
                                  "by facet's export, else the PFM's)");
+      import_command->add_option("--eye", importing->eye,
+                                 "Profile a3: the eye point x,y,z in the file's frame and "
+                                 "geometricUnit (default: the frame's origin)");
       import_command->callback([importing] {
         interop::MpcdiImportOptions options;
         if (importing->values == "absolute") {
@@ -70,8 +85,19 @@ const Registration registration{
           }
           options.warp_grid = grid;
         }
+        if (!importing->eye.empty()) {
+          glm::dvec3 eye;
+          char end = 0;
+          if (std::sscanf(importing->eye.c_str(), "%lf,%lf,%lf%c", &eye.x, &eye.y, &eye.z, &end) !=
+                  3 ||
+              !std::isfinite(eye.x + eye.y + eye.z)) {
+            throw InputError("--eye", "", "expected x,y,z: three finite numbers");
+          }
+          options.eye = eye;
+        }
         const auto files = interop::read_zip_file(importing->file);
         const auto display = interop::import_mpcdi(files, importing->file, options);
+        for (const std::string& note : display.notes) std::cerr << "facet: note: " << note << "\n";
         interop::write_display_folder(display, importing->out);
         std::cout << "wrote " << importing->out << "/display.json (" << display.projectors.size()
                   << " projectors)\n";

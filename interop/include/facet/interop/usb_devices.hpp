@@ -54,11 +54,30 @@ struct UsbListing {
 // Enumerates the devices now, sorted by bus path.
 UsbListing list_usb_devices();
 
-// Follows hotplug: calls `on_change(arrived, device)` for every device that arrives or leaves,
-// until `keep_going()` returns false (checked every `poll`), by comparing listings every `poll`
-// (which works where libusb has no hotplug support, as in containers).
-void watch_usb_devices(const std::function<void(bool arrived, const UsbDevice& device)>& on_change,
-                       const std::function<bool()>& keep_going,
-                       std::chrono::milliseconds poll = std::chrono::milliseconds(500));
+struct UsbChange {
+  bool arrived = false;  // false: removed
+  UsbDevice device;
+};
+// What changed from one listing to the next, devices keyed by bus path and VID:PID: removals
+// first, then arrivals, each in bus-path order. A device re-plugged into the same port between
+// the two listings does not show.
+std::vector<UsbChange> diff_devices(const std::vector<UsbDevice>& before,
+                                    const std::vector<UsbDevice>& after);
+// "+ VID:PID role bus-path stable-id" for an arrival, "- ..." for a removal.
+std::string format_change(const UsbChange& change);
+
+enum class UsbWatchMethod { hotplug, polling };
+const char* to_string(UsbWatchMethod method);
+// hotplug where libusb starts and reports LIBUSB_CAP_HAS_HOTPLUG (Linux with udev or netlink,
+// macOS), else polling.
+UsbWatchMethod usb_watch_method();
+
+// Follows hotplug until `keep_going()` returns false, calling `on_change` for every arrival and
+// removal (diff_devices of the listings before and after). With libusb's hotplug callbacks, an
+// event makes it list again and `keep_going` is checked at least every `poll`; without them it
+// lists every `poll`. Returns the method it used.
+UsbWatchMethod watch_usb_devices(const std::function<void(const UsbChange& change)>& on_change,
+                                 const std::function<bool()>& keep_going,
+                                 std::chrono::milliseconds poll = std::chrono::milliseconds(500));
 
 }  // namespace facet::interop
