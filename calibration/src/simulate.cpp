@@ -170,12 +170,27 @@ std::vector<Pattern> simulated_patterns(const Rig& rig, std::size_t index) {
   return standard_patterns(rig.projectors[index].size, options);
 }
 
-cv::Mat render_frame(const Rig& rig, const ProjectorView& view, std::size_t index,
-                     const Pattern& pattern, std::size_t frame_index) {
+std::uint64_t noise_seed(std::uint64_t seed, std::size_t projector, std::size_t frame,
+                         std::size_t repeat) {
+  std::uint64_t key = splitmix(splitmix(splitmix(seed) ^ projector) ^ frame);
+  // Repeat 0 keeps the seed of a single exposure, so one grab per frame equals simulate's frame.
+  if (repeat > 0) key = splitmix(key ^ repeat);
+  return key;
+}
+
+cv::Mat ambient_image(const Rig& rig, glm::ivec2 camera_size) {
+  return cv::Mat(camera_size.y, camera_size.x, CV_32F, cv::Scalar(rig.simulation.ambient));
+}
+
+void add_projector_light(const Rig& rig, const ProjectorView& view, std::size_t index,
+                         const cv::Mat& values, cv::Mat& image) {
   FACET_ASSERT(index < rig.projectors.size());
   const ProjectorModel& projector = rig.projectors[index];
+  FACET_ASSERT(values.type() == CV_32F && values.cols == projector.size.x &&
+               values.rows == projector.size.y);
+  FACET_ASSERT(image.type() == CV_32F && image.size() == view.q_projector.size());
   const SimulationSettings& s = rig.simulation;
-  cv::Mat emitted = render_pattern(pattern, projector.size);
+  cv::Mat emitted = values.clone();
   if (projector.gamma != 1.0) cv::pow(emitted, projector.gamma, emitted);
   const bool sharp = s.defocus_px <= 0;
   // Defocus spreads light beyond the image edge, so blur a zero-padded copy.
@@ -188,7 +203,6 @@ cv::Mat render_frame(const Rig& rig, const ProjectorView& view, std::size_t inde
     cv::GaussianBlur(light, light, cv::Size(0, 0), s.defocus_px, s.defocus_px, cv::BORDER_CONSTANT);
   }
   const int rows = view.q_projector.rows, cols = view.q_projector.cols;
-  cv::Mat image(rows, cols, CV_32F, cv::Scalar(s.ambient));
   for (int j = 0; j < rows; ++j) {
     const auto* q_row = view.q_projector.ptr<cv::Vec2d>(j);
     const auto* e_row = view.irradiance.ptr<float>(j);
@@ -216,16 +230,29 @@ cv::Mat render_frame(const Rig& rig, const ProjectorView& view, std::size_t inde
       out[i] += float(s.peak * e_row[i] * value);
     }
   }
+}
+
+void finish_camera_image(const Rig& rig, cv::Mat& image, std::size_t projector, std::size_t frame,
+                         std::size_t repeat) {
+  const SimulationSettings& s = rig.simulation;
   if (s.camera_blur_px > 0) {
     cv::GaussianBlur(image, image, cv::Size(0, 0), s.camera_blur_px, s.camera_blur_px,
                      cv::BORDER_REPLICATE);
   }
   if (s.noise > 0) {
-    cv::RNG rng(splitmix(splitmix(splitmix(s.seed) ^ index) ^ frame_index));
-    cv::Mat noise(rows, cols, CV_32F);
+    cv::RNG rng(noise_seed(s.seed, projector, frame, repeat));
+    cv::Mat noise(image.rows, image.cols, CV_32F);
     rng.fill(noise, cv::RNG::NORMAL, 0.0, s.noise);
     image += noise;
   }
+}
+
+cv::Mat render_frame(const Rig& rig, const ProjectorView& view, std::size_t index,
+                     const Pattern& pattern, std::size_t frame_index, std::size_t repeat) {
+  FACET_ASSERT(index < rig.projectors.size());
+  cv::Mat image = ambient_image(rig, {view.q_projector.cols, view.q_projector.rows});
+  add_projector_light(rig, view, index, render_pattern(pattern, rig.projectors[index].size), image);
+  finish_camera_image(rig, image, index, frame_index, repeat);
   return image;
 }
 

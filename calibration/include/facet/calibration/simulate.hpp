@@ -16,9 +16,11 @@
 //   6. exposure: image = ambient + peak · falloff · light;
 //   7. camera blur: a Gaussian of σ = camera_blur_px in camera pixels;
 //   8. sensor noise: Gaussian, σ = noise (fraction of full scale), from a generator seeded by
-//      (seed, projector, frame), so a capture is a pure function of the rig and settings;
+//      (seed, projector, frame, repeat), so a capture is a pure function of the rig and settings
+//      (repeat counts the exposures of one frame that a live capture averages; simulate takes one);
 //   9. quantisation: clamped to [0,1] and rounded to 8- or 16-bit PNG levels.
 // The other projectors are dark while one projector's frames are captured.
+#include <cstdint>
 #include <filesystem>
 #include <glm/glm.hpp>
 #include <opencv2/core.hpp>
@@ -60,10 +62,27 @@ ProjectorView view_projector(const Rig& rig, const CameraModel& camera, std::siz
 std::vector<Pattern> simulated_patterns(const Rig& rig, std::size_t projector);
 
 // Renders frame `pattern` of one projector as the camera image, CV_32F linear light, with every
-// step above except quantisation (values may lie outside [0,1] before it). `frame_index` feeds
-// the noise seed.
+// step above except quantisation (values may lie outside [0,1] before it). `frame_index` and
+// `repeat` feed the noise seed. This is ambient_image, add_projector_light of the pattern, then
+// finish_camera_image: the fake camera of live capture (fake_camera.hpp) forms its images from the
+// same three steps.
 cv::Mat render_frame(const Rig& rig, const ProjectorView& view, std::size_t projector,
-                     const Pattern& pattern, std::size_t frame_index);
+                     const Pattern& pattern, std::size_t frame_index, std::size_t repeat = 0);
+
+// The pieces of render_frame, for images lit by what projectors actually show.
+// Step 6's constant: the ambient light alone, CV_32F of camera_size (W, H).
+cv::Mat ambient_image(const Rig& rig, glm::ivec2 camera_size);
+// Steps 2–6 for one projector: adds to `image` (CV_32F, the camera size of `view`) the light of
+// `values`, the image the projector shows (CV_32F, the projector's size, values in [0,1] before
+// its gamma). All-zero values add nothing.
+void add_projector_light(const Rig& rig, const ProjectorView& view, std::size_t projector,
+                         const cv::Mat& values, cv::Mat& image);
+// Steps 7–8 in place: camera blur, then noise from noise_seed(seed, projector, frame, repeat).
+void finish_camera_image(const Rig& rig, cv::Mat& image, std::size_t projector, std::size_t frame,
+                         std::size_t repeat = 0);
+// The noise generator's seed of one exposure; repeat 0 is the seed of simulate's frame.
+std::uint64_t noise_seed(std::uint64_t seed, std::size_t projector, std::size_t frame,
+                         std::size_t repeat);
 
 struct SimulationReport {
   glm::ivec2 camera_size{0, 0};

@@ -1,0 +1,52 @@
+#pragma once
+// Real cameras for live capture: V4L2/UVC devices through OpenCV's VideoCapture, and the lookup of
+// a device's /dev/videoN node from sysfs so that configs can name a USB camera by its stable
+// identity (the interop library's `usb:VVVV:PPPP:SERIAL` or `usb:VVVV:PPPP@BUS-PATH`).
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "facet/calibration/live_capture.hpp"
+
+namespace facet::calibration {
+
+// A video4linux capture node and, for USB devices, the USB device it belongs to.
+struct VideoDevice {
+  std::filesystem::path node;  // e.g. /dev/video0
+  std::string name;            // the driver's name for the node (sysfs `name`)
+  int index = 0;               // sysfs `index`: 0 is a device's main capture node
+  bool usb = false;            // the fields below are set only for USB devices
+  std::uint16_t vendor_id = 0, product_id = 0;
+  std::string serial;               // empty when the device reports none
+  int bus = 0;                      // USB bus number
+  std::vector<std::uint8_t> ports;  // port numbers from the root hub down
+  std::string bus_path() const;     // "BUS-P1.P2…", the sysfs name of the USB port
+};
+
+// The video4linux nodes under `sysfs_root`/class/video4linux, sorted by node name, with their USB
+// identity read from the USB device directory above each node's `device` link (idVendor,
+// idProduct, serial, busnum, devpath). Nodes are named `dev_root`/<node>. Empty when sysfs has
+// no video4linux class (no cameras, or no sysfs).
+std::vector<VideoDevice> list_video_devices(const std::filesystem::path& sysfs_root = "/sys",
+                                            const std::filesystem::path& dev_root = "/dev");
+
+struct VideoCameraOptions {
+  std::optional<glm::ivec2> size;  // ask the driver for this frame size (W, H)
+  // Frames read and dropped before each grab, so that no frame buffered while the previous
+  // pattern was shown is used.
+  int discard = 2;
+};
+
+// A camera opened through OpenCV VideoCapture with the V4L2 backend: `device` is a device node
+// (/dev/videoN) or an index ("0"). `identity` names it in the capture journal (the stable USB id
+// when the config gave one, else the node). Frames become grey (BT.601 luma of colour frames),
+// scaled so that full scale is 1. Throws InputError("--camera", ...) when the device does not
+// open or delivers no frame, and when a grab later fails.
+std::unique_ptr<LiveCamera> open_video_camera(const std::string& device,
+                                              const std::string& identity,
+                                              const VideoCameraOptions& options = {});
+
+}  // namespace facet::calibration

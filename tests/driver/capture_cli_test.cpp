@@ -1,0 +1,234 @@
+// `facet capture` end to end with the fake camera: patterns drawn headless through EGL into one
+// framebuffer per projector, read back, and seen through the virtual rig of the calibration
+// replay tests. A capture stopped (--stop-after) or killed (SIGKILL) and then resumed must write
+// the same frames, byte for byte, as one that ran through, and calibrate to the replay targets.
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "../calibration/capture_rig.hpp"
+#include "../calibration/test_folder.hpp"
+#include "facet/calibration/calibrate.hpp"
+#include "facet/calibration/capture.hpp"
+#include "facet/calibration/live_capture.hpp"
+#include "facet/calibration/simulate.hpp"
+#include "facet/projection_io/rig_file.hpp"
+
+namespace facet::calibration {
+namespace {
+
+namespace fs = std::filesystem;
+
+int run_cli(const std::string& arguments, std::string* output = nullptr) {
+  const std::string command = std::string(FACET_CLI) + " " + arguments + " 2>&1";
+  std::string text;
+  if (FILE* pipe = ::popen(command.c_str(), "r")) {
+    char buffer[512];
+    while (std::fgets(buffer, sizeof buffer, pipe)) text += buffer;
+    const int status = ::pclose(pipe);
+    if (output) *output = text;
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  }
+  return -1;
+}
+
+std::string file_bytes(const fs::path& path) {
+  std::ifstream stream(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(stream), std::istreambuf_iterator<char>()};
+}
+
+// The rig as a file and a display.json naming its two projectors (no warps yet).
+struct RigFiles {
+  test::TempFolder temp;
+  fs::path rig = temp.path() / "rig.json";
+  fs::path display = temp.path() / "display.json";
+
+  explicit RigFiles(const Rig& value = test::capture_test_rig()) {
+    write_rig(rig, value);
+    nlohmann::json projectors = nlohmann::json::array();
+    int x = 0;
+    for (const ProjectorModel& p : value.projectors) {
+      projectors.push_back({{"name", p.name},
+                            {"size", {p.size.x, p.size.y}},
+                            {"gamma", 2.2},
+                            {"output", {{"window", {x, 0, p.size.x, p.size.y}}}}});
+      x += p.size.x;
+    }
+    std::ofstream(display) << nlohmann::json{
+        {"format", "facet-display/1"},
+        {"name", "capture-test"},
+        {"eye", {0, 0, 0}},
+        {"projectors",
+         projectors}}.dump(1);
+  }
+
+  std::string command(const fs::path& out, const std::string& extra = "") const {
+    return "capture --display " + display.string() + " --camera fake:" + rig.string() + " --out " +
+           out.string() + " --settle-ms 0 --quiet " + extra;
+  }
+};
+
+// Every frame file of the finished capture `a` exists in `b` with the same bytes, and both
+// capture.json files list the same frames.
+void expect_same_frames(const fs::path& a, const fs::path& b) {
+  const Capture first = read_capture(a), second = read_capture(b);
+  EXPECT_EQ(capture_to_json(first), capture_to_json(second));
+  std::size_t compared = 0;
+  for (const CaptureProjector& projector : first.projectors) {
+    for (const CaptureFrame& frame : projector.frames) {
+      EXPECT_EQ(file_bytes(first.resolve(frame.file)), file_bytes(second.resolve(frame.file)))
+          << frame.file;
+      ++compared;
+    }
+  }
+  EXPECT_EQ(compared, 2u * 38);
+}
+
+std::size_t journal_frames(const fs::path& out) {
+  std::ifstream stream(out / kCaptureJournalFile);
+  std::size_t done = 0;
+  std::string line;
+  while (std::getline(stream, line)) done += line.find("\"done\"") != std::string::npos;
+  return done;
+}
+
+TEST(CaptureCli, StoppedAndKilledCapturesResumeToTheSameFrames) {
+  const RigFiles setup;
+  const fs::path whole = setup.temp.path() / "whole";
+  ASSERT_EQ(run_cli(setup.command(whole)), 0);
+
+  // A deterministic stop: exit 3, nothing finished, then a resume that captures the rest.
+  const fs::path stopped = setup.temp.path() / "stopped";
+  std::string output;
+  ASSERT_EQ(run_cli(setup.command(stopped, "--stop-after 25"), &output), 3) << output;
+  EXPECT_FALSE(fs::exists(stopped / "capture.json"));
+  EXPECT_EQ(journal_frames(stopped), 25u);
+  ASSERT_EQ(run_cli(setup.command(stopped, "--json"), &output), 0) << output;
+  const nlohmann::json report = nlohmann::json::parse(output.substr(output.find('{')));
+  EXPECT_EQ(report["kept"], 25);
+  EXPECT_EQ(report["captured"], 2 * 38 - 25);
+  EXPECT_TRUE(report["complete"].get<bool>());
+  expect_same_frames(whole, stopped);
+
+  // A real interruption: SIGKILL once some frames exist.
+  const fs::path killed = setup.temp.path() / "killed";
+  const pid_t child = ::fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    std::freopen("/dev/null", "w", stdout);
+    const std::string display = setup.display.string(), camera = "fake:" + setup.rig.string(),
+                      out = killed.string();
+    ::execl(FACET_CLI, "facet", "capture", "--display", display.c_str(), "--camera", camera.c_str(),
+            "--out", out.c_str(), "--settle-ms", "20", "--quiet", static_cast<char*>(nullptr));
+    ::_exit(127);
+  }
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  while (journal_frames(killed) < 10 && std::chrono::steady_clock::now() < deadline) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  ::kill(child, SIGKILL);
+  int status = 0;
+  ::waitpid(child, &status, 0);
+  ASSERT_TRUE(WIFSIGNALED(status)) << "the capture ended before it was killed";
+  EXPECT_FALSE(fs::exists(killed / "capture.json"));
+  const std::size_t before = journal_frames(killed);
+  EXPECT_GE(before, 10u);
+  ASSERT_EQ(run_cli(setup.command(killed, "--json"), &output), 0) << output;
+  const nlohmann::json resumed = nlohmann::json::parse(output.substr(output.find('{')));
+  // At most one frame was renamed into place after its predecessor's journal line.
+  EXPECT_GE(resumed["kept"].get<std::size_t>(), before);
+  EXPECT_LE(resumed["kept"].get<std::size_t>(), before + 1);
+  EXPECT_EQ(resumed["kept"].get<std::size_t>() + resumed["captured"].get<std::size_t>(), 76u);
+  expect_same_frames(whole, killed);
+  // No temporary file survives the resume.
+  for (const auto& entry : fs::recursive_directory_iterator(killed)) {
+    EXPECT_EQ(entry.path().filename().string().find(".tmp"), std::string::npos) << entry.path();
+  }
+}
+
+TEST(CaptureCli, AResumedCaptureCalibratesLikeTheSimulatedOne) {
+  const RigFiles setup;
+  const fs::path live = setup.temp.path() / "live";
+  ASSERT_EQ(run_cli(setup.command(live, "--stop-after 40")), 3);
+  ASSERT_EQ(run_cli(setup.command(live)), 0);
+  const CalibrationReport live_report = calibrate(live, setup.temp.path() / "live-display");
+  const fs::path simulated = setup.temp.path() / "simulated";
+  simulate_capture(test::capture_test_rig(), simulated);
+  const CalibrationReport simulated_report =
+      calibrate(simulated, setup.temp.path() / "simulated-display");
+  ASSERT_EQ(live_report.projectors.size(), 2u);
+  for (std::size_t p = 0; p < 2; ++p) {
+    const ProjectorReport& a = live_report.projectors[p];
+    const ProjectorReport& b = simulated_report.projectors[p];
+    ASSERT_TRUE(a.accuracy && b.accuracy) << a.name;
+    std::printf("%s: live rms %.4f p99 %.4f max %.4f px; simulate rms %.4f p99 %.4f max %.4f px\n",
+                a.name.c_str(), a.accuracy->rms_px, a.accuracy->p99_px, a.accuracy->max_px,
+                b.accuracy->rms_px, b.accuracy->p99_px, b.accuracy->max_px);
+    // The replay test's targets (FORMATS.md §5, 8 px border), in output pixels.
+    EXPECT_LE(a.accuracy->rms_px, 0.1) << a.name;
+    EXPECT_LE(a.accuracy->p99_px, 0.3) << a.name;
+    EXPECT_LE(a.accuracy->max_px, 1.0) << a.name;
+    EXPECT_LE(a.accuracy->uncovered_fraction, 0.001) << a.name;
+    EXPECT_EQ(a.fit.folds, 0u) << a.name;
+    EXPECT_EQ(a.fit.holes, 0u) << a.name;
+    // Only the phase frames differ (8-bit output levels): the results must agree closely.
+    EXPECT_LE(std::abs(a.accuracy->rms_px - b.accuracy->rms_px), 0.01) << a.name;
+    EXPECT_LE(std::abs(a.accuracy->p99_px - b.accuracy->p99_px), 0.05) << a.name;
+  }
+  EXPECT_LE(live_report.blend_sum_max_err, 0.005);
+}
+
+TEST(CaptureCli, BadInputExitsTwoAndFinishesNothing) {
+  Rig bright = test::capture_test_rig();
+  bright.simulation.peak = 1;  // with ambient light, past full scale
+  bright.simulation.ambient = 0.3;
+  const RigFiles setup;
+  std::string output;
+  // An unknown camera device: nothing is created.
+  const fs::path none = setup.temp.path() / "none";
+  EXPECT_EQ(run_cli("capture --display " + setup.display.string() +
+                        " --camera /dev/video-none-here --camera-model x.cameramodel --out " +
+                        none.string(),
+                    &output),
+            2)
+      << output;
+  EXPECT_FALSE(fs::exists(none));
+  // A real camera needs its lens model.
+  EXPECT_EQ(run_cli("capture --display " + setup.display.string() + " --camera /dev/video0 --out " +
+                        none.string(),
+                    &output),
+            2);
+  EXPECT_NE(output.find("--camera-model"), std::string::npos) << output;
+  EXPECT_FALSE(fs::exists(none));
+  // A resume with other settings than the interrupted capture.
+  const fs::path out = setup.temp.path() / "capture";
+  ASSERT_EQ(run_cli(setup.command(out, "--stop-after 3")), 3);
+  EXPECT_EQ(run_cli(setup.command(out, "--average 2"), &output), 2) << output;
+  EXPECT_NE(output.find("settings.average"), std::string::npos) << output;
+  EXPECT_EQ(run_cli(setup.command(out, "--bits 8"), &output), 2) << output;
+  EXPECT_NE(output.find("settings.bits"), std::string::npos) << output;
+  EXPECT_FALSE(fs::exists(out / "capture.json"));
+  // Clipping on the white frame: exit 2 naming the projector, no capture.json.
+  const RigFiles clipped(bright);
+  const fs::path clipped_out = clipped.temp.path() / "capture";
+  EXPECT_EQ(run_cli(clipped.command(clipped_out), &output), 2) << output;
+  EXPECT_NE(output.find("projector 'left'"), std::string::npos) << output;
+  EXPECT_FALSE(fs::exists(clipped_out / "capture.json"));
+  // ... unless accepted.
+  EXPECT_EQ(run_cli(clipped.command(clipped_out, "--allow-clipping --stop-after 2"), &output), 3)
+      << output;
+}
+
+}  // namespace
+}  // namespace facet::calibration
