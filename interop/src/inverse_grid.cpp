@@ -53,6 +53,89 @@ void drop_inconsistent(std::vector<glm::dvec2>& offsets, const std::vector<bool>
   }
 }
 
+// Least-squares fit of forward offsets to the valid samples of an inverse grid: sample k at output
+// position q_k shows st_k, so Σ_i w_i(st_k)·(st_i·size + o_i) = q_k with the bilinear weights
+// of st_k's forward cell. A small pull towards the starting offsets keeps nodes that no sample
+// pins where they were. Conjugate gradients on the normal equations, x and y together.
+void fit_to_samples(std::vector<glm::dvec2>& offsets, const InverseGrid& grid, glm::ivec2 warp_grid,
+                    glm::ivec2 output_size) {
+  struct Sample {
+    std::size_t node[4];
+    double weight[4];
+    glm::dvec2 b;  // q_k − st_k·size
+  };
+  std::vector<Sample> samples;
+  const glm::dvec2 size(output_size);
+  const glm::dvec2 cells(warp_grid - 1);
+  for (int j = 0; j < grid.grid_size.y; ++j) {
+    for (int i = 0; i < grid.grid_size.x; ++i) {
+      const glm::dvec2 st = grid.st[std::size_t(j) * grid.grid_size.x + i];
+      if (!finite(st) || st.x < 0 || st.y < 0 || st.x > 1 || st.y > 1) continue;
+      const glm::dvec2 q{double(i) / (grid.grid_size.x - 1) * size.x,
+                         double(j) / (grid.grid_size.y - 1) * size.y};
+      const glm::dvec2 g = st * cells;
+      const int ci = std::min(int(g.x), warp_grid.x - 2), cj = std::min(int(g.y), warp_grid.y - 2);
+      const double fx = g.x - ci, fy = g.y - cj;
+      Sample sample;
+      const std::size_t k0 = std::size_t(cj) * warp_grid.x + ci;
+      sample.node[0] = k0;
+      sample.node[1] = k0 + 1;
+      sample.node[2] = k0 + warp_grid.x;
+      sample.node[3] = k0 + warp_grid.x + 1;
+      sample.weight[0] = (1 - fx) * (1 - fy);
+      sample.weight[1] = fx * (1 - fy);
+      sample.weight[2] = (1 - fx) * fy;
+      sample.weight[3] = fx * fy;
+      sample.b = q - st * size;
+      samples.push_back(sample);
+    }
+  }
+  if (samples.empty()) return;
+  constexpr double kPull = 1e-6;
+  const std::size_t n = offsets.size();
+  const std::vector<glm::dvec2> start = offsets;
+  // (AᵀA + λI)·x
+  const auto apply = [&](const std::vector<glm::dvec2>& x, std::vector<glm::dvec2>& out) {
+    for (std::size_t k = 0; k < n; ++k) out[k] = kPull * x[k];
+    for (const Sample& sample : samples) {
+      glm::dvec2 r{0.0};
+      for (int c = 0; c < 4; ++c) r += sample.weight[c] * x[sample.node[c]];
+      for (int c = 0; c < 4; ++c) out[sample.node[c]] += sample.weight[c] * r;
+    }
+  };
+  std::vector<glm::dvec2> rhs(n), r(n), p(n), Ap(n);
+  for (std::size_t k = 0; k < n; ++k) rhs[k] = kPull * start[k];
+  for (const Sample& sample : samples) {
+    for (int c = 0; c < 4; ++c) rhs[sample.node[c]] += sample.weight[c] * sample.b;
+  }
+  apply(offsets, Ap);
+  glm::dvec2 rr{0.0};
+  for (std::size_t k = 0; k < n; ++k) {
+    r[k] = rhs[k] - Ap[k];
+    p[k] = r[k];
+    rr += r[k] * r[k];
+  }
+  // x and y are independent systems with the same matrix: one CG step size each.
+  double rhs_norm = 0;
+  for (const glm::dvec2& v : rhs) rhs_norm += glm::dot(v, v);
+  for (int iteration = 0; iteration < 1000; ++iteration) {
+    if (rr.x + rr.y <= 1e-22 * std::max(rhs_norm, 1.0)) break;
+    apply(p, Ap);
+    glm::dvec2 pAp{0.0};
+    for (std::size_t k = 0; k < n; ++k) pAp += p[k] * Ap[k];
+    const glm::dvec2 alpha{pAp.x > 0 ? rr.x / pAp.x : 0.0, pAp.y > 0 ? rr.y / pAp.y : 0.0};
+    glm::dvec2 rr_next{0.0};
+    for (std::size_t k = 0; k < n; ++k) {
+      offsets[k] += alpha * p[k];
+      r[k] -= alpha * Ap[k];
+      rr_next += r[k] * r[k];
+    }
+    const glm::dvec2 beta{rr.x > 0 ? rr_next.x / rr.x : 0.0, rr.y > 0 ? rr_next.y / rr.y : 0.0};
+    for (std::size_t k = 0; k < n; ++k) p[k] = r[k] + beta * p[k];
+    rr = rr_next;
+  }
+}
+
 }  // namespace
 
 std::vector<bool> fill_missing(std::vector<glm::dvec2>& values, glm::ivec2 grid_size,
@@ -191,6 +274,14 @@ Warp warp_from_inverse_grid(const InverseGrid& grid, const BaseProjection& base,
   drop_inconsistent(offsets, from_anywhere, warp_grid, std::max(1.0, 0.1 * cell_px));
   for (std::size_t k = 0; k < offsets.size(); ++k) covered[k] = covered[k] && finite(offsets[k]);
   fill_missing(offsets, warp_grid, source);
+  // A dense inverse grid says more than its values at the forward nodes: every sample is a point
+  // of the map, and the map is bilinear in each forward cell. Fitting the forward offsets to all
+  // samples recovers a forward warp that was itself bilinear on this grid (facet's own export)
+  // where inverting at the nodes alone would leave the inverse grid's interpolation error, which
+  // is first order in its spacing at the forward cells' edges. Sparser grids do not pin the cells.
+  if (grid.grid_size.x >= 2 * warp_grid.x - 1 && grid.grid_size.y >= 2 * warp_grid.y - 1) {
+    fit_to_samples(offsets, grid, warp_grid, output_size);
+  }
 
   warp.offset_px.resize(offsets.size());
   warp.coverage.resize(offsets.size());
