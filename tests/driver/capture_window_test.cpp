@@ -1,0 +1,191 @@
+// `facet capture --windowed` on a real X server: Xorg with the dummy video driver and two
+// monitors, started here. Each projector's patterns go to a fullscreen window on its monitor
+// (vsync, swap, read back of the presented buffer); the fake camera must then record the same
+// frames, byte for byte, as the headless outputs, also across a stop and a resume. Skipped,
+// saying why, only where Xorg cannot start here.
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <thread>
+
+#include "../calibration/capture_rig.hpp"
+#include "facet/projection_io/rig_file.hpp"
+
+namespace facet {
+namespace {
+
+namespace fs = std::filesystem;
+
+int run_shell(const std::string& command, std::string* output = nullptr) {
+  std::string text;
+  FILE* pipe = ::popen((command + " 2>&1").c_str(), "r");
+  if (!pipe) return -1;
+  char buffer[512];
+  while (std::fgets(buffer, sizeof buffer, pipe)) text += buffer;
+  const int status = ::pclose(pipe);
+  if (output) *output = text;
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+std::string file_bytes(const fs::path& path) {
+  std::ifstream stream(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(stream), std::istreambuf_iterator<char>()};
+}
+
+class CaptureWindows : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    folder_ = fs::temp_directory_path() / ("facet_capture_xorg_" + std::to_string(::getpid()));
+    fs::remove_all(folder_);
+    fs::create_directories(folder_);
+    if (!fs::exists("/usr/bin/Xorg") || !fs::exists("/usr/lib/xorg/modules/drivers/dummy_drv.so")) {
+      skip_reason_ = "Xorg or its dummy video driver (xserver-xorg-video-dummy) is not installed";
+      return;
+    }
+    if (::geteuid() != 0) {
+      skip_reason_ = "Xorg with the dummy driver needs root here";
+      return;
+    }
+    std::ofstream(folder_ / "xorg.conf") << R"(Section "Device"
+  Identifier "dummy"
+  Driver "dummy"
+  VideoRam 64000
+EndSection
+Section "Monitor"
+  Identifier "monitor"
+  HorizSync 5.0-1000.0
+  VertRefresh 5.0-200.0
+EndSection
+Section "Screen"
+  Identifier "screen"
+  Device "dummy"
+  Monitor "monitor"
+  DefaultDepth 24
+  SubSection "Display"
+    Depth 24
+    Virtual 1280 480
+  EndSubSection
+EndSection
+)";
+    // Another number than the session tests' (:70–:169), which may run at the same time.
+    display_ = ":" + std::to_string(170 + ::getpid() % 100);
+    xorg_ = ::fork();
+    if (xorg_ == 0) {
+      const std::string config = (folder_ / "xorg.conf").string();
+      const std::string log = (folder_ / "xorg.log").string();
+      ::execl("/usr/bin/Xorg", "Xorg", display_.c_str(), "-config", config.c_str(), "-noreset",
+              "-nolisten", "tcp", "-logfile", log.c_str(), static_cast<char*>(nullptr));
+      ::_exit(127);
+    }
+    for (int attempt = 0; attempt < 100 && xrandr("--listmonitors") != 0; ++attempt) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(100));
+      if (::waitpid(xorg_, nullptr, WNOHANG) == xorg_) {
+        xorg_ = -1;
+        skip_reason_ = "Xorg exited at start; see " + (folder_ / "xorg.log").string();
+        return;
+      }
+    }
+    if (xrandr("--listmonitors") != 0) {
+      skip_reason_ = "Xorg did not answer within 10 s";
+      return;
+    }
+    // Two side-by-side 640×480 monitors DUMMY0 and DUMMY1, larger than the 128×96 projectors:
+    // the patterns land 1:1 at each window's top-left corner.
+    for (int i = 0; i < 2; ++i) {
+      const std::string output = "DUMMY" + std::to_string(i);
+      xrandr("--addmode " + output + " 640x480");
+      xrandr("--output " + output + " --mode 640x480 --pos " + std::to_string(i * 640) + "x0");
+    }
+    xrandr("--listmonitors");
+  }
+
+  static void TearDownTestSuite() {
+    if (xorg_ > 0) {
+      ::kill(xorg_, SIGTERM);
+      ::waitpid(xorg_, nullptr, 0);
+      xorg_ = -1;
+    }
+    std::error_code ignored;
+    fs::remove_all(folder_, ignored);
+  }
+
+  void SetUp() override {
+    if (!skip_reason_.empty()) GTEST_SKIP() << skip_reason_;
+  }
+
+  static int xrandr(const std::string& arguments) {
+    return run_shell("DISPLAY=" + display_ + " xrandr " + arguments + " > /dev/null");
+  }
+
+  static fs::path write_files(const std::string& name, const std::string& second_monitor) {
+    const fs::path dir = folder_ / name;
+    fs::create_directories(dir);
+    write_rig(dir / "rig.json", test::capture_test_rig());
+    nlohmann::json projectors = nlohmann::json::array();
+    for (const auto& [projector, monitor] :
+         {std::pair{"left", std::string("DUMMY0")}, std::pair{"right", second_monitor}}) {
+      projectors.push_back({{"name", projector},
+                            {"size", {128, 96}},
+                            {"gamma", 2.2},
+                            {"output", {{"monitor", monitor}}}});
+    }
+    std::ofstream(dir / "display.json") << nlohmann::json{{"format", "facet-display/1"},
+                                                          {"name", name},
+                                                          {"eye", {0, 0, 0}},
+                                                          {"projectors", projectors}};
+    return dir;
+  }
+
+  // Leak checking is off for windowed runs in the sanitizer build, as in the session tests: Mesa's
+  // GLX driver is unloaded before LeakSanitizer runs.
+  static std::string capture(const fs::path& dir, const std::string& out,
+                             const std::string& extra) {
+    return "ASAN_OPTIONS=detect_leaks=0 DISPLAY=" + display_ + " " + FACET_CLI +
+           " capture --display " + (dir / "display.json").string() +
+           " --camera fake:" + (dir / "rig.json").string() + " --out " + (dir / out).string() +
+           " --settle-ms 0 --quiet " + extra;
+  }
+
+  static inline fs::path folder_;
+  static inline std::string display_;
+  static inline pid_t xorg_ = -1;
+  static inline std::string skip_reason_;
+};
+
+TEST_F(CaptureWindows, WindowedFramesEqualHeadlessOnesAcrossAResume) {
+  const fs::path dir = write_files("windows", "DUMMY1");
+  std::string output;
+  ASSERT_EQ(run_shell(capture(dir, "windowed", "--windowed --stop-after 30"), &output), 3)
+      << output;
+  EXPECT_FALSE(fs::exists(dir / "windowed" / "capture.json"));
+  ASSERT_EQ(run_shell(capture(dir, "windowed", "--windowed"), &output), 0) << output;
+  ASSERT_EQ(run_shell(capture(dir, "headless", "--headless"), &output), 0) << output;
+  std::size_t compared = 0;
+  for (const auto& entry : fs::recursive_directory_iterator(dir / "headless")) {
+    if (entry.path().extension() != ".png") continue;
+    const fs::path relative = fs::relative(entry.path(), dir / "headless");
+    EXPECT_EQ(file_bytes(entry.path()), file_bytes(dir / "windowed" / relative)) << relative;
+    ++compared;
+  }
+  EXPECT_EQ(compared, 2u * 38);
+}
+
+TEST_F(CaptureWindows, AMissingMonitorIsAClearError) {
+  const fs::path dir = write_files("missing", "DP-9");
+  std::string output;
+  EXPECT_EQ(run_shell(capture(dir, "capture", "--windowed"), &output), 2) << output;
+  EXPECT_NE(output.find("DP-9"), std::string::npos) << output;
+  EXPECT_NE(output.find("projectors[1].output.monitor"), std::string::npos) << output;
+  EXPECT_FALSE(fs::exists(dir / "capture"));
+}
+
+}  // namespace
+}  // namespace facet
