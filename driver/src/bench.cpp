@@ -388,10 +388,13 @@ BenchReport run_bench(const BenchOptions& options, const std::string& renderer,
         ids.push_back(targets[i].read_ids());
         const IdComparison c =
             compare_ids(reference[i], ids.back(), targets[i].size(), {.wrap_x = wrap_x});
+        const EdgeDisplacement e = raycaster.edge_displacement(inverses[i], T0, reference[i],
+                                                               ids.back(), {.wrap_x = wrap_x});
         pooled.compared_pixels += c.compared_pixels;
         pooled.mismatched_pixels += c.mismatched_pixels;
-        pooled.max_edge_px = std::max(pooled.max_edge_px, c.max_edge_px);
-        pooled.p99_edge_px = std::max(pooled.p99_edge_px, c.p99_edge_px);
+        pooled.max_edge_px = std::max(pooled.max_edge_px, e.max_px);
+        pooled.p99_edge_px = std::max(pooled.p99_edge_px, e.p99_px);
+        row.edge_beyond_window_pixels += e.beyond_window;
       }
       row.id_mismatch = pooled.compared_pixels
                             ? double(pooled.mismatched_pixels) / double(pooled.compared_pixels)

@@ -92,6 +92,7 @@ nlohmann::json row_json(const BenchRow& row) {
             {"id_mismatch", row.id_mismatch},
             {"max_edge_px", row.max_edge_px},
             {"p99_edge_px", row.p99_edge_px},
+            {"edge_beyond_window_pixels", row.edge_beyond_window_pixels},
             {"geometric_max_px", row.geometric_max_px},
             {"geometric_rms_px", row.geometric_rms_px},
             {"geometric_source", row.geometric_source}});
@@ -137,6 +138,7 @@ std::string csv_text(const BenchReport& report) {
         number(row.id_mismatch),
         number(row.max_edge_px),
         number(row.p99_edge_px),
+        count(row.edge_beyond_window_pixels),
         number(row.geometric_max_px),
         number(row.geometric_rms_px),
         row.geometric_source,
@@ -310,6 +312,7 @@ std::vector<std::string> bench_csv_columns() {
           "id_mismatch",
           "max_edge_px",
           "p99_edge_px",
+          "edge_beyond_window_pixels",
           "geometric_max_px",
           "geometric_rms_px",
           "geometric_source",

@@ -1,10 +1,12 @@
 #include <embree3/rtcore.h>
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cmath>
 #include <exception>
 #include <limits>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <thread>
@@ -173,6 +175,204 @@ std::vector<std::uint32_t> reference_ids(const Scene& scene, const Warp& warp,
                                          const ReferenceOptions& options) {
   const ReferenceRaycaster raycaster(scene, options);
   return raycaster.ids(WarpInverse(warp), T_eye_world);
+}
+
+EdgeDisplacement ReferenceRaycaster::edge_displacement(
+    const WarpInverse& inverse, const glm::dmat4& T_eye_world,
+    const std::vector<std::uint32_t>& reference, const std::vector<std::uint32_t>& tested,
+    const EdgeDisplacementOptions& options) const {
+  const glm::ivec2 size = inverse.warp().output_size;
+  const std::size_t pixels = std::size_t(size.x) * std::size_t(size.y);
+  for (const auto* image : {&reference, &tested}) {
+    if (image->size() != pixels) {
+      throw InputError(image == &reference ? "reference ID image" : "tested ID image", "size",
+                       "expected " + std::to_string(size.x) + "×" + std::to_string(size.y) +
+                           " pixels, got " + std::to_string(image->size()));
+    }
+  }
+  if (options.subsamples < 1 || !(options.window_px > 0)) {
+    throw InputError("edge displacement", "options", "expected subsamples >= 1 and window_px > 0");
+  }
+  const glm::dmat4 T_world_eye = glm::inverse(T_eye_world);
+  const glm::dvec3 p_eye_world(T_world_eye[3]);
+  const glm::dmat3 R_world_eye(T_world_eye);
+  auto id_at = [&](glm::dvec2 q) -> std::uint32_t {
+    if (options.wrap_x) q.x -= std::floor(q.x / size.x) * size.x;
+    const auto found = inverse.invert(q);
+    return found ? id_along(p_eye_world, R_world_eye * found->v_eye) : 0u;
+  };
+
+  std::vector<glm::ivec2> differing;
+  for (int y = 0; y < size.y; ++y) {
+    for (int x = 0; x < size.x; ++x) {
+      const std::size_t i = std::size_t(y) * size.x + x;
+      if (tested[i] != reference[i]) differing.push_back({x, y});
+    }
+  }
+  const double step = 1.0 / options.subsamples;
+  const glm::dmat3 R_eye_world(T_eye_world);
+  const glm::dvec3 p_world_eye(T_eye_world[3]);
+
+  // Corners of triangle `id` as pixel offsets from `anchor`, through the local linear map of the
+  // warp there: the directions that meet a triangle form a spherical triangle, which the
+  // gnomonic projection onto the tangent plane at the anchor's direction keeps a straight-edged
+  // triangle, and the warp inverse at anchor ± 1/64 px gives the map of that plane to output
+  // pixels. Empty without a preimage or with a corner 90° or more from the anchor's direction.
+  auto corners_around = [&](glm::dvec2 anchor,
+                            std::uint32_t id) -> std::optional<std::array<glm::dvec2, 3>> {
+    const auto at_anchor = inverse.invert(anchor);
+    if (!at_anchor) return std::nullopt;
+    const glm::dvec3 v = glm::normalize(at_anchor->v_eye);
+    constexpr double kEpsPx = 1.0 / 64;
+    glm::dvec3 dv_dq[2];
+    for (int axis = 0; axis < 2; ++axis) {
+      glm::dvec2 offset(0.0);
+      offset[axis] = kEpsPx;
+      const auto plus = inverse.invert(anchor + offset), minus = inverse.invert(anchor - offset);
+      if (!plus || !minus) return std::nullopt;
+      dv_dq[axis] =
+          (plus->v_eye / glm::dot(plus->v_eye, v) - minus->v_eye / glm::dot(minus->v_eye, v)) /
+          (2 * kEpsPx);
+    }
+    // Tangent-plane point w ↦ pixel offset: least squares on the basis dv_dq.
+    const glm::dmat2 gram(glm::dot(dv_dq[0], dv_dq[0]), glm::dot(dv_dq[0], dv_dq[1]),
+                          glm::dot(dv_dq[1], dv_dq[0]), glm::dot(dv_dq[1], dv_dq[1]));
+    if (!(std::abs(glm::determinant(gram)) > 0)) return std::nullopt;
+    const glm::dmat2 gram_inverse = glm::inverse(gram);
+    std::array<glm::dvec2, 3> corner;
+    for (int k = 0; k < 3; ++k) {
+      const glm::dvec3 X =
+          R_eye_world * glm::dvec3(impl_->p_world[3 * std::size_t(id - 1) + k]) + p_world_eye;
+      const double along = glm::dot(X, v);
+      if (!(along > 1e-9 * glm::length(X))) return std::nullopt;
+      const glm::dvec3 w = X / along - v;
+      corner[k] = gram_inverse * glm::dvec2(glm::dot(w, dv_dq[0]), glm::dot(w, dv_dq[1]));
+    }
+    return corner;
+  };
+  // Nearest point on a triangle's edges to `target`, and whether `target` is inside.
+  struct Nearest {
+    glm::dvec2 point;
+    bool target_inside;
+  };
+  auto nearest_on_edges = [](const std::array<glm::dvec2, 3>& corner, glm::dvec2 target) {
+    const double area = (corner[1].x - corner[0].x) * (corner[2].y - corner[0].y) -
+                        (corner[1].y - corner[0].y) * (corner[2].x - corner[0].x);
+    Nearest result{glm::dvec2(0.0), area != 0};
+    for (int k = 0; k < 3 && result.target_inside; ++k) {
+      const glm::dvec2 a = corner[k], b = corner[(k + 1) % 3];
+      result.target_inside =
+          ((b.x - a.x) * (target.y - a.y) - (b.y - a.y) * (target.x - a.x)) * area >= 0;
+    }
+    double best = std::numeric_limits<double>::infinity();
+    for (int k = 0; k < 3; ++k) {
+      const glm::dvec2 a = corner[k], ab = corner[(k + 1) % 3] - a;
+      const double length2 = glm::dot(ab, ab);
+      const double u = length2 > 0 ? std::clamp(glm::dot(target - a, ab) / length2, 0.0, 1.0) : 0.0;
+      const glm::dvec2 p = a + u * ab;
+      if (glm::length(p - target) < best) {
+        best = glm::length(p - target);
+        result.point = p;
+      }
+    }
+    return result;
+  };
+  // The nearest point to q on the edge of triangle `id`'s image, seen from outside (q outside the
+  // triangle) or from inside: found in the linear map at q, then again in the map at that point,
+  // until it moves less than 1e-4 px, so it is exact up to that and the warp inverse. Empty where
+  // the maps do not apply or q is not on the side asked for. Also returns the direction into the
+  // triangle there (towards its centroid).
+  auto edge_point = [&](glm::dvec2 q, std::uint32_t id,
+                        bool q_inside) -> std::optional<std::pair<glm::dvec2, glm::dvec2>> {
+    glm::dvec2 point = q, inward(0.0);
+    for (int iteration = 0; iteration < 8; ++iteration) {
+      const auto corner = corners_around(point, id);
+      if (!corner) return std::nullopt;
+      const Nearest nearest = nearest_on_edges(*corner, q - point);
+      if (nearest.target_inside != q_inside) return std::nullopt;
+      const glm::dvec2 moved = point + nearest.point;
+      inward = point + ((*corner)[0] + (*corner)[1] + (*corner)[2]) / 3.0 - moved;
+      const bool settled = glm::length(moved - point) < 1e-4;
+      point = moved;
+      if (settled && iteration > 0) break;
+    }
+    return std::pair{point, inward};
+  };
+  // Distance from q, outside triangle `id`'s image, to where the triangle is seen. Empty where
+  // edge_point is, or where the triangle is hidden at the point found (a ray cast 0.01 px inside
+  // it); the lattice search then decides.
+  auto distance_to_triangle = [&](glm::dvec2 q, std::uint32_t id) -> std::optional<double> {
+    const auto found = edge_point(q, id, false);
+    if (!found) return std::nullopt;
+    const auto [point, inward] = *found;
+    if (glm::length(inward) == 0) return std::nullopt;
+    const glm::dvec2 probe = point + std::min(0.01, glm::length(inward)) * glm::normalize(inward);
+    if (id_at(probe) != id) return std::nullopt;
+    return glm::length(point - q);
+  };
+
+  // Negative: nothing within the window.
+  std::vector<double> distance(differing.size(), -1.0);
+  for_each_row(int(differing.size()), [&](int k) {
+    const glm::ivec2 pixel = differing[std::size_t(k)];
+    const std::uint32_t id = tested[std::size_t(pixel.y) * size.x + pixel.x];
+    const glm::dvec2 centre = glm::dvec2(pixel) + 0.5;
+    // The tested triangle drawn too far reaches q (the distance to where it is seen), or the
+    // reference triangle drawn too short leaves q (the distance to its edge): the smaller.
+    double limit = options.window_px;
+    const std::uint32_t expected = reference[std::size_t(pixel.y) * size.x + pixel.x];
+    if (expected != 0) {
+      if (const auto found = edge_point(centre, expected, true)) {
+        limit = std::min(limit, glm::length(found->first - centre));
+      }
+    }
+    if (id != 0) {
+      if (const auto exact = distance_to_triangle(centre, id)) limit = std::min(limit, *exact);
+      if (limit < options.window_px) {
+        distance[std::size_t(k)] = limit;
+        return;
+      }
+    }
+    const int rings = int(std::ceil(limit * options.subsamples));
+    // Every lattice point on Chebyshev ring r is at least r steps away, so the search ends once
+    // r² passes the best squared distance found.
+    long best = std::numeric_limits<long>::max();
+    for (int r = 1; r <= rings && long(r) * r <= best; ++r) {
+      for (int dy = -r; dy <= r; ++dy) {
+        const int stride = (dy == -r || dy == r) ? 1 : 2 * r;
+        for (int dx = -r; dx <= r; dx += stride) {
+          const long d2 = long(dx) * dx + long(dy) * dy;
+          if (d2 >= best || d2 > long(rings) * rings) continue;
+          if (id_at(centre + step * glm::dvec2(dx, dy)) == id) best = d2;
+        }
+      }
+    }
+    if (best <= long(rings) * rings) {
+      distance[std::size_t(k)] = std::min(limit, step * std::sqrt(double(best)));
+    } else if (limit < options.window_px) {
+      distance[std::size_t(k)] = limit;
+    }
+  });
+
+  EdgeDisplacement result;
+  result.differing_pixels = differing.size();
+  std::vector<double> measured;
+  for (const double d : distance) {
+    if (d < 0) {
+      ++result.beyond_window;
+    } else {
+      measured.push_back(d);
+    }
+  }
+  result.measured_pixels = measured.size();
+  if (!measured.empty()) {
+    result.max_px = *std::max_element(measured.begin(), measured.end());
+    const std::size_t k =
+        std::min(measured.size() - 1, std::size_t(0.99 * double(measured.size())));
+    std::nth_element(measured.begin(), measured.begin() + std::ptrdiff_t(k), measured.end());
+    result.p99_px = measured[k];
+  }
+  return result;
 }
 
 IdComparison compare_ids(const std::vector<std::uint32_t>& reference,

@@ -249,5 +249,85 @@ TEST(CompareIds, WrongSizesAreInputErrors) {
   EXPECT_THROW(compare_ids(reference, reference, {100, 41}), InputError);
 }
 
+// The rectangle of expected_rectangle_id drawn 2 px too far right: columns 50 and 51 lose it
+// (tested ID 0; the exact edge tan_x = -0.5 is q.x = 50, 0.5 and 1.5 px from their centres),
+// columns 150 and 151 gain it (the edge q.x = 150, again 0.5 and 1.5 px), and the diagonal
+// moves 2 px along x, 2/√5 ≈ 0.89 px across. The worst is 1.5 px: a distance to ID 0 (nothing),
+// found on the 1/8 px lattice, which overstates by at most √2/8 px.
+TEST(EdgeDisplacement, ShiftedRectangleIsMeasuredAgainstTheExactEdges) {
+  Scene scene;
+  add_rectangle(scene, {-1, -0.5f}, {1, 0.5f}, -2);
+  const ReferenceRaycaster raycaster(scene);
+  const Warp warp = square_view();
+  const WarpInverse inverse(warp);
+  const std::vector<std::uint32_t> reference = raycaster.ids(inverse, glm::dmat4(1));
+  EdgeDisplacement e =
+      raycaster.edge_displacement(inverse, glm::dmat4(1), reference, reference, {});
+  EXPECT_EQ(e.differing_pixels, 0u);
+  EXPECT_EQ(e.max_px, 0.0);
+
+  std::vector<std::uint32_t> tested(reference.size());
+  for (int y = 0; y < 200; ++y) {
+    for (int x = 0; x < 200; ++x) {
+      tested[std::size_t(y) * 200 + x] = x < 2 ? 0 : expected_rectangle_id(x - 2, y, 1);
+    }
+  }
+  e = raycaster.edge_displacement(inverse, glm::dmat4(1), reference, tested, {});
+  EXPECT_GT(e.differing_pixels, 4u * 50u);
+  EXPECT_EQ(e.beyond_window, 0u);
+  EXPECT_EQ(e.measured_pixels, e.differing_pixels);
+  EXPECT_GE(e.max_px, 1.5 - 1e-9);
+  EXPECT_LE(e.max_px, 1.5 + std::sqrt(2.0) / 8);
+  EXPECT_LE(e.p99_px, e.max_px);
+
+  // A pixel showing the rectangle's upper-left triangle 29.5 px left of its edge q.x = 50:
+  // beyond the 4 px window, counted and left out of max_px.
+  tested[100 * 200 + 20] = 2;
+  e = raycaster.edge_displacement(inverse, glm::dmat4(1), reference, tested, {});
+  EXPECT_EQ(e.beyond_window, 1u);
+  EXPECT_GE(e.max_px, 1.5 - 1e-9);
+  EXPECT_LE(e.max_px, 1.5 + std::sqrt(2.0) / 8);
+  // A wider window reaches it; a triangle's distance is computed, not searched.
+  e = raycaster.edge_displacement(inverse, glm::dmat4(1), reference, tested, {.window_px = 32});
+  EXPECT_EQ(e.beyond_window, 0u);
+  EXPECT_NEAR(e.max_px, 29.5, 1e-6);
+
+  EXPECT_THROW(raycaster.edge_displacement(inverse, glm::dmat4(1), reference,
+                                           std::vector<std::uint32_t>(10), {}),
+               InputError);
+}
+
+// A sliver: a rectangle 0.2 px tall, whose two triangles meet along a diagonal 100 px long. The
+// reference image shows few of its pixel centres; a tested image that gives the diagonal's
+// pixels to the other triangle, as a renderer moving the diagonal by a fraction of a pixel
+// does, is tens of pixels off by the image-based distance and within a pixel by the exact one.
+TEST(EdgeDisplacement, SliverIsMeasuredWhereItLies) {
+  Scene scene;
+  // tan_y in (0.0035, 0.0055) · 2 m: output rows y ∈ (99.45, 99.65), so only row 99's centres
+  // (99.5) are inside; tan_x in (-0.5, 0.5): columns 50..149.
+  add_rectangle(scene, {-1, 0.007f}, {1, 0.011f}, -2);
+  const ReferenceRaycaster raycaster(scene);
+  const WarpInverse inverse(square_view());
+  const std::vector<std::uint32_t> reference = raycaster.ids(inverse, glm::dmat4(1));
+  std::size_t first = 0, second = 0;
+  for (const std::uint32_t id : reference) {
+    first += id == 1;
+    second += id == 2;
+  }
+  ASSERT_GT(first, 16u);
+  ASSERT_GT(second, 16u);
+  // Every pixel of the row given to triangle 1.
+  std::vector<std::uint32_t> tested = reference;
+  for (std::uint32_t& id : tested) {
+    if (id == 2) id = 1;
+  }
+  const IdComparison image_based = compare_ids(reference, tested, {200, 200});
+  const EdgeDisplacement exact =
+      raycaster.edge_displacement(inverse, glm::dmat4(1), reference, tested, {});
+  EXPECT_GT(image_based.max_edge_px, 10.0);
+  EXPECT_EQ(exact.beyond_window, 0u);
+  EXPECT_LT(exact.max_px, 0.5);
+}
+
 }  // namespace
 }  // namespace facet::driver

@@ -56,38 +56,53 @@ Scene load_scene(const std::string& name) {
   return load_gltf(path);
 }
 
-// The last frame's IDs against the Embree ray cast of the same view, pooled over the outputs
-// (ratios of pooled pixel counts; edge distances are the worst output's).
+// The last frame's IDs against the Embree ray cast of the same view, pooled over the outputs:
+// id_mismatch from compare_ids (ratio of pooled pixel counts), edge distances from the exact
+// geometry (ReferenceRaycaster::edge_displacement; the worst output's).
 nlohmann::json compare_with_reference(const Scene& scene, const std::vector<OutputSpec>& outputs,
                                       const std::vector<OutputTarget>& targets,
-                                      const glm::dmat4& T_eye_world) {
+                                      const glm::dmat4& T_eye_world,
+                                      const std::filesystem::path& ids_folder) {
   const ReferenceRaycaster raycaster(scene);
   IdComparison pooled;
+  EdgeDisplacement edges;
   nlohmann::json per_output = nlohmann::json::array();
   for (std::size_t i = 0; i < outputs.size(); ++i) {
     const WarpInverse inverse(outputs[i].warp);
-    const IdCompareOptions compare{.wrap_x = outputs[i].warp.base.wraps_horizontally()};
-    const IdComparison c = compare_ids(raycaster.ids(inverse, T_eye_world), targets[i].read_ids(),
-                                       targets[i].size(), compare);
+    const bool wrap_x = outputs[i].warp.base.wraps_horizontally();
+    const std::vector<std::uint32_t> reference = raycaster.ids(inverse, T_eye_world);
+    if (!ids_folder.empty()) {
+      write_ids_exr(ids_folder / (outputs[i].name + ".reference.ids.exr"), targets[i].size(),
+                    reference);
+    }
+    const std::vector<std::uint32_t> tested = targets[i].read_ids();
+    const IdComparison c = compare_ids(reference, tested, targets[i].size(), {.wrap_x = wrap_x});
+    const EdgeDisplacement e =
+        raycaster.edge_displacement(inverse, T_eye_world, reference, tested, {.wrap_x = wrap_x});
     per_output.push_back({{"name", outputs[i].name},
                           {"id_mismatch", c.id_mismatch},
-                          {"max_edge_px", c.max_edge_px},
-                          {"p99_edge_px", c.p99_edge_px}});
+                          {"max_edge_px", e.max_px},
+                          {"p99_edge_px", e.p99_px},
+                          {"edge_beyond_window_pixels", e.beyond_window}});
     pooled.compared_pixels += c.compared_pixels;
     pooled.mismatched_pixels += c.mismatched_pixels;
-    pooled.differing_pixels += c.differing_pixels;
-    pooled.max_edge_px = std::max(pooled.max_edge_px, c.max_edge_px);
-    pooled.p99_edge_px = std::max(pooled.p99_edge_px, c.p99_edge_px);
+    edges.differing_pixels += e.differing_pixels;
+    edges.measured_pixels += e.measured_pixels;
+    edges.beyond_window += e.beyond_window;
+    edges.max_px = std::max(edges.max_px, e.max_px);
+    edges.p99_px = std::max(edges.p99_px, e.p99_px);
   }
   const double mismatch = pooled.compared_pixels
                               ? double(pooled.mismatched_pixels) / double(pooled.compared_pixels)
                               : 0.0;
   return {{"id_mismatch", mismatch},
-          {"max_edge_px", pooled.max_edge_px},
-          {"p99_edge_px", pooled.p99_edge_px},
           {"compared_pixels", pooled.compared_pixels},
           {"mismatched_pixels", pooled.mismatched_pixels},
-          {"differing_pixels", pooled.differing_pixels},
+          {"max_edge_px", edges.max_px},
+          {"p99_edge_px", edges.p99_px},
+          {"differing_pixels", edges.differing_pixels},
+          {"edge_beyond_window_pixels", edges.beyond_window},
+          {"edge_window_px", EdgeDisplacementOptions{}.window_px},
           {"outputs", per_output}};
 }
 
@@ -200,7 +215,9 @@ void run(const RenderOptions& options) {
                            {"pass_ms", pass_ms},
                            {"texture_anisotropy", gpu_scene.max_anisotropy}};
   if (options.reference)
-    report["reference"] = compare_with_reference(scene, outputs, targets, T_eye_world);
+    report["reference"] = compare_with_reference(
+        scene, outputs, targets, T_eye_world,
+        options.ids && !options.out.empty() ? std::filesystem::path(options.out) : "");
   if (options.json) {
     std::cout << report.dump(2) << "\n";
   } else {
@@ -217,9 +234,12 @@ void run(const RenderOptions& options) {
     }
     if (options.reference) {
       const nlohmann::json& r = report["reference"];
-      std::printf("  reference: id_mismatch %.6f, max_edge_px %.3f, p99_edge_px %.3f\n",
-                  r["id_mismatch"].get<double>(), r["max_edge_px"].get<double>(),
-                  r["p99_edge_px"].get<double>());
+      std::printf(
+          "  reference: id_mismatch %.6f, max_edge_px %.3f, p99_edge_px %.3f, %zu of %zu "
+          "differing pixels beyond %.0f px\n",
+          r["id_mismatch"].get<double>(), r["max_edge_px"].get<double>(),
+          r["p99_edge_px"].get<double>(), r["edge_beyond_window_pixels"].get<std::size_t>(),
+          r["differing_pixels"].get<std::size_t>(), r["edge_window_px"].get<double>());
     }
   }
 }
@@ -247,8 +267,9 @@ const Registration registration{
       command->add_option("--out", options->out, "Folder for <output>.png (and IDs, depth)");
       command->add_flag("--ids", options->ids, "Also write <output>.ids.exr (needs --out)");
       command->add_flag("--depth", options->depth, "Also write <output>.depth.exr (needs --out)");
-      command->add_flag("--reference", options->reference,
-                        "Compare the IDs with the CPU ray-cast reference");
+      command->add_flag(
+          "--reference", options->reference,
+          "Compare the IDs with the CPU ray-cast reference (with --ids: also write it)");
       command->add_option("--anisotropy", options->anisotropy,
                           "Texture anisotropy level (0: automatic, 8 on GPUs, off on llvmpipe)");
       command->add_flag("--json", options->json, "Print one JSON object");

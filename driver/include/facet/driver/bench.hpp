@@ -74,8 +74,12 @@ struct BenchRow {
   std::uint64_t facets = 0, triangles_in = 0, triangles_visible = 0, replicas = 0;
   double replication_ratio = 0;  // mean of replicas / triangles_in over the timed frames
   // Reference comparison on the accuracy frame, pooled over outputs: id_mismatch is
-  // Σ mismatched / Σ compared, max_edge_px the largest, p99_edge_px the largest output's p99.
+  // Σ mismatched / Σ compared (compare_ids); max_edge_px the largest and p99_edge_px the largest
+  // output's p99 of the edge displacement against the exact geometry
+  // (ReferenceRaycaster::edge_displacement), which leaves out the differing pixels counted in
+  // edge_beyond_window_pixels (more than 4 px).
   double id_mismatch = 0, max_edge_px = 0, p99_edge_px = 0;
+  std::uint64_t edge_beyond_window_pixels = 0;
   // Geometric error in output pixels: max (worst case) and RMS; see geometric_source.
   double geometric_max_px = 0, geometric_rms_px = 0;
   // "facet error" (evaluate_facet_error of the facets against the exact warp), "cube texel"
