@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <optional>
@@ -51,7 +52,8 @@ struct FakeRun {
   std::optional<MemoryOutputs> outputs;
   std::optional<FakeCamera> camera;
 
-  explicit FakeRun(bool phase = true, bool overexposed = false) {
+  explicit FakeRun(bool phase = true, bool overexposed = false, double noise = 0.01) {
+    rig.simulation.noise = noise;
     if (overexposed) {
       // The brightest white plus ambient light past full scale.
       rig.simulation.peak = 1;
@@ -223,6 +225,49 @@ TEST(LiveCapture, ClippingOnTheWhiteFrameIsAnInputErrorNamingTheProjector) {
   }
   EXPECT_FALSE(fs::exists(out / "capture.json"));
   EXPECT_FALSE(fs::exists(out / "left" / "white.png"));
+}
+
+TEST(LiveCapture, AveragingExposuresLowersTheNoise) {
+  const test::TempFolder temp;
+  // The white frame only (the first), with and without noise, 1 and 4 exposures.
+  FakeRun clean(false, false, 0.0), single(false), averaged(false);
+  clean.run(temp.path() / "clean", 1);
+  single.run(temp.path() / "single", 1);
+  averaged.run(temp.path() / "averaged", 1, 4);
+  const cv::Mat truth = read_luminance(temp.path() / "clean/left/white.png");
+  auto rms = [&](const char* name) {
+    const cv::Mat difference = read_luminance(temp.path() / name / "left/white.png") - truth;
+    return std::sqrt(cv::mean(difference.mul(difference))[0]);
+  };
+  const double one = rms("single"), four = rms("averaged");
+  std::printf("white frame noise RMS: 1 exposure %.5f, 4 exposures %.5f\n", one, four);
+  // σ = 1% of full scale per exposure; the mean of 4 independent exposures has half of it.
+  EXPECT_NEAR(one, 0.01, 0.001);
+  EXPECT_NEAR(four / one, 0.5, 0.05);
+}
+
+// A camera with a response curve: every pixel at 0.5 of full scale.
+class ConstantCamera : public LiveCamera {
+ public:
+  glm::ivec2 size() const override { return {320, 256}; }
+  cv::Mat grab(const GrabKey&) override { return cv::Mat(256, 320, CV_32F, cv::Scalar(0.5)); }
+  nlohmann::json identity() const override { return "constant"; }
+};
+
+TEST(LiveCapture, FramesAreWrittenInLinearLight) {
+  const test::TempFolder temp;
+  FakeRun run(false);
+  ConstantCamera camera;
+  LiveCaptureOptions options;
+  options.out = temp.path() / "capture";
+  options.camera_gamma = 2;
+  options.stop_after = 1;
+  run_live_capture(*run.outputs, camera, run.setup, options);
+  const cv::Mat white = read_luminance(options.out / "left/white.png");
+  double low = 0, high = 0;
+  cv::minMaxLoc(white, &low, &high);
+  EXPECT_NEAR(low, 0.25, 1.0 / 65535);  // 0.5^2
+  EXPECT_NEAR(high, 0.25, 1.0 / 65535);
 }
 
 TEST(VideoDevices, SysfsNodesCarryTheirUsbIdentity) {

@@ -157,6 +157,44 @@ TEST(CaptureCli, StoppedAndKilledCapturesResumeToTheSameFrames) {
   }
 }
 
+TEST(CaptureCli, SigintStopsBetweenFramesAndLeavesTheCaptureResumable) {
+  const RigFiles files;
+  const fs::path out = files.temp.path() / "interrupted";
+  const pid_t child = ::fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    std::freopen("/dev/null", "w", stdout);
+    const std::string display = files.display.string(), camera = "fake:" + files.rig.string(),
+                      folder = out.string();
+    ::execl(FACET_CLI, "facet", "capture", "--display", display.c_str(), "--camera", camera.c_str(),
+            "--out", folder.c_str(), "--settle-ms", "20", "--quiet", static_cast<char*>(nullptr));
+    ::_exit(127);
+  }
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  while (journal_frames(out) < 5 && std::chrono::steady_clock::now() < deadline) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  ::kill(child, SIGINT);
+  int status = 0;
+  ::waitpid(child, &status, 0);
+  // Stopped after the frame in hand: the incomplete capture's exit status, every frame journaled.
+  ASSERT_TRUE(WIFEXITED(status)) << "killed by the signal instead of stopping";
+  EXPECT_EQ(WEXITSTATUS(status), 3);
+  EXPECT_FALSE(fs::exists(out / "capture.json"));
+  const std::size_t journaled = journal_frames(out);
+  std::size_t images = 0;
+  for (const auto& entry : fs::recursive_directory_iterator(out)) {
+    images += entry.path().extension() == ".png";
+  }
+  EXPECT_EQ(images, journaled);
+  EXPECT_LT(journaled, 76u);
+  std::string output;
+  ASSERT_EQ(run_cli(files.command(out, "--json"), &output), 0) << output;
+  const nlohmann::json report = nlohmann::json::parse(output.substr(output.find('{')));
+  EXPECT_EQ(report["kept"].get<std::size_t>(), journaled);
+  EXPECT_EQ(report["kept"].get<std::size_t>() + report["captured"].get<std::size_t>(), 76u);
+}
+
 TEST(CaptureCli, AResumedCaptureCalibratesLikeTheSimulatedOne) {
   const RigFiles setup;
   const fs::path live = setup.temp.path() / "live";
