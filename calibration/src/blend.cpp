@@ -154,23 +154,15 @@ double covered_depth_px(const Warp& warp, const cv::Mat& depth_px, glm::dvec3 v_
   return bilinear(depth_px, q);
 }
 
-// The distance of v from the part of projector k's covered edge that matters for blending, as
-// an angle: the feather distance map at k's position of v (bilinear between pixel centres), times
-// the local angle per output pixel (the square root of the area ratio of direction and output
-// Jacobians). 0 where k does not cover v.
-double edge_distance_rad(const Warp& warp, const cv::Mat& distance, glm::dvec3 v_eye) {
-  const auto projected = warp.project(v_eye);
-  if (!projected || !projected->covered) return 0;
-  const glm::dvec2 q = projected->q;
-  if (!(q.x > 0 && q.y > 0 && q.x < warp.output_size.x && q.y < warp.output_size.y)) return 0;
-  const double d_px = bilinear(distance, q);
-  if (!(d_px > 0)) return 0;
-  // Differences over two cells each way: the bilinear warp's own Jacobian jumps from cell to cell
-  // (by a few percent with noisy nodes), and a weight that jumped with it would break the sum
-  // between pixels. Over a fixed step the estimate is continuous in st.
+// Output pixels per radian at projector k's position st: the square root of the area ratio of
+// output and direction Jacobians, from differences over two cells each way (the bilinear warp's
+// own Jacobian jumps from cell to cell, by a few percent with noisy nodes, and a weight that
+// jumped with it would break the sum between pixels; over a fixed step the estimate is
+// continuous in st). 0 where it is degenerate.
+double rad_per_px(const Warp& warp, glm::dvec2 st_at) {
   const glm::dvec2 h(std::min(0.25, 2.0 / (warp.grid_size.x - 1)),
                      std::min(0.25, 2.0 / (warp.grid_size.y - 1)));
-  const glm::dvec2 st = glm::clamp(projected->st, h, glm::dvec2(1.0) - h);
+  const glm::dvec2 st = glm::clamp(st_at, h, glm::dvec2(1.0) - h);
   const glm::dvec2 ds(h.x, 0), dt(0, h.y);
   const glm::dvec2 dq_ds = warp.q_from_st(st + ds) - warp.q_from_st(st - ds);
   const glm::dvec2 dq_dt = warp.q_from_st(st + dt) - warp.q_from_st(st - dt);
@@ -179,13 +171,72 @@ double edge_distance_rad(const Warp& warp, const cv::Mat& distance, glm::dvec3 v
   const double area_q = std::abs(dq_ds.x * dq_dt.y - dq_ds.y * dq_dt.x);
   const double area_v = glm::length(glm::cross(dv_ds, dv_dt));
   if (!(area_q > 0) || !(area_v > 0)) return 0;
-  return d_px * std::sqrt(area_v / area_q);
+  return std::sqrt(area_v / area_q);
 }
 
 double smoothstep(double x) {
   x = std::clamp(x, 0.0, 1.0);
   return x * x * (3 - 2 * x);
 }
+
+// Beyond an edge of its covered region, a projector's raw weight is carried on, unchanged for
+// kContinueFlatPx and then falling to 0 over kContinueFadePx (output pixels from its covered pixel
+// centres), in the sums of the projectors that go on lighting there (see compute_blend).
+constexpr double kContinueFlatPx = 2;
+constexpr double kContinueFadePx = 6;
+constexpr int kContinuePad = int(kContinueFlatPx + kContinueFadePx) + 2;
+
+// Distance in output pixels from each point of the image padded by kContinuePad on every side to
+// the nearest covered pixel centre. CV_32F, (W + 2·pad) × (H + 2·pad).
+cv::Mat beyond_covered_px(const cv::Mat& padded_covered_mask) {
+  const cv::Mat inner = padded_covered_mask(
+      cv::Rect(1, 1, padded_covered_mask.cols - 2, padded_covered_mask.rows - 2));
+  cv::Mat uncovered(inner.rows + 2 * kContinuePad, inner.cols + 2 * kContinuePad, CV_8U,
+                    cv::Scalar(1));
+  cv::Mat centre = uncovered(cv::Rect(kContinuePad, kContinuePad, inner.cols, inner.rows));
+  centre.setTo(0, inner != 0);
+  cv::Mat distance;
+  cv::distanceTransform(uncovered, distance, cv::DIST_L2, cv::DIST_MASK_PRECISE, CV_32F);
+  return distance;
+}
+
+// What a projector needs to weigh a direction: its warp, its feather distance map (output pixels,
+// W × H) and its beyond_covered_px map.
+struct Weighing {
+  const Warp* warp = nullptr;
+  cv::Mat feather_px;
+  cv::Mat beyond_px;
+
+  // smoothstep(d / feather_rad), d the feather distance at the projector's position q of v times
+  // its angle per pixel there; the map is read at the nearest point of the image when q lies
+  // outside it (a warp's coverage may end a fraction of a pixel past the image edge, and the
+  // weight must follow the warp's coverage, which is what check_blend and the renderer use).
+  // Where the projector does not cover v: 0, or with `continued` its weight carried on past its
+  // edge, times a factor falling from 1 to 0 between kContinueFlatPx and kContinueFlatPx +
+  // kContinueFadePx from its covered pixel centres.
+  double raw(glm::dvec3 v_eye, double feather_rad, bool continued) const {
+    const auto projected = warp->project(v_eye);
+    if (!projected) return 0;
+    const glm::dvec2 q = projected->q;
+    double carried = 1;
+    if (!projected->covered) {
+      if (!continued) return 0;
+      const bool in_base = projected->st.x >= 0 && projected->st.x <= 1 && projected->st.y >= 0 &&
+                           projected->st.y <= 1;
+      const glm::dvec2 padded = q + double(kContinuePad);
+      if (!in_base || !(padded.x > 0.5 && padded.y > 0.5 && padded.x < beyond_px.cols - 0.5 &&
+                        padded.y < beyond_px.rows - 0.5)) {
+        return 0;
+      }
+      const double beyond = bilinear(beyond_px, padded);
+      carried = 1 - smoothstep((beyond - kContinueFlatPx) / kContinueFadePx);
+      if (!(carried > 0)) return 0;
+    }
+    const double d_px = bilinear(feather_px, q);
+    if (!(d_px > 0)) return 0;
+    return carried * smoothstep(d_px * rad_per_px(*warp, projected->st) / feather_rad);
+  }
+};
 
 }  // namespace
 
@@ -256,6 +307,12 @@ BlendResult compute_blend(std::span<const Warp> warps, const BlendOptions& optio
                      cv::BORDER_REPLICATE);
     feather_px.push_back(feather);
   }
+  std::vector<Weighing> weighing(warps.size());
+  for (std::size_t k = 0; k < warps.size(); ++k) {
+    weighing[k].warp = &warps[k];
+    weighing[k].feather_px = feather_px[k];
+    weighing[k].beyond_px = beyond_covered_px(padded_covered(st_of_pixel[k], warps[k].output_size));
+  }
   // How many projectors overlap at most, for the black-level target.
   std::vector<cv::Mat> overlap_count;
   for (std::size_t p = 0; p < warps.size(); ++p) {
@@ -270,9 +327,10 @@ BlendResult compute_blend(std::span<const Warp> warps, const BlendOptions& optio
         double own = 0, sum = 0;
         int covering = 0;
         for (std::size_t k = 0; k < warps.size(); ++k) {
-          const double raw =
-              smoothstep(edge_distance_rad(warps[k], feather_px[k], v) / options.feather_rad);
-          if (raw > 0) ++covering;
+          const auto projected = warps[k].project(v);
+          const bool covers = projected && projected->covered;
+          const double raw = weighing[k].raw(v, options.feather_rad, k != p);
+          if (covers && raw > 0) ++covering;
           sum += raw;
           if (k == p) own = raw;
         }
@@ -310,6 +368,8 @@ BlendResult compute_blend(std::span<const Warp> warps, const BlendOptions& optio
   return result;
 }
 
+constexpr double kSingleTolerance = 0.005;
+
 BlendCheck check_blend(std::span<const Warp> warps, std::span<const projection_io::BlendMap> alpha,
                        int stride, double border_px) {
   FACET_ASSERT(warps.size() == alpha.size() && stride >= 1);
@@ -327,6 +387,9 @@ BlendCheck check_blend(std::span<const Warp> warps, std::span<const projection_i
     std::vector<double> row_error(std::size_t(size.y), 0.0);
     std::vector<std::size_t> row_count(std::size_t(size.y), 0);
     std::vector<glm::dvec2> row_worst(std::size_t(size.y), glm::dvec2(0.0));
+    std::vector<std::size_t> row_single(std::size_t(size.y), 0),
+        row_single_dim(std::size_t(size.y), 0);
+    std::vector<double> row_single_min(std::size_t(size.y), 1.0);
     parallel_rows(size.y, [&](int y) {
       if (y % stride != 0) return;
       for (int x = 0; x < size.x; x += stride) {
@@ -343,7 +406,15 @@ BlendCheck check_blend(std::span<const Warp> warps, std::span<const projection_i
           sum += alpha[k].sample(q);
           ++covering;
         }
-        if (covering < 2 || near_edge) continue;
+        if (covering == 0 || near_edge) continue;
+        if (covering == 1) {
+          // Where one projector lights alone, its α is below 1 only where it carries on a
+          // neighbour's weight past that neighbour's edge.
+          ++row_single[std::size_t(y)];
+          if (sum < 1 - kSingleTolerance) ++row_single_dim[std::size_t(y)];
+          row_single_min[std::size_t(y)] = std::min(row_single_min[std::size_t(y)], sum);
+          continue;
+        }
         if (std::abs(sum - 1) > row_error[std::size_t(y)]) {
           row_error[std::size_t(y)] = std::abs(sum - 1);
           row_worst[std::size_t(y)] = {x + 0.5, y + 0.5};
@@ -358,6 +429,9 @@ BlendCheck check_blend(std::span<const Warp> warps, std::span<const projection_i
         check.worst_q = row_worst[std::size_t(y)];
       }
       check.overlap_directions += row_count[std::size_t(y)];
+      check.single_directions += row_single[std::size_t(y)];
+      check.single_dim_directions += row_single_dim[std::size_t(y)];
+      check.single_min_sum = std::min(check.single_min_sum, row_single_min[std::size_t(y)]);
     }
   }
   return check;

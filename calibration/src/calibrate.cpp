@@ -112,6 +112,9 @@ nlohmann::json CalibrationReport::to_json() const {
           {"blend_sum_max_err", blend_sum_max_err},
           {"blend_overlap_directions", blend_overlap_directions},
           {"blend_worst", blend_worst},
+          {"blend_single_directions", blend_single_directions},
+          {"blend_single_dim_directions", blend_single_dim_directions},
+          {"blend_single_min", blend_single_min},
           {"seconds", seconds}};
 }
 
@@ -190,6 +193,9 @@ CalibrationReport calibrate(const fs::path& capture_path, const fs::path& out,
   const BlendCheck check = check_blend(warps, blend.alpha);
   report.blend_sum_max_err = check.sum_max_err;
   report.blend_overlap_directions = check.overlap_directions;
+  report.blend_single_directions = check.single_directions;
+  report.blend_single_dim_directions = check.single_dim_directions;
+  report.blend_single_min = check.single_min_sum;
   if (check.sum_max_err > 0) {
     report.blend_worst = capture.projectors[check.worst_projector].name + " at (" +
                          std::to_string(check.worst_q.x) + ", " + std::to_string(check.worst_q.y) +

@@ -5,6 +5,7 @@
 #include <limits>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core/matx.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "facet/projection/errors.hpp"
 #include "facet/projection/screen.hpp"
@@ -181,6 +182,76 @@ using Basis = cv::Vec<double, 6>;
 
 Basis quadratic_basis(double du, double dv) { return {1, du, dv, du * du, du * dv, dv * dv}; }
 
+// Signed distance in output pixels from each output pixel centre to the edge of the part of the
+// image the camera saw, positive inside: CV_32F, W × H. `q_seen` are decoded positions that agree
+// with the fitted warp. Pixels holding one are closed over gaps of a few sample spacings (the
+// camera samples the image at its own resolution). Positions within `band_px` of the image edge
+// are pulled inwards by defocus and dropped by the fit, so the band is not judged from them: the
+// region seen just inside it is carried straight out to the image edge.
+cv::Mat seen_signed_distance(std::span<const glm::dvec2> q_seen, glm::ivec2 size, int band_px) {
+  cv::Mat seen(size.y, size.x, CV_8U, cv::Scalar(0));
+  for (const glm::dvec2& q : q_seen) {
+    const int x = int(std::floor(q.x)), y = int(std::floor(q.y));
+    if (x >= 0 && y >= 0 && x < size.x && y < size.y) seen.at<std::uint8_t>(y, x) = 1;
+  }
+  // Samples per pixel where there are any, from 8×8 blocks holding at least one.
+  std::size_t blocks = 0;
+  for (int by = 0; by < size.y; by += 8) {
+    for (int bx = 0; bx < size.x; bx += 8) {
+      const cv::Rect block(bx, by, std::min(8, size.x - bx), std::min(8, size.y - by));
+      blocks += cv::countNonZero(seen(block)) > 0 ? 1 : 0;
+    }
+  }
+  const double density =
+      blocks == 0 ? 1.0 : std::min(1.0, double(cv::countNonZero(seen)) / (64.0 * double(blocks)));
+  const int radius = std::max(2, int(std::ceil(1.5 / std::sqrt(density))));
+  const cv::Mat disc = cv::getStructuringElement(
+      cv::MORPH_ELLIPSE, cv::Size(2 * radius + 1, 2 * radius + 1), cv::Point(radius, radius));
+  cv::morphologyEx(seen, seen, cv::MORPH_CLOSE, disc, cv::Point(-1, -1), 1, cv::BORDER_CONSTANT,
+                   cv::Scalar(0));
+  const int band = std::min({band_px, (size.x - 1) / 2, (size.y - 1) / 2});
+  if (band > 0) {
+    const cv::Rect inner(band, band, size.x - 2 * band, size.y - 2 * band);
+    cv::Mat carried;
+    cv::copyMakeBorder(seen(inner), carried, band, band, band, band,
+                       cv::BORDER_REPLICATE | cv::BORDER_ISOLATED);
+    seen = carried;
+  }
+  // Beyond the image the region goes on as it meets the edge: the image edge itself is no edge
+  // of what the camera saw.
+  constexpr int kPad = 2;
+  cv::Mat padded, inside, outside;
+  cv::copyMakeBorder(seen, padded, kPad, kPad, kPad, kPad, cv::BORDER_REPLICATE);
+  cv::distanceTransform(padded, inside, cv::DIST_L2, cv::DIST_MASK_PRECISE, CV_32F);
+  cv::distanceTransform(1 - padded, outside, cv::DIST_L2, cv::DIST_MASK_PRECISE, CV_32F);
+  const cv::Rect image(kPad, kPad, size.x, size.y);
+  inside = inside(image);
+  outside = outside(image);
+  // Pixel centres next to the edge lie half a pixel from it.
+  cv::Mat signed_distance(size.y, size.x, CV_32F);
+  for (int y = 0; y < size.y; ++y) {
+    for (int x = 0; x < size.x; ++x) {
+      // (A distance transform with nothing to measure to gives a huge value.)
+      const float distance = seen.at<std::uint8_t>(y, x) != 0 ? inside.at<float>(y, x) - 0.5f
+                                                              : 0.5f - outside.at<float>(y, x);
+      signed_distance.at<float>(y, x) = std::clamp(distance, -1e4f, 1e4f);
+    }
+  }
+  return signed_distance;
+}
+
+// A CV_32F map read bilinearly between pixel centres at output position q, clamped at the edge.
+double bilinear(const cv::Mat& map, glm::dvec2 q) {
+  const double fx = std::clamp(q.x - 0.5, 0.0, double(map.cols - 1));
+  const double fy = std::clamp(q.y - 0.5, 0.0, double(map.rows - 1));
+  const int x0 = std::min(int(fx), std::max(0, map.cols - 2));
+  const int y0 = std::min(int(fy), std::max(0, map.rows - 2));
+  const int x1 = std::min(x0 + 1, map.cols - 1), y1 = std::min(y0 + 1, map.rows - 1);
+  const double ax = fx - x0, ay = fy - y0;
+  return (1 - ay) * ((1 - ax) * map.at<float>(y0, x0) + ax * map.at<float>(y0, x1)) +
+         ay * ((1 - ax) * map.at<float>(y1, x0) + ax * map.at<float>(y1, x1));
+}
+
 }  // namespace
 
 cv::Mat eye_directions(const CameraModel& model, const CaptureCamera& camera,
@@ -283,11 +354,15 @@ WarpFit fit_warp(std::span<const FitSample> samples, glm::ivec2 output_size,
 
   // Base coordinates of every sample.
   const glm::dmat3 R_base_eye = glm::transpose(cover.R_eye_base);
-  std::vector<glm::dvec2> st(samples.size(), glm::dvec2(kNaN));
+  // st_any: every sample in the base image; st: those the fit uses.
+  std::vector<glm::dvec2> st(samples.size(), glm::dvec2(kNaN)), st_any = st;
   parallel_range(int((samples.size() + 4095) / 4096), [&](int block) {
     const std::size_t end = std::min(samples.size(), std::size_t(block + 1) * 4096);
     for (std::size_t k = std::size_t(block) * 4096; k < end; ++k) {
       const auto value = cover.base.st_from_direction(R_base_eye * samples[k].v_eye, 0.5);
+      if (value && value->x >= 0 && value->x <= 1 && value->y >= 0 && value->y <= 1) {
+        st_any[k] = *value;
+      }
       const glm::dvec2 q = samples[k].q;
       const double guard = options.edge_guard_px;
       if (q.x < guard || q.y < guard || q.x > output_size.x - guard ||
@@ -550,29 +625,44 @@ WarpFit fit_warp(std::span<const FitSample> samples, glm::ivec2 output_size,
     }
   }
 
-  // Coverage: a ramp across one node spacing centred on the image edge, so that A = 0.5 (the
-  // covered boundary after bilinear interpolation) falls close to where q leaves the image.
-  // Filled nodes are extrapolations: the rings around the supported nodes within extrapolate_px
-  // keep the ramp (the image edge's last nodes lie beyond the samples); farther ones are
-  // uncovered, so inside the image the covered region ends half a node past the last kept ring.
-  // The rest of the image, which the camera never saw well enough, is left uncovered rather than
-  // guessed.
-  const double spacing_px = 0.5 * (step.x + step.y);
-  const int extrapolate_rings = std::max(1, int(std::ceil(options.extrapolate_px / spacing_px)));
+  // Coverage: A at each node from the signed distance of its output position to the edge of what
+  // the projector can light there, the nearer of the image edge and the edge of the part of the
+  // image the camera saw, as 0.5 + distance / ramp. Within a cell, q is bilinear in st, so a
+  // distance to a straight edge is bilinear too, and with no node of a cell clamped (the ramp
+  // spans more than a cell either way) the interpolated A = 0.5 falls on the edge itself. The
+  // camera's view ends at the same place on the screen for every projector, so neighbouring
+  // projectors' covered regions end together there (to within a pixel), not at node-sized steps
+  // a node or two beyond the last samples, which were extrapolated. Filled nodes more than
+  // extrapolate_px rings out are uncovered whatever the distance says.
   warp.offset_px.resize(nodes.size());
-  warp.coverage.resize(nodes.size());
+  for (std::size_t k = 0; k < nodes.size(); ++k) warp.offset_px[k] = glm::vec2(offset[k]);
+  warp.coverage.assign(nodes.size(), 1.0f);
+  std::vector<glm::dvec2> q_seen;
+  q_seen.reserve(samples.size());
+  for (std::size_t k = 0; k < samples.size(); ++k) {
+    if (std::isnan(st_any[k].x)) continue;
+    if (glm::length(warp.q_from_st(st_any[k]) - samples[k].q) <= options.outlier_px) {
+      q_seen.push_back(samples[k].q);
+    }
+  }
+  const cv::Mat seen_px =
+      seen_signed_distance(q_seen, output_size, int(std::ceil(options.edge_guard_px)) + 3);
+  q_seen = {};
+  const double spacing_px = 0.5 * (step.x + step.y);
+  const double ramp_px = 3 * std::max(step.x, step.y);
+  const int extrapolate_rings = std::max(1, int(std::ceil(options.extrapolate_px / spacing_px)));
   for (int j = 0; j < grid.y; ++j) {
     for (int i = 0; i < grid.x; ++i) {
       const std::size_t k = std::size_t(j) * grid.x + i;
       const glm::dvec2 q = glm::dvec2(i * step.x, j * step.y) + offset[k];
-      const double inside =
+      const double inside_image =
           std::min(std::min(q.x, output_size.x - q.x), std::min(q.y, output_size.y - q.y));
-      warp.offset_px[k] = glm::vec2(offset[k]);
-      double coverage = std::clamp(0.5 + inside / spacing_px, 0.0, 1.0);
+      const double inside = std::min(inside_image, bilinear(seen_px, q));
+      double coverage = std::clamp(0.5 + inside / ramp_px, 0.0, 1.0);
       if (ring[k] > extrapolate_rings) coverage = 0;
       warp.coverage[k] = float(coverage);
-      if (ring[k] > 0 && inside > 0) {
-        ++(ring[k] > extrapolate_rings ? result.report.holes : result.report.filled);
+      if (ring[k] > 0 && inside_image > 0) {
+        ++(coverage < 0.5 ? result.report.holes : result.report.filled);
       }
     }
   }

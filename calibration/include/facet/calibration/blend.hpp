@@ -44,6 +44,11 @@ struct BlendCheck {
   std::size_t overlap_directions = 0;  // directions sampled where two or more projectors cover
   std::size_t worst_projector = 0;     // the sampled direction with the largest error: whose
   glm::dvec2 worst_q{0.0};             // output pixel centre it came from
+  // Directions sampled where one projector lights alone, how many of them have α below
+  // 1 − 0.005, and the least α among them.
+  std::size_t single_directions = 0;
+  std::size_t single_dim_directions = 0;
+  double single_min_sum = 1;
 };
 
 // Measures the blend independently of how it was made: directions at every `stride`-th output

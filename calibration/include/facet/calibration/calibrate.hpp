@@ -51,6 +51,12 @@ struct CalibrationReport {
   double blend_sum_max_err = 0;  // see check_blend
   std::size_t blend_overlap_directions = 0;
   std::string blend_worst;  // where blend_sum_max_err occurs: "projector at (x, y)"
+  // Where one projector lights alone (see check_blend): directions sampled, how many of them have
+  // α below 1 − 0.005 (next to where a neighbour's covered region ends, its weight is carried on
+  // for a few pixels), and the least α among them.
+  std::size_t blend_single_directions = 0;
+  std::size_t blend_single_dim_directions = 0;
+  double blend_single_min = 1;
   double seconds = 0;
 
   nlohmann::json to_json() const;
