@@ -210,9 +210,12 @@ TEST(CaptureCli, AResumedCaptureCalibratesLikeTheSimulatedOne) {
     const ProjectorReport& a = live_report.projectors[p];
     const ProjectorReport& b = simulated_report.projectors[p];
     ASSERT_TRUE(a.accuracy && b.accuracy) << a.name;
-    std::printf("%s: live rms %.4f p99 %.4f max %.4f px; simulate rms %.4f p99 %.4f max %.4f px\n",
-                a.name.c_str(), a.accuracy->rms_px, a.accuracy->p99_px, a.accuracy->max_px,
-                b.accuracy->rms_px, b.accuracy->p99_px, b.accuracy->max_px);
+    std::printf(
+        "%s: live rms %.4f p99 %.4f max %.4f px, holes %zu, folds %zu; simulate rms %.4f p99 "
+        "%.4f max %.4f px, holes %zu, folds %zu\n",
+        a.name.c_str(), a.accuracy->rms_px, a.accuracy->p99_px, a.accuracy->max_px, a.fit.holes,
+        a.fit.folds, b.accuracy->rms_px, b.accuracy->p99_px, b.accuracy->max_px, b.fit.holes,
+        b.fit.folds);
     // The replay test's targets (FORMATS.md §5, 8 px border), in output pixels.
     EXPECT_LE(a.accuracy->rms_px, 0.1) << a.name;
     EXPECT_LE(a.accuracy->p99_px, 0.3) << a.name;
