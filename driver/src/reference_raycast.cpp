@@ -209,7 +209,6 @@ EdgeDisplacement ReferenceRaycaster::edge_displacement(
       if (tested[i] != reference[i]) differing.push_back({x, y});
     }
   }
-  const double step = 1.0 / options.subsamples;
   const glm::dmat3 R_eye_world(T_eye_world);
   const glm::dvec3 p_world_eye(T_eye_world[3]);
 
@@ -317,38 +316,45 @@ EdgeDisplacement ReferenceRaycaster::edge_displacement(
     const glm::ivec2 pixel = differing[std::size_t(k)];
     const std::uint32_t id = tested[std::size_t(pixel.y) * size.x + pixel.x];
     const glm::dvec2 centre = glm::dvec2(pixel) + 0.5;
-    // The tested triangle drawn too far reaches q (the distance to where it is seen), or the
-    // reference triangle drawn too short leaves q (the distance to its edge): the smaller.
-    double limit = options.window_px;
+    // A triangle drawn too far: how far it reaches past where it is seen. Nothing drawn (ID 0):
+    // how far the reference's triangle, and what lies around it, was pulled back from q. The
+    // computed distance bounds the true one from above (another surface may hide or uncover the
+    // triangle nearer, along an edge of its own or where two surfaces cross), so the lattice
+    // search below looks for nearer points within it.
     const std::uint32_t expected = reference[std::size_t(pixel.y) * size.x + pixel.x];
-    if (expected != 0) {
-      if (const auto found = edge_point(centre, expected, true)) {
-        limit = std::min(limit, glm::length(found->first - centre));
-      }
-    }
+    double limit = options.window_px;
     if (id != 0) {
       if (const auto exact = distance_to_triangle(centre, id)) limit = std::min(limit, *exact);
-      if (limit < options.window_px) {
-        distance[std::size_t(k)] = limit;
-        return;
-      }
+    } else if (const auto found = edge_point(centre, expected, true)) {
+      limit = std::min(limit, glm::length(found->first - centre));
     }
-    const int rings = int(std::ceil(limit * options.subsamples));
-    // Every lattice point on Chebyshev ring r is at least r steps away, so the search ends once
-    // r² passes the best squared distance found.
-    long best = std::numeric_limits<long>::max();
-    for (int r = 1; r <= rings && long(r) * r <= best; ++r) {
-      for (int dy = -r; dy <= r; ++dy) {
-        const int stride = (dy == -r || dy == r) ? 1 : 2 * r;
-        for (int dx = -r; dx <= r; dx += stride) {
-          const long d2 = long(dx) * dx + long(dy) * dy;
-          if (d2 >= best || d2 > long(rings) * rings) continue;
-          if (id_at(centre + step * glm::dvec2(dx, dy)) == id) best = d2;
+    auto marks_the_edge = [&](glm::dvec2 q) {
+      const std::uint32_t seen = id_at(q);
+      return id != 0 ? seen == id : seen != expected;
+    };
+    // Every lattice point on Chebyshev ring r is at least r steps away, so a search ends once r²
+    // passes the best squared distance found.
+    auto search = [&](int subsamples, double radius_px) -> std::optional<double> {
+      const double lattice_step = 1.0 / subsamples;
+      const int rings = int(std::ceil(radius_px * subsamples));
+      long best = std::numeric_limits<long>::max();
+      for (int r = 1; r <= rings && long(r) * r <= best; ++r) {
+        for (int dy = -r; dy <= r; ++dy) {
+          const int stride = (dy == -r || dy == r) ? 1 : 2 * r;
+          for (int dx = -r; dx <= r; dx += stride) {
+            const long d2 = long(dx) * dx + long(dy) * dy;
+            if (d2 >= best || d2 > long(rings) * rings) continue;
+            if (marks_the_edge(centre + lattice_step * glm::dvec2(dx, dy))) best = d2;
+          }
         }
       }
-    }
-    if (best <= long(rings) * rings) {
-      distance[std::size_t(k)] = std::min(limit, step * std::sqrt(double(best)));
+      if (best > long(rings) * rings) return std::nullopt;
+      return lattice_step * std::sqrt(double(best));
+    };
+    auto found = search(options.subsamples, std::min(limit, options.fine_radius_px));
+    if (!found && limit > options.fine_radius_px) found = search(options.coarse_subsamples, limit);
+    if (found) {
+      distance[std::size_t(k)] = std::min(limit, *found);
     } else if (limit < options.window_px) {
       distance[std::size_t(k)] = limit;
     }
