@@ -259,6 +259,8 @@ LiveCaptureReport run_live_capture(PatternOutputs& outputs, LiveCamera& camera,
       report.kept += done[p].back();
     }
   }
+  // capture.json says the capture is whole: not while a frame is missing (deleted since).
+  if (report.kept < report.frames) fs::remove(out / "capture.json", error);
   if (report.kept > 0) {
     log("kept " + std::to_string(report.kept) + " of " + std::to_string(report.frames) +
         " frames from an earlier run");

@@ -157,6 +157,15 @@ TEST(LiveCapture, AStoppedCaptureResumesToTheSameFrames) {
   const LiveCaptureReport again = parts.run(out);
   EXPECT_TRUE(again.complete);
   EXPECT_EQ(again.captured, 0u);
+  // A frame lost since: capture.json no longer claims a whole capture until it is captured again.
+  const fs::path lost = out / a.projectors[1].frames[5].file;
+  fs::remove(lost);
+  EXPECT_FALSE(parts.run(out, 0).complete);
+  EXPECT_FALSE(fs::exists(out / "capture.json"));
+  const LiveCaptureReport repaired = parts.run(out);
+  EXPECT_TRUE(repaired.complete);
+  EXPECT_EQ(repaired.captured, 1u);
+  EXPECT_EQ(file_bytes(lost), file_bytes(a.resolve(a.projectors[1].frames[5].file)));
 }
 
 TEST(LiveCapture, ResumeAdoptsAFrameRenamedBeforeItsJournalLineAndToleratesATornLine) {

@@ -8,6 +8,7 @@
 //   camera.cameramodel   the camera's lens model (written first)
 //   <projector>/<file>   one image per frame, each written atomically (temporary name, rename)
 //   capture.json         written last, atomically: its presence means the capture is complete
+//                        (a later run that finds a frame missing removes it until it is whole)
 //
 // capture.journal: line 1 is {"format": "facet-capture-journal/1", "identity": {...}}, where the
 // identity holds the display's projectors, the camera, the frames (file and pattern) and every
