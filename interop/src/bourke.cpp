@@ -1,6 +1,8 @@
 #include "facet/interop/bourke.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 
 #include "facet/interop/inverse_grid.hpp"
@@ -38,6 +40,37 @@ bool numbers(std::string_view line, std::vector<double>& out) {
     out.push_back(value);
     p = end;
   }
+}
+
+// The automatic warp grid: refined while an interior node is reproduced worse than this, up to
+// this many nodes per side.
+constexpr double kAutoGridBoundPx = 1.0;
+constexpr int kMaxAutoGrid = 1025;
+
+// The worst distance in output pixels between where `warp` sends a used mesh node's source
+// position and the node's output position, over nodes whose eight neighbours are used too (the
+// others sit next to extrapolated cells).
+double worst_node_error_px(const BourkeMesh& mesh, const Warp& warp) {
+  const int nx = mesh.grid_size.x, ny = mesh.grid_size.y;
+  const auto used = [&](int i, int j) {
+    const BourkeNode& n = mesh.nodes[std::size_t(j) * nx + i];
+    return n.u >= 0 && n.v >= 0;
+  };
+  double worst = 0;
+  for (int j = 1; j + 1 < ny; ++j) {
+    for (int i = 1; i + 1 < nx; ++i) {
+      bool interior = true;
+      for (int dj = -1; dj <= 1; ++dj) {
+        for (int di = -1; di <= 1; ++di) interior = interior && used(i + di, j + dj);
+      }
+      if (!interior) continue;
+      const BourkeNode& n = mesh.nodes[std::size_t(j) * nx + i];
+      const glm::dvec2 q{(n.x / mesh.aspect + 1) / 2 * warp.output_size.x,
+                         (1 - n.y) / 2 * warp.output_size.y};
+      worst = std::max(worst, glm::length(warp.q_from_st({n.u, 1 - n.v}) - q));
+    }
+  }
+  return worst;
 }
 
 }  // namespace
@@ -107,8 +140,74 @@ BourkeMesh parse_bourke(std::string_view text, const std::string& source) {
   return mesh;
 }
 
-ImportedProjector import_bourke(const BourkeMesh& mesh, const BourkeImportOptions& options,
+std::vector<glm::ivec2> unfold_bourke(BourkeMesh& mesh) {
+  const int nx = mesh.grid_size.x, ny = mesh.grid_size.y;
+  const auto node = [&](int i, int j) -> BourkeNode& {
+    return mesh.nodes[std::size_t(j) * nx + i];
+  };
+  const auto used = [&](int i, int j) {
+    return i >= 0 && j >= 0 && i < nx && j < ny && node(i, j).u >= 0 && node(i, j).v >= 0;
+  };
+  const auto uv = [&](int i, int j) { return glm::dvec2(node(i, j).u, node(i, j).v); };
+  const auto cross = [](glm::dvec2 a, glm::dvec2 b) { return a.x * b.y - a.y * b.x; };
+  // Output x right and y up, source u right and v up: an unfolded cell keeps its orientation.
+  // Collapsed means under a thousandth of the median cell's area.
+  std::vector<double> areas;
+  for (int j = 0; j + 1 < ny; ++j) {
+    for (int i = 0; i + 1 < nx; ++i) {
+      if (used(i, j) && used(i + 1, j) && used(i, j + 1) && used(i + 1, j + 1)) {
+        areas.push_back(cross(uv(i + 1, j) - uv(i, j), uv(i, j + 1) - uv(i, j)));
+      }
+    }
+  }
+  if (areas.empty()) return {};
+  std::nth_element(areas.begin(), areas.begin() + areas.size() / 2, areas.end());
+  const double min_area = 1e-3 * std::abs(areas[areas.size() / 2]);
+  const double sign = areas[areas.size() / 2] >= 0 ? 1.0 : -1.0;
+  const auto folded = [&](int i, int j) {
+    if (!(used(i, j) && used(i + 1, j) && used(i, j + 1) && used(i + 1, j + 1))) return false;
+    const glm::dvec2 a = uv(i, j), b = uv(i + 1, j), c = uv(i, j + 1), d = uv(i + 1, j + 1);
+    return !(sign * cross(b - a, c - a) > min_area && sign * cross(c - d, b - d) > min_area);
+  };
+  // How far a node strays from the continuation of its used neighbours, in source units.
+  const auto stray = [&](int i, int j) {
+    double worst = 0;
+    const int di[4] = {1, -1, 0, 0}, dj[4] = {0, 0, 1, -1};
+    for (int d = 0; d < 4; ++d) {
+      if (used(i + di[d], j + dj[d]) && used(i + 2 * di[d], j + 2 * dj[d])) {
+        const glm::dvec2 line = 2.0 * uv(i + di[d], j + dj[d]) - uv(i + 2 * di[d], j + 2 * dj[d]);
+        worst = std::max(worst, glm::length(uv(i, j) - line));
+      }
+    }
+    return worst;
+  };
+  std::vector<glm::ivec2> masked;
+  for (bool changed = true; changed;) {
+    changed = false;
+    for (int j = 0; j + 1 < ny; ++j) {
+      for (int i = 0; i + 1 < nx; ++i) {
+        if (!folded(i, j)) continue;
+        glm::ivec2 worst_node{i, j};
+        double worst = -1;
+        for (int c = 0; c < 4; ++c) {
+          const glm::ivec2 n{i + c % 2, j + c / 2};
+          const double s = stray(n.x, n.y);
+          if (s > worst) worst = s, worst_node = n;
+        }
+        node(worst_node.x, worst_node.y).u = -1;
+        node(worst_node.x, worst_node.y).v = -1;
+        masked.push_back(worst_node);
+        changed = true;
+      }
+    }
+  }
+  return masked;
+}
+
+ImportedProjector import_bourke(const BourkeMesh& original, const BourkeImportOptions& options,
                                 const std::string& source, const std::string& name) {
+  BourkeMesh mesh = original;
+  const std::vector<glm::ivec2> masked = unfold_bourke(mesh);
   const glm::ivec2 size = options.output_size;
   FACET_ASSERT(size.x > 0 && size.y > 0);
   if (std::abs(double(size.x) / size.y / mesh.aspect - 1) > 0.01) {
@@ -136,9 +235,43 @@ ImportedProjector import_bourke(const BourkeMesh& mesh, const BourkeImportOption
   }
   ImportedProjector projector;
   projector.name = name;
-  const glm::ivec2 warp_grid = options.warp_grid.x >= 2 ? options.warp_grid : nodes;
-  projector.warp =
-      warp_from_inverse_grid(grid, options.base, options.R_eye_base, size, warp_grid, source);
+  for (const glm::ivec2& n : masked) {
+    const BourkeNode& node = original.nodes[std::size_t(n.y) * nodes.x + n.x];
+    char text[256];
+    std::snprintf(text, sizeof text,
+                  "mesh node (%d, %d) (line %d) at output pixel (%.0f, %.0f) shows (u, v) = "
+                  "(%g, %g), which folds the mesh over its neighbours: taken as unused",
+                  n.x, n.y, n.y * nodes.x + n.x + 3, (node.x / mesh.aspect + 1) / 2 * size.x,
+                  (1 - node.y) / 2 * size.y, node.u, node.v);
+    projector.notes.push_back(text);
+  }
+  if (options.warp_grid.x >= 2) {
+    projector.warp = warp_from_inverse_grid(grid, options.base, options.R_eye_base, size,
+                                            options.warp_grid, source);
+  } else {
+    // The forward grid is uniform over the source image, the mesh is not: where a mirror's edge
+    // crowds many mesh rows into a sliver of the source, a forward grid as coarse as the mesh
+    // cannot follow it. Refine until every interior mesh node is reproduced within the bound.
+    glm::ivec2 warp_grid = nodes;
+    for (;;) {
+      projector.warp =
+          warp_from_inverse_grid(grid, options.base, options.R_eye_base, size, warp_grid, source);
+      const double worst = worst_node_error_px(mesh, projector.warp);
+      const glm::ivec2 finer = glm::min(2 * (warp_grid - 1) + 1, glm::ivec2(kMaxAutoGrid));
+      if (worst <= kAutoGridBoundPx || finer == warp_grid) {
+        if (warp_grid != nodes) {
+          char text[200];
+          std::snprintf(text, sizeof text,
+                        "warp grid %d×%d (the mesh's %d×%d does not follow it within %.0f px); "
+                        "interior mesh nodes reproduced within %.2f px",
+                        warp_grid.x, warp_grid.y, nodes.x, nodes.y, kAutoGridBoundPx, worst);
+          projector.notes.push_back(text);
+        }
+        break;
+      }
+      warp_grid = finer;
+    }
+  }
   projection_io::BlendMap blend = projection_io::BlendMap::constant(size, 0.0f);
   for (int y = 0; y < size.y; ++y) {
     for (int x = 0; x < size.x; ++x) {

@@ -202,7 +202,6 @@ TEST(MpcdiA3, SampleDomeRoundTripsWithin001PxAwayFromItsCoverageEdge) {
         config.projectors[p].name.c_str(), interior, everywhere);
     EXPECT_LT(interior, 0.01) << config.projectors[p].name;
     EXPECT_LT(everywhere, 0.05) << config.projectors[p].name;
-    EXPECT_LT(everywhere, 0.25) << config.projectors[p].name;
     // Every direction the projector shows at least one PFM node spacing (4 px) inside its image
     // stays covered.
     EXPECT_GT(covered_fraction(original, back, 4), 0.999) << config.projectors[p].name;

@@ -32,8 +32,10 @@ const Registration registration{
       import_command->add_option(
           "--fov", options->fov,
           "Field of view of the fisheye source image, degrees (default 180)");
-      import_command->add_option("--grid", options->grid,
-                                 "Node count GXxGY of the warp (default: the mesh's)");
+      import_command->add_option(
+          "--grid", options->grid,
+          "Node count GXxGY of the warp (default: the mesh's, doubled up to 1025 "
+          "per side until its nodes are followed within 1 px)");
       import_command->add_option("--intensity-gamma", options->gamma,
                                  "Linear blend = intensity^gamma (default 2.2)");
       import_command->callback([options] {
@@ -63,6 +65,9 @@ const Registration registration{
         display.name = std::filesystem::path(options->file).stem().string();
         display.projectors.push_back(interop::import_bourke(mesh, import, options->file,
                                                             interop::sanitize_name(display.name)));
+        for (const std::string& note : display.projectors[0].notes) {
+          std::cerr << "facet: note: " << options->file << ": " << note << "\n";
+        }
         interop::write_display_folder(display, options->out);
         std::cout << "wrote " << options->out << "/display.json\n";
       });

@@ -42,13 +42,23 @@ struct BourkeImportOptions {
   glm::ivec2 output_size{1920, 1080};  // must match the mesh's aspect within 1%
   BaseProjection base = BaseProjection::fisheye(180);
   glm::dmat3 R_eye_base{1.0};
-  glm::ivec2 warp_grid{0, 0};  // 0: the mesh's own node counts
+  // 0: automatic: the mesh's own node counts, doubled (up to 1025 per side) while an interior mesh
+  // node is reproduced worse than 1 px.
+  glm::ivec2 warp_grid{0, 0};
   // The intensity multiplies encoded values; linear α = intensity^gamma.
   double intensity_gamma = 2.2;
 };
 
+// Nodes that fold the mesh: mesh cells (all four nodes used) whose source quadrilateral turns over
+// or collapses show the same source positions as their neighbours, so no forward warp holds them.
+// Node by node, the one of a folded cell that strays furthest from the straight continuation of
+// its neighbours is taken as unused, until no cell folds. Returns the nodes taken, in file
+// numbering (i from the left, j from the bottom row).
+std::vector<glm::ivec2> unfold_bourke(BourkeMesh& mesh);
+
 // One projector: the warp and the blend map (linear α from the intensity column, bilinear between
-// nodes, 0 where the mesh shows nothing).
+// nodes, 0 where the mesh shows nothing). Folding nodes are masked first (unfold_bourke); the
+// projector's notes say which, and where they are in the output.
 ImportedProjector import_bourke(const BourkeMesh& mesh, const BourkeImportOptions& options,
                                 const std::string& source, const std::string& name);
 

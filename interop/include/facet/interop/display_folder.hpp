@@ -18,6 +18,7 @@ struct ImportedProjector {
   std::optional<projection_io::BlendMap> blend;  // α at the output size
   std::optional<projection_io::BlendMap> black;  // β at the output size
   projection_io::DisplayOutput output;           // where the image goes
+  std::vector<std::string> notes;                // what the importer changed or guessed
 };
 
 struct ImportedDisplay {
