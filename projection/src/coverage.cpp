@@ -37,6 +37,24 @@ glm::dvec3 centroid_direction(const FacetMesh& mesh, std::uint32_t f) {
 
 bool triangle_meets_cone(const std::array<glm::dvec3, 3>& triangle, const glm::dvec3* planes,
                          int plane_count) {
+  double scale = 0;
+  for (const auto& p : triangle) scale = std::max(scale, glm::length(p));
+  // Most tests end here, with the answer clipping would give. Every corner outside one plane:
+  // so is the whole triangle. A corner inside every plane: clipping keeps it as it is, and the
+  // eye test below is then decided by its length.
+  std::array<bool, 3> corner_inside{true, true, true};
+  for (int k = 0; k < plane_count; ++k) {
+    bool any_inside = false;
+    for (int c = 0; c < 3; ++c) {
+      const bool inside = glm::dot(planes[k], triangle[c]) >= 0;
+      any_inside = any_inside || inside;
+      corner_inside[c] = corner_inside[c] && inside;
+    }
+    if (!any_inside) return false;
+  }
+  for (int c = 0; c < 3; ++c) {
+    if (corner_inside[c] && glm::length(triangle[c]) > 1e-12 * scale) return true;
+  }
   // A triangle clipped by k planes has at most 3 + k vertices.
   glm::dvec3 buffer_a[12], buffer_b[12];
   std::copy(triangle.begin(), triangle.end(), buffer_a);
@@ -50,8 +68,6 @@ bool triangle_meets_cone(const std::array<glm::dvec3, 3>& triangle, const glm::d
   if (count == 0) return false;
   // The eye itself lies in every cone; a triangle that meets the cone only there is seen edge-on
   // through the eye and covers nothing. Anything else left after clipping lies strictly inside.
-  double scale = 0;
-  for (const auto& p : triangle) scale = std::max(scale, glm::length(p));
   for (int k = 0; k < count; ++k) {
     if (glm::length(current[k]) > 1e-12 * scale) return true;
   }

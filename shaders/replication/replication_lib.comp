@@ -119,6 +119,25 @@ void triangle_eye(uint t, out vec3 p[3]) {
 // True when the triangle meets the cone {X : planes[k]·X >= -slack·|X|, k < plane_count}:
 // Sutherland–Hodgman clipping, as triangle_meets_cone in projection/src/coverage.cpp.
 bool meets_cone(vec3 p[3], vec4 planes[4], int plane_count) {
+  // Most tests end here. Every corner outside one plane: the whole triangle is (the slack term is
+  // convex, so the signed distance of a point of the triangle is at most the same mix of its
+  // corners'). A corner inside every plane: clipping would keep it as it is, and the eye test
+  // below is then decided by its length.
+  float scale = max(length(p[0]), max(length(p[1]), length(p[2])));
+  bool corner_inside[3] = bool[3](true, true, true);
+  for (int k = 0; k < plane_count; ++k) {
+    vec3 n = planes[k].xyz;
+    bool any_inside = false;
+    for (int c = 0; c < 3; ++c) {
+      bool inside = dot(n, p[c]) + kCoverageSlack * length(p[c]) >= 0.0;
+      any_inside = any_inside || inside;
+      corner_inside[c] = corner_inside[c] && inside;
+    }
+    if (!any_inside) return false;
+  }
+  for (int c = 0; c < 3; ++c) {
+    if (corner_inside[c] && length(p[c]) > 1e-6 * scale) return true;
+  }
   vec3 poly[8];
   vec3 next[8];
   poly[0] = p[0];
@@ -141,7 +160,6 @@ bool meets_cone(vec3 p[3], vec4 planes[4], int plane_count) {
   }
   if (count == 0) return false;
   // What meets the cone only at the eye is seen edge-on and covers nothing.
-  float scale = max(length(p[0]), max(length(p[1]), length(p[2])));
   for (int i = 0; i < count; ++i) {
     if (length(poly[i]) > 1e-6 * scale) return true;
   }
