@@ -151,6 +151,46 @@ TEST(InteropCli, BadFilesExitWithStatus2AndLeaveNothingBehind) {
   EXPECT_FALSE(fs::exists(scratch.path / "l.exr"));
 }
 
+TEST(InteropCli, ProfileA3ThroughTheCommands) {
+  test::ScratchFolder scratch("cli-a3");
+  const std::string dome = std::string(FACET_SOURCE_DIR) + "/configs/displays/dome4";
+  const fs::path container = scratch.path / "dome4.mpcdi";
+  CliRun r =
+      run("mpcdi export " + dome + " --profile a3 --node-spacing 8 --out " + container.string(),
+          scratch.path);
+  ASSERT_EQ(r.status, 0) << r.output;
+  r = run("mpcdi import " + container.string() + " --eye 0,0,0 --out " +
+              (scratch.path / "back").string(),
+          scratch.path);
+  ASSERT_EQ(r.status, 0) << r.output;
+  const auto display = projection_io::read_display_config(scratch.path / "back" / "display.json");
+  EXPECT_EQ(display.projectors.size(), 4u);
+  // Bad options and a bad unit: status 2 naming what is wrong, nothing written.
+  r = run("mpcdi export " + dome + " --profile 2d --out " + (scratch.path / "x.mpcdi").string(),
+          scratch.path);
+  EXPECT_EQ(r.status, 2) << r.output;
+  EXPECT_NE(r.output.find("--profile"), std::string::npos) << r.output;
+  r = run(
+      "mpcdi import " + container.string() + " --eye 1,2 --out " + (scratch.path / "y").string(),
+      scratch.path);
+  EXPECT_EQ(r.status, 2) << r.output;
+  EXPECT_NE(r.output.find("--eye"), std::string::npos) << r.output;
+  MpcdiFiles files = read_zip_file(container);
+  const std::string unit = "<geometricUnit>m</geometricUnit>";
+  std::string& xml = files.at("mpcdi.xml");
+  ASSERT_NE(xml.find(unit), std::string::npos) << xml;
+  xml.replace(xml.find(unit), unit.size(), "<geometricUnit>parsec</geometricUnit>");
+  write_zip_file(scratch.path / "bad_unit.mpcdi", files);
+  r = run("mpcdi import " + (scratch.path / "bad_unit.mpcdi").string() + " --out " +
+              (scratch.path / "z").string(),
+          scratch.path);
+  EXPECT_EQ(r.status, 2) << r.output;
+  EXPECT_NE(r.output.find("geometryWarpFile/geometricUnit"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(scratch.path / "x.mpcdi"));
+  EXPECT_FALSE(fs::exists(scratch.path / "y"));
+  EXPECT_FALSE(fs::exists(scratch.path / "z"));
+}
+
 TEST(InteropCli, LookupOfAWarp) {
   test::ScratchFolder scratch("cli-lookup");
   write_warp((scratch.path / "w.warp.exr").string(), test::calibrated_like_warp({64, 40}, {5, 5}));
@@ -170,6 +210,10 @@ TEST(InteropCli, DevicesListsOrSaysThereAreNone) {
       << r.output;
   r = run("devices --watch --for 1", scratch.path);
   EXPECT_EQ(r.status, 0) << r.output;
+  // It says how it follows hotplug.
+  EXPECT_TRUE(r.output.find("(libusb hotplug events)") != std::string::npos ||
+              r.output.find("(polling)") != std::string::npos)
+      << r.output;
   r = run("devices --find camera0", scratch.path);
   EXPECT_EQ(r.status, 2) << r.output;
 }
