@@ -103,7 +103,7 @@ std::size_t journal_frames(const fs::path& out) {
   return done;
 }
 
-TEST(CaptureCli, StoppedAndKilledCapturesResumeToTheSameFrames) {
+TEST(CaptureCli, AStoppedCaptureResumesToTheSameFrames) {
   const RigFiles setup;
   const fs::path whole = setup.temp.path() / "whole";
   ASSERT_EQ(run_cli(setup.command(whole)), 0);
@@ -120,7 +120,13 @@ TEST(CaptureCli, StoppedAndKilledCapturesResumeToTheSameFrames) {
   EXPECT_EQ(report["captured"], 2 * 38 - 25);
   EXPECT_TRUE(report["complete"].get<bool>());
   expect_same_frames(whole, stopped);
+}
 
+TEST(CaptureCli, AKilledCaptureResumesToTheSameFrames) {
+  const RigFiles setup;
+  const fs::path whole = setup.temp.path() / "whole";
+  ASSERT_EQ(run_cli(setup.command(whole)), 0);
+  std::string output;
   // A real interruption: SIGKILL once some frames exist.
   const fs::path killed = setup.temp.path() / "killed";
   const pid_t child = ::fork();
