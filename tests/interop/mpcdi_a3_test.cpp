@@ -208,6 +208,25 @@ TEST(MpcdiA3, SampleDomeRoundTripsWithin001PxAwayFromItsCoverageEdge) {
   }
 }
 
+TEST(MpcdiDome, SampleDomeRoundTripsThroughProfile3dToo) {
+  // The same display through frusta and source positions. Before the inverse grid's guards the
+  // filled-in corners of these PFMs sent interior base positions 200-600 px off.
+  const auto config = projection_io::read_display_config(std::string(FACET_SOURCE_DIR) +
+                                                         "/configs/displays/dome4/display.json");
+  const ImportedDisplay display = import_mpcdi(export_mpcdi(config), "dome4.mpcdi");
+  for (std::size_t p = 0; p < config.projectors.size(); ++p) {
+    const Warp original = read_warp(config.resolve(config.projectors[p].warp).string());
+    const double interior = max_difference_px(original, display.projectors[p].warp, 201, 2);
+    const double everywhere = max_difference_px(original, display.projectors[p].warp, 201);
+    std::printf(
+        "3d round trip, dome4 %s: max %.5f px two cells inside the coverage edge, %.5f px "
+        "everywhere covered\n",
+        config.projectors[p].name.c_str(), interior, everywhere);
+    EXPECT_LT(interior, 0.01) << config.projectors[p].name;
+    EXPECT_LT(everywhere, 0.05) << config.projectors[p].name;
+  }
+}
+
 TEST(MpcdiA3, OtherToolsFilesImportOnABaseOfTheirOwn) {
   // No facet.json: the import chooses a base that covers the region's directions, so compare
   // where directions land rather than base positions.
