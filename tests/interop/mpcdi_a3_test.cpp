@@ -211,8 +211,10 @@ TEST(MpcdiA3, SampleDomeRoundTripsWithin001PxAwayFromItsCoverageEdge) {
 TEST(MpcdiDome, SampleDomeRoundTripsThroughProfile3dToo) {
   // The same display through frusta and source positions. Before the inverse grid's guards the
   // filled-in corners of these PFMs sent interior base positions 200-600 px off.
-  const auto config = projection_io::read_display_config(std::string(FACET_SOURCE_DIR) +
+  auto config = projection_io::read_display_config(std::string(FACET_SOURCE_DIR) +
                                                          "/configs/displays/dome4/display.json");
+  // One projector (the a3 test above covers all four): p0 has the widest uncovered corners.
+  config.projectors.resize(1);
   const ImportedDisplay display = import_mpcdi(export_mpcdi(config), "dome4.mpcdi");
   for (std::size_t p = 0; p < config.projectors.size(); ++p) {
     const Warp original = read_warp(config.resolve(config.projectors[p].warp).string());
