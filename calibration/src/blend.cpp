@@ -14,13 +14,16 @@ namespace {
 
 // An uncovered pixel of one projector counts as an edge to fade towards when another projector
 // covers its direction at least this far (output pixels) inside its own covered region. Covered
-// regions that end at the same place on the screen (where the camera's view ends) do so along
-// node-sized steps of each warp; a margin of a little more than the node spacing keeps those
-// steps from counting as overlaps.
+// regions that end together on the screen (where the camera's view ends, or where two images'
+// edges cross at a small angle) are a few pixels apart near where they meet: too little room to
+// fade across, so neither fades there (see kContinueFlatPx for the step that leaves in the
+// other's weight). The warps' coverage follows such edges within about a pixel but bends only
+// from node to node, so the margin is at least a little more than a node spacing.
+constexpr double kMinOverlapMarginPx = 10;
 double overlap_margin_px(const Warp& warp) {
   const double spacing = 0.5 * (double(warp.output_size.x) / (warp.grid_size.x - 1) +
                                 double(warp.output_size.y) / (warp.grid_size.y - 1));
-  return 1.25 * spacing;
+  return std::max(kMinOverlapMarginPx, 1.25 * spacing);
 }
 
 template <typename Body>
@@ -179,11 +182,15 @@ double smoothstep(double x) {
   return x * x * (3 - 2 * x);
 }
 
-// Beyond an edge of its covered region, a projector's raw weight is carried on, unchanged for
-// kContinueFlatPx and then falling to 0 over kContinueFadePx (output pixels from its covered pixel
-// centres), in the sums of the projectors that go on lighting there (see compute_blend).
-constexpr double kContinueFlatPx = 2;
-constexpr double kContinueFadePx = 6;
+// Where projector k's covered region ends inside j's without k having faded out (an edge within
+// the overlap margin), j's share would jump there from 1 − α_k to 1, and j's weights, read between
+// pixel centres, would break the sum across a band as wide as j's pixels. So in j's sums, k's raw
+// weight is carried on past k's edge: unchanged for kContinueFlatPx (output pixels from k's
+// covered pixel centres, more than the reach of j's bilinear interpolation across it) and then
+// falling to 0 over kContinueFadePx. Where j lights alone within those few pixels, its weight is
+// below 1 (check_blend reports how much); a deep edge of k has faded to 0 and carries nothing.
+constexpr double kContinueFlatPx = 1.5;
+constexpr double kContinueFadePx = 2.5;
 constexpr int kContinuePad = int(kContinueFlatPx + kContinueFadePx) + 2;
 
 // Distance in output pixels from each point of the image padded by kContinuePad on every side to
@@ -329,6 +336,7 @@ BlendResult compute_blend(std::span<const Warp> warps, const BlendOptions& optio
         for (std::size_t k = 0; k < warps.size(); ++k) {
           const auto projected = warps[k].project(v);
           const bool covers = projected && projected->covered;
+          // Another projector's weight is carried on past its edge; p's own is not (p covers v).
           const double raw = weighing[k].raw(v, options.feather_rad, k != p);
           if (covers && raw > 0) ++covering;
           sum += raw;

@@ -187,8 +187,10 @@ Basis quadratic_basis(double du, double dv) { return {1, du, dv, du * du, du * d
 // with the fitted warp. Pixels holding one are closed over gaps of a few sample spacings (the
 // camera samples the image at its own resolution). Positions within `band_px` of the image edge
 // are pulled inwards by defocus and dropped by the fit, so the band is not judged from them: the
-// region seen just inside it is carried straight out to the image edge.
-cv::Mat seen_signed_distance(std::span<const glm::dvec2> q_seen, glm::ivec2 size, int band_px) {
+// region seen just inside it is carried straight out to the image edge. Unseen holes enclosed by
+// the seen region whose points all lie within `bridge_px` of it count as seen.
+cv::Mat seen_signed_distance(std::span<const glm::dvec2> q_seen, glm::ivec2 size, int band_px,
+                             double bridge_px) {
   cv::Mat seen(size.y, size.x, CV_8U, cv::Scalar(0));
   for (const glm::dvec2& q : q_seen) {
     const int x = int(std::floor(q.x)), y = int(std::floor(q.y));
@@ -216,6 +218,30 @@ cv::Mat seen_signed_distance(std::span<const glm::dvec2> q_seen, glm::ivec2 size
     cv::copyMakeBorder(seen(inner), carried, band, band, band, band,
                        cv::BORDER_REPLICATE | cv::BORDER_ISOLATED);
     seen = carried;
+  }
+  // Holes enclosed by what was seen (a speck of dust, an occluder) are bridged from every side by
+  // the node fits: small ones count as seen.
+  {
+    const cv::Mat unseen = 1 - seen;
+    cv::Mat labels, stats, centroids, gap;
+    const int count = cv::connectedComponentsWithStats(unseen, labels, stats, centroids, 8, CV_32S);
+    cv::distanceTransform(unseen, gap, cv::DIST_L2, cv::DIST_MASK_PRECISE, CV_32F);
+    std::vector<float> widest(std::size_t(count), 0.0f);
+    for (int y = 0; y < size.y; ++y) {
+      for (int x = 0; x < size.x; ++x) {
+        const int label = labels.at<std::int32_t>(y, x);
+        if (label > 0)
+          widest[std::size_t(label)] = std::max(widest[std::size_t(label)], gap.at<float>(y, x));
+      }
+    }
+    for (int label = 1; label < count; ++label) {
+      const int left = stats.at<std::int32_t>(label, cv::CC_STAT_LEFT);
+      const int top = stats.at<std::int32_t>(label, cv::CC_STAT_TOP);
+      const bool enclosed = left > 0 && top > 0 &&
+                            left + stats.at<std::int32_t>(label, cv::CC_STAT_WIDTH) < size.x &&
+                            top + stats.at<std::int32_t>(label, cv::CC_STAT_HEIGHT) < size.y;
+      if (enclosed && widest[std::size_t(label)] <= bridge_px) seen.setTo(1, labels == label);
+    }
   }
   // Beyond the image the region goes on as it meets the edge: the image edge itself is no edge
   // of what the camera saw.
@@ -645,10 +671,10 @@ WarpFit fit_warp(std::span<const FitSample> samples, glm::ivec2 output_size,
       q_seen.push_back(samples[k].q);
     }
   }
-  const cv::Mat seen_px =
-      seen_signed_distance(q_seen, output_size, int(std::ceil(options.edge_guard_px)) + 3);
-  q_seen = {};
   const double spacing_px = 0.5 * (step.x + step.y);
+  const cv::Mat seen_px = seen_signed_distance(
+      q_seen, output_size, int(std::ceil(options.edge_guard_px)) + 3, options.bridge_px);
+  q_seen = {};
   const double ramp_px = 3 * std::max(step.x, step.y);
   const int extrapolate_rings = std::max(1, int(std::ceil(options.extrapolate_px / spacing_px)));
   for (int j = 0; j < grid.y; ++j) {

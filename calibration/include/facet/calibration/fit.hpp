@@ -56,6 +56,10 @@ struct FitOptions {
   // many output pixels of the supported nodes (at least one ring) stay covered, enough for the
   // image edges, where the last nodes lie beyond the samples; the rest are left uncovered.
   double extrapolate_px = 8;
+  // The covered region ends where the camera's view of the image ends (within about a pixel), not
+  // where the extrapolated nodes do. Holes in that view enclosed by it, every point within this
+  // many output pixels of a seen one, are interpolated from all sides by the fit and stay covered.
+  double bridge_px = 24;
   int irls_iterations = 3;
   // Tukey biweight cut-off: max(tukey_sigmas · robust σ, min_cutoff_px).
   double tukey_sigmas = 4.685;
