@@ -212,7 +212,7 @@ TEST(MpcdiDome, SampleDomeRoundTripsThroughProfile3dToo) {
   // The same display through frusta and source positions. Before the inverse grid's guards the
   // filled-in corners of these PFMs sent interior base positions 200-600 px off.
   auto config = projection_io::read_display_config(std::string(FACET_SOURCE_DIR) +
-                                                         "/configs/displays/dome4/display.json");
+                                                   "/configs/displays/dome4/display.json");
   // One projector (the a3 test above covers all four): p0 has the widest uncovered corners.
   config.projectors.resize(1);
   const ImportedDisplay display = import_mpcdi(export_mpcdi(config), "dome4.mpcdi");
