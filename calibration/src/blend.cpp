@@ -228,8 +228,10 @@ struct Weighing {
     double carried = 1;
     if (!projected->covered) {
       if (!continued) return 0;
+      // Only next to the covered region, where the nodes hold the coverage ramp: farther out the
+      // offsets are extrapolated over many nodes and q can land anywhere, even back in the image.
       const bool in_base = projected->st.x >= 0 && projected->st.x <= 1 && projected->st.y >= 0 &&
-                           projected->st.y <= 1;
+                           projected->st.y <= 1 && warp->coverage_at(projected->st) > 0;
       const glm::dvec2 padded = q + double(kContinuePad);
       if (!in_base || !(padded.x > 0.5 && padded.y > 0.5 && padded.x < beyond_px.cols - 0.5 &&
                         padded.y < beyond_px.rows - 0.5)) {

@@ -185,12 +185,13 @@ Basis quadratic_basis(double du, double dv) { return {1, du, dv, du * du, du * d
 // Signed distance in output pixels from each output pixel centre to the edge of the part of the
 // image the camera saw, positive inside: CV_32F, W × H. `q_seen` are decoded positions that agree
 // with the fitted warp. Pixels holding one are closed over gaps of a few sample spacings (the
-// camera samples the image at its own resolution). Positions within `band_px` of the image edge
-// are pulled inwards by defocus and dropped by the fit, so the band is not judged from them: the
-// region seen just inside it is carried straight out to the image edge. Unseen holes enclosed by
-// the seen region whose points all lie within `bridge_px` of it count as seen.
+// camera samples the image at its own resolution) and at least `close_px`. Positions within
+// `band_px` of the image edge are pulled inwards by defocus and dropped by the fit, so the band is
+// not judged from them: the region seen just inside it is carried straight out to the image edge.
+// Unseen holes enclosed by the seen region whose points all lie within `bridge_px` of it count as
+// seen.
 cv::Mat seen_signed_distance(std::span<const glm::dvec2> q_seen, glm::ivec2 size, int band_px,
-                             double bridge_px) {
+                             double close_px, double bridge_px) {
   cv::Mat seen(size.y, size.x, CV_8U, cv::Scalar(0));
   for (const glm::dvec2& q : q_seen) {
     const int x = int(std::floor(q.x)), y = int(std::floor(q.y));
@@ -206,11 +207,18 @@ cv::Mat seen_signed_distance(std::span<const glm::dvec2> q_seen, glm::ivec2 size
   }
   const double density =
       blocks == 0 ? 1.0 : std::min(1.0, double(cv::countNonZero(seen)) / (64.0 * double(blocks)));
-  const int radius = std::max(2, int(std::ceil(1.5 / std::sqrt(density))));
+  // Gaps between the samples, and where a few decoded badly, are closed; the coverage ramp
+  // cannot follow finer detail than about a node spacing anyway.
+  const int radius = std::max(int(std::ceil(1.5 / std::sqrt(density))), int(std::lround(close_px)));
   const cv::Mat disc = cv::getStructuringElement(
       cv::MORPH_ELLIPSE, cv::Size(2 * radius + 1, 2 * radius + 1), cv::Point(radius, radius));
-  cv::morphologyEx(seen, seen, cv::MORPH_CLOSE, disc, cv::Point(-1, -1), 1, cv::BORDER_CONSTANT,
-                   cv::Scalar(0));
+  {
+    // Padded as it meets the image edge, so that closing does not eat into the edge.
+    cv::Mat padded;
+    cv::copyMakeBorder(seen, padded, radius, radius, radius, radius, cv::BORDER_REPLICATE);
+    cv::morphologyEx(padded, padded, cv::MORPH_CLOSE, disc);
+    padded(cv::Rect(radius, radius, size.x, size.y)).copyTo(seen);
+  }
   const int band = std::min({band_px, (size.x - 1) / 2, (size.y - 1) / 2});
   if (band > 0) {
     const cv::Rect inner(band, band, size.x - 2 * band, size.y - 2 * band);
@@ -672,8 +680,9 @@ WarpFit fit_warp(std::span<const FitSample> samples, glm::ivec2 output_size,
     }
   }
   const double spacing_px = 0.5 * (step.x + step.y);
-  const cv::Mat seen_px = seen_signed_distance(
-      q_seen, output_size, int(std::ceil(options.edge_guard_px)) + 3, options.bridge_px);
+  const cv::Mat seen_px =
+      seen_signed_distance(q_seen, output_size, int(std::ceil(options.edge_guard_px)) + 3,
+                           0.75 * spacing_px, options.bridge_px);
   q_seen = {};
   const double ramp_px = 3 * std::max(step.x, step.y);
   const int extrapolate_rings = std::max(1, int(std::ceil(options.extrapolate_px / spacing_px)));
