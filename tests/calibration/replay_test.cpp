@@ -163,6 +163,34 @@ TEST(Replay, BlendWeightsSumToOneWhereProjectorsOverlap) {
   }
 }
 
+// The replay rig with the camera looking 45° up and seeing 90° across its height: its view ends
+// about 6° above the projectors' bottom edges, across both images and the middle of their
+// overlap, so the covered regions of both warps end together there, as on the sample dome where
+// the camera misses the images' bottom corners.
+TEST(Replay, BlendSumsToOneWhereTheCameraViewEndsInsideAnOverlap) {
+  const test::TempFolder folder;
+  Rig rig = replay_rig();
+  rig.camera.fov_deg = 90;
+  const glm::dvec3 forward(0, std::sin(glm::radians(45.0)), -std::cos(glm::radians(45.0)));
+  const glm::dvec3 right(1, 0, 0);
+  rig.camera.R_eye_camera = glm::dmat3(right, glm::cross(forward, right), forward);
+  simulate_capture(rig, folder.path() / "capture");
+  const CalibrationReport report = calibrate(folder.path() / "capture", folder.path() / "display");
+  print("cut", report);
+  ASSERT_EQ(report.projectors.size(), 2u);
+  for (const ProjectorReport& p : report.projectors) {
+    ASSERT_TRUE(p.accuracy.has_value()) << p.name;
+    // The camera misses a band along the bottom of each image (more than the 8 px border).
+    EXPECT_GT(p.accuracy->uncovered_fraction, 0.02) << p.name;
+    EXPECT_LT(p.accuracy->uncovered_fraction, 0.3) << p.name;
+    // Where the view ends, the coverage ends with it rather than extrapolating beyond.
+    EXPECT_LE(p.accuracy->rms_px, 0.1) << p.name;
+    EXPECT_LE(p.accuracy->max_px, 1.0) << p.name;
+  }
+  EXPECT_GT(report.blend_overlap_directions, 200u);
+  EXPECT_LE(report.blend_sum_max_err, 0.005) << report.blend_worst;
+}
+
 // Runs the `facet` command; its exit status.
 int run_cli(const std::string& arguments) {
   const std::string command = std::string(FACET_CLI) + " " + arguments + " 2>/dev/null";
