@@ -43,7 +43,7 @@ struct CaptureArgs {
   std::optional<double> projector_gamma;
   int average = 1;
   int settle_ms = 100;
-  int bits = 16;
+  std::optional<int> bits;
   int discard = 2;
   std::optional<double> phase_period;
   std::optional<int> phase_steps;
@@ -268,7 +268,7 @@ int run_capture(const CaptureArgs& args) {
   calibration::LiveCaptureOptions options;
   options.out = args.out;
   options.average = args.average;
-  options.bits = args.bits;
+  options.bits = args.bits ? *args.bits : rig ? rig->simulation.bits : 16;
   options.camera_gamma = args.camera_gamma;
   options.max_clipped_fraction = args.max_clipped;
   options.allow_clipping = args.allow_clipping;
@@ -353,7 +353,9 @@ const Registration registration{
                       "wait after each pattern is on screen, milliseconds (default 100)");
       cmd->add_option("--discard", args->discard,
                       "real camera: frames dropped before each grab (default 2)");
-      cmd->add_option("--bits", args->bits, "PNG bits per sample of the frames, 8 or 16 (16)");
+      cmd->add_option(
+          "--bits", args->bits,
+          "PNG bits per sample of the frames, 8 or 16 (16; the rig's for a fake camera)");
       cmd->add_option("--phase-period", args->phase_period,
                       "phase-shift period in projector pixels (default 16; the rig's for a fake "
                       "camera)");
