@@ -32,11 +32,15 @@ struct BlendResult {
 // eye direction with WarpInverse; pixels no direction maps to get α = 0. The raw weight of
 // projector k at direction v is smoothstep(d_k(v) / feather_rad): d_k is the distance in output
 // pixels from k's position of v to the edges of k's covered region that another projector covers
-// (each edge point raised by 4× how far short of 1.25 node spacings inside the other projector
-// it lies, so an edge that projector barely reaches hardly counts), lightly smoothed (Gaussian,
-// σ = 3 px), times k's local angle per pixel; 0 where k does not cover v. Edges no other
-// projector covers beyond (the display's outer edge) need no fading. α is the raw weight over
-// the sum of raw weights, so the weights sum to 1 at every pixel centre.
+// (each edge point raised by 4× how far short of max(10 px, 1.25 node spacings) inside the other
+// projector it lies, so an edge that projector barely reaches hardly counts), lightly smoothed
+// (Gaussian, σ = 3 px), times k's local angle per pixel; 0 where k's warp does not cover v
+// (covered means Warp::project's `covered`, also where that reaches a fraction of a pixel past
+// the image edge). Edges no other projector covers beyond (the display's outer edge) need no
+// fading. α is the raw weight over the sum of raw weights, so the weights sum to 1 at every pixel
+// centre. In the sums of the other projectors, k's raw weight is carried on 1.5 px past its
+// covered pixel centres and fades out over the next 2.5 px, so that their α has no step where k
+// ends without having faded out; there, where one projector lights alone, its α is below 1.
 BlendResult compute_blend(std::span<const Warp> warps, const BlendOptions& options = {});
 
 struct BlendCheck {
@@ -56,6 +60,7 @@ struct BlendCheck {
 // bilinearly at its own position of the direction, summed. Directions that some covering
 // projector places within `border_px` of the edge of its covered region (the image edge, or where
 // its warp stops covering) are left out: there α meets the 0 beyond the edge between two pixels.
+// Directions lit by one projector alone are counted apart, with how many have α below 0.995.
 BlendCheck check_blend(std::span<const Warp> warps, std::span<const projection_io::BlendMap> alpha,
                        int stride = 3, double border_px = 1.0);
 

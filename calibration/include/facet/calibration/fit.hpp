@@ -9,7 +9,9 @@
 // (IRLS) that drop wrong Gray codes. Noise is averaged by the fit, never blurred afterwards.
 // Binning the samples by st and taking a node's neighbours from the bins is the same as
 // projecting the node's direction into the camera and taking the camera pixels around it, but
-// works unchanged when the camera is offset from the eye.
+// works unchanged when the camera is offset from the eye. The covered region ends at the nearer
+// of the image edge and the edge of what the camera saw of the image (the decoded positions that
+// agree with the fit), each within about a pixel.
 #include <cstddef>
 #include <glm/glm.hpp>
 #include <opencv2/core.hpp>
@@ -52,9 +54,9 @@ struct FitOptions {
   // Noise gain of the fitted value, [N⁻¹]₀₀·Σw: 1 for a plain mean, a few for a centred
   // quadratic, large when the node lies beyond the samples and the fit would extrapolate.
   double max_gain = 40;
-  // Unsupported nodes are filled by extrapolating outwards, ring by ring; the rings within this
-  // many output pixels of the supported nodes (at least one ring) stay covered, enough for the
-  // image edges, where the last nodes lie beyond the samples; the rest are left uncovered.
+  // Unsupported nodes are filled by extrapolating outwards, ring by ring; the rings beyond this
+  // many output pixels of the supported nodes (at least one ring) are uncovered, whatever the
+  // image edge and the camera's view say.
   double extrapolate_px = 8;
   // The covered region ends where the camera's view of the image ends (within about a pixel), not
   // where the extrapolated nodes do. Holes in that view enclosed by it, every point within this
