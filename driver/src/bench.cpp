@@ -502,6 +502,8 @@ BenchReport run_bench(const BenchOptions& options, const std::string& renderer,
       row.triangles_in = last.triangles_in;
       row.triangles_visible = last.triangles_visible;
       row.replicas = last.replicas;
+      row.dropped_triangles = last.dropped_triangles;
+      row.seam_copies = last.seam_copies;
       say(format("  %-9s %-12s %9.2f ms/frame (median of %d), GPU %8.2f ms, ratio %.3f",
                  row.method.c_str(), row.setting.c_str(), row.frame_ms, options.frames, row.gpu_ms,
                  row.replication_ratio));

@@ -29,7 +29,7 @@ constexpr float kTessellationTolerancePx = 0.25f;
 // GL 4.5 guarantees tessellation levels up to 64.
 constexpr int kMaxTessellation = 64;
 
-constexpr std::uint32_t kCounters = 2;  // VertexCounters in vertex.geom
+constexpr std::uint32_t kCounters = 4;  // VertexCounters in vertex.geom
 
 double radians(double degrees) { return degrees * std::numbers::pi / 180.0; }
 
@@ -300,6 +300,8 @@ class VertexMethod final : public RenderMethod {
     counters_.get_sub_data(0, sizeof counts, counts);
     stats.triangles_visible = counts[0];
     stats.replicas = counts[1];
+    stats.dropped_triangles = counts[2];
+    stats.seam_copies = counts[3];
     check_gl_error("vertex render");
     return stats;
   }

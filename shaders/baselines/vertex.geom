@@ -40,6 +40,8 @@ layout(location = 29) uniform float z_near;
 layout(std430, binding = 4) buffer VertexCounters {
   uint visible_triangles;  // scene triangles (patches) past back-face culling
   uint drawn_triangles;    // triangles emitted to the rasterizer, seam copies included
+  uint dropped_triangles;  // triangles (tessellated pieces) dropped near a singular direction
+  uint seam_copies;        // emissions beyond a triangle's first on a 360° base
 };
 
 vec3 q_from_eye(vec3 p_eye, float s_hint, bool use_hint);
@@ -49,13 +51,14 @@ bool faces_eye(vec3 p0, vec3 p1, vec3 p2);
 bool surrounds_singularity(vec3 p0, vec3 p1, vec3 p2);
 bool beyond_guard(vec2 st);
 
-void emit(vec3 st[3], float shift) {
+// True when the triangle was drawn (some part of it may lie in the output).
+bool emit(vec3 st[3], float shift) {
   vec2 q[3];
   for (int k = 0; k < 3; ++k) q[k] = q_from_st(st[k].xy + vec2(shift, 0.0));
   // Wholly beyond one edge of the output: not drawn.
   vec2 q_min = min(min(q[0], q[1]), q[2]), q_max = max(max(q[0], q[1]), q[2]);
   if (q_max.x < 0.0 || q_max.y < 0.0 || q_min.x > output_size.x || q_min.y > output_size.y) {
-    return;
+    return false;
   }
   for (int k = 0; k < 3; ++k) {
     // y flips once: output rows run down, GL window rows up.
@@ -68,6 +71,7 @@ void emit(vec3 st[3], float shift) {
   }
   EndPrimitive();
   atomicAdd(drawn_triangles, 1u);
+  return true;
 }
 
 void main() {
@@ -80,9 +84,12 @@ void main() {
   st[0] = st_from_eye(g_p_eye[0], 0.0, false);
   st[1] = st_from_eye(g_p_eye[1], st[0].x, true);
   st[2] = st_from_eye(g_p_eye[2], st[0].x, true);
-  if (st[0].z * st[1].z * st[2].z == 0.0) return;
-  if (surrounds_singularity(g_p_eye[0], g_p_eye[1], g_p_eye[2])) return;
-  if (beyond_guard(st[0].xy) || beyond_guard(st[1].xy) || beyond_guard(st[2].xy)) return;
+  if (st[0].z * st[1].z * st[2].z == 0.0 ||
+      surrounds_singularity(g_p_eye[0], g_p_eye[1], g_p_eye[2]) || beyond_guard(st[0].xy) ||
+      beyond_guard(st[1].xy) || beyond_guard(st[2].xy)) {
+    atomicAdd(dropped_triangles, 1u);
+    return;
+  }
   if (s_period == 0.0) {
     emit(st, 0.0);
     return;
@@ -92,5 +99,7 @@ void main() {
   float s_min = min(min(st[0].x, st[1].x), st[2].x), s_max = max(max(st[0].x, st[1].x), st[2].x);
   int k_first = int(ceil(-s_max / s_period)), k_last = int(floor((1.0 - s_min) / s_period));
   k_last = min(k_last, k_first + 2);
-  for (int k = k_first; k <= k_last; ++k) emit(st, float(k) * s_period);
+  uint drawn = 0u;
+  for (int k = k_first; k <= k_last; ++k) drawn += emit(st, float(k) * s_period) ? 1u : 0u;
+  if (drawn > 1u) atomicAdd(seam_copies, drawn - 1u);
 }

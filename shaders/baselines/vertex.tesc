@@ -27,6 +27,8 @@ layout(location = 28) uniform float max_level;
 layout(std430, binding = 4) buffer VertexCounters {
   uint visible_triangles;
   uint drawn_triangles;
+  uint dropped_triangles;
+  uint seam_copies;
 };
 
 vec3 q_from_eye(vec3 p_eye, float s_hint, bool use_hint);

@@ -275,8 +275,16 @@ TEST(VertexBaseline, TrianglesAcrossTheSeamDrawOnBothSides) {
   f.T_eye_world = glm::dmat4(1);
   f.reference = reference_ids(f.scene, f.warp, f.T_eye_world);
   for (int level : {1, 8}) {
-    const std::vector<std::uint32_t> ids = render(f, "vertex", vertex_settings(level)).ids;
+    const Rendered rendered = render(f, "vertex", vertex_settings(level));
+    const std::vector<std::uint32_t>& ids = rendered.ids;
     const IdComparison c = print("seam " + std::to_string(level), compare(f, ids));
+    // Both triangles cross the seam and are drawn twice; tessellated, their pieces that cross it.
+    if (level == 1) {
+      EXPECT_EQ(rendered.stats.seam_copies, 2u);
+    } else {
+      EXPECT_GE(rendered.stats.seam_copies, 2u);
+    }
+    EXPECT_EQ(rendered.stats.dropped_triangles, 0u);
     EXPECT_EQ(c.mismatched_pixels, 0u);
     EXPECT_LE(c.max_edge_px, 1.0);
     const int row = 96 * 256;
@@ -317,8 +325,17 @@ TEST(VertexBaseline, TrianglesThroughTheEyeDoNotBreakIt) {
         method->prepare(scene, gpu_scene, outputs, settings);
         std::vector<OutputTarget> targets;
         targets.push_back(OutputTarget::create(warp.output_size));
-        EXPECT_NO_THROW(method->render(glm::dmat4(1), targets));
+        RenderStats stats;
+        EXPECT_NO_THROW(stats = method->render(glm::dmat4(1), targets));
         EXPECT_EQ(glGetError(), GLenum(GL_NO_ERROR));
+        // The corner at the eye has no projection: its triangles are dropped, and counted.
+        if (!cull) {
+          EXPECT_GE(stats.dropped_triangles, 1u);
+        }
+        // Untessellated, what is dropped is whole scene triangles (tessellated: pieces).
+        if (level == 1) {
+          EXPECT_LE(stats.dropped_triangles, stats.triangles_visible);
+        }
         for (std::uint32_t id : targets[0].read_ids()) {
           ASSERT_LE(id, triangles);
           if (warp.base.kind == BaseKind::perspective) {

@@ -211,6 +211,8 @@ void run(const RenderOptions& options) {
                            {"replication_ratio", last.replication_ratio()},
                            {"replication_ratio_mean", ratio_sum / options.frames},
                            {"reused_frames", reused},
+                           {"dropped_triangles", last.dropped_triangles},
+                           {"seam_copies", last.seam_copies},
                            {"frame_ms", median(frame_ms)},
                            {"pass_ms", pass_ms},
                            {"texture_anisotropy", gpu_scene.max_anisotropy}};

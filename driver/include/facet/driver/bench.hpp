@@ -72,6 +72,7 @@ struct BenchRow {
   // The same share from the GPU timer: median over frames of (pass1 + pass2) / all passes.
   std::optional<double> passes12_share_gpu;
   std::uint64_t facets = 0, triangles_in = 0, triangles_visible = 0, replicas = 0;
+  std::uint64_t dropped_triangles = 0, seam_copies = 0;  // vertex only (RenderStats)
   double replication_ratio = 0;  // mean of replicas / triangles_in over the timed frames
   // Reference comparison on the accuracy frame, pooled over outputs: id_mismatch is
   // Σ mismatched / Σ compared (compare_ids); max_edge_px the largest and p99_edge_px the largest

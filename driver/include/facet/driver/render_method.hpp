@@ -90,6 +90,11 @@ struct RenderStats {
   std::uint64_t replicas = 0;           // triangle draws issued, summed over outputs
   std::uint64_t facets = 0;             // facets over all outputs (0 for non-facet methods)
   bool reused_replication = false;      // passes 1+2 skipped: neither view nor scene changed
+  // Per-vertex baseline only: triangles (tessellated pieces) dropped because the warp's P has no
+  // value at a corner or they surround or near a singular direction, and draws beyond a
+  // triangle's first on a 360° base (seam copies, included in replicas).
+  std::uint64_t dropped_triangles = 0;
+  std::uint64_t seam_copies = 0;
   // replicas / triangles_in; the seed paper's replication ratio.
   double replication_ratio() const {
     return triangles_in == 0 ? 0.0 : double(replicas) / double(triangles_in);
