@@ -166,7 +166,10 @@ TEST(Replay, BlendWeightsSumToOneWhereProjectorsOverlap) {
 // The replay rig with the camera looking 45° up and seeing 90° across its height: its view ends
 // about 6° above the projectors' bottom edges, across both images and the middle of their
 // overlap, so the covered regions of both warps end together there, as on the sample dome where
-// the camera misses the images' bottom corners.
+// the camera misses the images' bottom corners. Before the coverage followed the camera's view,
+// the warps were extrapolated past it: RMS 0.102–0.109 px, p99 0.49–0.53 px here. (The blend sum
+// stayed within 0.002 then too: this small rig does not reproduce dome4's step at a neighbour's
+// edge.)
 TEST(Replay, BlendSumsToOneWhereTheCameraViewEndsInsideAnOverlap) {
   const test::TempFolder folder;
   Rig rig = replay_rig();
