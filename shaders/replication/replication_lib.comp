@@ -116,33 +116,31 @@ void triangle_eye(uint t, out vec3 p[3]) {
   for (uint c = 0u; c < 3u; ++c) p[c] = eye_position(object, vertex_of(e, t, c));
 }
 
-// True when the triangle meets the cone {X : planes[k]·X >= -slack·|X|, k < plane_count}:
-// Sutherland–Hodgman clipping, as triangle_meets_cone in projection/src/coverage.cpp.
-bool meets_cone(vec3 p[3], vec4 planes[4], int plane_count) {
-  // Most tests end here. Every corner outside one plane: the whole triangle is (the slack term is
-  // convex, so the signed distance of a point of the triangle is at most the same mix of its
-  // corners'). A corner inside every plane: clipping would keep it as it is, and the eye test
-  // below is then decided by its length.
-  float scale = max(length(p[0]), max(length(p[1]), length(p[2])));
+// True when the triangle with unit corner directions u meets the cone
+// {X : planes[k]·X >= -slack·|X|, k < plane_count}: Sutherland–Hodgman clipping, as
+// triangle_meets_cone in projection/src/coverage.cpp. The cone over a triangle from the eye is the
+// cone over its corner directions, so unit corners give the same answer, and every point met
+// below has |X| <= 1: a constant slack is at least slack·|X|, and never loses a facet.
+bool meets_cone(vec3 u[3], vec4 planes[4], int plane_count) {
+  // Most tests end here. Every corner outside one plane: so is the whole triangle. A corner
+  // inside every plane: clipping would keep it as it is.
   bool corner_inside[3] = bool[3](true, true, true);
   for (int k = 0; k < plane_count; ++k) {
     vec3 n = planes[k].xyz;
     bool any_inside = false;
     for (int c = 0; c < 3; ++c) {
-      bool inside = dot(n, p[c]) + kCoverageSlack * length(p[c]) >= 0.0;
+      bool inside = dot(n, u[c]) + kCoverageSlack >= 0.0;
       any_inside = any_inside || inside;
       corner_inside[c] = corner_inside[c] && inside;
     }
     if (!any_inside) return false;
   }
-  for (int c = 0; c < 3; ++c) {
-    if (corner_inside[c] && length(p[c]) > 1e-6 * scale) return true;
-  }
+  if (corner_inside[0] || corner_inside[1] || corner_inside[2]) return true;
   vec3 poly[8];
   vec3 next[8];
-  poly[0] = p[0];
-  poly[1] = p[1];
-  poly[2] = p[2];
+  poly[0] = u[0];
+  poly[1] = u[1];
+  poly[2] = u[2];
   int count = 3;
   for (int k = 0; k < plane_count && count > 0; ++k) {
     vec3 n = planes[k].xyz;
@@ -150,18 +148,17 @@ bool meets_cone(vec3 p[3], vec4 planes[4], int plane_count) {
     for (int i = 0; i < count; ++i) {
       vec3 a = poly[i];
       vec3 b = poly[(i + 1) % count];
-      float da = dot(n, a) + kCoverageSlack * length(a);
-      float db = dot(n, b) + kCoverageSlack * length(b);
+      float da = dot(n, a) + kCoverageSlack;
+      float db = dot(n, b) + kCoverageSlack;
       if (da >= 0.0 && written < 8) next[written++] = a;
       if ((da >= 0.0) != (db >= 0.0) && written < 8) next[written++] = a + (b - a) * (da / (da - db));
     }
     count = written;
     for (int i = 0; i < count; ++i) poly[i] = next[i];
   }
-  if (count == 0) return false;
   // What meets the cone only at the eye is seen edge-on and covers nothing.
   for (int i = 0; i < count; ++i) {
-    if (length(poly[i]) > 1e-6 * scale) return true;
+    if (length(poly[i]) > 1e-6) return true;
   }
   return false;
 }
@@ -189,19 +186,20 @@ void write_pair(uint at, uint t, uint facet);
 uint walk_coverage(vec3 p[3], uint t, uint pair_base, uint wanted, out uint wanted_facet) {
   wanted_facet = kNone;
   if (!triangle_may_cover(p)) return 0u;
+  vec3 u[3] = vec3[3](normalize(p[0]), normalize(p[1]), normalize(p[2]));
   uint found = 0u;
   uint stack[64];
   int top = 0;
   stack[top++] = 0u;
   while (top > 0) {
     Node node = nodes[stack[--top]];
-    if (node.bounded != 0u && !meets_cone(p, node.pyramid, 4)) continue;
+    if (node.bounded != 0u && !meets_cone(u, node.pyramid, 4)) continue;
     if (node.count > 0u) {
       for (uint k = node.first; k < node.first + node.count; ++k) {
         uint f = facet_order[k];
         vec4 planes[4] = vec4[4](facets[f].clip_planes[0], facets[f].clip_planes[1],
                                  facets[f].clip_planes[2], vec4(0.0));
-        if (!meets_cone(p, planes, 3)) continue;
+        if (!meets_cone(u, planes, 3)) continue;
         if (found == wanted) {
           wanted_facet = f;
           return found + 1u;
