@@ -18,6 +18,7 @@
 
 #include "../calibration/capture_rig.hpp"
 #include "facet/projection_io/rig_file.hpp"
+#include "xorg_dummy.hpp"
 
 namespace facet {
 namespace {
@@ -46,57 +47,11 @@ class CaptureWindows : public ::testing::Test {
     folder_ = fs::temp_directory_path() / ("facet_capture_xorg_" + std::to_string(::getpid()));
     fs::remove_all(folder_);
     fs::create_directories(folder_);
-    if (!fs::exists("/usr/bin/Xorg") || !fs::exists("/usr/lib/xorg/modules/drivers/dummy_drv.so")) {
-      skip_reason_ = "Xorg or its dummy video driver (xserver-xorg-video-dummy) is not installed";
-      return;
-    }
-    if (::geteuid() != 0) {
-      skip_reason_ = "Xorg with the dummy driver needs root here";
-      return;
-    }
-    std::ofstream(folder_ / "xorg.conf") << R"(Section "Device"
-  Identifier "dummy"
-  Driver "dummy"
-  VideoRam 64000
-EndSection
-Section "Monitor"
-  Identifier "monitor"
-  HorizSync 5.0-1000.0
-  VertRefresh 5.0-200.0
-EndSection
-Section "Screen"
-  Identifier "screen"
-  Device "dummy"
-  Monitor "monitor"
-  DefaultDepth 24
-  SubSection "Display"
-    Depth 24
-    Virtual 1280 480
-  EndSubSection
-EndSection
-)";
-    // Another number than the session tests' (:70–:169), which may run at the same time.
-    display_ = ":" + std::to_string(170 + ::getpid() % 100);
-    xorg_ = ::fork();
-    if (xorg_ == 0) {
-      const std::string config = (folder_ / "xorg.conf").string();
-      const std::string log = (folder_ / "xorg.log").string();
-      ::execl("/usr/bin/Xorg", "Xorg", display_.c_str(), "-config", config.c_str(), "-noreset",
-              "-nolisten", "tcp", "-logfile", log.c_str(), static_cast<char*>(nullptr));
-      ::_exit(127);
-    }
-    for (int attempt = 0; attempt < 100 && xrandr("--listmonitors") != 0; ++attempt) {
-      std::this_thread::sleep_for(std::chrono::milliseconds(100));
-      if (::waitpid(xorg_, nullptr, WNOHANG) == xorg_) {
-        xorg_ = -1;
-        skip_reason_ = "Xorg exited at start; see " + (folder_ / "xorg.log").string();
-        return;
-      }
-    }
-    if (xrandr("--listmonitors") != 0) {
-      skip_reason_ = "Xorg did not answer within 10 s";
-      return;
-    }
+    // Another display number than the session tests' (:70–:169), which may run at the same time.
+    skip_reason_ =
+        server_.start(folder_, ":" + std::to_string(170 + ::getpid() % 100), 1280, 480, 64000);
+    display_ = server_.display();
+    if (!skip_reason_.empty()) return;
     // Two side-by-side 640×480 monitors DUMMY0 and DUMMY1, larger than the 128×96 projectors:
     // the patterns land 1:1 at each window's top-left corner.
     for (int i = 0; i < 2; ++i) {
@@ -108,11 +63,7 @@ EndSection
   }
 
   static void TearDownTestSuite() {
-    if (xorg_ > 0) {
-      ::kill(xorg_, SIGTERM);
-      ::waitpid(xorg_, nullptr, 0);
-      xorg_ = -1;
-    }
+    server_.stop();
     std::error_code ignored;
     fs::remove_all(folder_, ignored);
   }
@@ -121,9 +72,7 @@ EndSection
     if (!skip_reason_.empty()) GTEST_SKIP() << skip_reason_;
   }
 
-  static int xrandr(const std::string& arguments) {
-    return run_shell("DISPLAY=" + display_ + " xrandr " + arguments + " > /dev/null");
-  }
+  static int xrandr(const std::string& arguments) { return server_.xrandr(arguments); }
 
   static fs::path write_files(const std::string& name, const std::string& second_monitor) {
     const fs::path dir = folder_ / name;
@@ -154,9 +103,9 @@ EndSection
            " --settle-ms 0 --quiet " + extra;
   }
 
+  static inline test::XorgDummyServer server_;
   static inline fs::path folder_;
   static inline std::string display_;
-  static inline pid_t xorg_ = -1;
   static inline std::string skip_reason_;
 };
 

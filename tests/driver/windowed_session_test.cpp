@@ -18,6 +18,7 @@
 
 #include "facet/projection_io/display_config.hpp"
 #include "facet/projection_io/warp_file.hpp"
+#include "xorg_dummy.hpp"
 
 namespace facet {
 namespace {
@@ -38,67 +39,12 @@ class XorgDummy : public ::testing::Test {
     folder_ = fs::temp_directory_path() / ("facet_xorg_" + std::to_string(::getpid()));
     fs::remove_all(folder_);
     fs::create_directories(folder_);
-    if (!fs::exists("/usr/bin/Xorg") || !fs::exists("/usr/lib/xorg/modules/drivers/dummy_drv.so")) {
-      skip_reason_ = "Xorg or its dummy video driver (xserver-xorg-video-dummy) is not installed";
-      return;
-    }
-    if (::geteuid() != 0) {
-      skip_reason_ = "Xorg with the dummy driver needs root here";
-      return;
-    }
-    std::ofstream(folder_ / "xorg.conf") << R"(Section "Device"
-  Identifier "dummy"
-  Driver "dummy"
-  VideoRam 256000
-EndSection
-Section "Monitor"
-  Identifier "monitor"
-  HorizSync 5.0-1000.0
-  VertRefresh 5.0-200.0
-EndSection
-Section "Screen"
-  Identifier "screen"
-  Device "dummy"
-  Monitor "monitor"
-  DefaultDepth 24
-  SubSection "Display"
-    Depth 24
-    Virtual 4096 2048
-  EndSubSection
-EndSection
-)";
-    display_ = ":" + std::to_string(70 + ::getpid() % 100);
-    xorg_ = ::fork();
-    if (xorg_ == 0) {
-      const std::string config = (folder_ / "xorg.conf").string();
-      const std::string log = (folder_ / "xorg.log").string();
-      ::execl("/usr/bin/Xorg", "Xorg", display_.c_str(), "-config", config.c_str(), "-noreset",
-              "-nolisten", "tcp", "-logfile", log.c_str(), static_cast<char*>(nullptr));
-      ::_exit(127);
-    }
-    for (int attempt = 0; attempt < 100; ++attempt) {
-      if (xrandr("--listmonitors") == 0) break;
-      std::this_thread::sleep_for(std::chrono::milliseconds(100));
-      int status = 0;
-      if (::waitpid(xorg_, &status, WNOHANG) == xorg_) {
-        xorg_ = -1;
-        skip_reason_ = "Xorg exited at start; see " + (folder_ / "xorg.log").string();
-        return;
-      }
-    }
-    if (xrandr("--listmonitors") != 0) {
-      skip_reason_ = "Xorg did not answer within 10 s";
-      return;
-    }
+    skip_reason_ =
+        server_.start(folder_, ":" + std::to_string(70 + ::getpid() % 100), 4096, 2048, 256000);
+    display_ = server_.display();
   }
 
-  static void TearDownTestSuite() {
-    if (xorg_ > 0) {
-      ::kill(xorg_, SIGTERM);
-      ::waitpid(xorg_, nullptr, 0);
-      xorg_ = -1;
-    }
-  }
+  static void TearDownTestSuite() { server_.stop(); }
 
   void SetUp() override {
     if (!skip_reason_.empty()) GTEST_SKIP() << skip_reason_;
@@ -130,9 +76,7 @@ EndSection
     ASSERT_EQ(seen, kMonitors) << "facet run --monitors does not list the three monitors";
   }
 
-  static int xrandr(const std::string& arguments) {
-    return run_shell("DISPLAY=" + display_ + " xrandr " + arguments + " > /dev/null 2>&1");
-  }
+  static int xrandr(const std::string& arguments) { return server_.xrandr(arguments); }
 
   // display.json with one projector per monitor, each a perspective view 60° apart.
   static fs::path write_display(const std::string& name, const std::string& missing_name = {}) {
@@ -172,9 +116,9 @@ EndSection
            display.string() + " --no-path " + extra;
   }
 
+  static inline test::XorgDummyServer server_;
   static inline fs::path folder_;
   static inline std::string display_;
-  static inline pid_t xorg_ = -1;
   static inline std::string skip_reason_;
 };
 
