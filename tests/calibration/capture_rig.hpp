@@ -1,5 +1,5 @@
 #pragma once
-// The small dome of the calibration replay tests (replay_test.cpp), for the live-capture tests:
+// The small dome of the calibration replay tests (replay_test.cpp) and the live-capture tests:
 // two 128×96 projectors ("left", "right") on a 4 m sphere, 70° wide, aimed 25° left and right and
 // 20° up with 20° overlap; a 320×256 stereographic camera (160°) at the eye looking 15° up. The
 // rig's image effects are the calibration target's defaults (noise 1%, defocus 1 px, gamma 2.2,

@@ -24,6 +24,7 @@
 #include <optional>
 #include <string>
 
+#include "capture_rig.hpp"
 #include "facet/calibration/calibrate.hpp"
 #include "facet/calibration/image_io.hpp"
 #include "facet/calibration/simulate.hpp"
@@ -36,46 +37,9 @@ namespace {
 
 namespace fs = std::filesystem;
 
-glm::dmat3 look(const glm::dvec3& from, const glm::dvec3& to) {
-  const glm::dvec3 forward = glm::normalize(to - from);
-  const glm::dvec3 right = glm::normalize(glm::cross(forward, glm::dvec3(0, 1, 0)));
-  return glm::dmat3(right, glm::cross(forward, right), forward);
-}
-
-// A small dome (sphere, r = 4 m): two 128×96 projectors 0.8 m behind the eye, 70° wide, aimed 25°
-// left and right of ahead and 20° up, so that their images overlap by about 20° in the middle; a
-// 320×256 stereographic camera at the eye sees both whole. Distortion, gamma and the image
-// effects are the rig defaults of the calibration target.
-Rig replay_rig() {
-  Rig rig;
-  rig.screen.type = Screen::Type::sphere;
-  rig.screen.radius = 4;
-  for (int side = 0; side < 2; ++side) {
-    ProjectorModel p;
-    p.name = side == 0 ? "left" : "right";
-    p.size = {128, 96};
-    const double f = 64 / std::tan(glm::radians(35.0));
-    p.focal_px = {f, f};
-    p.principal_px = {64, 48};
-    p.k = {-0.02, 0.002, 0};
-    p.gamma = 2.2;
-    p.t_eye_projector = {side == 0 ? 0.2 : -0.2, -0.3, 0.8};
-    const double azimuth = glm::radians(side == 0 ? -25.0 : 25.0), elevation = glm::radians(20.0);
-    const glm::dvec3 ahead(std::sin(azimuth) * std::cos(elevation), std::sin(elevation),
-                           -std::cos(azimuth) * std::cos(elevation));
-    p.R_eye_projector = look(p.t_eye_projector, 4.0 * ahead);
-    rig.projectors.push_back(p);
-  }
-  rig.camera.lensmodel = "LENSMODEL_STEREOGRAPHIC";
-  rig.camera.size = {320, 256};
-  rig.camera.fov_deg = 160;
-  // Camera frame: x right, y down, z forward; looking 15° up.
-  const glm::dvec3 forward(0, std::sin(glm::radians(15.0)), -std::cos(glm::radians(15.0)));
-  const glm::dvec3 right(1, 0, 0);
-  rig.camera.R_eye_camera = glm::dmat3(right, glm::cross(forward, right), forward);
-  // SimulationSettings defaults: noise 0.01, defocus 1 px, ambient 0.05, 16-bit, phase 16 px / 4.
-  return rig;
-}
+// The small dome of capture_rig.hpp; SimulationSettings defaults: noise 0.01, defocus 1 px,
+// ambient 0.05, 16-bit, phase 16 px / 4.
+Rig replay_rig() { return test::capture_test_rig(); }
 
 struct Replay {
   std::optional<test::TempFolder> folder;
