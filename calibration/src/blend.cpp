@@ -8,6 +8,7 @@
 
 #include "facet/projection/errors.hpp"
 #include "facet/projection/warp_inverse.hpp"
+#include "map_sampling.hpp"
 
 namespace facet::calibration {
 namespace {
@@ -135,17 +136,7 @@ cv::Mat raised_distance_px(const cv::Mat& height) {
   return distance;
 }
 
-// A CV_32F map read bilinearly between pixel centres at output position q, clamped at the edge.
-double bilinear(const cv::Mat& map, glm::dvec2 q) {
-  const double fx = std::clamp(q.x - 0.5, 0.0, double(map.cols - 1));
-  const double fy = std::clamp(q.y - 0.5, 0.0, double(map.rows - 1));
-  const int x0 = std::min(int(fx), std::max(0, map.cols - 2));
-  const int y0 = std::min(int(fy), std::max(0, map.rows - 2));
-  const int x1 = std::min(x0 + 1, map.cols - 1), y1 = std::min(y0 + 1, map.rows - 1);
-  const double ax = fx - x0, ay = fy - y0;
-  return (1 - ay) * ((1 - ax) * map.at<float>(y0, x0) + ax * map.at<float>(y0, x1)) +
-         ay * ((1 - ax) * map.at<float>(y1, x0) + ax * map.at<float>(y1, x1));
-}
+using detail::bilinear;
 
 // How far inside its covered region projector k's position of v lies, in output pixels; 0 where
 // k does not cover v.
