@@ -433,29 +433,12 @@ class GridFitter {
   int max_cells_;
 };
 
-}  // namespace
-
-FacetMesh build_facets(const Warp& warp, const FacetBuildOptions& options) {
-  warp.validate();
-  if (const auto* strips = std::get_if<FacetStrips>(&options.layout)) {
-    if (strips->count < 1) throw InputError({}, "pieces", "expected at least 1 strip");
-    return assemble(warp, uniform_breaks(strips->count), uniform_breaks(1), kBuildSubdivisions);
-  }
-  if (const auto* grid = std::get_if<FacetGrid>(&options.layout)) {
-    if (grid->columns < 1 || grid->rows < 1) {
-      throw InputError({}, "grid", "expected at least 1×1 cells");
-    }
-    return assemble(warp, uniform_breaks(grid->columns), uniform_breaks(grid->rows),
-                    kBuildSubdivisions);
-  }
-  const double tolerance = std::get<FacetTolerance>(options.layout).px;
-  if (!(tolerance > 0) || !std::isfinite(tolerance)) {
-    throw InputError({}, "tolerance", "expected a positive number of pixels");
-  }
-  // Start from the smallest uniform grid with some slack, then let each axis in turn take the
-  // slack with a greedy sweep, keeping the layout with the fewest cells. Each sweep may use more
-  // of the tolerance than the one before, so that it has room to move.
-  GridFitter fitter(warp, tolerance, options.max_cells);
+// The tolerance layout with per-cell targets `tolerance`: start from the smallest uniform grid
+// with some slack, then let each axis in turn take the slack with a greedy sweep, keeping the
+// layout with the fewest cells. Each sweep may use more of the tolerance than the one before, so
+// that it has room to move.
+FacetMesh build_tolerance_layout(const Warp& warp, double tolerance, int max_cells) {
+  GridFitter fitter(warp, tolerance, max_cells);
   auto [s_breaks, t_breaks] = fitter.uniform_start(0.8);
   auto cells = [](const std::vector<double>& s, const std::vector<double>& t) {
     return (s.size() - 1) * (t.size() - 1);
@@ -477,6 +460,48 @@ FacetMesh build_facets(const Warp& warp, const FacetBuildOptions& options) {
     }
   }
   return assemble(warp, std::move(s_breaks), std::move(t_breaks), kBuildSubdivisions);
+}
+
+}  // namespace
+
+FacetMesh build_facets(const Warp& warp, const FacetBuildOptions& options) {
+  warp.validate();
+  if (const auto* strips = std::get_if<FacetStrips>(&options.layout)) {
+    if (strips->count < 1) throw InputError({}, "pieces", "expected at least 1 strip");
+    return assemble(warp, uniform_breaks(strips->count), uniform_breaks(1), kBuildSubdivisions);
+  }
+  if (const auto* grid = std::get_if<FacetGrid>(&options.layout)) {
+    if (grid->columns < 1 || grid->rows < 1) {
+      throw InputError({}, "grid", "expected at least 1×1 cells");
+    }
+    return assemble(warp, uniform_breaks(grid->columns), uniform_breaks(grid->rows),
+                    kBuildSubdivisions);
+  }
+  const double tolerance = std::get<FacetTolerance>(options.layout).px;
+  if (!(tolerance > 0) || !std::isfinite(tolerance)) {
+    throw InputError({}, "tolerance", "expected a positive number of pixels");
+  }
+  // The per-cell checks sample each cell alone; the mesh is then measured as a whole, as
+  // evaluate_facet_error measures it (every covered direction against the facet that holds it,
+  // which near a cell's edge may be its neighbour's). Where that exceeds the tolerance (a warp
+  // with a kink, such as a folded node masked by an import), the build is repeated with the
+  // cells' target scaled down by the overshoot, twice at most, and gives up rather than return
+  // facets that break the tolerance.
+  double target = tolerance;
+  FacetError measured;
+  for (int attempt = 0; attempt < 3; ++attempt) {
+    FacetMesh mesh = build_tolerance_layout(warp, target, options.max_cells);
+    measured = evaluate_facet_error(warp, mesh);
+    if (measured.max_px <= tolerance) return mesh;
+    target *= 0.9 * tolerance / measured.max_px;
+  }
+  throw InputError({}, "tolerance",
+                   "the facets built for " + std::to_string(tolerance) + " px still reach " +
+                       std::to_string(measured.max_px) + " px at output pixel (" +
+                       std::to_string(measured.worst_q.x) + ", " +
+                       std::to_string(measured.worst_q.y) +
+                       "): the warp is not smooth enough there; a larger tolerance or a grid "
+                       "layout renders it");
 }
 
 }  // namespace facet

@@ -79,8 +79,10 @@ struct FacetBuildOptions {
   int max_cells = 1 << 20;
 };
 
-// Builds facets over the covered part of the warp. Throws InputError for a layout that cannot
-// be met (a facet spanning 180° or more, a tolerance that needs more than max_cells).
+// Builds facets over the covered part of the warp. A tolerance layout is checked as a whole with
+// evaluate_facet_error before it is returned: its max_px is at most the tolerance. Throws
+// InputError for a layout that cannot be met (a facet spanning 180° or more, a tolerance that
+// needs more than max_cells, or one the builder misses three times, naming the worst pixel).
 FacetMesh build_facets(const Warp& warp, const FacetBuildOptions& options);
 
 }  // namespace facet
