@@ -104,8 +104,9 @@ TEST(Facets, EdgesLieWithinTheToleranceOfTheReference) {
       const std::vector<std::uint32_t> ids = render(*f, "facets", settings).ids;
       const IdComparison c = print(what, compare(*f, ids));
       const EdgeDisplacement e = edges(*f, what, ids);
-      // A pixel whose 3×3 neighbourhood holds one ID in the reference has its centre at least
-      // half a pixel from every edge there, so an edge moved by less cannot reach it.
+      // Where edges move by less than half a pixel, a pixel whose 3×3 neighbourhood holds one ID
+      // in the reference can differ only next to a sliver that meets no pixel centre; on these
+      // views there is none at 0.25 px (at 1 px the dome has one mismatched pixel).
       if (tolerance + 0.02 < 0.5) {
         EXPECT_EQ(c.mismatched_pixels, 0u) << what;
       }
