@@ -19,6 +19,7 @@
 
 #include "../calibration/capture_rig.hpp"
 #include "../calibration/test_folder.hpp"
+#include "cli_process.hpp"
 #include "facet/calibration/calibrate.hpp"
 #include "facet/calibration/capture.hpp"
 #include "facet/calibration/live_capture.hpp"
@@ -31,22 +32,9 @@ namespace {
 namespace fs = std::filesystem;
 
 int run_cli(const std::string& arguments, std::string* output = nullptr) {
-  const std::string command = std::string(FACET_CLI) + " " + arguments + " 2>&1";
-  std::string text;
-  if (FILE* pipe = ::popen(command.c_str(), "r")) {
-    char buffer[512];
-    while (std::fgets(buffer, sizeof buffer, pipe)) text += buffer;
-    const int status = ::pclose(pipe);
-    if (output) *output = text;
-    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  }
-  return -1;
+  return test::run_facet(arguments, output);
 }
-
-std::string file_bytes(const fs::path& path) {
-  std::ifstream stream(path, std::ios::binary);
-  return {std::istreambuf_iterator<char>(stream), std::istreambuf_iterator<char>()};
-}
+std::string file_bytes(const fs::path& path) { return test::slurp(path); }
 
 // The rig as a file and a display.json naming its two projectors (no warps yet).
 struct RigFiles {

@@ -17,6 +17,7 @@
 #include <thread>
 
 #include "../calibration/capture_rig.hpp"
+#include "cli_process.hpp"
 #include "facet/projection_io/rig_file.hpp"
 #include "xorg_dummy.hpp"
 
@@ -24,22 +25,9 @@ namespace facet {
 namespace {
 
 namespace fs = std::filesystem;
+using test::run_shell;
 
-int run_shell(const std::string& command, std::string* output = nullptr) {
-  std::string text;
-  FILE* pipe = ::popen((command + " 2>&1").c_str(), "r");
-  if (!pipe) return -1;
-  char buffer[512];
-  while (std::fgets(buffer, sizeof buffer, pipe)) text += buffer;
-  const int status = ::pclose(pipe);
-  if (output) *output = text;
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
-
-std::string file_bytes(const fs::path& path) {
-  std::ifstream stream(path, std::ios::binary);
-  return {std::istreambuf_iterator<char>(stream), std::istreambuf_iterator<char>()};
-}
+std::string file_bytes(const fs::path& path) { return test::slurp(path); }
 
 class CaptureWindows : public ::testing::Test {
  protected:

@@ -10,21 +10,16 @@
 #include <string>
 #include <vector>
 
+#include "cli_process.hpp"
+
 namespace facet {
 namespace {
 
 namespace fs = std::filesystem;
+using test::slurp;
 
 int run(const std::string& arguments, const fs::path& log) {
-  const std::string command =
-      std::string(FACET_CLI) + " " + arguments + " > " + log.string() + " 2>&1";
-  const int status = std::system(command.c_str());
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
-
-std::string slurp(const fs::path& path) {
-  std::ifstream in(path);
-  return {std::istreambuf_iterator<char>(in), {}};
+  return test::run_facet(arguments, log);
 }
 
 struct Png {

@@ -16,6 +16,7 @@
 #include <string>
 #include <thread>
 
+#include "cli_process.hpp"
 #include "facet/projection_io/display_config.hpp"
 #include "facet/projection_io/warp_file.hpp"
 #include "xorg_dummy.hpp"
@@ -24,14 +25,10 @@ namespace facet {
 namespace {
 
 namespace fs = std::filesystem;
+using test::run_shell;
 
 constexpr int kMonitors = 3;
 constexpr int kWidth = 640, kHeight = 480;
-
-int run_shell(const std::string& command) {
-  const int status = std::system(command.c_str());
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
 
 class XorgDummy : public ::testing::Test {
  protected:
