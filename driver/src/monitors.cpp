@@ -38,4 +38,14 @@ OutputPlacement place_output(const projection_io::DisplayOutput& output,
                        "); or set \"missing_monitor\": \"window\"");
 }
 
+void apply_placement(const OutputPlacement& placement, WindowOptions& options) {
+  if (placement.kind == OutputPlacement::Kind::fullscreen) {
+    options.monitor = placement.monitor;
+  } else {
+    options.position = glm::ivec2(placement.rect.x, placement.rect.y);
+    options.width = placement.rect.z;
+    options.height = placement.rect.w;
+  }
+}
+
 }  // namespace facet::driver

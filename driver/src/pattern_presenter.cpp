@@ -169,14 +169,8 @@ class WindowedPresenter : public PatternPresenter {
       WindowOptions options;
       options.title = "facet capture: " + projector.name;
       options.vsync = true;
-      if (placement.kind == OutputPlacement::Kind::fullscreen) {
-        options.monitor = placement.monitor;
-      } else {
-        options.position = glm::ivec2(placement.rect.x, placement.rect.y);
-        options.width = placement.rect.z;
-        options.height = placement.rect.w;
-        options.decorated = false;
-      }
+      apply_placement(placement, options);
+      options.decorated = false;  // no effect full screen
       options.share = windows_.empty() ? nullptr : windows_.front().context.get();
       Window window;
       window.context = std::make_unique<GlfwWindowContext>(options);

@@ -289,13 +289,7 @@ void run_windowed_session(const SessionDisplay& display, const Scene& scene, con
     for (std::size_t i = 0; i < placements.size(); ++i) {
       WindowOptions one;
       const OutputPlacement& p = placements[i];
-      if (p.kind == OutputPlacement::Kind::fullscreen) {
-        one.monitor = p.monitor;
-      } else {
-        one.position = glm::ivec2(p.rect.x, p.rect.y);
-        one.width = p.rect.z;
-        one.height = p.rect.w;
-      }
+      apply_placement(p, one);
       Window window = open_window(one);
       const glm::ivec2 size = window.context->framebuffer_size();
       window.outputs.push_back(i);

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "facet/driver/gl_context.hpp"
 #include "facet/projection_io/display_config.hpp"
 
 namespace facet::driver {
@@ -39,5 +40,8 @@ OutputPlacement place_output(const projection_io::DisplayOutput& output,
                              std::span<const MonitorInfo> monitors,
                              projection_io::MissingMonitor missing, glm::ivec2 fallback_size,
                              const std::string& source, const std::string& field);
+
+// Sets where a window goes: full screen on the placement's monitor, or at its desktop rectangle.
+void apply_placement(const OutputPlacement& placement, WindowOptions& options);
 
 }  // namespace facet::driver
