@@ -55,33 +55,82 @@ int interval_of(const std::vector<double>& breaks, double x) {
   return std::clamp(int(it - breaks.begin()) - 1, 0, int(breaks.size()) - 2);
 }
 
-// The facet containing direction d at st, searched in st's cell and its neighbours (facet edges
-// are chords, so a direction near a cell edge may belong to the neighbour).
-std::optional<std::uint32_t> find_facet(const FacetMesh& mesh, glm::dvec2 st, glm::dvec3 d,
-                                        bool wraps) {
-  const int columns = int(mesh.s_breaks.size()) - 1, rows = int(mesh.t_breaks.size()) - 1;
-  const int c0 = interval_of(mesh.s_breaks, st.x), r0 = interval_of(mesh.t_breaks, st.y);
-  std::optional<std::uint32_t> best;
-  double best_margin = -1e-12;
-  for (int dr = -1; dr <= 1; ++dr) {
-    for (int dc = -1; dc <= 1; ++dc) {
-      int c = c0 + dc;
-      const int r = r0 + dr;
-      if (wraps) c = (c + columns) % columns;
-      if (c < 0 || c >= columns || r < 0 || r >= rows) continue;
-      const std::uint32_t first = mesh.cell_first_facet[std::size_t(r) * columns + c];
-      if (first == UINT32_MAX) continue;
-      for (std::uint32_t f = first; f < first + 2; ++f) {
-        const double margin = detail::inside_margin(mesh.facets[f], d);
-        if (margin > best_margin) {
-          best_margin = margin;
-          best = f;
+// Finds the facet containing a direction: the candidates near st, then the one whose pyramid
+// holds the direction with the largest margin (facet edges are chords, so a direction near an
+// edge in st may belong to the neighbour).
+class FacetLocator {
+ public:
+  FacetLocator(const FacetMesh& mesh, bool wraps) : mesh_(mesh), wraps_(wraps) {
+    if (!mesh.s_breaks.empty()) return;
+    // Any other layout: buckets over st holding every facet whose padded st box meets them.
+    const double count = std::max<double>(1, double(mesh.facets.size()) / 2);
+    const double aspect = double(mesh.output_size.x) / std::max(1, mesh.output_size.y);
+    buckets_ = {std::clamp(int(std::sqrt(count * aspect)), 1, 4096),
+                std::clamp(int(std::sqrt(count / aspect)), 1, 4096)};
+    bucket_facets_.resize(std::size_t(buckets_.x) * buckets_.y);
+    for (std::uint32_t f = 0; f < mesh.facets.size(); ++f) {
+      glm::dvec2 lo(std::numeric_limits<double>::infinity()), hi(-lo);
+      for (std::uint32_t v : mesh.facets[f].vertex) {
+        lo = glm::min(lo, mesh.vertices[v].st);
+        hi = glm::max(hi, mesh.vertices[v].st);
+      }
+      const glm::dvec2 pad = 0.25 * (hi - lo) + 0.5 / glm::dvec2(buckets_);
+      const glm::ivec2 b0 = glm::ivec2(glm::floor((lo - pad) * glm::dvec2(buckets_)));
+      const glm::ivec2 b1 = glm::ivec2(glm::floor((hi + pad) * glm::dvec2(buckets_)));
+      for (int by = std::max(b0.y, 0); by <= std::min(b1.y, buckets_.y - 1); ++by) {
+        for (int bx = b0.x; bx <= b1.x; ++bx) {
+          int column = bx;
+          if (wraps_) {
+            column = ((bx % buckets_.x) + buckets_.x) % buckets_.x;
+          } else if (bx < 0 || bx >= buckets_.x) {
+            continue;
+          }
+          auto& list = bucket_facets_[std::size_t(by) * buckets_.x + column];
+          if (list.empty() || list.back() != f) list.push_back(f);
         }
       }
     }
   }
-  return best;
-}
+
+  std::optional<std::uint32_t> find(glm::dvec2 st, glm::dvec3 d) const {
+    std::optional<std::uint32_t> best;
+    double best_margin = -1e-12;
+    const auto consider = [&](std::uint32_t f) {
+      const double margin = detail::inside_margin(mesh_.facets[f], d);
+      if (margin > best_margin) {
+        best_margin = margin;
+        best = f;
+      }
+    };
+    if (mesh_.s_breaks.empty()) {
+      const glm::ivec2 b = glm::clamp(glm::ivec2(glm::floor(st * glm::dvec2(buckets_))),
+                                      glm::ivec2(0), buckets_ - 1);
+      for (std::uint32_t f : bucket_facets_[std::size_t(b.y) * buckets_.x + b.x]) consider(f);
+      return best;
+    }
+    const int columns = int(mesh_.s_breaks.size()) - 1, rows = int(mesh_.t_breaks.size()) - 1;
+    const int c0 = interval_of(mesh_.s_breaks, st.x), r0 = interval_of(mesh_.t_breaks, st.y);
+    for (int dr = -1; dr <= 1; ++dr) {
+      for (int dc = -1; dc <= 1; ++dc) {
+        int c = c0 + dc;
+        const int r = r0 + dr;
+        if (wraps_) c = (c + columns) % columns;
+        if (c < 0 || c >= columns || r < 0 || r >= rows) continue;
+        const std::uint32_t first = mesh_.cell_first_facet[std::size_t(r) * columns + c];
+        if (first == UINT32_MAX) continue;
+        consider(first);
+        consider(first + 1);
+      }
+    }
+    return best;
+  }
+
+ private:
+  const FacetMesh& mesh_;
+  bool wraps_;
+  glm::ivec2 buckets_{1, 1};
+  std::vector<std::vector<std::uint32_t>> bucket_facets_;
+};
 
 struct Accumulator {
   double max_px = 0, sum_squares = 0, float_max = 0, float_sum_squares = 0;
@@ -129,7 +178,7 @@ FacetError evaluate_facet_error(const Warp& warp, const FacetMesh& mesh,
   for (std::size_t f = 0; f < mesh.facets.size(); ++f) {
     clip_from_eye[f] = glm::mat4(mesh.facets[f].clip_from_eye(mesh.output_size, kZNear));
   }
-  const bool wraps = warp.base.wraps_horizontally();
+  const FacetLocator locator(mesh, warp.base.wraps_horizontally());
 
   double per_axis = options.grid_samples_per_px;
   const double full = double(warp.output_size.x) * warp.output_size.y * per_axis * per_axis;
@@ -146,7 +195,7 @@ FacetError evaluate_facet_error(const Warp& warp, const FacetMesh& mesh,
       const glm::dvec2 st{double(i) / (nx - 1), double(j) / (ny - 1)};
       if (warp.coverage_at(st) < 0.5) continue;
       const glm::dvec3 d = warp.p_eye_surface_from_st(st);
-      const auto f = find_facet(mesh, st, d, wraps);
+      const auto f = locator.find(st, d);
       if (!f) {
         ++total.missed;
         continue;

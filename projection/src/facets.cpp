@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <optional>
 
 #include "facet/projection/errors.hpp"
 #include "facet/projection/facet_error.hpp"
@@ -108,20 +109,6 @@ std::optional<Facet> make_facet(const FacetVertex& a, const FacetVertex& b, cons
   return facet;
 }
 
-}  // namespace detail
-
-namespace {
-
-using detail::make_facet;
-
-constexpr double kPi = std::numbers::pi;
-// Largest angle between two corners of a cell, well short of the 180° at which a chord plane
-// passes through the eye and the facet's matrix degenerates.
-constexpr double kMaxFacetAngle = 150.0 * kPi / 180.0;
-// The builder aims below the requested tolerance because the final evaluation samples more
-// densely than the builder does.
-constexpr double kBuildMargin = 0.97;
-constexpr int kBuildSubdivisions = 10;
 
 FacetVertex vertex_at(const Warp& warp, glm::dvec2 st) {
   return {warp.p_eye_surface_from_st(st), st, warp.q_from_st(st)};
@@ -131,9 +118,6 @@ double angle_between(glm::dvec3 a, glm::dvec3 b) {
   return std::atan2(glm::length(glm::cross(a, b)), glm::dot(a, b));
 }
 
-// Largest coverage inside the cell. Coverage is bilinear between nodes, so its maximum over a
-// rectangle lies on a node line crossing or a rectangle corner.
-// The node lines of an axis with `nodes` nodes that lie in [a, b], appended to `values`.
 void append_node_lines(double a, double b, int nodes, std::vector<double>& values) {
   for (int i = int(std::ceil(a * (nodes - 1))); i <= int(std::floor(b * (nodes - 1))); ++i) {
     values.push_back(double(i) / (nodes - 1));
@@ -150,6 +134,21 @@ double max_coverage(const Warp& warp, double s0, double s1, double t0, double t1
   }
   return best;
 }
+
+}  // namespace detail
+
+namespace {
+
+using detail::make_facet;
+
+using detail::angle_between;
+using detail::append_node_lines;
+using detail::kBuildMargin;
+using detail::kBuildSubdivisions;
+using detail::kMaxFacetAngle;
+using detail::kPi;
+using detail::max_coverage;
+using detail::vertex_at;
 
 struct Cell {
   std::array<FacetVertex, 4> corner;  // (s0,t0) (s1,t0) (s0,t1) (s1,t1)
@@ -459,7 +458,36 @@ FacetMesh build_tolerance_layout(const Warp& warp, double tolerance, int max_cel
       t_breaks = t_next;
     }
   }
+  if (cells(s_breaks, t_breaks) > std::size_t(max_cells)) {
+    throw InputError({}, "tolerance",
+                     "meeting " + std::to_string(tolerance) + " px needs more than " +
+                         std::to_string(max_cells) + " cells");
+  }
   return assemble(warp, std::move(s_breaks), std::move(t_breaks), kBuildSubdivisions);
+}
+
+// Of the two tolerance layouts, the one with fewer facets. A tensor-product grid suits warps whose
+// difficulty lines up with the base image's axes (a cylinder's strips are exact along their
+// height); bisection suits warps that are hard to follow in one place only (a spherical mirror's
+// crowded rim). Bisection is built first because it is quick; the tensor grid then gets a cell
+// budget of four times bisection's facet count (its uniform start and first sweep pass through
+// layouts several times larger than its result) and gives up past it.
+FacetMesh build_fewest_facets(const Warp& warp, double target, int max_cells) {
+  std::optional<FacetMesh> adaptive;
+  try {
+    adaptive = detail::build_adaptive_layout(warp, target, max_cells);
+  } catch (const InputError&) {
+    // The tensor grid may still meet the target; if not, its error is the one reported.
+  }
+  const int tensor_cells =
+      adaptive ? int(std::min<std::size_t>(max_cells, 4 * adaptive->facets.size())) : max_cells;
+  try {
+    FacetMesh tensor = build_tolerance_layout(warp, target, tensor_cells);
+    if (!adaptive || tensor.facets.size() <= adaptive->facets.size()) return tensor;
+  } catch (const InputError&) {
+    if (!adaptive) throw;
+  }
+  return std::move(*adaptive);
 }
 
 }  // namespace
@@ -477,7 +505,8 @@ FacetMesh build_facets(const Warp& warp, const FacetBuildOptions& options) {
     return assemble(warp, uniform_breaks(grid->columns), uniform_breaks(grid->rows),
                     kBuildSubdivisions);
   }
-  const double tolerance = std::get<FacetTolerance>(options.layout).px;
+  const FacetTolerance& layout = std::get<FacetTolerance>(options.layout);
+  const double tolerance = layout.px;
   if (!(tolerance > 0) || !std::isfinite(tolerance)) {
     throw InputError({}, "tolerance", "expected a positive number of pixels");
   }
@@ -490,7 +519,12 @@ FacetMesh build_facets(const Warp& warp, const FacetBuildOptions& options) {
   double target = tolerance;
   FacetError measured;
   for (int attempt = 0; attempt < 3; ++attempt) {
-    FacetMesh mesh = build_tolerance_layout(warp, target, options.max_cells);
+    FacetMesh mesh =
+        layout.builder == FacetTolerance::Builder::tensor
+            ? build_tolerance_layout(warp, target, options.max_cells)
+        : layout.builder == FacetTolerance::Builder::bisection
+            ? detail::build_adaptive_layout(warp, target, options.max_cells)
+            : build_fewest_facets(warp, target, options.max_cells);
     measured = evaluate_facet_error(warp, mesh);
     if (measured.max_px <= tolerance) return mesh;
     target *= 0.9 * tolerance / measured.max_px;

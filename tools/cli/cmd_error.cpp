@@ -39,6 +39,10 @@ ErrorRow measure(const std::string& display, const Warp& warp, const FacetLayout
   row.build_ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   row.facets = mesh.facets.size();
+  // Which builder a tolerance layout ended with: only the tensor grid records its breaks.
+  if (std::holds_alternative<FacetTolerance>(layout)) {
+    row.layout += mesh.s_breaks.empty() ? ", bisection" : ", tensor";
+  }
   row.error = evaluate_facet_error(warp, mesh);
   return row;
 }
@@ -58,12 +62,12 @@ nlohmann::json to_json(const ErrorRow& row) {
 }
 
 void print_header() {
-  std::printf("%-34s %-18s %8s %10s %10s %12s %10s\n", "display", "facets from", "facets", "max px",
+  std::printf("%-34s %-28s %8s %10s %10s %12s %10s\n", "display", "facets from", "facets", "max px",
               "rms px", "float32 px", "build ms");
 }
 
 void print_row(const ErrorRow& row) {
-  std::printf("%-34s %-18s %8zu %10.4f %10.4f %12.2e %10.1f\n", row.display.c_str(),
+  std::printf("%-34s %-28s %8zu %10.4f %10.4f %12.2e %10.1f\n", row.display.c_str(),
               row.layout.c_str(), row.facets, row.error.max_px, row.error.rms_px,
               row.error.float32_max_px, row.build_ms);
   if (row.error.missed_samples) {

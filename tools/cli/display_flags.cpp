@@ -108,6 +108,12 @@ void LayoutFlags::add_to(CLI::App& command) {
   group->add_option("--grid", grid, "A uniform GXxGY grid of cells, two facets each");
   group->add_option("--tolerance", tolerance_px, "Fewest facets with max error <= PX pixels");
   group->require_option(0, 1);
+  command
+      .add_option("--builder", builder,
+                  "How a tolerance layout is built: fewest (default: both, keeping the one with "
+                  "fewer facets), tensor (rows and columns spaced to fit) or bisection (refined "
+                  "only where the warp needs it)")
+      ->check(CLI::IsMember({"fewest", "tensor", "bisection"}));
 }
 
 FacetLayout LayoutFlags::layout() const {
@@ -116,7 +122,10 @@ FacetLayout LayoutFlags::layout() const {
     const glm::ivec2 g = parse_size(grid, "--grid");
     return FacetGrid{g.x, g.y};
   }
-  return FacetTolerance{tolerance_px.value_or(0.25)};
+  FacetTolerance tolerance{tolerance_px.value_or(0.25)};
+  if (builder == "tensor") tolerance.builder = FacetTolerance::Builder::tensor;
+  if (builder == "bisection") tolerance.builder = FacetTolerance::Builder::bisection;
+  return tolerance;
 }
 
 }  // namespace facet::cli

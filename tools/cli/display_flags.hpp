@@ -29,6 +29,7 @@ struct LayoutFlags {
   std::optional<int> pieces;
   std::string grid;
   std::optional<double> tolerance_px;
+  std::string builder = "fewest";
 
   void add_to(CLI::App& command);
   // Defaults to a tolerance of 0.25 px when no flag is given.

@@ -47,7 +47,7 @@ struct FacetMesh {
   glm::ivec2 output_size{0, 0};
   std::vector<FacetVertex> vertices;
   std::vector<Facet> facets;
-  // The tensor-product layout the facets came from: cell (c, r) spans
+  // The tensor-product layout the facets came from (empty for any other layout): cell (c, r) spans
   // [s_breaks[c], s_breaks[c+1]] × [t_breaks[r], t_breaks[r+1]] and holds facets 2·(r·C + c) and
   // 2·(r·C + c) + 1, where C = s_breaks.size() − 1. Cells outside the coverage hold none and
   // cell_first_facet marks them with UINT32_MAX.
@@ -70,6 +70,12 @@ struct FacetGrid {  // a uniform Gx × Gy grid of cells, two facets per cell (th
 };
 struct FacetTolerance {  // as few facets as the builder can find with max error <= px
   double px = 0.25;
+  enum class Builder {
+    fewest,     // both below, keeping the one with fewer facets
+    tensor,     // a tensor-product grid whose rows and columns are spaced to fit
+    bisection,  // newest-vertex bisection, refined only where the warp needs it
+  };
+  Builder builder = Builder::fewest;
 };
 using FacetLayout = std::variant<FacetStrips, FacetGrid, FacetTolerance>;
 
