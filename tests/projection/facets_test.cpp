@@ -3,8 +3,10 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <map>
 #include <random>
+#include <set>
 
 #include "facet/projection/errors.hpp"
 #include "facet/projection/facet_error.hpp"
@@ -181,6 +183,95 @@ TEST(Facets, GuardBandIsAtMostTheRequestedPixels) {
   }
 }
 
+// Conformity of a bisection mesh: no vertex lies inside another facet's edge, and no edge has more
+// than two facets. Bisection adds vertices at edge midpoints only, so a hanging vertex is a vertex
+// at some edge's midpoint. On a 360° base s is taken modulo 1, so the seam's sides are one edge.
+struct Conformity {
+  std::size_t hanging_vertices = 0, overused_edges = 0;
+};
+Conformity conformity(const FacetMesh& mesh, bool wraps) {
+  const auto canonical = [&](glm::dvec2 st) {
+    if (wraps && st.x >= 1.0) st.x -= 1.0;
+    return std::pair{st.x, st.y};
+  };
+  std::set<std::pair<double, double>> vertices;
+  for (const FacetVertex& v : mesh.vertices) vertices.insert(canonical(v.st));
+  std::map<std::pair<std::pair<double, double>, std::pair<double, double>>, int> uses;
+  Conformity result;
+  for (const Facet& facet : mesh.facets) {
+    for (int k = 0; k < 3; ++k) {
+      const glm::dvec2 a = mesh.vertices[facet.vertex[k]].st;
+      const glm::dvec2 b = mesh.vertices[facet.vertex[(k + 1) % 3]].st;
+      if (vertices.count(canonical((a + b) / 2.0))) ++result.hanging_vertices;
+      const auto ca = canonical(a), cb = canonical(b);
+      if (++uses[{std::min(ca, cb), std::max(ca, cb)}] == 3) ++result.overused_edges;
+    }
+  }
+  return result;
+}
+
+TEST(Facets, BisectionMeetsTheToleranceWithoutHangingVertices) {
+  for (const auto& [name, warp] : test::displays_for_tolerance_tests()) {
+    for (double tolerance : {1.0, 0.25}) {
+      SCOPED_TRACE(name + " at " + std::to_string(tolerance) + " px");
+      FacetTolerance layout{tolerance};
+      layout.builder = FacetTolerance::Builder::bisection;
+      const FacetMesh mesh = build_facets(warp, {layout});
+      EXPECT_TRUE(mesh.s_breaks.empty()) << "a bisection mesh has no tensor layout";
+      const FacetError error = evaluate_facet_error(warp, mesh);
+      EXPECT_LE(error.max_px, tolerance);  // worst case over dense samples
+      EXPECT_EQ(error.missed_samples, 0u) << "a covered direction fell in no facet";
+      // Each bisection shrinks a facet's error about fourfold; the worst facet stays above that.
+      EXPECT_GE(error.max_px, 0.25 * tolerance) << mesh.facets.size() << " facets";
+      EXPECT_LE(error.float32_max_px, 0.01);
+      const Conformity c = conformity(mesh, warp.base.wraps_horizontally());
+      EXPECT_EQ(c.hanging_vertices, 0u);
+      EXPECT_EQ(c.overused_edges, 0u);
+      EXPECT_LE(worst_shared_edge_gap(mesh), 1e-6);
+    }
+  }
+}
+
+// A 180° dome master whose offset map bends sharply in one place only: a 6 px bump of 10 px
+// radius (Gaussian) at output pixel (190, 70).
+Warp dome_with_one_bump() {
+  Warp warp = Warp::analytic(BaseProjection::fisheye(180), {256, 256}, {129, 129});
+  for (int j = 0; j < warp.grid_size.y; ++j) {
+    for (int i = 0; i < warp.grid_size.x; ++i) {
+      const glm::dvec2 q{256.0 * i / 128, 256.0 * j / 128};
+      const double r2 = glm::dot(q - glm::dvec2(190, 70), q - glm::dvec2(190, 70));
+      warp.offset_px[warp.node_index(i, j)] += glm::vec2(float(6 * std::exp(-r2 / 100)), 0.0f);
+    }
+  }
+  return warp;
+}
+
+TEST(Facets, TheDefaultBuilderKeepsTheLayoutWithFewerFacets) {
+  const auto count = [](const Warp& warp, FacetTolerance::Builder builder) {
+    FacetTolerance layout{0.25};
+    layout.builder = builder;
+    return build_facets(warp, {layout}).facets.size();
+  };
+  using Builder = FacetTolerance::Builder;
+  // The cylinder's error does not change along its height: tall tensor strips follow it.
+  const Warp cylinder =
+      Warp::analytic(BaseProjection::cylindrical(-180, 180, 1, -1), {1600, 1200});
+  const std::size_t cylinder_tensor = count(cylinder, Builder::tensor);
+  const std::size_t cylinder_bisection = count(cylinder, Builder::bisection);
+  std::printf("cylinder 1600x1200 at 0.25 px: tensor %zu, bisection %zu facets\n", cylinder_tensor,
+              cylinder_bisection);
+  EXPECT_LT(cylinder_tensor, cylinder_bisection);
+  EXPECT_EQ(count(cylinder, Builder::fewest), cylinder_tensor);
+  // A bump is hard in one place: a tensor grid refines whole rows and columns through it.
+  const Warp bump = dome_with_one_bump();
+  const std::size_t bump_tensor = count(bump, Builder::tensor);
+  const std::size_t bump_bisection = count(bump, Builder::bisection);
+  std::printf("dome with one bump at 0.25 px: tensor %zu, bisection %zu facets\n", bump_tensor,
+              bump_bisection);
+  EXPECT_LT(bump_bisection, bump_tensor);
+  EXPECT_EQ(count(bump, Builder::fewest), bump_bisection);
+}
+
 TEST(Facets, ImpossibleLayoutsAreRejected) {
   const Warp cylinder = Warp::analytic(BaseProjection::cylindrical(-180, 180, 1, -1), {1600, 1200});
   EXPECT_THROW(build_facets(cylinder, {FacetStrips{2}}), InputError);  // 180° strips
@@ -189,6 +280,11 @@ TEST(Facets, ImpossibleLayoutsAreRejected) {
   EXPECT_THROW(build_facets(cylinder, {FacetTolerance{NAN}}), InputError);
   // A tolerance that needs more cells than allowed gives a clear error, not a runaway build.
   EXPECT_THROW(build_facets(cylinder, {FacetTolerance{1e-4}, 64}), InputError);
+  for (auto builder : {FacetTolerance::Builder::tensor, FacetTolerance::Builder::bisection}) {
+    FacetTolerance layout{1e-4};
+    layout.builder = builder;
+    EXPECT_THROW(build_facets(cylinder, {layout, 64}), InputError);
+  }
 }
 
 }  // namespace
