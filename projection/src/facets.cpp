@@ -109,7 +109,6 @@ std::optional<Facet> make_facet(const FacetVertex& a, const FacetVertex& b, cons
   return facet;
 }
 
-
 FacetVertex vertex_at(const Warp& warp, glm::dvec2 st) {
   return {warp.p_eye_surface_from_st(st), st, warp.q_from_st(st)};
 }
@@ -519,12 +518,11 @@ FacetMesh build_facets(const Warp& warp, const FacetBuildOptions& options) {
   double target = tolerance;
   FacetError measured;
   for (int attempt = 0; attempt < 3; ++attempt) {
-    FacetMesh mesh =
-        layout.builder == FacetTolerance::Builder::tensor
-            ? build_tolerance_layout(warp, target, options.max_cells)
-        : layout.builder == FacetTolerance::Builder::bisection
-            ? detail::build_adaptive_layout(warp, target, options.max_cells)
-            : build_fewest_facets(warp, target, options.max_cells);
+    FacetMesh mesh = layout.builder == FacetTolerance::Builder::tensor
+                         ? build_tolerance_layout(warp, target, options.max_cells)
+                     : layout.builder == FacetTolerance::Builder::bisection
+                         ? detail::build_adaptive_layout(warp, target, options.max_cells)
+                         : build_fewest_facets(warp, target, options.max_cells);
     measured = evaluate_facet_error(warp, mesh);
     if (measured.max_px <= tolerance) return mesh;
     target *= 0.9 * tolerance / measured.max_px;

@@ -254,7 +254,9 @@ double angular_extent(const Warp& warp, int axis) {
   constexpr int kSamples = 64;
   for (int across = 0; across <= 4; ++across) {
     const double other = across / 4.0;
-    const auto st = [&](double x) { return axis == 0 ? glm::dvec2(x, other) : glm::dvec2(other, x); };
+    const auto st = [&](double x) {
+      return axis == 0 ? glm::dvec2(x, other) : glm::dvec2(other, x);
+    };
     double total = 0;
     for (int k = 0; k < kSamples; ++k) {
       total += angle_between(warp.v_eye_from_st(st(double(k) / kSamples)),
@@ -271,8 +273,8 @@ FacetMesh build_adaptive_layout(const Warp& warp, double target_px, int max_cell
   // Start cells about square in output pixels and no wider than kStartAngle.
   int columns = std::max(1, int(std::ceil(angular_extent(warp, 0) / kStartAngle)));
   int rows = std::max(1, int(std::ceil(angular_extent(warp, 1) / kStartAngle)));
-  const double cell_px = std::max(double(warp.output_size.x) / columns,
-                                  double(warp.output_size.y) / rows);
+  const double cell_px =
+      std::max(double(warp.output_size.x) / columns, double(warp.output_size.y) / rows);
   columns = std::max(columns, int(std::ceil(warp.output_size.x / cell_px - 1e-9)));
   rows = std::max(rows, int(std::ceil(warp.output_size.y / cell_px - 1e-9)));
   // A seam needs distinct vertices on either side of every starting cell.

@@ -74,9 +74,9 @@ TEST(InteropCli, RealFilesFromOtherToolsImportToReadableDisplays) {
   const std::size_t max_at = error.output.find("\"max_px\":");
   ASSERT_NE(max_at, std::string::npos) << error.output;
   EXPECT_LE(std::strtod(error.output.c_str() + max_at + 9, nullptr), 0.25) << error.output;
-  EXPECT_EQ(run("error --warp " + warp_path + " --tolerance 0.25 --builder tensor", scratch.path)
-                .status,
-            2);
+  EXPECT_EQ(
+      run("error --warp " + warp_path + " --tolerance 0.25 --builder tensor", scratch.path).status,
+      2);
 }
 
 TEST(InteropCli, ExportImportRoundTripThroughTheCommands) {

@@ -254,8 +254,7 @@ TEST(Facets, TheDefaultBuilderKeepsTheLayoutWithFewerFacets) {
   };
   using Builder = FacetTolerance::Builder;
   // The cylinder's error does not change along its height: tall tensor strips follow it.
-  const Warp cylinder =
-      Warp::analytic(BaseProjection::cylindrical(-180, 180, 1, -1), {1600, 1200});
+  const Warp cylinder = Warp::analytic(BaseProjection::cylindrical(-180, 180, 1, -1), {1600, 1200});
   const std::size_t cylinder_tensor = count(cylinder, Builder::tensor);
   const std::size_t cylinder_bisection = count(cylinder, Builder::bisection);
   std::printf("cylinder 1600x1200 at 0.25 px: tensor %zu, bisection %zu facets\n", cylinder_tensor,
