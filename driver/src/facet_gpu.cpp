@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "facet/projection/errors.hpp"
+
 namespace facet::driver {
 
 std::vector<GpuFacet> pack_facets(const FacetMesh& mesh, double z_near, double guard_px) {
@@ -31,8 +33,14 @@ std::vector<GpuCoverageNode> pack_coverage_nodes(const CoverageIndex& index) {
     out = {};
     out.first = node.first;
     out.count = node.count;
+    // The shader's leaf loop has a constant trip count (kCoverageLeafSize in replication_lib).
+    FACET_ASSERT(node.count <= 4);
     out.bounded = node.cos_half_angle > -1 ? 1u : 0u;
     if (!out.bounded) continue;
+    out.cone[0] = float(node.axis.x);
+    out.cone[1] = float(node.axis.y);
+    out.cone[2] = float(node.axis.z);
+    out.cone[3] = float(node.sin_half_angle);
     // The same tangent pyramid as CoverageIndex::query: planes sin·a ± cos·e for two unit
     // directions e perpendicular to the axis a.
     const glm::dvec3 a = node.axis;
@@ -47,6 +55,20 @@ std::vector<GpuCoverageNode> pack_coverage_nodes(const CoverageIndex& index) {
       out.pyramid[k][1] = float(n.y);
       out.pyramid[k][2] = float(n.z);
       out.pyramid[k][3] = 0.0f;
+    }
+  }
+  // Each split partitions its parent's range of the order, so a subtree's facets are contiguous;
+  // children come after their parent, so a backward pass meets them first.
+  for (std::size_t i = packed.size(); i-- > 0;) {
+    GpuCoverageNode& out = packed[i];
+    if (out.count > 0) {
+      out.range_first = out.first;
+      out.range_count = out.count;
+    } else {
+      const GpuCoverageNode& a = packed[out.first];
+      const GpuCoverageNode& b = packed[out.first + 1];
+      out.range_first = std::min(a.range_first, b.range_first);
+      out.range_count = a.range_count + b.range_count;
     }
   }
   return packed;

@@ -35,10 +35,15 @@ layout(std430, binding = 6) readonly buffer Facets { Facet facets[]; };
 
 struct Node {  // GpuCoverageNode
   vec4 pyramid[4];
+  vec4 cone;  // bounded nodes: unit axis, sine of the half-angle
   uint first;
   uint count;
   uint bounded;
   uint padding;
+  uint range_first;  // every facet below: facet_order[range_first, range_first + range_count)
+  uint range_count;
+  uint padding1;
+  uint padding2;
 };
 layout(std430, binding = 7) readonly buffer Nodes { Node nodes[]; };
 layout(std430, binding = 8) readonly buffer Order { uint facet_order[]; };
@@ -57,6 +62,7 @@ layout(location = 41) uniform uint cull_back_faces;  // 1: front is counter-cloc
 // that float rounding never loses a facet the double-precision reference finds.
 const float kCoverageSlack = 2e-6;
 const uint kNone = 0xffffffffu;
+const uint kCoverageLeafSize = 4u;  // CoverageIndex's leaf size, checked by pack_coverage_nodes
 
 // The list entry holding list triangle t (binary search on first_triangle).
 uint entry_of_triangle(uint t) {
@@ -121,11 +127,15 @@ void triangle_eye(uint t, out vec3 p[3]) {
 // triangle_meets_cone in projection/src/coverage.cpp. The cone over a triangle from the eye is the
 // cone over its corner directions, so unit corners give the same answer, and every point met
 // below has |X| <= 1: a constant slack is at least slack·|X|, and never loses a facet.
+// Every loop has a constant trip count, so the compiler unrolls it: llvmpipe ends a shader
+// invocation's loops after 65535 iterations shared by all of them (LP_MAX_TGSI_LOOP_ITERATIONS),
+// and a walk over thousands of facets with loops left in here reached that and lost facets.
 bool meets_cone(vec3 u[3], vec4 planes[4], int plane_count) {
   // Most tests end here. Every corner outside one plane: so is the whole triangle. A corner
   // inside every plane: clipping would keep it as it is.
   bool corner_inside[3] = bool[3](true, true, true);
-  for (int k = 0; k < plane_count; ++k) {
+  for (int k = 0; k < 4; ++k) {
+    if (k >= plane_count) break;
     vec3 n = planes[k].xyz;
     bool any_inside = false;
     for (int c = 0; c < 3; ++c) {
@@ -136,31 +146,47 @@ bool meets_cone(vec3 u[3], vec4 planes[4], int plane_count) {
     if (!any_inside) return false;
   }
   if (corner_inside[0] || corner_inside[1] || corner_inside[2]) return true;
+  // Each plane adds at most one vertex: 3 + 4 at most.
   vec3 poly[8];
   vec3 next[8];
   poly[0] = u[0];
   poly[1] = u[1];
   poly[2] = u[2];
   int count = 3;
-  for (int k = 0; k < plane_count && count > 0; ++k) {
+  for (int k = 0; k < 4; ++k) {
+    if (k >= plane_count || count == 0) break;
     vec3 n = planes[k].xyz;
     int written = 0;
-    for (int i = 0; i < count; ++i) {
-      vec3 a = poly[i];
-      vec3 b = poly[(i + 1) % count];
-      float da = dot(n, a) + kCoverageSlack;
-      float db = dot(n, b) + kCoverageSlack;
-      if (da >= 0.0 && written < 8) next[written++] = a;
-      if ((da >= 0.0) != (db >= 0.0) && written < 8) next[written++] = a + (b - a) * (da / (da - db));
+    for (int i = 0; i < 7; ++i) {
+      if (i < count) {
+        vec3 a = poly[i];
+        vec3 b = poly[i + 1 < count ? i + 1 : 0];
+        float da = dot(n, a) + kCoverageSlack;
+        float db = dot(n, b) + kCoverageSlack;
+        if (da >= 0.0 && written < 8) next[written++] = a;
+        if ((da >= 0.0) != (db >= 0.0) && written < 8)
+          next[written++] = a + (b - a) * (da / (da - db));
+      }
     }
     count = written;
-    for (int i = 0; i < count; ++i) poly[i] = next[i];
+    for (int i = 0; i < 8; ++i) poly[i] = next[i];
   }
   // What meets the cone only at the eye is seen edge-on and covers nothing.
-  for (int i = 0; i < count; ++i) {
-    if (length(poly[i]) > 1e-6) return true;
+  for (int i = 0; i < 7; ++i) {
+    if (i < count && length(poly[i]) > 1e-6) return true;
   }
   return false;
+}
+
+// Whether the cone (unit axis, sine of its half-angle) lies inside the triangle's cone, given the
+// inward unit normals of the triangle's edge planes, with room to spare for float rounding: then
+// every facet below meets the triangle.
+bool cone_inside(vec3 e[3], vec4 cone) {
+  const float kInsideMargin = 1e-5;
+  for (int k = 0; k < 3; ++k) {
+    if (dot(e[k], cone.xyz) < cone.w + kInsideMargin) return false;
+  }
+  return true;
 }
 
 // False for triangles that are culled before any facet test: non-finite corners, degenerate or
@@ -187,6 +213,16 @@ uint walk_coverage(vec3 p[3], uint t, uint pair_base, uint wanted, out uint want
   wanted_facet = kNone;
   if (!triangle_may_cover(p)) return 0u;
   vec3 u[3] = vec3[3](normalize(p[0]), normalize(p[1]), normalize(p[2]));
+  // Inward unit normals of the triangle's own cone. A node whose cone lies inside it holds only
+  // facets the triangle covers: they are taken as a range, without a test each, which keeps the
+  // walk short (and within llvmpipe's loop budget) for triangles that cover many facets.
+  float orientation = dot(cross(u[0], u[1]), u[2]) >= 0.0 ? 1.0 : -1.0;
+  vec3 e[3];
+  for (int k = 0; k < 3; ++k) {
+    vec3 normal = orientation * cross(u[k], u[k < 2 ? k + 1 : 0]);
+    float len = length(normal);
+    e[k] = len > 0.0 ? normal / len : vec3(0.0);
+  }
   uint found = 0u;
   uint stack[64];
   int top = 0;
@@ -194,9 +230,28 @@ uint walk_coverage(vec3 p[3], uint t, uint pair_base, uint wanted, out uint want
   while (top > 0) {
     Node node = nodes[stack[--top]];
     if (node.bounded != 0u && !meets_cone(u, node.pyramid, 4)) continue;
+    if (node.bounded != 0u && cone_inside(e, node.cone)) {
+      if (wanted != kNone && wanted < found + node.range_count) {
+        wanted_facet = facet_order[node.range_first + (wanted - found)];
+        return wanted + 1u;
+      }
+      if (pair_base != kNone) {
+        // Eight pairs per iteration: a fraction of the loop budget per facet.
+        for (uint k = 0u; k < node.range_count; k += 8u) {
+          for (uint m = 0u; m < 8u; ++m) {
+            if (k + m < node.range_count)
+              write_pair(pair_base + found + k + m, t, facet_order[node.range_first + k + m]);
+          }
+        }
+      }
+      found += node.range_count;
+      continue;
+    }
     if (node.count > 0u) {
-      for (uint k = node.first; k < node.first + node.count; ++k) {
-        uint f = facet_order[k];
+      // A leaf holds at most kCoverageLeafSize facets (GpuCoverageNode).
+      for (uint m = 0u; m < kCoverageLeafSize; ++m) {
+        if (m >= node.count) break;
+        uint f = facet_order[node.first + m];
         vec4 planes[4] = vec4[4](facets[f].clip_planes[0], facets[f].clip_planes[1],
                                  facets[f].clip_planes[2], vec4(0.0));
         if (!meets_cone(u, planes, 3)) continue;

@@ -150,8 +150,13 @@ TEST(Pipeline, GpuCoverageMatchesCpuReference) {
   triangles.push_back({glm::vec3(-1, -1, 0), glm::vec3(1, -1, 0), glm::vec3(0, 1, 0)});  // eye
   triangles.push_back({glm::vec3(-1e4f, -1, -1e4f), glm::vec3(1e4f, -1, -1e4f),
                        glm::vec3(0, -1, 1e4f)});  // huge ground
+  // Dense facets: large triangles cover thousands of them (up to 26,060 here), far more than
+  // llvmpipe's loop budget per shader invocation would allow one test each.
+  RenderSettings dense;
+  dense.facets.layout = FacetGrid{120, 120};
   for (const auto& [name, outputs, settings] : {std::tuple{"cylinder", cylinder(), strips(40)},
-                                                std::tuple{"dome", dome(), RenderSettings{}}}) {
+                                                std::tuple{"dome", dome(), RenderSettings{}},
+                                                std::tuple{"dome, 28,800 facets", dome(), dense}}) {
     for (bool cull : {false, true}) {
       RenderSettings s = settings;
       s.cull_back_faces = cull;
@@ -177,7 +182,8 @@ TEST(Pipeline, GpuCoverageMatchesCpuReference) {
         gpu_pairs += gpu[t].size();
         // Conservative: every facet the reference lists.
         EXPECT_TRUE(std::includes(gpu[t].begin(), gpu[t].end(), expected.begin(), expected.end()))
-            << name << " triangle " << t;
+            << name << " triangle " << t << ": " << gpu[t].size() << " facets listed, "
+            << expected.size() << " in the reference";
         // Tight: nothing beyond the reference grown by 0.25 px of guard band.
         EXPECT_TRUE(std::includes(bound.begin(), bound.end(), gpu[t].begin(), gpu[t].end()))
             << name << " triangle " << t;

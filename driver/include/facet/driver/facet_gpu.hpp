@@ -48,9 +48,12 @@ static_assert(sizeof(GpuFacet) == 112);
 // order[first, first + count); inner nodes have children first and first + 1.
 struct GpuCoverageNode {
   float pyramid[4][4];
+  float cone[4];  // bounded nodes: the unit axis, then the sine of the half-angle
   std::uint32_t first, count, bounded, padding;
+  // Every facet below the node: order[range_first, range_first + range_count).
+  std::uint32_t range_first, range_count, padding1, padding2;
 };
-static_assert(sizeof(GpuCoverageNode) == 80);
+static_assert(sizeof(GpuCoverageNode) == 112);
 
 // std430: one run of triangles that share an object and a material (an object's primitive).
 struct GpuRecord {
