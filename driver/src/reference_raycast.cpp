@@ -310,12 +310,46 @@ EdgeDisplacement ReferenceRaycaster::edge_displacement(
     return glm::length(point - q);
   };
 
-  // Negative: nothing within the window.
+  // Distance along the world ray (origin, unit v) to triangle `id`, in its plane and within its
+  // edges up to a relative 1e-6; empty when the ray misses it.
+  auto ray_distance = [&](const glm::dvec3& origin, const glm::dvec3& v,
+                          std::uint32_t id) -> std::optional<double> {
+    const glm::dvec3 a(impl_->p_world[3 * std::size_t(id - 1)]);
+    const glm::dvec3 b(impl_->p_world[3 * std::size_t(id - 1) + 1]);
+    const glm::dvec3 c(impl_->p_world[3 * std::size_t(id - 1) + 2]);
+    const glm::dvec3 n = glm::cross(b - a, c - a);
+    const double along = glm::dot(n, v);
+    if (!(std::abs(along) > 1e-12 * glm::length(n))) return std::nullopt;
+    const double d = glm::dot(n, a - origin) / along;
+    if (!(d > 0)) return std::nullopt;
+    const glm::dvec3 x = origin + d * v;
+    const double slack = -1e-6 * glm::dot(n, n);
+    if (glm::dot(glm::cross(b - a, x - a), n) < slack || glm::dot(glm::cross(c - b, x - b), n) < slack ||
+        glm::dot(glm::cross(a - c, x - c), n) < slack) {
+      return std::nullopt;
+    }
+    return d;
+  };
+  // Both triangles on the pixel centre's ray at the same distance: surfaces that coincide there.
+  auto depth_tie = [&](glm::dvec2 q, std::uint32_t a, std::uint32_t b) {
+    if (a == 0 || b == 0) return false;
+    const auto found = inverse.invert(q);
+    if (!found) return false;
+    const glm::dvec3 v = glm::normalize(R_world_eye * found->v_eye);
+    const auto da = ray_distance(p_eye_world, v, a), db = ray_distance(p_eye_world, v, b);
+    return da && db && std::abs(*da - *db) <= 1e-5 * std::max(*da, *db);
+  };
+
+  // Negative: nothing within the window; NaN: a depth tie.
   std::vector<double> distance(differing.size(), -1.0);
   for_each_row(int(differing.size()), [&](int k) {
     const glm::ivec2 pixel = differing[std::size_t(k)];
     const std::uint32_t id = tested[std::size_t(pixel.y) * size.x + pixel.x];
     const glm::dvec2 centre = glm::dvec2(pixel) + 0.5;
+    if (depth_tie(centre, id, reference[std::size_t(pixel.y) * size.x + pixel.x])) {
+      distance[std::size_t(k)] = std::numeric_limits<double>::quiet_NaN();
+      return;
+    }
     // A triangle drawn too far: how far it reaches past where it is seen. Nothing drawn (ID 0):
     // how far the reference's triangle, and what lies around it, was pulled back from q. The
     // computed distance bounds the true one from above (another surface may hide or uncover the
@@ -363,16 +397,22 @@ EdgeDisplacement ReferenceRaycaster::edge_displacement(
   EdgeDisplacement result;
   result.differing_pixels = differing.size();
   std::vector<double> measured;
-  for (const double d : distance) {
-    if (d < 0) {
+  for (std::size_t k = 0; k < distance.size(); ++k) {
+    const double d = distance[k];
+    if (std::isnan(d)) {
+      ++result.depth_ties;
+    } else if (d < 0) {
       ++result.beyond_window;
     } else {
       measured.push_back(d);
+      if (d > result.max_px || result.worst_pixel.x < 0) {
+        result.max_px = d;
+        result.worst_pixel = differing[k];
+      }
     }
   }
   result.measured_pixels = measured.size();
   if (!measured.empty()) {
-    result.max_px = *std::max_element(measured.begin(), measured.end());
     const std::size_t k =
         std::min(measured.size() - 1, std::size_t(0.99 * double(measured.size())));
     std::nth_element(measured.begin(), measured.begin() + std::ptrdiff_t(k), measured.end());

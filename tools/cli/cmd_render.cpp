@@ -83,12 +83,15 @@ nlohmann::json compare_with_reference(const Scene& scene, const std::vector<Outp
                           {"id_mismatch", c.id_mismatch},
                           {"max_edge_px", e.max_px},
                           {"p99_edge_px", e.p99_px},
-                          {"edge_beyond_window_pixels", e.beyond_window}});
+                          {"edge_beyond_window_pixels", e.beyond_window},
+                          {"depth_tie_pixels", e.depth_ties},
+                          {"worst_edge_pixel", {e.worst_pixel.x, e.worst_pixel.y}}});
     pooled.compared_pixels += c.compared_pixels;
     pooled.mismatched_pixels += c.mismatched_pixels;
     edges.differing_pixels += e.differing_pixels;
     edges.measured_pixels += e.measured_pixels;
     edges.beyond_window += e.beyond_window;
+    edges.depth_ties += e.depth_ties;
     edges.max_px = std::max(edges.max_px, e.max_px);
     edges.p99_px = std::max(edges.p99_px, e.p99_px);
   }
@@ -102,6 +105,7 @@ nlohmann::json compare_with_reference(const Scene& scene, const std::vector<Outp
           {"p99_edge_px", edges.p99_px},
           {"differing_pixels", edges.differing_pixels},
           {"edge_beyond_window_pixels", edges.beyond_window},
+          {"depth_tie_pixels", edges.depth_ties},
           {"edge_window_px", EdgeDisplacementOptions{}.window_px},
           {"outputs", per_output}};
 }

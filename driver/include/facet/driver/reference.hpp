@@ -136,8 +136,9 @@ struct IdComparison {
 // Unlike compare_ids' image-based edge distance, a sliver that holds few pixel centres is
 // measured where it truly lies: a diagonal between two triangles of a quad, moved by a tenth of
 // a pixel, gives a tenth of a pixel here, and can give tens of pixels from the reference image.
-// Pixels whose displacement exceeds window_px (a wrong triangle, or surfaces that coincide, where
-// depth decides by rounding) are counted in beyond_window and left out of max_px and p99_px.
+// Pixels whose two triangles coincide along the pixel's ray are depth ties (either is right), and
+// pixels whose displacement exceeds window_px (a wrong triangle) are counted in beyond_window;
+// both are left out of max_px and p99_px.
 struct EdgeDisplacementOptions {
   bool wrap_x = false;
   int subsamples = 32;
@@ -152,6 +153,10 @@ struct EdgeDisplacement {
   std::size_t differing_pixels = 0;
   std::size_t measured_pixels = 0;  // differing pixels with a point within window_px
   std::size_t beyond_window = 0;    // differing pixels without one
+  // Differing pixels whose centre ray meets both triangles at the same distance (within 1e-5 of
+  // it): coinciding surfaces, where either ID is right and depth rounding picks one. Not measured.
+  std::size_t depth_ties = 0;
+  glm::ivec2 worst_pixel{-1, -1};  // the pixel of max_px
 };
 
 // InputError when either image is not size.x · size.y pixels.
