@@ -324,7 +324,8 @@ EdgeDisplacement ReferenceRaycaster::edge_displacement(
     if (!(d > 0)) return std::nullopt;
     const glm::dvec3 x = origin + d * v;
     const double slack = -1e-6 * glm::dot(n, n);
-    if (glm::dot(glm::cross(b - a, x - a), n) < slack || glm::dot(glm::cross(c - b, x - b), n) < slack ||
+    if (glm::dot(glm::cross(b - a, x - a), n) < slack ||
+        glm::dot(glm::cross(c - b, x - b), n) < slack ||
         glm::dot(glm::cross(a - c, x - c), n) < slack) {
       return std::nullopt;
     }

@@ -264,15 +264,14 @@ Warp warp_from_inverse_grid(const InverseGrid& grid, const BaseProjection& base,
         const glm::dvec2 output = (*a * cells_padded - glm::dvec2(pad)) / cells_in_grid;
         const std::size_t k = warp.node_index(i, j);
         offsets[k] = output * glm::dvec2(output_size) - st_node * glm::dvec2(output_size);
-        covered[k] = output.x >= 0 && output.y >= 0 && output.x <= 1 && output.y <= 1 &&
-                     valid_at(output) >= 0.5;
       }
     }
   }
   // A smooth map bends by a small part of a cell from one node to the next.
   const double cell_px = glm::length(glm::dvec2(output_size) / glm::dvec2(warp_grid - 1));
   drop_inconsistent(offsets, from_anywhere, warp_grid, std::max(1.0, 0.1 * cell_px));
-  for (std::size_t k = 0; k < offsets.size(); ++k) covered[k] = covered[k] && finite(offsets[k]);
+  std::vector<bool> inverted(offsets.size());
+  for (std::size_t k = 0; k < offsets.size(); ++k) inverted[k] = finite(offsets[k]);
   fill_missing(offsets, warp_grid, source);
   // A dense inverse grid says more than its values at the forward nodes: every sample is a point
   // of the map, and the map is bilinear in each forward cell. Fitting the forward offsets to all
@@ -281,6 +280,33 @@ Warp warp_from_inverse_grid(const InverseGrid& grid, const BaseProjection& base,
   // is first order in its spacing at the forward cells' edges. Sparser grids do not pin the cells.
   if (grid.grid_size.x >= 2 * warp_grid.x - 1 && grid.grid_size.y >= 2 * warp_grid.y - 1) {
     fit_to_samples(offsets, grid, warp_grid, output_size);
+  }
+
+  // Covered: what the output shows. Coverage is bilinear between nodes, so a node just outside the
+  // image is covered too when a cell of it reaches into the image; otherwise coverage would fall
+  // below 0.5 inside the image's edge pixels, by up to half a cell, which where the map crowds
+  // many output pixels into a cell is several pixels the facets are not held to.
+  const glm::dvec2 size(output_size);
+  const auto output_of = [&](int i, int j) {
+    const glm::dvec2 st_node{double(i) / (warp_grid.x - 1), double(j) / (warp_grid.y - 1)};
+    return st_node + offsets[warp.node_index(i, j)] / size;
+  };
+  for (int j = 0; j < warp_grid.y; ++j) {
+    for (int i = 0; i < warp_grid.x; ++i) {
+      const std::size_t k = warp.node_index(i, j);
+      const glm::dvec2 output = output_of(i, j);
+      if (!inverted[k]) continue;
+      const glm::dvec2 nearest = glm::clamp(output, glm::dvec2(0.0), glm::dvec2(1.0));
+      glm::dvec2 reach(0.0);
+      const int di[4] = {1, -1, 0, 0}, dj[4] = {0, 0, 1, -1};
+      for (int d = 0; d < 4; ++d) {
+        const int i1 = i + di[d], j1 = j + dj[d];
+        if (i1 < 0 || j1 < 0 || i1 >= warp_grid.x || j1 >= warp_grid.y) continue;
+        reach = glm::max(reach, glm::abs(output_of(i1, j1) - output));
+      }
+      covered[k] = glm::all(glm::lessThanEqual(glm::abs(output - nearest), reach)) &&
+                   valid_at(nearest) >= 0.5;
+    }
   }
 
   warp.offset_px.resize(offsets.size());
