@@ -247,28 +247,32 @@ Warp dome_with_one_bump() {
 }
 
 TEST(Facets, TheDefaultBuilderKeepsTheLayoutWithFewerFacets) {
-  const auto count = [](const Warp& warp, FacetTolerance::Builder builder) {
-    FacetTolerance layout{0.25};
-    layout.builder = builder;
-    return build_facets(warp, {layout}).facets.size();
+  struct Counts {
+    std::size_t tensor, bisection, fewest;
   };
-  using Builder = FacetTolerance::Builder;
+  const auto counts = [](const std::string& name, const Warp& warp) {
+    const auto count = [&](FacetTolerance::Builder builder) {
+      FacetTolerance layout{0.25};
+      layout.builder = builder;
+      return build_facets(warp, {layout}).facets.size();
+    };
+    const Counts c{count(FacetTolerance::Builder::tensor),
+                   count(FacetTolerance::Builder::bisection),
+                   count(FacetTolerance::Builder::fewest)};
+    std::printf("%s at 0.25 px: tensor %zu, bisection %zu facets\n", name.c_str(), c.tensor,
+                c.bisection);
+    return c;
+  };
   // The cylinder's error does not change along its height: tall tensor strips follow it.
-  const Warp cylinder = Warp::analytic(BaseProjection::cylindrical(-180, 180, 1, -1), {1600, 1200});
-  const std::size_t cylinder_tensor = count(cylinder, Builder::tensor);
-  const std::size_t cylinder_bisection = count(cylinder, Builder::bisection);
-  std::printf("cylinder 1600x1200 at 0.25 px: tensor %zu, bisection %zu facets\n", cylinder_tensor,
-              cylinder_bisection);
-  EXPECT_LT(cylinder_tensor, cylinder_bisection);
-  EXPECT_EQ(count(cylinder, Builder::fewest), cylinder_tensor);
+  const Counts cylinder =
+      counts("cylinder 1600x1200",
+             Warp::analytic(BaseProjection::cylindrical(-180, 180, 1, -1), {1600, 1200}));
+  EXPECT_LT(cylinder.tensor, cylinder.bisection);
+  EXPECT_EQ(cylinder.fewest, cylinder.tensor);
   // A bump is hard in one place: a tensor grid refines whole rows and columns through it.
-  const Warp bump = dome_with_one_bump();
-  const std::size_t bump_tensor = count(bump, Builder::tensor);
-  const std::size_t bump_bisection = count(bump, Builder::bisection);
-  std::printf("dome with one bump at 0.25 px: tensor %zu, bisection %zu facets\n", bump_tensor,
-              bump_bisection);
-  EXPECT_LT(bump_bisection, bump_tensor);
-  EXPECT_EQ(count(bump, Builder::fewest), bump_bisection);
+  const Counts bump = counts("dome with one bump", dome_with_one_bump());
+  EXPECT_LT(bump.bisection, bump.tensor);
+  EXPECT_EQ(bump.fewest, bump.bisection);
 }
 
 TEST(Facets, ImpossibleLayoutsAreRejected) {
