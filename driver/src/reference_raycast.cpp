@@ -196,6 +196,10 @@ EdgeDisplacement ReferenceRaycaster::edge_displacement(
   const glm::dmat4 T_world_eye = glm::inverse(T_eye_world);
   const glm::dvec3 p_eye_world(T_world_eye[3]);
   const glm::dmat3 R_world_eye(T_world_eye);
+  auto covered = [&](glm::dvec2 q) {
+    if (options.wrap_x) q.x -= std::floor(q.x / size.x) * size.x;
+    return inverse.invert(q).has_value();
+  };
   auto id_at = [&](glm::dvec2 q) -> std::uint32_t {
     if (options.wrap_x) q.x -= std::floor(q.x / size.x) * size.x;
     const auto found = inverse.invert(q);
@@ -357,13 +361,20 @@ EdgeDisplacement ReferenceRaycaster::edge_displacement(
     // triangle nearer, along an edge of its own or where two surfaces cross), so the lattice
     // search below looks for nearer points within it.
     const std::uint32_t expected = reference[std::size_t(pixel.y) * size.x + pixel.x];
+    // Drawn where the display shows nothing (no direction maps to the centre): what was drawn
+    // there is the facets' guard band or a facet's edge displaced from the display's, and the
+    // distance that counts is how far the centre lies outside what the display covers.
+    const bool outside_display = id != 0 && !covered(centre);
     double limit = options.window_px;
-    if (id != 0) {
+    if (id != 0 && !outside_display) {
       if (const auto exact = distance_to_triangle(centre, id)) limit = std::min(limit, *exact);
-    } else if (const auto found = edge_point(centre, expected, true)) {
-      limit = std::min(limit, glm::length(found->first - centre));
+    } else if (id == 0) {
+      if (const auto found = edge_point(centre, expected, true)) {
+        limit = std::min(limit, glm::length(found->first - centre));
+      }
     }
     auto marks_the_edge = [&](glm::dvec2 q) {
+      if (outside_display) return covered(q);
       const std::uint32_t seen = id_at(q);
       return id != 0 ? seen == id : seen != expected;
     };

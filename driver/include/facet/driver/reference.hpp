@@ -136,7 +136,10 @@ struct IdComparison {
 // Unlike compare_ids' image-based edge distance, a sliver that holds few pixel centres is
 // measured where it truly lies: a diagonal between two triangles of a quad, moved by a tenth of
 // a pixel, gives a tenth of a pixel here, and can give tens of pixels from the reference image.
-// Pixels whose two triangles coincide along the pixel's ray are depth ties (either is right), and
+// A pixel drawn where the display shows nothing (no direction maps to its centre: the facets'
+// guard band, or a facet edge displaced from the display's own edge) is measured as the distance
+// from its centre to what the display covers. Pixels whose two triangles coincide along the
+// pixel's ray are depth ties (either is right), and
 // pixels whose displacement exceeds window_px (a wrong triangle) are counted in beyond_window;
 // both are left out of max_px and p99_px.
 struct EdgeDisplacementOptions {
