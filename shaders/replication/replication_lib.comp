@@ -127,9 +127,11 @@ void triangle_eye(uint t, out vec3 p[3]) {
 // triangle_meets_cone in projection/src/coverage.cpp. The cone over a triangle from the eye is the
 // cone over its corner directions, so unit corners give the same answer, and every point met
 // below has |X| <= 1: a constant slack is at least slack·|X|, and never loses a facet.
-// Every loop has a constant trip count, so the compiler unrolls it: llvmpipe ends a shader
-// invocation's loops after 65535 iterations shared by all of them (LP_MAX_TGSI_LOOP_ITERATIONS),
-// and a walk over thousands of facets with loops left in here reached that and lost facets.
+// The corner and plane loops have constant trip counts, so the compiler unrolls them: llvmpipe
+// ends a shader invocation's loops after 65535 iterations shared by all of them
+// (LP_MAX_TGSI_LOOP_ITERATIONS). The clipping loops stay loops: unrolled to their longest they
+// made the facet frame twice as slow, and walk_coverage takes whole subtrees, so only the facets
+// along a triangle's edges come here.
 bool meets_cone(vec3 u[3], vec4 planes[4], int plane_count) {
   // Most tests end here. Every corner outside one plane: so is the whole triangle. A corner
   // inside every plane: clipping would keep it as it is.
@@ -157,23 +159,21 @@ bool meets_cone(vec3 u[3], vec4 planes[4], int plane_count) {
     if (k >= plane_count || count == 0) break;
     vec3 n = planes[k].xyz;
     int written = 0;
-    for (int i = 0; i < 7; ++i) {
-      if (i < count) {
-        vec3 a = poly[i];
-        vec3 b = poly[i + 1 < count ? i + 1 : 0];
-        float da = dot(n, a) + kCoverageSlack;
-        float db = dot(n, b) + kCoverageSlack;
-        if (da >= 0.0 && written < 8) next[written++] = a;
-        if ((da >= 0.0) != (db >= 0.0) && written < 8)
-          next[written++] = a + (b - a) * (da / (da - db));
-      }
+    for (int i = 0; i < count; ++i) {
+      vec3 a = poly[i];
+      vec3 b = poly[i + 1 < count ? i + 1 : 0];
+      float da = dot(n, a) + kCoverageSlack;
+      float db = dot(n, b) + kCoverageSlack;
+      if (da >= 0.0 && written < 8) next[written++] = a;
+      if ((da >= 0.0) != (db >= 0.0) && written < 8)
+        next[written++] = a + (b - a) * (da / (da - db));
     }
     count = written;
-    for (int i = 0; i < 8; ++i) poly[i] = next[i];
+    for (int i = 0; i < count; ++i) poly[i] = next[i];
   }
   // What meets the cone only at the eye is seen edge-on and covers nothing.
-  for (int i = 0; i < 7; ++i) {
-    if (i < count && length(poly[i]) > 1e-6) return true;
+  for (int i = 0; i < count; ++i) {
+    if (length(poly[i]) > 1e-6) return true;
   }
   return false;
 }
