@@ -400,6 +400,8 @@ BenchReport run_bench(const BenchOptions& options, const std::string& renderer,
         pooled.p99_edge_px = std::max(pooled.p99_edge_px, e.p99_px);
         row.edge_beyond_window_pixels += e.beyond_window;
         row.depth_tie_pixels += e.depth_ties;
+        row.outside_display_pixels += e.outside_display;
+        row.outside_display_max_px = std::max(row.outside_display_max_px, e.outside_display_max_px);
       }
       row.id_mismatch = pooled.compared_pixels
                             ? double(pooled.mismatched_pixels) / double(pooled.compared_pixels)
@@ -439,13 +441,15 @@ BenchReport run_bench(const BenchOptions& options, const std::string& renderer,
         row.geometric_rms_px = row.p99_edge_px;
         row.geometric_source = "reference edges";
       }
-      say(
-          format("  %-9s %-12s prepared in %7.0f ms: id_mismatch %.5f, edges max %.2f px (output "
-                 "%zu pixel %d,%d) p99 %.2f px, %llu depth ties, geometric max %.3f px",
-                 setting.method.c_str(), setting.label.c_str(), prepare_ms, row.id_mismatch,
-                 row.max_edge_px, row.worst_edge_output, row.worst_edge_pixel.x,
-                 row.worst_edge_pixel.y, row.p99_edge_px,
-                 static_cast<unsigned long long>(row.depth_tie_pixels), row.geometric_max_px));
+      say(format(
+          "  %-9s %-12s prepared in %7.0f ms: id_mismatch %.5f, edges max %.2f px (output "
+          "%zu pixel %d,%d) p99 %.2f px, %llu depth ties, %llu drawn outside the display "
+          "(up to %.2f px), geometric max %.3f px",
+          setting.method.c_str(), setting.label.c_str(), prepare_ms, row.id_mismatch,
+          row.max_edge_px, row.worst_edge_output, row.worst_edge_pixel.x, row.worst_edge_pixel.y,
+          row.p99_edge_px, static_cast<unsigned long long>(row.depth_tie_pixels),
+          static_cast<unsigned long long>(row.outside_display_pixels), row.outside_display_max_px,
+          row.geometric_max_px));
       runners.push_back(std::move(runner));
     }
 

@@ -347,6 +347,7 @@ EdgeDisplacement ReferenceRaycaster::edge_displacement(
 
   // Negative: nothing within the window; NaN: a depth tie.
   std::vector<double> distance(differing.size(), -1.0);
+  std::vector<char> outside(differing.size(), 0);
   for_each_row(int(differing.size()), [&](int k) {
     const glm::ivec2 pixel = differing[std::size_t(k)];
     const std::uint32_t id = tested[std::size_t(pixel.y) * size.x + pixel.x];
@@ -361,10 +362,12 @@ EdgeDisplacement ReferenceRaycaster::edge_displacement(
     // triangle nearer, along an edge of its own or where two surfaces cross), so the lattice
     // search below looks for nearer points within it.
     const std::uint32_t expected = reference[std::size_t(pixel.y) * size.x + pixel.x];
-    // Drawn where the display shows nothing (no direction maps to the centre): what was drawn
-    // there is the facets' guard band or a facet's edge displaced from the display's, and the
-    // distance that counts is how far the centre lies outside what the display covers.
+    // Drawn where the display shows nothing (no direction maps to the centre): the facets' guard
+    // band, or the part of a facet beyond the coverage's edge (a facet straddling it is kept
+    // whole), which the blend map hides. Measured apart: how far the centre lies outside what the
+    // display covers.
     const bool outside_display = id != 0 && !covered(centre);
+    outside[std::size_t(k)] = outside_display;
     double limit = options.window_px;
     if (id != 0 && !outside_display) {
       if (const auto exact = distance_to_triangle(centre, id)) limit = std::min(limit, *exact);
@@ -413,6 +416,10 @@ EdgeDisplacement ReferenceRaycaster::edge_displacement(
     const double d = distance[k];
     if (std::isnan(d)) {
       ++result.depth_ties;
+    } else if (outside[k]) {
+      ++result.outside_display;
+      result.outside_display_max_px =
+          std::max(result.outside_display_max_px, d < 0 ? options.window_px : d);
     } else if (d < 0) {
       ++result.beyond_window;
     } else {

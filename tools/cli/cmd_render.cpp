@@ -85,6 +85,8 @@ nlohmann::json compare_with_reference(const Scene& scene, const std::vector<Outp
                           {"p99_edge_px", e.p99_px},
                           {"edge_beyond_window_pixels", e.beyond_window},
                           {"depth_tie_pixels", e.depth_ties},
+                          {"outside_display_pixels", e.outside_display},
+                          {"outside_display_max_px", e.outside_display_max_px},
                           {"worst_edge_pixel", {e.worst_pixel.x, e.worst_pixel.y}}});
     pooled.compared_pixels += c.compared_pixels;
     pooled.mismatched_pixels += c.mismatched_pixels;
@@ -92,6 +94,8 @@ nlohmann::json compare_with_reference(const Scene& scene, const std::vector<Outp
     edges.measured_pixels += e.measured_pixels;
     edges.beyond_window += e.beyond_window;
     edges.depth_ties += e.depth_ties;
+    edges.outside_display += e.outside_display;
+    edges.outside_display_max_px = std::max(edges.outside_display_max_px, e.outside_display_max_px);
     edges.max_px = std::max(edges.max_px, e.max_px);
     edges.p99_px = std::max(edges.p99_px, e.p99_px);
   }
@@ -106,6 +110,8 @@ nlohmann::json compare_with_reference(const Scene& scene, const std::vector<Outp
           {"differing_pixels", edges.differing_pixels},
           {"edge_beyond_window_pixels", edges.beyond_window},
           {"depth_tie_pixels", edges.depth_ties},
+          {"outside_display_pixels", edges.outside_display},
+          {"outside_display_max_px", edges.outside_display_max_px},
           {"edge_window_px", EdgeDisplacementOptions{}.window_px},
           {"outputs", per_output}};
 }

@@ -81,7 +81,10 @@ struct BenchRow {
   // edge_beyond_window_pixels (more than 4 px).
   double id_mismatch = 0, max_edge_px = 0, p99_edge_px = 0;
   std::uint64_t edge_beyond_window_pixels = 0;
-  std::uint64_t depth_tie_pixels = 0;   // coinciding surfaces, left out of the edge figures
+  std::uint64_t depth_tie_pixels = 0;  // coinciding surfaces, left out of the edge figures
+  // Drawn where the display covers nothing, and the farthest of those from what it covers.
+  std::uint64_t outside_display_pixels = 0;
+  double outside_display_max_px = 0;
   glm::ivec2 worst_edge_pixel{-1, -1};  // of max_edge_px, in its output
   std::size_t worst_edge_output = 0;
   // Geometric error in output pixels: max (worst case) and RMS; see geometric_source.

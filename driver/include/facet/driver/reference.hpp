@@ -136,12 +136,12 @@ struct IdComparison {
 // Unlike compare_ids' image-based edge distance, a sliver that holds few pixel centres is
 // measured where it truly lies: a diagonal between two triangles of a quad, moved by a tenth of
 // a pixel, gives a tenth of a pixel here, and can give tens of pixels from the reference image.
-// A pixel drawn where the display shows nothing (no direction maps to its centre: the facets'
-// guard band, or a facet edge displaced from the display's own edge) is measured as the distance
-// from its centre to what the display covers. Pixels whose two triangles coincide along the
-// pixel's ray are depth ties (either is right), and
+// Pixels drawn where the display covers nothing (no direction maps to the centre: the facets'
+// guard band, or the part of a facet that straddles the coverage's edge, which the blend map
+// hides) are counted in outside_display with their distance to what the display covers. Pixels
+// whose two triangles coincide along the pixel's ray are depth ties (either is right), and
 // pixels whose displacement exceeds window_px (a wrong triangle) are counted in beyond_window;
-// both are left out of max_px and p99_px.
+// all three are left out of max_px and p99_px.
 struct EdgeDisplacementOptions {
   bool wrap_x = false;
   int subsamples = 32;
@@ -159,6 +159,10 @@ struct EdgeDisplacement {
   // Differing pixels whose centre ray meets both triangles at the same distance (within 1e-5 of
   // it): coinciding surfaces, where either ID is right and depth rounding picks one. Not measured.
   std::size_t depth_ties = 0;
+  // Pixels drawn where the display covers nothing (no direction maps to the centre), and the
+  // largest distance from such a centre to what the display covers (window_px when farther).
+  std::size_t outside_display = 0;
+  double outside_display_max_px = 0;
   glm::ivec2 worst_pixel{-1, -1};  // the pixel of max_px
 };
 
