@@ -19,6 +19,7 @@
 #include "facet/projection/screen.hpp"
 #include "facet/projection/warp_inverse.hpp"
 #include "facet/projection_io/warp_file.hpp"
+#include "image_map.hpp"
 
 namespace facet::interop {
 namespace {
@@ -40,53 +41,6 @@ const std::string& member(const MpcdiFiles& files, const std::string& name,
     if (std::filesystem::path(path).filename().string() == base) return bytes;
   }
   throw InputError(source, field, "expected a member named \"" + name + "\" in the container");
-}
-
-// Decodes a PNG (or any image OpenImageIO reads) to `size` by bilinear resampling at output pixel
-// centres; each value becomes value^gamma_embedded, clamped to [0,1].
-projection_io::BlendMap decode_map(const std::string& bytes, const MpcdiMap& map, glm::ivec2 size,
-                                   const std::string& source) {
-  OIIO::Filesystem::IOMemReader reader(bytes.data(), bytes.size());
-  auto input = OIIO::ImageInput::open(map.path, nullptr, &reader);
-  if (!input) {
-    (void)OIIO::geterror();
-    throw InputError(source, map.path, "expected a PNG image");
-  }
-  const OIIO::ImageSpec spec = input->spec();
-  if (spec.width < 1 || spec.height < 1 || spec.nchannels < 1 ||
-      std::size_t(spec.width) * std::size_t(spec.height) > (std::size_t(1) << 26)) {
-    throw InputError(source, map.path, "expected an image of at most 2^26 pixels");
-  }
-  std::vector<float> pixels(std::size_t(spec.width) * spec.height * spec.nchannels);
-  if (!input->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, pixels.data())) {
-    (void)input->geterror();
-    throw InputError(source, map.path, "expected a readable PNG image");
-  }
-  const int channels = spec.nchannels >= 3 ? 3 : 1;
-  projection_io::BlendMap result;
-  result.size = size;
-  result.channels = channels;
-  result.values.resize(std::size_t(size.x) * size.y * channels);
-  const auto texel = [&](int x, int y, int c) {
-    x = std::clamp(x, 0, spec.width - 1);
-    y = std::clamp(y, 0, spec.height - 1);
-    return double(pixels[(std::size_t(y) * spec.width + x) * spec.nchannels + c]);
-  };
-  for (int y = 0; y < size.y; ++y) {
-    for (int x = 0; x < size.x; ++x) {
-      const double u = (x + 0.5) / size.x * spec.width - 0.5;
-      const double v = (y + 0.5) / size.y * spec.height - 0.5;
-      const int x0 = int(std::floor(u)), y0 = int(std::floor(v));
-      const double fx = u - x0, fy = v - y0;
-      for (int c = 0; c < channels; ++c) {
-        double value = (texel(x0, y0, c) * (1 - fx) + texel(x0 + 1, y0, c) * fx) * (1 - fy) +
-                       (texel(x0, y0 + 1, c) * (1 - fx) + texel(x0 + 1, y0 + 1, c) * fx) * fy;
-        value = std::pow(std::clamp(value, 0.0, 1.0), map.gamma_embedded);
-        result.at(x, y, c) = float(std::isfinite(value) ? value : 0.0);
-      }
-    }
-  }
-  return result;
 }
 
 // Fraction of complete cells of a node grid whose image keeps the grid's orientation with a
@@ -513,13 +467,14 @@ ImportedDisplay import_mpcdi(const MpcdiFiles& files, const std::string& source,
     }
     if (region.alpha) {
       projector.blend =
-          decode_map(member(files, region.alpha->path, xml_source, field + "/alphaMap/path"),
-                     *region.alpha, region.resolution, source + ":" + region.alpha->path);
+          decode_image_map(member(files, region.alpha->path, xml_source, field + "/alphaMap/path"),
+                           region.alpha->path, region.alpha->gamma_embedded, region.resolution,
+                           source + ":" + region.alpha->path);
     }
     if (region.beta) {
-      projector.black =
-          decode_map(member(files, region.beta->path, xml_source, field + "/betaMap/path"),
-                     *region.beta, region.resolution, source + ":" + region.beta->path);
+      projector.black = decode_image_map(
+          member(files, region.beta->path, xml_source, field + "/betaMap/path"), region.beta->path,
+          region.beta->gamma_embedded, region.resolution, source + ":" + region.beta->path);
     }
     // Buffers sit left to right on the desktop, regions inside them by their extents.
     int x0 = 0;

@@ -137,6 +137,10 @@ TEST(InteropCli, BadFilesExitWithStatus2AndLeaveNothingBehind) {
       "mpcdi import " + (scratch.path / "missing.mpcdi").string(),
       "bourke import " + (scratch.path / "bad.data").string(),
       "bourke import " + kWarps + "sgct-mesh/standard_16x9.data --size 1000x1000",
+      "sgct import " + (scratch.path / "bad.data").string(),
+      "sgct import " + kWarps + "sgct-dome/sciss/channel1_planar.sgc " +
+          (scratch.path / "bad.data").string(),
+      "sgct import " + kWarps + "sgct-dome/sciss/channel1_planar.sgc --size 0x10",
   };
   for (const std::string& command : commands) {
     const fs::path out = scratch.path / "out";
@@ -157,6 +161,40 @@ TEST(InteropCli, BadFilesExitWithStatus2AndLeaveNothingBehind) {
                             scratch.path);
   EXPECT_EQ(lookup.status, 2) << lookup.output;
   EXPECT_FALSE(fs::exists(scratch.path / "l.exr"));
+}
+
+TEST(InteropCli, AnSgctDomeConfigurationAndBareSgcMeshesImport) {
+  test::ScratchFolder scratch("cli-sgct");
+  const fs::path dome = scratch.path / "dome";
+  CliRun r = run("sgct import " + kWarps + "sgct-dome/sciss/dome_alpha.xml --out " + dome.string(),
+                 scratch.path);
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("6 projectors"), std::string::npos) << r.output;
+  const auto display = projection_io::read_display_config(dome / "display.json");
+  ASSERT_EQ(display.projectors.size(), 6u);
+  for (const auto& projector : display.projectors) {
+    EXPECT_EQ(projector.size, glm::ivec2(1920, 1200));
+    ASSERT_TRUE(projector.blend);
+    EXPECT_NO_THROW(read_warp(display.resolve(projector.warp).string()));
+  }
+  // The imported warps meet facet's default 0.25 px with facets (worst case, output px).
+  const CliRun error =
+      run("error --warp " + display.resolve(display.projectors[0].warp).string() + " --json",
+          scratch.path);
+  ASSERT_EQ(error.status, 0) << error.output;
+  const std::size_t max_at = error.output.find("\"max_px\":");
+  ASSERT_NE(max_at, std::string::npos) << error.output;
+  EXPECT_LE(std::strtod(error.output.c_str() + max_at + 9, nullptr), 0.25) << error.output;
+
+  const fs::path meshes = scratch.path / "meshes";
+  r = run("sgct import " + kWarps + "sgct-dome/simcad/channel1_warp_u2.sgc " + kWarps +
+              "sgct-dome/simcad/channel2_warp_u3.sgc --size 1024x640 --out " + meshes.string(),
+          scratch.path);
+  ASSERT_EQ(r.status, 0) << r.output;
+  const auto bare = projection_io::read_display_config(meshes / "display.json");
+  ASSERT_EQ(bare.projectors.size(), 2u);
+  EXPECT_EQ(bare.projectors[1].output.window, glm::ivec4(1024, 0, 1024, 640));
+  EXPECT_FALSE(bare.projectors[0].blend);
 }
 
 TEST(InteropCli, ProfileA3ThroughTheCommands) {

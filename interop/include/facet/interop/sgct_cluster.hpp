@@ -1,0 +1,38 @@
+#pragma once
+// SGCT cluster configurations (XML) whose viewports carry SCISS `.sgc` correction meshes and
+// soft-edge masks, as dome installations ship them:
+//
+//   <Cluster> <Node> <Window> <Pos x y/>? <Size x y/>
+//     <Viewport name mesh="channel1.sgc" mask="channel1.png"> <Pos x y/>? <Size x y/>? ...
+//   ... <User> <Pos x y z/> </User>
+//
+// Every viewport with a mesh becomes a projector: its output is the viewport's part of its
+// window (viewport Pos and Size are fractions of the window, default the whole window), and the
+// mesh's own frustum and rotation (sgc.hpp) give the warp. The mask is an image over the output
+// that SGCT multiplies into the encoded colour, so the linear blend weight is mask^gamma.
+// Viewports without a mesh (an operator's GUI window) are left out with a note. Each node is its
+// own machine; the import places the nodes' windows left to right on one desktop.
+//
+// Mesh and mask paths are often absolute paths of the machine that wrote the file; a path that
+// does not exist is looked up by its file name in the configuration's folder, with a note.
+#include <filesystem>
+#include <string>
+
+#include "facet/interop/display_folder.hpp"
+#include "facet/interop/sgc.hpp"
+
+namespace facet::interop {
+
+struct SgctImportOptions {
+  double mask_gamma = 2.2;     // linear α = mask^gamma
+  glm::ivec2 warp_grid{0, 0};  // as SgcImportOptions
+};
+
+// Throws InputError naming the file and the element or attribute: not XML, no <Cluster>, a
+// window without a positive <Size>, viewport fractions outside [0,1], a mesh that is not a
+// `.sgc` file or cannot be found, no viewport with a mesh, and every error of parse_sgc and
+// import_sgc for the meshes.
+ImportedDisplay import_sgct_cluster(const std::filesystem::path& config,
+                                    const SgctImportOptions& options);
+
+}  // namespace facet::interop

@@ -1,0 +1,208 @@
+// SGCT cluster configurations with SCISS meshes and masks into an imported display.
+#include "facet/interop/sgct_cluster.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <fstream>
+#include <pugixml.hpp>
+#include <set>
+#include <sstream>
+
+#include "facet/projection/errors.hpp"
+#include "image_map.hpp"
+
+namespace facet::interop {
+namespace {
+
+std::string read_file(const std::filesystem::path& path, const std::string& source,
+                      const std::string& field) {
+  std::ifstream stream(path, std::ios::binary);
+  if (!stream) throw InputError(source, field, "cannot open \"" + path.string() + "\"");
+  std::ostringstream bytes;
+  bytes << stream.rdbuf();
+  return bytes.str();
+}
+
+double number_attribute(const pugi::xml_node& node, const char* name, double fallback,
+                        const std::string& source, const std::string& path) {
+  const pugi::xml_attribute attribute = node.attribute(name);
+  if (!attribute) return fallback;
+  const std::string text = attribute.value();
+  std::size_t used = 0;
+  double value = 0;
+  try {
+    value = std::stod(text, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  if (used == 0 || used != text.size() || !std::isfinite(value)) {
+    throw InputError(source, path + "@" + name,
+                     "expected a number, found \"" + text.substr(0, 40) + "\"");
+  }
+  return value;
+}
+
+// The first of `names` the element has, or "".
+std::string attribute_of(const pugi::xml_node& node, std::initializer_list<const char*> names) {
+  for (const char* name : names) {
+    if (const pugi::xml_attribute a = node.attribute(name)) return a.value();
+  }
+  return {};
+}
+
+// A path as written, else relative to the configuration's folder, else its file name there
+// (Windows separators included).
+std::filesystem::path resolve(const std::string& written, const std::filesystem::path& folder,
+                              const std::string& source, const std::string& field,
+                              std::vector<std::string>& notes) {
+  const std::filesystem::path as_written(written);
+  if (as_written.is_absolute() && std::filesystem::is_regular_file(as_written)) return as_written;
+  if (std::filesystem::is_regular_file(folder / as_written)) return folder / as_written;
+  const std::size_t slash = written.find_last_of("/\\");
+  const std::string name = slash == std::string::npos ? written : written.substr(slash + 1);
+  if (!name.empty() && std::filesystem::is_regular_file(folder / name)) {
+    notes.push_back(field + " \"" + written + "\" not found; took \"" + name +
+                    "\" next to the configuration");
+    return folder / name;
+  }
+  throw InputError(source, field,
+                   "expected an existing file; neither \"" + written + "\" nor \"" + name +
+                       "\" next to the configuration exists");
+}
+
+bool has_extension(const std::string& path, const std::string& extension) {
+  if (path.size() < extension.size()) return false;
+  std::string tail = path.substr(path.size() - extension.size());
+  std::transform(tail.begin(), tail.end(), tail.begin(),
+                 [](unsigned char c) { return char(std::tolower(c)); });
+  return tail == extension;
+}
+
+}  // namespace
+
+ImportedDisplay import_sgct_cluster(const std::filesystem::path& config,
+                                    const SgctImportOptions& options) {
+  const std::string source = config.string();
+  const std::string xml = read_file(config, source, "");
+  pugi::xml_document document;
+  const pugi::xml_parse_result parsed = document.load_buffer(xml.data(), xml.size());
+  if (!parsed) {
+    throw InputError(source, "",
+                     std::string("expected well-formed XML: ") + parsed.description() +
+                         " at byte " + std::to_string(parsed.offset));
+  }
+  const pugi::xml_node cluster = document.child("Cluster");
+  if (!cluster) throw InputError(source, "Cluster", "expected the root element <Cluster>");
+  const std::filesystem::path folder = config.parent_path();
+
+  ImportedDisplay display;
+  display.name = config.stem().string();
+  if (const pugi::xml_node user_pos = cluster.child("User").child("Pos")) {
+    for (int c = 0; c < 3; ++c) {
+      const char* axis[3] = {"x", "y", "z"};
+      display.eye[c] = number_attribute(user_pos, axis[c], 0, source, "User/Pos");
+    }
+  }
+  std::set<std::string> names;
+  int desktop_x = 0;
+  int node_index = 0;
+  for (const pugi::xml_node& node : cluster.children("Node")) {
+    const std::string node_path = "Node[" + std::to_string(node_index++) + "]";
+    int node_right = desktop_x;
+    int window_index = 0;
+    for (const pugi::xml_node& window : node.children("Window")) {
+      const std::string window_path = node_path + "/Window[" + std::to_string(window_index++) + "]";
+      const pugi::xml_node size_node = window.child("Size");
+      const double width = number_attribute(size_node, "x", 0, source, window_path + "/Size");
+      const double height = number_attribute(size_node, "y", 0, source, window_path + "/Size");
+      if (!(width >= 1 && height >= 1 && width <= 65536 && height <= 65536)) {
+        throw InputError(source, window_path + "/Size",
+                         "expected x and y, whole pixels in [1, 65536]");
+      }
+      const pugi::xml_node pos_node = window.child("Pos");
+      const glm::ivec2 window_pos{
+          int(number_attribute(pos_node, "x", 0, source, window_path + "/Pos")),
+          int(number_attribute(pos_node, "y", 0, source, window_path + "/Pos"))};
+      const glm::dvec2 window_size{std::floor(width), std::floor(height)};
+      int viewport_index = 0;
+      for (const pugi::xml_node& viewport : window.children("Viewport")) {
+        const std::string path =
+            window_path + "/Viewport[" + std::to_string(viewport_index++) + "]";
+        const std::string mesh_written = attribute_of(viewport, {"mesh", "correctionMesh"});
+        const std::string viewport_name = viewport.attribute("name").value();
+        if (mesh_written.empty()) {
+          display.notes.push_back(path + (viewport_name.empty() ? "" : " (" + viewport_name + ")") +
+                                  " has no correction mesh: not a projector, left out");
+          continue;
+        }
+        if (!has_extension(mesh_written, ".sgc")) {
+          throw InputError(source, path + "@mesh",
+                           "expected a SCISS .sgc mesh, found \"" + mesh_written +
+                               "\" (MPCDI and Paul Bourke meshes have their own import commands)");
+        }
+        glm::dvec2 fraction_pos{0.0}, fraction_size{1.0};
+        const pugi::xml_node vp_pos = viewport.child("Pos"), vp_size = viewport.child("Size");
+        fraction_pos = {number_attribute(vp_pos, "x", 0, source, path + "/Pos"),
+                        number_attribute(vp_pos, "y", 0, source, path + "/Pos")};
+        fraction_size = {number_attribute(vp_size, "x", 1, source, path + "/Size"),
+                         number_attribute(vp_size, "y", 1, source, path + "/Size")};
+        if (!(fraction_pos.x >= 0 && fraction_pos.y >= 0 && fraction_size.x > 0 &&
+              fraction_size.y > 0 && fraction_pos.x + fraction_size.x <= 1 + 1e-9 &&
+              fraction_pos.y + fraction_size.y <= 1 + 1e-9)) {
+          throw InputError(source, path + "/Pos",
+                           "expected the viewport's Pos and Size as fractions of the window "
+                           "within [0,1]");
+        }
+        const glm::ivec2 output_size =
+            glm::max(glm::ivec2(glm::round(fraction_size * window_size)), glm::ivec2(1));
+        const glm::ivec2 output_pos =
+            window_pos + glm::ivec2(glm::round(fraction_pos * window_size));
+
+        std::vector<std::string> notes;
+        const std::filesystem::path mesh_path =
+            resolve(mesh_written, folder, source, path + "@mesh", notes);
+        const std::string mesh_source = mesh_path.string();
+        const SgcMesh mesh = parse_sgc(read_file(mesh_path, mesh_source, ""), mesh_source);
+        SgcImportOptions import;
+        import.output_size = output_size;
+        import.warp_grid = options.warp_grid;
+        std::string name =
+            sanitize_name(viewport_name.empty() ? mesh_path.stem().string() : viewport_name);
+        for (std::string base = name; !names.insert(name).second;) {
+          name = base + "-" + std::to_string(names.size());
+        }
+        ImportedProjector projector = import_sgc(mesh, import, mesh_source, name).projector;
+        const std::string mask_written = attribute_of(viewport, {"mask", "blendMask"});
+        if (!mask_written.empty()) {
+          const std::filesystem::path mask_path =
+              resolve(mask_written, folder, source, path + "@mask", notes);
+          projection_io::BlendMap mask =
+              decode_image_map(read_file(mask_path, mask_path.string(), ""), mask_path.string(),
+                               options.mask_gamma, output_size, mask_path.string());
+          collapse_equal_channels(mask);
+          projector.blend = std::move(mask);
+        }
+        projector.output.kind = projection_io::DisplayOutput::Kind::window;
+        projector.output.window = {desktop_x + output_pos.x, output_pos.y, output_size.x,
+                                   output_size.y};
+        node_right = std::max(node_right, projector.output.window.x + output_size.x);
+        projector.notes.insert(projector.notes.begin(), notes.begin(), notes.end());
+        display.projectors.push_back(std::move(projector));
+      }
+    }
+    desktop_x = node_right;
+  }
+  if (display.projectors.empty()) {
+    throw InputError(source, "Node/Window/Viewport@mesh",
+                     "expected at least one viewport with a .sgc correction mesh");
+  }
+  if (node_index > 1) {
+    display.notes.push_back(
+        "the cluster's nodes are separate machines; their windows are placed "
+        "left to right on one desktop");
+  }
+  return display;
+}
+
+}  // namespace facet::interop

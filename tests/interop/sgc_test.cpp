@@ -1,0 +1,433 @@
+#include "facet/interop/sgc.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <random>
+#include <sstream>
+
+#include "facet/interop/mpcdi.hpp"
+#include "facet/interop/sgct_cluster.hpp"
+#include "facet/projection/errors.hpp"
+#include "test_util.hpp"
+
+namespace facet::interop {
+namespace {
+
+namespace fs = std::filesystem;
+const std::string kDome = std::string(FACET_SHARED_DATA_DIR) + "/warps/sgct-dome/";
+
+std::string read_bytes(const std::string& path) {
+  std::ifstream stream(path, std::ios::binary);
+  EXPECT_TRUE(stream.good()) << path;
+  std::ostringstream bytes;
+  bytes << stream.rdbuf();
+  return bytes.str();
+}
+
+// A point inside a random non-degenerate triangle of the mesh, in both spaces.
+struct MeshPoint {
+  glm::dvec2 st, q_norm;
+};
+std::vector<MeshPoint> random_mesh_points(const SgcMesh& mesh, int count, unsigned seed) {
+  std::mt19937 random(seed);
+  std::uniform_int_distribution<std::size_t> pick(0, mesh.triangles.size() - 1);
+  std::uniform_real_distribution<double> unit(0, 1);
+  std::vector<MeshPoint> points;
+  while (int(points.size()) < count) {
+    const glm::uvec3 t = mesh.triangles[pick(random)];
+    const SgcVertex &a = mesh.vertices[t.x], &b = mesh.vertices[t.y], &c = mesh.vertices[t.z];
+    const glm::dvec2 e1 = b.st - a.st, e2 = c.st - a.st;
+    if (std::abs(e1.x * e2.y - e1.y * e2.x) < 1e-12) continue;
+    double u = unit(random), v = unit(random);
+    if (u + v > 1) u = 1 - u, v = 1 - v;
+    const MeshPoint p{a.st + u * e1 + v * e2,
+                      a.q_norm + u * (b.q_norm - a.q_norm) + v * (c.q_norm - a.q_norm)};
+    if (p.st.x < 0 || p.st.y < 0 || p.st.x > 1 || p.st.y > 1) continue;
+    points.push_back(p);
+  }
+  return points;
+}
+
+// Worst and RMS distance, output px, between the warp and the mesh's piecewise-linear map.
+std::pair<double, double> follow_error_px(const SgcMesh& mesh, const Warp& warp, int count,
+                                          unsigned seed) {
+  double worst = 0, sum_sq = 0;
+  const std::vector<MeshPoint> points = random_mesh_points(mesh, count, seed);
+  for (const MeshPoint& p : points) {
+    const double e = glm::length(warp.q_from_st(p.st) - p.q_norm * glm::dvec2(warp.output_size));
+    worst = std::max(worst, e);
+    sum_sq += e * e;
+  }
+  return {worst, std::sqrt(sum_sq / double(points.size()))};
+}
+
+// A mesh over a 60°×45° frustum whose map bends smoothly by up to ~3% of the image.
+glm::dvec2 bent(glm::dvec2 st) {
+  return st + glm::dvec2(0.03 * std::sin(3 * st.y + 1) * st.x, 0.02 * std::cos(2.5 * st.x) * st.y);
+}
+SgcMesh synthetic_mesh(SgcGridSide side, glm::ivec2 nodes, unsigned seed = 7) {
+  SgcMesh mesh;
+  mesh.version = 2;
+  mesh.q_world_frustum = glm::angleAxis(glm::radians(20.0), glm::dvec3(0, 1, 0));
+  mesh.up_deg = 20, mesh.down_deg = -25, mesh.left_deg = -30, mesh.right_deg = 30;
+  std::mt19937 random(seed);
+  std::uniform_real_distribution<double> jitter(-0.3, 0.3);
+  for (int j = 0; j < nodes.y; ++j) {
+    for (int i = 0; i < nodes.x; ++i) {
+      glm::dvec2 g{double(i) / (nodes.x - 1), double(j) / (nodes.y - 1)};
+      const bool interior = i > 0 && j > 0 && i + 1 < nodes.x && j + 1 < nodes.y;
+      if (side == SgcGridSide::neither && interior) {
+        g += glm::dvec2(jitter(random) / (nodes.x - 1), jitter(random) / (nodes.y - 1));
+      }
+      SgcVertex v;
+      if (side == SgcGridSide::texture) {
+        v.st = g, v.q_norm = bent(g);
+      } else {
+        // The inverse: output position g shows the st that bent() sends there (3 fixed-point
+        // steps are exact to 1e-6 for this gentle map).
+        glm::dvec2 st = g;
+        for (int k = 0; k < 8; ++k) st += g - bent(st);
+        v.q_norm = g, v.st = st;
+      }
+      mesh.vertices.push_back(v);
+    }
+  }
+  for (int j = 0; j + 1 < nodes.y; ++j) {
+    for (int i = 0; i + 1 < nodes.x; ++i) {
+      const std::uint32_t k = std::uint32_t(j * nodes.x + i);
+      mesh.triangles.emplace_back(k, k + 1, k + nodes.x);
+      mesh.triangles.emplace_back(k + 1, k + nodes.x + 1, k + nodes.x);
+    }
+  }
+  return mesh;
+}
+
+TEST(Sgc, RealScissDomeChannelsImportAndFollowTheirMeshes) {
+  for (int channel = 1; channel <= 6; ++channel) {
+    const std::string path = kDome + "sciss/channel" + std::to_string(channel) + "_planar.sgc";
+    SCOPED_TRACE(path);
+    const SgcMesh mesh = parse_sgc(read_bytes(path), path);
+    EXPECT_EQ(mesh.version, 1);
+    EXPECT_EQ(mesh.vertices.size(), 91u * 91u);
+    if (channel == 1) {
+      // The header as written (degrees, signed edge angles).
+      EXPECT_NEAR(mesh.up_deg, 36.0706, 1e-3);
+      EXPECT_NEAR(mesh.down_deg, -32.1078, 1e-3);
+      EXPECT_NEAR(mesh.left_deg, -47.3247, 1e-3);
+      EXPECT_NEAR(mesh.right_deg, 47.5199, 1e-3);
+    }
+    SgcImportOptions options;
+    options.output_size = {1920, 1200};
+    const SgcImport imported = import_sgc(mesh, options, path, "channel");
+    EXPECT_EQ(imported.side, SgcGridSide::output);
+    EXPECT_NO_THROW(imported.projector.warp.validate(path));
+    // At the vertices and centroids the import checks itself against its bound; at random points
+    // inside the triangles (what SGCT draws), worst case and RMS, output px.
+    EXPECT_LE(imported.worst_follow_px, options.follow_bound_px);
+    const auto [worst, rms] = follow_error_px(mesh, imported.projector.warp, 20000, channel);
+    std::printf("channel %d: warp grid %d×%d, worst %.3f px, RMS %.4f px\n", channel,
+                imported.projector.warp.grid_size.x, imported.projector.warp.grid_size.y, worst,
+                rms);
+    EXPECT_LE(worst, 0.3);
+    EXPECT_LE(rms, 0.05);
+  }
+}
+
+// Seen from the eye, the six channels of the real dome must tile it: five around from one spring
+// line up, one cap, no gap. That holds only if the rotation, the frustum and both flips of the mesh
+// are read the way the dome's maker wrote them (a conjugated quaternion, both axes flipped, or the
+// roles of position and texture swapped each fail one of the checks below), so it checks the
+// conventions against the real installation rather than against our own reading. The masks are
+// compared with what they are, not with an ideal: where two have faded in, their sum (γ 2.2) has
+// median 1.43, so they do not add up to one; facet keeps them as written, as SGCT does.
+TEST(Sgc, RealScissDomeChannelsTileTheDomeSeenFromTheEye) {
+  const ImportedDisplay display = import_sgct_cluster(kDome + "sciss/dome_alpha.xml", {});
+  ASSERT_EQ(display.projectors.size(), 6u);
+  const auto covering = [&](const glm::dvec3& v_eye, std::vector<double>* alphas) {
+    int seen_by = 0;
+    for (const ImportedProjector& p : display.projectors) {
+      const auto st = p.warp.base.st_from_direction(glm::transpose(p.warp.R_eye_base) * v_eye);
+      double alpha = -1;
+      if (st && st->x >= 0 && st->y >= 0 && st->x <= 1 && st->y <= 1 &&
+          p.warp.coverage_at(*st) >= 0.5) {
+        const glm::dvec2 q = p.warp.q_from_st(*st);
+        if (q.x >= 0 && q.y >= 0 && q.x < p.warp.output_size.x && q.y < p.warp.output_size.y) {
+          alpha = p.blend->sample(q);
+          ++seen_by;
+        }
+      }
+      if (alphas) alphas->push_back(alpha);
+    }
+    return seen_by;
+  };
+  const auto direction = [](double azimuth_deg, double elevation_deg) {
+    const double a = glm::radians(azimuth_deg), e = glm::radians(elevation_deg);
+    return glm::dvec3(std::cos(e) * std::sin(a), std::sin(e), -std::cos(e) * std::cos(a));
+  };
+  // Each channel's lowest covered elevation, on a 0.25° × 0.05° lattice.
+  std::vector<double> lowest(6, 90.0);
+  for (double azimuth = -180; azimuth < 180; azimuth += 0.25) {
+    for (double elevation = -10; elevation < 30; elevation += 0.05) {
+      std::vector<double> alphas;
+      covering(direction(azimuth, elevation), &alphas);
+      for (int c = 0; c < 6; ++c) {
+        if (alphas[c] >= 0) lowest[c] = std::min(lowest[c], elevation);
+      }
+    }
+  }
+  std::printf("lowest covered elevation per channel, degrees: %.2f %.2f %.2f %.2f %.2f %.2f\n",
+              lowest[0], lowest[1], lowest[2], lowest[3], lowest[4], lowest[5]);
+  const double spring_lo = *std::min_element(lowest.begin(), lowest.begin() + 5);
+  const double spring_hi = *std::max_element(lowest.begin(), lowest.begin() + 5);
+  EXPECT_LE(spring_hi - spring_lo, 2.0);  // the five lower channels start at one spring line
+  EXPECT_EQ(lowest[5], 90.0);             // channel 6 is the cap: it lights nothing below 30°
+  // 2° above the spring line every direction is lit; where one channel lights alone its mask is
+  // bright; where two overlap, both masks have faded in (their sum is what the mask's maker made).
+  int samples = 0, holes = 0, overlaps = 0;
+  std::vector<double> alone, overlap_sums;
+  for (double elevation = spring_hi + 2; elevation < 90; elevation += 0.5) {
+    const double step = 0.5 / std::max(0.02, std::cos(glm::radians(elevation)));
+    for (double azimuth = -180; azimuth < 180; azimuth += step) {
+      std::vector<double> alphas;
+      const int seen_by = covering(direction(azimuth, elevation), &alphas);
+      ++samples;
+      if (seen_by == 0) ++holes;
+      double sum = 0;
+      int faded_in = 0;
+      for (double a : alphas) {
+        if (a > 0.01) sum += a, ++faded_in;
+      }
+      if (seen_by == 1) alone.push_back(sum);
+      if (seen_by >= 2) ++overlaps;
+      if (faded_in >= 2) overlap_sums.push_back(sum);
+    }
+  }
+  std::sort(alone.begin(), alone.end());
+  std::sort(overlap_sums.begin(), overlap_sums.end());
+  const auto at = [](const std::vector<double>& v, double p) {
+    return v[std::min(v.size() - 1, std::size_t(p * double(v.size())))];
+  };
+  std::printf(
+      "%d directions from 2° above the spring line: %d unlit, %.1f%% in overlaps; lone "
+      "channel's alpha p10 %.2f; where two masks are above 0.01 their sum (gamma 2.2) "
+      "p10 %.2f, median %.2f, p90 %.2f\n",
+      samples, holes, 100.0 * overlaps / samples, at(alone, 0.1), at(overlap_sums, 0.1),
+      at(overlap_sums, 0.5), at(overlap_sums, 0.9));
+  EXPECT_EQ(holes, 0);
+  EXPECT_GT(overlaps, samples / 5);
+  EXPECT_LT(overlaps, samples * 3 / 5);
+  EXPECT_GE(at(alone, 0.1), 0.75);
+}
+
+// The SimCAD exports of another dome hold the same warps as `.sgc` version 1 (`_u2`), version 2
+// (`_u3`) and the `_mesh.csv` table; the cluster file next to them gives each projector's
+// frustum orientation as heading and pitch.
+TEST(Sgc, SimcadMeshesAgreeWithTheirTableAndTheirClusterOrientation) {
+  // dome_bravo.xml's <Orientation heading pitch> of projectors 1 to 6, degrees.
+  const double heading[6] = {-45, 45, 135, -135, 57, -123}, pitch[6] = {0, 0, 0, 0, 48, 48};
+  for (int channel = 1; channel <= 6; ++channel) {
+    const std::string stem = kDome + "simcad/channel" + std::to_string(channel) + "_warp";
+    SCOPED_TRACE(stem);
+    const SgcMesh v1 = parse_sgc(read_bytes(stem + "_u2.sgc"), stem + "_u2.sgc");
+    const SgcMesh v2 = parse_sgc(read_bytes(stem + "_u3.sgc"), stem + "_u3.sgc");
+    EXPECT_EQ(v1.version, 1);
+    EXPECT_EQ(v2.version, 2);
+    ASSERT_EQ(v1.vertices.size(), 33u * 33u);
+    ASSERT_EQ(v2.vertices.size(), v1.vertices.size());
+    ASSERT_EQ(v2.triangles.size(), v1.triangles.size());
+    std::istringstream table(read_bytes(stem + "_mesh.csv"));
+    std::string line;
+    std::getline(table, line);  // x;y;u;v;column;row
+    double worst_q = 0, worst_st = 0;
+    for (std::size_t k = 0; k < v1.vertices.size(); ++k) {
+      ASSERT_TRUE(std::getline(table, line));
+      std::replace(line.begin(), line.end(), ';', ' ');
+      std::istringstream fields(line);
+      double x, y, u, v;
+      int column, row;
+      ASSERT_TRUE(fields >> x >> y >> u >> v >> column >> row);
+      EXPECT_EQ(v1.vertices[k].q_norm, v2.vertices[k].q_norm);
+      worst_q = std::max(worst_q, glm::length(v1.vertices[k].q_norm - glm::dvec2(x, y)));
+      worst_st = std::max(worst_st, glm::length(v1.vertices[k].st - glm::dvec2(u, v)));
+    }
+    // The table prints 6 decimals; the .sgc stores floats.
+    EXPECT_LE(worst_q, 2e-6);
+    EXPECT_LE(worst_st, 2e-6);
+    MpcdiFrustum orientation;
+    orientation.yaw_deg = heading[channel - 1];
+    orientation.pitch_deg = pitch[channel - 1];
+    const glm::dmat3 expected = R_eye_frustum(orientation), got = sgc_R_eye_frustum(v1);
+    for (int c = 0; c < 3; ++c) EXPECT_LE(glm::length(got[c] - expected[c]), 1e-5) << c;
+
+    SgcImportOptions options;
+    options.output_size = {2560, 1600};
+    const SgcImport imported = import_sgc(v2, options, stem + "_u3.sgc", "p");
+    EXPECT_EQ(imported.side, SgcGridSide::texture);
+    const auto [worst, rms] = follow_error_px(v2, imported.projector.warp, 20000, channel);
+    std::printf("channel %d: warp grid %d×%d, worst %.3f px, RMS %.4f px\n", channel,
+                imported.projector.warp.grid_size.x, imported.projector.warp.grid_size.y, worst,
+                rms);
+    EXPECT_LE(worst, 0.3);
+    EXPECT_LE(rms, 0.05);
+  }
+}
+
+TEST(Sgc, SyntheticMeshesAreFollowedWhicheverSideIsRegular) {
+  for (SgcGridSide side : {SgcGridSide::texture, SgcGridSide::output, SgcGridSide::neither}) {
+    SCOPED_TRACE(int(side));
+    const SgcMesh mesh = synthetic_mesh(side, {25, 19});
+    const SgcMesh read = parse_sgc(format_sgc(mesh), "synthetic.sgc");
+    SgcImportOptions options;
+    options.output_size = {800, 600};
+    const SgcImport imported = import_sgc(read, options, "synthetic.sgc", "p");
+    EXPECT_EQ(imported.side, side);
+    const auto [worst, rms] = follow_error_px(read, imported.projector.warp, 20000, 3);
+    std::printf("side %d: warp grid %d×%d, worst %.3f px, RMS %.4f px\n", int(side),
+                imported.projector.warp.grid_size.x, imported.projector.warp.grid_size.y, worst,
+                rms);
+    EXPECT_LE(worst, 0.3);
+    EXPECT_LE(rms, 0.05);
+    // The frustum: its centre direction turned 20° left about y.
+    const glm::dvec3 axis = imported.projector.warp.R_eye_base * glm::dvec3(0, 0, -1);
+    EXPECT_NEAR(axis.x, -std::sin(glm::radians(20.0)), 1e-6);  // stored as floats
+  }
+}
+
+TEST(Sgc, FormatThenParseGivesTheMeshBack) {
+  const SgcMesh mesh = synthetic_mesh(SgcGridSide::neither, {5, 4});
+  const SgcMesh read = parse_sgc(format_sgc(mesh), "m.sgc");
+  ASSERT_EQ(read.vertices.size(), mesh.vertices.size());
+  ASSERT_EQ(read.triangles, mesh.triangles);
+  for (std::size_t k = 0; k < mesh.vertices.size(); ++k) {
+    EXPECT_LE(glm::length(read.vertices[k].q_norm - mesh.vertices[k].q_norm), 1e-7);
+    EXPECT_LE(glm::length(read.vertices[k].st - mesh.vertices[k].st), 1e-7);
+  }
+  EXPECT_NEAR(read.up_deg, 20, 1e-5);
+  EXPECT_NEAR(read.down_deg, -25, 1e-5);
+  EXPECT_NEAR(glm::angle(read.q_world_frustum), glm::radians(20.0), 1e-6);
+}
+
+TEST(Sgc, BadFilesNameTheField) {
+  const std::string good = format_sgc(synthetic_mesh(SgcGridSide::texture, {4, 3}));
+  const auto with = [&](std::size_t offset, auto value) {
+    std::string bytes = good;
+    std::memcpy(bytes.data() + offset, &value, sizeof value);
+    return bytes;
+  };
+  // Offsets: magic 0, version 3, type 4, view floats 8..51, size 52 and 56, vertices from 60.
+  const std::size_t indices_at = 60 + 12 * 24;
+  const struct {
+    std::string bytes, field;
+  } cases[] = {
+      {"", "magic"},
+      {"SGX" + good.substr(3), "magic"},
+      {with(3, std::uint8_t(3)), "version"},
+      {with(4, std::uint32_t(1)), "mapping type"},
+      {with(8, std::numeric_limits<float>::quiet_NaN()), "quaternion x"},
+      {with(8, 0.0f).replace(20, 4, std::string(4, '\0')), "quaternion"},
+      {with(36, 95.0f), "fov up"},
+      {with(40, 30.0f), "fov down"},
+      {with(56, std::uint32_t(1u << 30)), "vertex count"},
+      {with(60, std::numeric_limits<float>::infinity()), "vertex 0"},
+      {good.substr(0, 100), "vertices"},
+      {good.substr(0, indices_at + 2), "index count"},
+      {good + "x", "index count"},
+      {with(indices_at + 4, std::uint32_t(12)), "indices"},
+      {with(indices_at, std::uint32_t(7)).substr(0, indices_at + 4 + 28), "index count"},
+  };
+  for (const auto& c : cases) {
+    try {
+      parse_sgc(c.bytes, "bad.sgc");
+      ADD_FAILURE() << "no error for field " << c.field;
+    } catch (const InputError& e) {
+      EXPECT_EQ(e.source(), "bad.sgc");
+      EXPECT_EQ(e.field(), c.field) << e.what();
+    }
+  }
+}
+
+TEST(Sgc, AFoldedMeshIsRefusedNamingTheTriangle) {
+  SgcMesh mesh = synthetic_mesh(SgcGridSide::texture, {6, 5});
+  // An interior vertex pushed past its neighbours in the output turns its triangles over.
+  mesh.vertices[2 * 6 + 2].q_norm.x += 0.5;
+  try {
+    import_sgc(mesh, {}, "folded.sgc", "p");
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.field(), "mesh");
+    EXPECT_NE(std::string(e.what()).find("turned over"), std::string::npos) << e.what();
+  }
+}
+
+TEST(SgctCluster, TheRealDomeConfigurationImportsEveryChannelWithItsMask) {
+  const ImportedDisplay display = import_sgct_cluster(kDome + "sciss/dome_alpha.xml", {});
+  ASSERT_EQ(display.projectors.size(), 6u);
+  for (int k = 0; k < 6; ++k) {
+    const ImportedProjector& p = display.projectors[k];
+    EXPECT_EQ(p.name, "Channel_" + std::to_string(k + 1));
+    EXPECT_EQ(p.warp.output_size, glm::ivec2(1920, 1200));
+    EXPECT_EQ(p.output.window, glm::ivec4(1920 * k, 0, 1920, 1200));
+    ASSERT_TRUE(p.blend);
+    EXPECT_EQ(p.blend->channels, 1);  // the masks are grey stored as RGB
+    EXPECT_NO_THROW(p.blend->validate());
+    // The configuration names the meshes by another machine's paths: found next to it.
+    ASSERT_FALSE(p.notes.empty());
+    EXPECT_NE(p.notes[0].find("not found; took \"channel"), std::string::npos) << p.notes[0];
+  }
+  // The master's GUI viewport has no mesh.
+  ASSERT_FALSE(display.notes.empty());
+  EXPECT_NE(display.notes[0].find("no correction mesh"), std::string::npos) << display.notes[0];
+}
+
+TEST(SgctCluster, BadConfigurationsNameTheElement) {
+  test::ScratchFolder scratch("sgct-bad");
+  fs::copy_file(kDome + "sciss/channel1_planar.sgc", scratch.path / "c1.sgc");
+  const auto cluster = [](const std::string& window) {
+    return "<Cluster><Node><Window>" + window + "</Window></Node></Cluster>";
+  };
+  const struct {
+    std::string xml, field;
+  } cases[] = {
+      {"<Cluster><Node>", ""},
+      {"<Config/>", "Cluster"},
+      {cluster("<Size x=\"0\" y=\"10\"/><Viewport mesh=\"c1.sgc\"/>"), "Node[0]/Window[0]/Size"},
+      {cluster("<Size x=\"640\" y=\"wide\"/><Viewport mesh=\"c1.sgc\"/>"),
+       "Node[0]/Window[0]/Size@y"},
+      {cluster("<Size x=\"640\" y=\"400\"/><Viewport mesh=\"c1.simcad\"/>"),
+       "Node[0]/Window[0]/Viewport[0]@mesh"},
+      {cluster("<Size x=\"640\" y=\"400\"/><Viewport mesh=\"D:/x/missing.sgc\"/>"),
+       "Node[0]/Window[0]/Viewport[0]@mesh"},
+      {cluster("<Size x=\"640\" y=\"400\"/><Viewport mesh=\"c1.sgc\" mask=\"none.png\"/>"),
+       "Node[0]/Window[0]/Viewport[0]@mask"},
+      {cluster("<Size x=\"640\" y=\"400\"/><Viewport mesh=\"c1.sgc\"><Pos x=\"0.5\" "
+               "y=\"0\"/><Size x=\"0.6\" y=\"1\"/></Viewport>"),
+       "Node[0]/Window[0]/Viewport[0]/Pos"},
+      {cluster("<Size x=\"640\" y=\"400\"/><Viewport/>"), "Node/Window/Viewport@mesh"},
+  };
+  for (const auto& c : cases) {
+    const fs::path path = scratch.path / "cluster.xml";
+    std::ofstream(path) << c.xml;
+    try {
+      import_sgct_cluster(path, {});
+      ADD_FAILURE() << "no error for " << c.xml;
+    } catch (const InputError& e) {
+      EXPECT_EQ(e.source(), path.string());
+      EXPECT_EQ(e.field(), c.field) << e.what();
+    }
+  }
+  // A viewport's part of its window: the output is that part, at its place.
+  std::ofstream(scratch.path / "cluster.xml") << cluster(
+      "<Pos x=\"100\" y=\"0\"/><Size x=\"1280\" y=\"400\"/><Viewport mesh=\"c1.sgc\">"
+      "<Pos x=\"0.5\" y=\"0\"/><Size x=\"0.5\" y=\"1\"/></Viewport>");
+  const ImportedDisplay display = import_sgct_cluster(scratch.path / "cluster.xml", {});
+  ASSERT_EQ(display.projectors.size(), 1u);
+  EXPECT_EQ(display.projectors[0].output.window, glm::ivec4(740, 0, 640, 400));
+  EXPECT_EQ(display.projectors[0].warp.output_size, glm::ivec2(640, 400));
+}
+
+}  // namespace
+}  // namespace facet::interop

@@ -1,0 +1,117 @@
+// facet sgct: SGCT cluster configurations with SCISS .sgc meshes, or bare .sgc meshes, into a
+// display folder.
+#include <fstream>
+#include <iostream>
+#include <sstream>
+
+#include "command.hpp"
+#include "display_flags.hpp"
+#include "facet/interop/sgct_cluster.hpp"
+#include "facet/projection/errors.hpp"
+
+namespace facet::cli {
+namespace {
+
+bool ends_with_sgc(const std::string& path) {
+  if (path.size() < 4) return false;
+  std::string tail = path.substr(path.size() - 4);
+  for (char& c : tail) c = char(std::tolower(static_cast<unsigned char>(c)));
+  return tail == ".sgc";
+}
+
+const Registration registration{
+    61, [](CLI::App& app) {
+      auto* command = app.add_subcommand(
+          "sgct", "Import SGCT cluster configurations with SCISS .sgc meshes and masks");
+      command->require_subcommand(1);
+      struct Options {
+        std::vector<std::string> files;
+        std::string out, size = "1920x1200", grid;
+        double gamma = 2.2;
+      };
+      auto options = std::make_shared<Options>();
+      auto* import_command = command->add_subcommand(
+          "import",
+          "Read CLUSTER.xml (every viewport with a .sgc mesh and its mask) or bare .sgc meshes "
+          "into DIR/display.json");
+      import_command->add_option("files", options->files, "CLUSTER.xml, or one or more .sgc files")
+          ->required();
+      import_command->add_option("--out", options->out, "The folder to create")->required();
+      import_command->add_option(
+          "--size", options->size,
+          "Projector resolution WxH of bare .sgc meshes (default 1920x1200; a cluster "
+          "configuration gives its own)");
+      import_command->add_option(
+          "--grid", options->grid,
+          "Node count GXxGY of every warp (default: the mesh's, doubled up to 1025 per side "
+          "until it is followed within 0.25 px)");
+      import_command->add_option("--mask-gamma", options->gamma,
+                                 "Linear blend = mask^gamma (default 2.2)");
+      import_command->callback([options] {
+        if (!(options->gamma > 0 && options->gamma <= 10)) {
+          throw InputError("--mask-gamma", "", "expected a gamma in (0, 10]");
+        }
+        glm::ivec2 grid{0, 0};
+        if (!options->grid.empty()) {
+          grid = parse_size(options->grid, "--grid");
+          if (grid.x < 2 || grid.y < 2 || grid.x > 4096 || grid.y > 4096) {
+            throw InputError("--grid", "", "expected GXxGY with each count in [2, 4096]");
+          }
+        }
+        const bool meshes = ends_with_sgc(options->files.front());
+        if (!meshes && options->files.size() != 1) {
+          throw InputError(options->files[1], "",
+                           "expected either one cluster configuration or .sgc meshes only");
+        }
+        interop::ImportedDisplay display;
+        if (meshes) {
+          const glm::ivec2 size = parse_size(options->size, "--size");
+          display.name = std::filesystem::path(options->files.front()).stem().string();
+          int x = 0;
+          for (const std::string& file : options->files) {
+            if (!ends_with_sgc(file)) {
+              throw InputError(file, "", "expected a .sgc mesh like the other files");
+            }
+            std::ifstream stream(file, std::ios::binary);
+            if (!stream) throw InputError(file, "", "cannot open the file");
+            std::ostringstream bytes;
+            bytes << stream.rdbuf();
+            interop::SgcImportOptions import;
+            import.output_size = size;
+            import.warp_grid = grid;
+            interop::ImportedProjector projector =
+                interop::import_sgc(
+                    interop::parse_sgc(bytes.str(), file), import, file,
+                    interop::sanitize_name(std::filesystem::path(file).stem().string()))
+                    .projector;
+            for (const auto& other : display.projectors) {
+              if (other.name == projector.name) {
+                throw InputError(
+                    file, "",
+                    "expected file names that differ: two are \"" + projector.name + "\"");
+              }
+            }
+            projector.output.window = {x, 0, size.x, size.y};
+            x += size.x;
+            display.projectors.push_back(std::move(projector));
+          }
+        } else {
+          interop::SgctImportOptions import;
+          import.mask_gamma = options->gamma;
+          import.warp_grid = grid;
+          display = interop::import_sgct_cluster(options->files.front(), import);
+        }
+        for (const std::string& note : display.notes) std::cerr << "facet: note: " << note << "\n";
+        for (const auto& projector : display.projectors) {
+          for (const std::string& note : projector.notes) {
+            std::cerr << "facet: note: " << projector.name << ": " << note << "\n";
+          }
+        }
+        interop::write_display_folder(display, options->out);
+        std::cout << "wrote " << options->out << "/display.json (" << display.projectors.size()
+                  << " projectors)\n";
+      });
+    }};
+
+}  // namespace
+}  // namespace facet::cli
