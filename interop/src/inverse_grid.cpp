@@ -209,6 +209,16 @@ Warp warp_from_inverse_grid(const InverseGrid& grid, const BaseProjection& base,
     }
   }
   const std::vector<bool> valid = fill_missing(st, padded, source);
+  FACET_ASSERT(grid.shown.empty() || grid.shown.size() == grid.st.size());
+  std::vector<bool> shown = valid;
+  if (!grid.shown.empty()) {
+    for (int j = 0; j < grid.grid_size.y; ++j) {
+      for (int i = 0; i < grid.grid_size.x; ++i) {
+        const std::size_t k = std::size_t(j + pad.y) * padded.x + i + pad.x;
+        shown[k] = shown[k] && grid.shown[std::size_t(j) * grid.grid_size.x + i];
+      }
+    }
+  }
   Warp auxiliary;
   auxiliary.output_size = {kAuxiliaryScale, kAuxiliaryScale};
   auxiliary.grid_size = padded;
@@ -233,13 +243,14 @@ Warp warp_from_inverse_grid(const InverseGrid& grid, const BaseProjection& base,
   const WarpInverse anywhere(auxiliary);
   for (std::size_t k = 0; k < st.size(); ++k) auxiliary.coverage[k] = valid[k] ? 1.0f : 0.0f;
   const WarpInverse inside(std::move(auxiliary));
-  // Bilinear mask of the nodes that were valid, at a normalised output position.
-  const auto valid_at = [&](glm::dvec2 output) {
+  // Bilinear mask of the nodes that were valid and show something, at a normalised output
+  // position.
+  const auto shown_at = [&](glm::dvec2 output) {
     const glm::dvec2 g = output * cells_in_grid + glm::dvec2(pad);
     const int i = std::clamp(int(std::floor(g.x)), 0, padded.x - 2);
     const int j = std::clamp(int(std::floor(g.y)), 0, padded.y - 2);
     const double fx = g.x - i, fy = g.y - j;
-    const auto v = [&](int a, int b) { return valid[std::size_t(b) * padded.x + a] ? 1.0 : 0.0; };
+    const auto v = [&](int a, int b) { return shown[std::size_t(b) * padded.x + a] ? 1.0 : 0.0; };
     return (v(i, j) * (1 - fx) + v(i + 1, j) * fx) * (1 - fy) +
            (v(i, j + 1) * (1 - fx) + v(i + 1, j + 1) * fx) * fy;
   };
@@ -305,7 +316,7 @@ Warp warp_from_inverse_grid(const InverseGrid& grid, const BaseProjection& base,
         reach = glm::max(reach, glm::abs(output_of(i1, j1) - output));
       }
       covered[k] = glm::all(glm::lessThanEqual(glm::abs(output - nearest), reach)) &&
-                   valid_at(nearest) >= 0.5;
+                   shown_at(nearest) >= 0.5;
     }
   }
 
@@ -319,26 +330,61 @@ Warp warp_from_inverse_grid(const InverseGrid& grid, const BaseProjection& base,
   return warp;
 }
 
-InverseGrid inverse_grid_from_warp(
-    const Warp& warp, glm::ivec2 grid_size,
-    const std::function<std::optional<glm::dvec2>(const glm::dvec3& v_eye)>& st_of_direction) {
-  FACET_ASSERT(grid_size.x >= 2 && grid_size.y >= 2);
+NodeDirections node_directions(const Warp& warp, glm::ivec2 grid_size, int continued_rings) {
+  FACET_ASSERT(grid_size.x >= 2 && grid_size.y >= 2 && continued_rings >= 0);
   const WarpInverse inverse(warp);
-  InverseGrid grid;
-  grid.grid_size = grid_size;
-  grid.st.assign(std::size_t(grid_size.x) * grid_size.y,
-                 glm::dvec2(std::numeric_limits<double>::quiet_NaN()));
+  const auto q_of = [&](int i, int j) {
+    return glm::dvec2(double(i) / (grid_size.x - 1) * warp.output_size.x,
+                      double(j) / (grid_size.y - 1) * warp.output_size.y);
+  };
+  NodeDirections nodes;
+  nodes.v_eye.resize(std::size_t(grid_size.x) * grid_size.y);
+  nodes.shown.assign(nodes.v_eye.size(), false);
   for (int j = 0; j < grid_size.y; ++j) {
     for (int i = 0; i < grid_size.x; ++i) {
-      const glm::dvec2 q{double(i) / (grid_size.x - 1) * warp.output_size.x,
-                         double(j) / (grid_size.y - 1) * warp.output_size.y};
-      if (auto inverted = inverse.invert(q)) {
-        if (auto st = st_of_direction(inverted->v_eye)) {
-          grid.st[std::size_t(j) * grid_size.x + i] = *st;
-        }
+      const std::size_t k = std::size_t(j) * grid_size.x + i;
+      if (auto inverted = inverse.invert(q_of(i, j))) {
+        nodes.v_eye[k] = inverted->v_eye;
+        nodes.shown[k] = true;
       }
     }
   }
+  if (continued_rings == 0) return nodes;
+  Warp continued = warp;
+  continued.coverage.assign(continued.coverage.size(), 1.0f);
+  const WarpInverse continued_inverse(std::move(continued));
+  for (int j = 0; j < grid_size.y; ++j) {
+    for (int i = 0; i < grid_size.x; ++i) {
+      const std::size_t k = std::size_t(j) * grid_size.x + i;
+      if (nodes.shown[k]) continue;
+      bool near_shown = false;
+      for (int dj = -continued_rings; dj <= continued_rings && !near_shown; ++dj) {
+        for (int di = -continued_rings; di <= continued_rings && !near_shown; ++di) {
+          const int i1 = i + di, j1 = j + dj;
+          near_shown = i1 >= 0 && j1 >= 0 && i1 < grid_size.x && j1 < grid_size.y &&
+                       nodes.shown[std::size_t(j1) * grid_size.x + i1];
+        }
+      }
+      if (!near_shown) continue;
+      if (auto inverted = continued_inverse.invert(q_of(i, j))) nodes.v_eye[k] = inverted->v_eye;
+    }
+  }
+  return nodes;
+}
+
+InverseGrid inverse_grid_from_warp(
+    const Warp& warp, glm::ivec2 grid_size,
+    const std::function<std::optional<glm::dvec2>(const glm::dvec3& v_eye)>& st_of_direction,
+    int continued_rings) {
+  const NodeDirections nodes = node_directions(warp, grid_size, continued_rings);
+  InverseGrid grid;
+  grid.grid_size = grid_size;
+  grid.st.assign(nodes.v_eye.size(), glm::dvec2(std::numeric_limits<double>::quiet_NaN()));
+  for (std::size_t k = 0; k < nodes.v_eye.size(); ++k) {
+    if (!nodes.v_eye[k]) continue;
+    if (auto st = st_of_direction(*nodes.v_eye[k])) grid.st[k] = *st;
+  }
+  if (continued_rings > 0) grid.shown = nodes.shown;
   return grid;
 }
 

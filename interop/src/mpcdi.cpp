@@ -63,8 +63,25 @@ double orientation_score(const std::vector<glm::dvec2>& positions, glm::ivec2 si
   return complete ? double(good) / complete : 0.0;
 }
 
+// facet's export continues each warp one PFM node past its coverage (node_directions) and lists
+// those nodes in facet.json, so that the import can pin the forward cells across the coverage's
+// edge without taking them as shown. Empty when the hint has no valid list.
+constexpr int kContinuedRings = 1;
+std::vector<bool> shown_from_hint(const nlohmann::json* hint, glm::ivec2 size) {
+  if (!hint || !hint->contains("continued_nodes") || !(*hint)["continued_nodes"].is_array()) {
+    return {};
+  }
+  std::vector<bool> shown(std::size_t(size.x) * size.y, true);
+  for (const nlohmann::json& k : (*hint)["continued_nodes"]) {
+    if (!k.is_number_unsigned() || k.get<std::uint64_t>() >= shown.size()) return {};
+    shown[k.get<std::size_t>()] = false;
+  }
+  return shown;
+}
+
 struct RegionWarpInput {
   const PfmImage* pfm;
+  std::vector<bool> shown;  // InverseGrid::shown
   BaseProjection base;
   glm::dmat3 R{1.0};
   glm::ivec2 output_size;
@@ -109,6 +126,7 @@ Warp region_warp(const RegionWarpInput& in, MpcdiWarpValues values, const std::s
     InverseGrid grid;
     grid.grid_size = size;
     grid.st = std::move(absolute);
+    grid.shown = in.shown;
     return warp_from_inverse_grid(grid, in.base, in.R, in.output_size, in.warp_grid, source);
   }
   // Offset form: the PFM grid is already a forward map over the base image.
@@ -264,6 +282,7 @@ Warp region_warp_a3(const PfmImage& pfm, glm::dvec3 eye_file, glm::ivec2 output_
   const glm::dmat3 R_base_eye = glm::transpose(cover->R_eye_base);
   InverseGrid grid;
   grid.grid_size = size;
+  grid.shown = shown_from_hint(hint, size);
   grid.st.assign(v_eye.size(), glm::dvec2(std::numeric_limits<double>::quiet_NaN()));
   for (int j = 0; j < size.y; ++j) {
     // Wrapping bases pick the branch next to the row's previous node, so that rows stay
@@ -456,6 +475,7 @@ ImportedDisplay import_mpcdi(const MpcdiFiles& files, const std::string& source,
         (*hint)["warp_values"] == "absolute") {
       values = MpcdiWarpValues::absolute;
     }
+    in.shown = shown_from_hint(hint, {pfm.width, pfm.height});
     ImportedProjector projector;
     projector.name = sanitize_name(region.id);
     if (document.profile == MpcdiProfile::advanced_3d) {
@@ -519,27 +539,25 @@ MpcdiFiles export_mpcdi(const projection_io::DisplayConfig& display,
     pfm.channels = 3;
     nlohmann::json& hint = hints["regions"][projector.name];
     hint = {{"warp_grid", {warp.grid_size.x, warp.grid_size.y}}, {"pfm_nodes", {nodes.x, nodes.y}}};
+    std::vector<std::size_t> continued;  // PFM nodes past the coverage, row-major
     if (a3) {
       region.unit = MpcdiUnit::m;
       region.origin = MpcdiOrigin::ideal_eye_point;
-      const WarpInverse inverse(warp);
+      const NodeDirections directions = node_directions(warp, nodes, kContinuedRings);
       const glm::dmat3 R_file_eye = glm::transpose(R_eye_mpcdi3d());
       const float nan = std::numeric_limits<float>::quiet_NaN();
-      for (int j = 0; j < nodes.y; ++j) {
-        for (int i = 0; i < nodes.x; ++i) {
-          const glm::dvec2 q{double(i) / (nodes.x - 1) * warp.output_size.x,
-                             double(j) / (nodes.y - 1) * warp.output_size.y};
-          std::optional<glm::dvec3> p_eye;
-          if (auto inverted = inverse.invert(q)) {
-            if (!display.screen) {
-              p_eye = inverted->v_eye;
-            } else if (auto hit = screen_hit(*display.screen, display.eye, inverted->v_eye)) {
-              p_eye = *hit - display.eye;
-            }
+      for (std::size_t k = 0; k < directions.v_eye.size(); ++k) {
+        std::optional<glm::dvec3> p_eye;
+        if (const auto& v_eye = directions.v_eye[k]) {
+          if (!display.screen) {
+            p_eye = *v_eye;
+          } else if (auto hit = screen_hit(*display.screen, display.eye, *v_eye)) {
+            p_eye = *hit - display.eye;
           }
-          const glm::dvec3 p = p_eye ? R_file_eye * *p_eye : glm::dvec3(nan);
-          pfm.values.insert(pfm.values.end(), {float(p.x), float(p.y), float(p.z)});
         }
+        const glm::dvec3 p = p_eye ? R_file_eye * *p_eye : glm::dvec3(nan);
+        pfm.values.insert(pfm.values.end(), {float(p.x), float(p.y), float(p.z)});
+        if (p_eye && !directions.shown[k]) continued.push_back(k);
       }
       hint["base"] = base_hint(warp.base, warp.R_eye_base);
     }
@@ -578,16 +596,20 @@ MpcdiFiles export_mpcdi(const projection_io::DisplayConfig& display,
       region.frustum = frustum;
       const BaseProjection base = frustum_base(frustum);
       const glm::dmat3 R_frustum_eye = glm::transpose(R_eye_frustum(frustum));
-      const InverseGrid grid = inverse_grid_from_warp(warp, nodes, [&](const glm::dvec3& v_eye) {
-        return base.st_from_direction(R_frustum_eye * v_eye);
-      });
-      for (const glm::dvec2& st : grid.st) {
+      const InverseGrid grid = inverse_grid_from_warp(
+          warp, nodes,
+          [&](const glm::dvec3& v_eye) { return base.st_from_direction(R_frustum_eye * v_eye); },
+          kContinuedRings);
+      for (std::size_t k = 0; k < grid.st.size(); ++k) {
+        const glm::dvec2 st = grid.st[k];
         pfm.values.push_back(float(st.x));
         pfm.values.push_back(float(st.y));
         pfm.values.push_back(std::isfinite(st.x) ? 0.0f : std::numeric_limits<float>::quiet_NaN());
+        if (std::isfinite(st.x) && !grid.shown[k]) continued.push_back(k);
       }
       hint["warp_values"] = "absolute";
     }
+    hint["continued_nodes"] = continued;
     region.warp_path = projector.name + ".pfm";
     files[region.warp_path] = format_pfm(pfm);
     if (projector.blend) {

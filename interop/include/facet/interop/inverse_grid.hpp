@@ -20,6 +20,10 @@ namespace facet::interop {
 struct InverseGrid {
   glm::ivec2 grid_size{0, 0};  // Gw, Gh, each >= 2
   std::vector<glm::dvec2> st;  // row-major, j·Gw + i
+  // Empty, or a flag per node: false marks a node that continues the map a little past what the
+  // output shows (facet's own export writes such nodes next to the coverage's edge, so that the
+  // forward cells across that edge are pinned): its value is trusted, but it shows nothing.
+  std::vector<bool> shown;
 };
 
 // Replaces every NaN node of a row-major grid by extrapolating from its valid neighbours, front
@@ -40,11 +44,23 @@ Warp warp_from_inverse_grid(const InverseGrid& grid, const BaseProjection& base,
                             const glm::dmat3& R_eye_base, glm::ivec2 output_size,
                             glm::ivec2 warp_grid, const std::string& source);
 
-// Samples a forward warp into an inverse grid of `grid_size` nodes: each node's output position
-// is inverted exactly (WarpInverse) to an eye direction, which `st_of_direction` turns into the
-// position in the target image (nullopt: NaN). Nodes the warp does not cover are NaN.
+// The eye direction at each node of a grid of `grid_size` nodes over the warp's output, by exact
+// inversion (WarpInverse); nullopt where the warp covers nothing. With `continued_rings` > 0, a
+// node the warp does not cover but that lies within that many nodes (in both directions) of one
+// it covers gets the direction of the warp's map continued past its coverage, the offsets being
+// defined there too, and shown = false; nullopt where even that map does not reach.
+struct NodeDirections {
+  std::vector<std::optional<glm::dvec3>> v_eye;  // row-major, j·Gw + i
+  std::vector<bool> shown;
+};
+NodeDirections node_directions(const Warp& warp, glm::ivec2 grid_size, int continued_rings = 0);
+
+// Samples a forward warp into an inverse grid of `grid_size` nodes: node_directions, each turned
+// by `st_of_direction` into the position in the target image (nullopt: NaN). With
+// `continued_rings` > 0 the grid's `shown` flags mark the continued nodes.
 InverseGrid inverse_grid_from_warp(
     const Warp& warp, glm::ivec2 grid_size,
-    const std::function<std::optional<glm::dvec2>(const glm::dvec3& v_eye)>& st_of_direction);
+    const std::function<std::optional<glm::dvec2>(const glm::dvec3& v_eye)>& st_of_direction,
+    int continued_rings = 0);
 
 }  // namespace facet::interop
