@@ -137,6 +137,35 @@ TEST(RunCli, AnImportedSphericalMirrorMeshRendersAtItsDefaultTolerance) {
   EXPECT_GT(lit, png.pixels.size() / std::size_t(png.channels) / 2);
 }
 
+TEST(RunCli, AnImportedMpcdiFileOfAnotherToolRenders) {
+  // SGCT's real MPCDI 3d container: one 512×540 region whose frustum looks up and to the left.
+  const fs::path folder = fresh_folder("mpcdi");
+  ASSERT_EQ(
+      run("mpcdi import " + std::string(FACET_SHARED_DATA_DIR) +
+              "/warps/sgct-mpcdi/correction_mesh.mpcdi --out " + (folder / "display").string(),
+          folder / "import.log"),
+      0)
+      << slurp(folder / "import.log");
+  ASSERT_EQ(run("run " + (folder / "display" / "display.json").string() +
+                    " --headless --frames 1 --scale 0.5 --out " + (folder / "frames").string(),
+                folder / "run.log"),
+            0)
+      << slurp(folder / "run.log");
+  const fs::path frames = folder / "frames";
+  fs::path frame;
+  for (const auto& entry : fs::directory_iterator(frames)) {
+    if (entry.is_directory()) frame = entry.path() / "00000.png";
+  }
+  ASSERT_TRUE(fs::exists(frame)) << slurp(folder / "run.log");
+  const Png png = read_png(frame);
+  EXPECT_EQ(png.width, 256);
+  EXPECT_EQ(png.height, 270);
+  std::size_t lit = 0;
+  for (std::size_t i = 0; i < png.pixels.size(); i += std::size_t(png.channels))
+    lit += png.pixels[i] > 0 || png.pixels[i + 1] > 0 || png.pixels[i + 2] > 0;
+  EXPECT_GT(lit, png.pixels.size() / std::size_t(png.channels) / 10);
+}
+
 TEST(RunCli, AnImportedScissDomeRendersEveryChannel) {
   // The real six-channel SGCT dome configuration, with its windows made 240×150 so that the test
   // stays quick: the meshes are normalised, the masks are resampled to the output.
