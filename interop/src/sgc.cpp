@@ -8,6 +8,8 @@
 #include <limits>
 #include <map>
 #include <optional>
+#include <pugixml.hpp>
+#include <sstream>
 
 #include "facet/interop/inverse_grid.hpp"
 #include "facet/projection/errors.hpp"
@@ -378,6 +380,80 @@ SgcMesh parse_sgc(std::string_view bytes, const std::string& source) {
   return mesh;
 }
 
+SgcMesh parse_simcad(std::string_view xml, const SgcMesh& frustum, const std::string& source) {
+  pugi::xml_document document;
+  const pugi::xml_parse_result parsed = document.load_buffer(xml.data(), xml.size());
+  if (!parsed) {
+    throw InputError(source, "",
+                     std::string("expected well-formed XML: ") + parsed.description() +
+                         " at byte " + std::to_string(parsed.offset));
+  }
+  const pugi::xml_node definition = document.child("GeometryFile").child("GeometryDefinition");
+  if (!definition) {
+    throw InputError(source, "GeometryFile/GeometryDefinition", "expected this element");
+  }
+  struct Axis {
+    double range = 0;
+    std::vector<double> values;
+  };
+  const auto read_axis = [&](const char* name) {
+    const std::string field = std::string("GeometryFile/GeometryDefinition/") + name;
+    const pugi::xml_node node = definition.child(name);
+    if (!node) throw InputError(source, field, "expected this element");
+    Axis axis;
+    axis.range = node.attribute("range").as_double(0);
+    if (!(axis.range > 0 && std::isfinite(axis.range))) {
+      throw InputError(source, field + "@range", "expected a positive number of pixels");
+    }
+    std::istringstream numbers(node.text().get());
+    std::string token;
+    while (numbers >> token) {
+      std::size_t used = 0;
+      double value = std::numeric_limits<double>::quiet_NaN();
+      try {
+        value = std::stod(token, &used);
+      } catch (const std::exception&) {
+      }
+      if (used != token.size() || !std::isfinite(value) || std::abs(value) > 100 * axis.range) {
+        throw InputError(source, field,
+                         "expected finite pixel offsets, found \"" + token.substr(0, 40) + "\"");
+      }
+      axis.values.push_back(value);
+      if (axis.values.size() > kMaxCount) {
+        throw InputError(source, field, "expected at most 2^24 numbers");
+      }
+    }
+    return axis;
+  };
+  const Axis x = read_axis("X-FlatParameters"), y = read_axis("Y-FlatParameters");
+  const int n = int(std::lround(std::sqrt(double(x.values.size()))));
+  if (x.values.size() != y.values.size() || n < 2 || std::size_t(n) * n != x.values.size()) {
+    throw InputError(source, "GeometryFile/GeometryDefinition",
+                     "expected the same square count n² (n >= 2) of X and Y offsets; got " +
+                         std::to_string(x.values.size()) + " and " +
+                         std::to_string(y.values.size()));
+  }
+  SgcMesh mesh = frustum;
+  mesh.version = 0;
+  mesh.bilinear_grid = true;
+  mesh.vertices.assign(x.values.size(), {});
+  mesh.triangles.clear();
+  for (int r = 0; r < n; ++r) {
+    for (int c = 0; c < n; ++c) {
+      const std::size_t k = std::size_t(r) * n + c;
+      const glm::dvec2 st{double(c) / (n - 1), double(r) / (n - 1)};
+      mesh.vertices[k].st = st;
+      mesh.vertices[k].q_norm = st + glm::dvec2(x.values[k] / x.range, y.values[k] / y.range);
+      if (r + 1 < n && c + 1 < n) {
+        const auto at = [&](int dc, int dr) { return std::uint32_t((r + dr) * n + c + dc); };
+        mesh.triangles.emplace_back(at(0, 0), at(1, 0), at(0, 1));
+        mesh.triangles.emplace_back(at(1, 0), at(1, 1), at(0, 1));
+      }
+    }
+  }
+  return mesh;
+}
+
 std::string format_sgc(const SgcMesh& mesh) {
   std::string bytes = "SGC";
   const auto put = [&](auto value) {
@@ -446,6 +522,17 @@ SgcImport import_sgc(const SgcMesh& mesh, const SgcImportOptions& options,
   ImportedProjector& projector = result.projector;
   projector.name = name;
   glm::ivec2 grid = options.warp_grid.x >= 2 ? options.warp_grid : *mesh_grid;
+  if (mesh.bilinear_grid && result.side == SgcGridSide::texture) {
+    projector.warp = build(*mesh_grid);
+    projector.warp.validate(source);
+    char text[160];
+    std::snprintf(text, sizeof text, "a %d×%d node grid over the frustum image, taken as it is",
+                  mesh_grid->x, mesh_grid->y);
+    projector.notes.push_back(text);
+    projector.output.kind = projection_io::DisplayOutput::Kind::window;
+    projector.output.window = {0, 0, options.output_size.x, options.output_size.y};
+    return result;
+  }
   for (;;) {
     projector.warp = build(grid);
     result.worst_follow_px = worst_follow_px(mesh, proper, projector.warp);

@@ -9,6 +9,7 @@
 #include <set>
 #include <sstream>
 
+#include "facet/interop/mpcdi.hpp"
 #include "facet/projection/errors.hpp"
 #include "image_map.hpp"
 
@@ -69,6 +70,57 @@ std::filesystem::path resolve(const std::string& written, const std::filesystem:
   throw InputError(source, field,
                    "expected an existing file; neither \"" + written + "\" nor \"" + name +
                        "\" next to the configuration exists");
+}
+
+// The frustum of a viewport's <PlanarProjection>: <FOV left right up down> (degrees, each positive
+// outwards from the axis, so down="-7.7" puts the bottom edge above it) and <Orientation> as
+// heading, pitch, roll (degrees, R = Ry(−heading)·Rx(pitch)·Rz(−roll), as facet reads MPCDI
+// frusta) or as a quaternion x, y, z, w.
+SgcMesh planar_projection(const pugi::xml_node& viewport, const std::string& source,
+                          const std::string& path) {
+  const pugi::xml_node projection = viewport.child("PlanarProjection");
+  const std::string projection_path = path + "/PlanarProjection";
+  if (!projection) {
+    throw InputError(source, projection_path,
+                     "expected this element: a .simcad mesh holds no frustum");
+  }
+  const pugi::xml_node fov = projection.child("FOV");
+  const std::string fov_path = projection_path + "/FOV";
+  if (!fov) throw InputError(source, fov_path, "expected this element");
+  const auto required = [&](const pugi::xml_node& node, const char* name, const std::string& at) {
+    if (!node.attribute(name)) throw InputError(source, at + "@" + name, "expected this attribute");
+    return number_attribute(node, name, 0, source, at);
+  };
+  SgcMesh frustum;
+  frustum.left_deg = -required(fov, "left", fov_path);
+  frustum.right_deg = required(fov, "right", fov_path);
+  frustum.up_deg = required(fov, "up", fov_path);
+  frustum.down_deg = -required(fov, "down", fov_path);
+  if (!(std::abs(frustum.left_deg) < 89 && std::abs(frustum.right_deg) < 89 &&
+        std::abs(frustum.up_deg) < 89 && std::abs(frustum.down_deg) < 89 &&
+        frustum.left_deg < frustum.right_deg && frustum.down_deg < frustum.up_deg)) {
+    throw InputError(source, fov_path,
+                     "expected edge angles within (−89°, 89°) that enclose the axis' side "
+                     "(left + right > 0, up + down > 0)");
+  }
+  const pugi::xml_node orientation = projection.child("Orientation");
+  const std::string orientation_path = projection_path + "/Orientation";
+  if (orientation && orientation.attribute("w")) {
+    const glm::dquat q(
+        required(orientation, "w", orientation_path), required(orientation, "x", orientation_path),
+        required(orientation, "y", orientation_path), required(orientation, "z", orientation_path));
+    if (!(glm::length(q) > 0.5 && glm::length(q) < 2)) {
+      throw InputError(source, orientation_path, "expected a unit quaternion x, y, z, w");
+    }
+    frustum.q_world_frustum = glm::normalize(q);
+  } else {
+    MpcdiFrustum angles;
+    angles.yaw_deg = number_attribute(orientation, "heading", 0, source, orientation_path);
+    angles.pitch_deg = number_attribute(orientation, "pitch", 0, source, orientation_path);
+    angles.roll_deg = number_attribute(orientation, "roll", 0, source, orientation_path);
+    frustum.q_world_frustum = glm::normalize(glm::quat_cast(R_eye_frustum(angles)));
+  }
+  return frustum;
 }
 
 bool has_extension(const std::string& path, const std::string& extension) {
@@ -136,9 +188,10 @@ ImportedDisplay import_sgct_cluster(const std::filesystem::path& config,
                                   " has no correction mesh: not a projector, left out");
           continue;
         }
-        if (!has_extension(mesh_written, ".sgc")) {
+        const bool simcad = has_extension(mesh_written, ".simcad");
+        if (!simcad && !has_extension(mesh_written, ".sgc")) {
           throw InputError(source, path + "@mesh",
-                           "expected a SCISS .sgc mesh, found \"" + mesh_written +
+                           "expected a SCISS .sgc or SimCAD .simcad mesh, found \"" + mesh_written +
                                "\" (MPCDI and Paul Bourke meshes have their own import commands)");
         }
         glm::dvec2 fraction_pos{0.0}, fraction_size{1.0};
@@ -163,7 +216,11 @@ ImportedDisplay import_sgct_cluster(const std::filesystem::path& config,
         const std::filesystem::path mesh_path =
             resolve(mesh_written, folder, source, path + "@mesh", notes);
         const std::string mesh_source = mesh_path.string();
-        const SgcMesh mesh = parse_sgc(read_file(mesh_path, mesh_source, ""), mesh_source);
+        const std::string mesh_bytes = read_file(mesh_path, mesh_source, "");
+        const SgcMesh mesh =
+            simcad
+                ? parse_simcad(mesh_bytes, planar_projection(viewport, source, path), mesh_source)
+                : parse_sgc(mesh_bytes, mesh_source);
         SgcImportOptions import;
         import.output_size = output_size;
         import.warp_grid = options.warp_grid;
@@ -195,7 +252,7 @@ ImportedDisplay import_sgct_cluster(const std::filesystem::path& config,
   }
   if (display.projectors.empty()) {
     throw InputError(source, "Node/Window/Viewport@mesh",
-                     "expected at least one viewport with a .sgc correction mesh");
+                     "expected at least one viewport with a .sgc or .simcad correction mesh");
   }
   if (node_index > 1) {
     display.notes.push_back(

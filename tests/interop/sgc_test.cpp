@@ -276,6 +276,104 @@ TEST(Sgc, SimcadMeshesAgreeWithTheirTableAndTheirClusterOrientation) {
   }
 }
 
+// The SimCAD XML files hold the same warps as their `.sgc` exports but no frustum: an SGCT cluster
+// names them from viewports with a <PlanarProjection>. dome_bravo.xml is that configuration without
+// the mesh attributes; with them added, each channel must come out as its `.sgc` does.
+TEST(SgctCluster, SimcadMeshesTakeTheirFrustumFromTheViewport) {
+  test::ScratchFolder scratch("simcad");
+  std::string xml = read_bytes(kDome + "simcad/dome_bravo.xml");
+  int channel = 0;
+  for (std::size_t at = 0; (at = xml.find("<Viewport>", at)) != std::string::npos; at += 10) {
+    const std::size_t end = xml.find("</Viewport>", at);
+    if (xml.substr(at, end - at).find("<PlanarProjection>") == std::string::npos) continue;
+    ++channel;
+    xml.replace(at, 10, "<Viewport mesh=\"channel" + std::to_string(channel) + "_warp.simcad\">");
+    fs::copy_file(kDome + "simcad/channel" + std::to_string(channel) + "_warp.simcad",
+                  scratch.path / ("channel" + std::to_string(channel) + "_warp.simcad"));
+  }
+  ASSERT_EQ(channel, 6);
+  std::ofstream(scratch.path / "dome_bravo.xml") << xml;
+  const ImportedDisplay display = import_sgct_cluster(scratch.path / "dome_bravo.xml", {});
+  ASSERT_EQ(display.projectors.size(), 6u);
+  for (int c = 1; c <= 6; ++c) {
+    SCOPED_TRACE(c);
+    const Warp& from_simcad = display.projectors[std::size_t(c - 1)].warp;
+    EXPECT_EQ(from_simcad.output_size, glm::ivec2(4096, 2160));
+    EXPECT_EQ(from_simcad.grid_size, glm::ivec2(33, 33));
+    const std::string sgc = kDome + "simcad/channel" + std::to_string(c) + "_warp_u2.sgc";
+    const SgcMesh mesh = parse_sgc(read_bytes(sgc), sgc);
+    SgcImportOptions options;
+    options.output_size = from_simcad.output_size;
+    const Warp from_sgc = import_sgc(mesh, options, sgc, "p").projector.warp;
+    // The cluster's FOV and Orientation against the mesh's own header (floats).
+    for (int k = 0; k < 4; ++k) {
+      EXPECT_NEAR(from_simcad.base.tan_extent[std::size_t(k)],
+                  from_sgc.base.tan_extent[std::size_t(k)], 1e-5)
+          << k;
+    }
+    for (int k = 0; k < 3; ++k) {
+      EXPECT_LE(glm::length(from_simcad.R_eye_base[k] - from_sgc.R_eye_base[k]), 1e-5) << k;
+    }
+    // At the 33×33 nodes (both imports hold them exactly; between nodes the .sgc strip's
+    // triangles and the SimCAD grid's bilinear cells part), output px.
+    double worst = 0;
+    for (int j = 0; j < 33; ++j) {
+      for (int i = 0; i < 33; ++i) {
+        const glm::dvec2 st{i / 32.0, j / 32.0};
+        if (from_sgc.coverage_at(st) < 0.5) continue;
+        worst = std::max(worst, glm::length(from_simcad.q_from_st(st) - from_sgc.q_from_st(st)));
+      }
+    }
+    std::printf("channel %d: .simcad against .sgc at the nodes, worst %.5f px\n", c, worst);
+    EXPECT_LE(worst, 0.005);  // the .sgc stores floats: 2^-24 of 4096 px is 0.0002 px
+  }
+  // Without a <PlanarProjection> a .simcad mesh cannot be placed.
+  std::ofstream(scratch.path / "bare.xml")
+      << "<Cluster><Node><Window><Size x=\"640\" y=\"400\"/><Viewport "
+         "mesh=\"channel1_warp.simcad\"/></Window></Node></Cluster>";
+  try {
+    import_sgct_cluster(scratch.path / "bare.xml", {});
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.field(), "Node[0]/Window[0]/Viewport[0]/PlanarProjection") << e.what();
+  }
+}
+
+TEST(Sgc, SimcadFilesNameTheElement) {
+  const SgcMesh frustum = synthetic_mesh(SgcGridSide::texture, {2, 2});
+  const auto file = [](const std::string& x, const std::string& y) {
+    return "<GeometryFile><GeometryDefinition>" + x + y + "</GeometryDefinition></GeometryFile>";
+  };
+  const std::string x4 = "<X-FlatParameters range=\"100\">1 2 3 4</X-FlatParameters>";
+  const std::string y4 = "<Y-FlatParameters range=\"50\">0 0 1 1</Y-FlatParameters>";
+  const SgcMesh good = parse_simcad(file(x4, y4), frustum, "good.simcad");
+  ASSERT_EQ(good.vertices.size(), 4u);
+  EXPECT_NEAR(good.vertices[3].q_norm.x, 1 + 4 / 100.0, 1e-12);
+  EXPECT_NEAR(good.vertices[3].q_norm.y, 1 + 1 / 50.0, 1e-12);
+  const struct {
+    std::string xml, field;
+  } cases[] = {
+      {"<GeometryFile>", ""},
+      {"<GeometryFile/>", "GeometryFile/GeometryDefinition"},
+      {file("", y4), "GeometryFile/GeometryDefinition/X-FlatParameters"},
+      {file("<X-FlatParameters>1 2 3 4</X-FlatParameters>", y4),
+       "GeometryFile/GeometryDefinition/X-FlatParameters@range"},
+      {file("<X-FlatParameters range=\"100\">1 2 x 4</X-FlatParameters>", y4),
+       "GeometryFile/GeometryDefinition/X-FlatParameters"},
+      {file("<X-FlatParameters range=\"100\">1 2 3</X-FlatParameters>", y4),
+       "GeometryFile/GeometryDefinition"},
+  };
+  for (const auto& c : cases) {
+    try {
+      parse_simcad(c.xml, frustum, "bad.simcad");
+      ADD_FAILURE() << "no error for " << c.xml;
+    } catch (const InputError& e) {
+      EXPECT_EQ(e.source(), "bad.simcad");
+      EXPECT_EQ(e.field(), c.field) << e.what();
+    }
+  }
+}
+
 TEST(Sgc, SyntheticMeshesAreFollowedWhicheverSideIsRegular) {
   for (SgcGridSide side : {SgcGridSide::texture, SgcGridSide::output, SgcGridSide::neither}) {
     SCOPED_TRACE(int(side));
@@ -397,7 +495,7 @@ TEST(SgctCluster, BadConfigurationsNameTheElement) {
       {cluster("<Size x=\"0\" y=\"10\"/><Viewport mesh=\"c1.sgc\"/>"), "Node[0]/Window[0]/Size"},
       {cluster("<Size x=\"640\" y=\"wide\"/><Viewport mesh=\"c1.sgc\"/>"),
        "Node[0]/Window[0]/Size@y"},
-      {cluster("<Size x=\"640\" y=\"400\"/><Viewport mesh=\"c1.simcad\"/>"),
+      {cluster("<Size x=\"640\" y=\"400\"/><Viewport mesh=\"c1.data\"/>"),
        "Node[0]/Window[0]/Viewport[0]@mesh"},
       {cluster("<Size x=\"640\" y=\"400\"/><Viewport mesh=\"D:/x/missing.sgc\"/>"),
        "Node[0]/Window[0]/Viewport[0]@mesh"},

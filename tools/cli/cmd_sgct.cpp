@@ -32,8 +32,8 @@ const Registration registration{
       auto options = std::make_shared<Options>();
       auto* import_command = command->add_subcommand(
           "import",
-          "Read CLUSTER.xml (every viewport with a .sgc mesh and its mask) or bare .sgc meshes "
-          "into DIR/display.json");
+          "Read CLUSTER.xml (every viewport with a .sgc or .simcad mesh and its mask) or bare .sgc "
+          "meshes into DIR/display.json");
       import_command->add_option("files", options->files, "CLUSTER.xml, or one or more .sgc files")
           ->required();
       import_command->add_option("--out", options->out, "The folder to create")->required();
@@ -56,6 +56,13 @@ const Registration registration{
           grid = parse_size(options->grid, "--grid");
           if (grid.x < 2 || grid.y < 2 || grid.x > 4096 || grid.y > 4096) {
             throw InputError("--grid", "", "expected GXxGY with each count in [2, 4096]");
+          }
+        }
+        for (const std::string& file : options->files) {
+          if (file.size() >= 7 && file.compare(file.size() - 7, 7, ".simcad") == 0) {
+            throw InputError(file, "",
+                             "a .simcad mesh holds no frustum: import the SGCT cluster file whose "
+                             "viewport names it with a <PlanarProjection>");
           }
         }
         const bool meshes = ends_with_sgc(options->files.front());

@@ -38,7 +38,7 @@ struct SgcVertex {
 };
 
 struct SgcMesh {
-  int version = 1;
+  int version = 1;                         // of a .sgc file; 0 for a mesh read from a SimCAD file
   glm::dquat q_world_frustum{1, 0, 0, 0};  // normalised on parse
   glm::dvec3 position{0.0};                // the view's position; facet keeps it as a note
   // Signed edge angles, degrees: a direction at angle a right of (or above) the axis has
@@ -46,6 +46,9 @@ struct SgcMesh {
   double up_deg = 0, down_deg = 0, left_deg = 0, right_deg = 0;
   std::vector<SgcVertex> vertices;
   std::vector<glm::uvec3> triangles;  // non-degenerate triangles of the strip or list
+  // A SimCAD grid: its nodes are the data, bilinear between them as facet's warp is; the
+  // triangles only serve the checks.
+  bool bilinear_grid = false;
 };
 
 // Throws InputError(source, field, expected) for a wrong magic, version or mapping type, a
@@ -53,6 +56,17 @@ struct SgcMesh {
 // ±100, a zero quaternion, a frustum whose edges are not ordered within (−89°, 89°), or an index
 // out of range.
 SgcMesh parse_sgc(std::string_view bytes, const std::string& source);
+
+// SimCAD `.simcad` warps (XML): <GeometryFile><GeometryDefinition> with <X-FlatParameters
+// range="RX"> and <Y-FlatParameters range="RY">, each n² numbers, row-major over an n×n grid
+// over the frustum image: node (c, r) shows st = (c, r)/(n − 1) (t down) at the output position
+// (c/(n − 1) + X/RX, r/(n − 1) + Y/RY) (x right, y down, normalised). The file holds no frustum;
+// it comes from the SGCT viewport that names the file (sgct_cluster.hpp). The frustum fields of
+// `frustum` are copied; the result is a bilinear grid (two triangles per cell for the checks),
+// which import_sgc takes node for node.
+// Throws InputError naming the element for malformed XML, missing or non-positive ranges,
+// counts that differ or are not a square of at least 2², and non-finite numbers.
+SgcMesh parse_simcad(std::string_view xml, const SgcMesh& frustum, const std::string& source);
 
 // The mesh as a version-2 file with a triangle list (size values 4 and the vertex count), for
 // tools that read SCISS meshes; parse_sgc reads it back exactly (floats).

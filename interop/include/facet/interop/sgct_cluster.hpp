@@ -1,6 +1,6 @@
 #pragma once
-// SGCT cluster configurations (XML) whose viewports carry SCISS `.sgc` correction meshes and
-// soft-edge masks, as dome installations ship them:
+// SGCT cluster configurations (XML) whose viewports carry SCISS `.sgc` or SimCAD `.simcad`
+// correction meshes and soft-edge masks, as dome installations ship them:
 //
 //   <Cluster> <Node> <Window> <Pos x y/>? <Size x y/>
 //     <Viewport name mesh="channel1.sgc" mask="channel1.png"> <Pos x y/>? <Size x y/>? ...
@@ -8,7 +8,8 @@
 //
 // Every viewport with a mesh becomes a projector: its output is the viewport's part of its
 // window (viewport Pos and Size are fractions of the window, default the whole window), and the
-// mesh's own frustum and rotation (sgc.hpp) give the warp. The mask is an image over the output
+// mesh's own frustum and rotation (sgc.hpp) give the warp; a `.simcad` file holds none, so its
+// viewport's <PlanarProjection> (FOV, Orientation) gives them. The mask is an image over the output
 // that SGCT multiplies into the encoded colour, so the linear blend weight is mask^gamma.
 // Viewports without a mesh (an operator's GUI window) are left out with a note. Each node is its
 // own machine; the import places the nodes' windows left to right on one desktop.
@@ -30,8 +31,8 @@ struct SgctImportOptions {
 
 // Throws InputError naming the file and the element or attribute: not XML, no <Cluster>, a
 // window without a positive <Size>, viewport fractions outside [0,1], a mesh that is not a
-// `.sgc` file or cannot be found, no viewport with a mesh, and every error of parse_sgc and
-// import_sgc for the meshes.
+// `.sgc` or `.simcad` file or cannot be found, a `.simcad` mesh without a <PlanarProjection>, no
+// viewport with a mesh, and every error of parse_sgc, parse_simcad and import_sgc.
 ImportedDisplay import_sgct_cluster(const std::filesystem::path& config,
                                     const SgctImportOptions& options);
 
