@@ -7,6 +7,7 @@
 
 #include "facet/interop/mpcdi.hpp"
 #include "facet/projection/errors.hpp"
+#include "xml_document.hpp"
 
 namespace facet::interop {
 namespace {
@@ -174,12 +175,7 @@ MpcdiFrustum frustum_from_base(const BaseProjection& perspective, const glm::dma
 
 MpcdiDocument parse_mpcdi_xml(std::string_view xml, const std::string& source) {
   pugi::xml_document document;
-  const pugi::xml_parse_result parsed = document.load_buffer(xml.data(), xml.size());
-  if (!parsed) {
-    throw InputError(source, "",
-                     std::string("expected well-formed XML: ") + parsed.description() +
-                         " at byte " + std::to_string(parsed.offset));
-  }
+  load_xml(document, xml, source);
   const pugi::xml_node root = document.child("MPCDI");
   if (!root) throw InputError(source, "MPCDI", "expected the root element <MPCDI>");
   MpcdiDocument result;

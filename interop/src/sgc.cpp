@@ -13,6 +13,7 @@
 
 #include "facet/interop/inverse_grid.hpp"
 #include "facet/projection/errors.hpp"
+#include "xml_document.hpp"
 
 namespace facet::interop {
 namespace {
@@ -382,12 +383,7 @@ SgcMesh parse_sgc(std::string_view bytes, const std::string& source) {
 
 SgcMesh parse_simcad(std::string_view xml, const SgcMesh& frustum, const std::string& source) {
   pugi::xml_document document;
-  const pugi::xml_parse_result parsed = document.load_buffer(xml.data(), xml.size());
-  if (!parsed) {
-    throw InputError(source, "",
-                     std::string("expected well-formed XML: ") + parsed.description() +
-                         " at byte " + std::to_string(parsed.offset));
-  }
+  load_xml(document, xml, source);
   const pugi::xml_node definition = document.child("GeometryFile").child("GeometryDefinition");
   if (!definition) {
     throw InputError(source, "GeometryFile/GeometryDefinition", "expected this element");

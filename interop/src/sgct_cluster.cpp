@@ -12,6 +12,7 @@
 #include "facet/interop/mpcdi.hpp"
 #include "facet/projection/errors.hpp"
 #include "image_map.hpp"
+#include "xml_document.hpp"
 
 namespace facet::interop {
 namespace {
@@ -138,12 +139,7 @@ ImportedDisplay import_sgct_cluster(const std::filesystem::path& config,
   const std::string source = config.string();
   const std::string xml = read_file(config, source, "");
   pugi::xml_document document;
-  const pugi::xml_parse_result parsed = document.load_buffer(xml.data(), xml.size());
-  if (!parsed) {
-    throw InputError(source, "",
-                     std::string("expected well-formed XML: ") + parsed.description() +
-                         " at byte " + std::to_string(parsed.offset));
-  }
+  load_xml(document, xml, source);
   const pugi::xml_node cluster = document.child("Cluster");
   if (!cluster) throw InputError(source, "Cluster", "expected the root element <Cluster>");
   const std::filesystem::path folder = config.parent_path();
