@@ -55,6 +55,21 @@ projection_io::BlendMap decode_image_map(const std::string& bytes, const std::st
   return result;
 }
 
+std::string encode_png(const projection_io::BlendMap& map, int bits) {
+  FACET_ASSERT(bits == 8 || bits == 16);
+  std::vector<unsigned char> buffer;
+  OIIO::Filesystem::IOVecOutput output(buffer);
+  auto out = OIIO::ImageOutput::create("map.png", &output);
+  FACET_ASSERT(out);
+  OIIO::ImageSpec spec(map.size.x, map.size.y, map.channels,
+                       bits == 8 ? OIIO::TypeDesc::UINT8 : OIIO::TypeDesc::UINT16);
+  if (!out->open("map.png", spec) || !out->write_image(OIIO::TypeDesc::FLOAT, map.values.data()) ||
+      !out->close()) {
+    throw std::runtime_error("PNG encoding failed: " + out->geterror());
+  }
+  return std::string(buffer.begin(), buffer.end());
+}
+
 void collapse_equal_channels(projection_io::BlendMap& map) {
   if (map.channels != 3) return;
   const std::size_t pixels = std::size_t(map.size.x) * map.size.y;

@@ -13,6 +13,9 @@ namespace facet::interop {
 projection_io::BlendMap decode_image_map(const std::string& bytes, const std::string& name,
                                          double gamma, glm::ivec2 size, const std::string& source);
 
+// The map's values (in [0,1]) as a PNG of 8 or 16 bits per channel.
+std::string encode_png(const projection_io::BlendMap& map, int bits);
+
 // A three-channel map whose channels agree at every pixel becomes one channel.
 void collapse_equal_channels(projection_io::BlendMap& map);
 

@@ -154,19 +154,6 @@ Warp region_warp(const RegionWarpInput& in, MpcdiWarpValues values, const std::s
 
 // ---- writing -----------------------------------------------------------------------------------
 
-std::string encode_png16(const projection_io::BlendMap& map) {
-  std::vector<unsigned char> buffer;
-  OIIO::Filesystem::IOVecOutput output(buffer);
-  auto out = OIIO::ImageOutput::create("map.png", &output);
-  FACET_ASSERT(out);
-  OIIO::ImageSpec spec(map.size.x, map.size.y, map.channels, OIIO::TypeDesc::UINT16);
-  if (!out->open("map.png", spec) || !out->write_image(OIIO::TypeDesc::FLOAT, map.values.data()) ||
-      !out->close()) {
-    throw std::runtime_error("PNG encoding failed: " + out->geterror());
-  }
-  return std::string(buffer.begin(), buffer.end());
-}
-
 // ---- profile a3
 // ----------------------------------------------------------------------------------
 
@@ -513,6 +500,33 @@ ImportedDisplay import_mpcdi(const MpcdiFiles& files, const std::string& source,
   return display;
 }
 
+MpcdiFrustum covering_frustum(const Warp& warp, const std::string& source) {
+  if (warp.base.kind == BaseKind::perspective) return frustum_from_base(warp.base, warp.R_eye_base);
+  // Directions of the output image's border and interior, found by exact inversion.
+  const WarpInverse inverse(warp);
+  std::vector<glm::dvec3> directions;
+  const int n = 64;
+  for (int j = 0; j <= n; ++j) {
+    for (int i = 0; i <= n; ++i) {
+      const glm::dvec2 q{double(i) / n * warp.output_size.x, double(j) / n * warp.output_size.y};
+      if (auto inverted = inverse.invert(q)) directions.push_back(inverted->v_eye);
+    }
+  }
+  if (directions.empty()) {
+    throw InputError(source, "coverage", "expected a warp that covers some output pixels");
+  }
+  CoverOptions cover;
+  cover.max_perspective_half_angle_rad = glm::radians(80.0);
+  cover.up_eye = warp.R_eye_base * glm::dvec3(0, 1, 0);
+  const BaseCover covered = cover_directions(directions, cover);
+  if (covered.base.kind != BaseKind::perspective) {
+    throw InputError(source, "base",
+                     "expected a projector footprint within 80° of its centre, so that one "
+                     "perspective frustum holds it");
+  }
+  return frustum_from_base(covered.base, covered.R_eye_base);
+}
+
 MpcdiFiles export_mpcdi(const projection_io::DisplayConfig& display,
                         const MpcdiExportOptions& options) {
   FACET_ASSERT(options.node_spacing_px > 0);
@@ -561,37 +575,7 @@ MpcdiFiles export_mpcdi(const projection_io::DisplayConfig& display,
       }
       hint["base"] = base_hint(warp.base, warp.R_eye_base);
     }
-    MpcdiFrustum frustum;
-    if (a3) {
-      // No frustum: the points say everything.
-    } else if (warp.base.kind == BaseKind::perspective) {
-      frustum = frustum_from_base(warp.base, warp.R_eye_base);
-    } else {
-      // A perspective frustum around everything the projector shows: directions of the output
-      // image's border and interior, found by exact inversion.
-      const WarpInverse inverse(warp);
-      std::vector<glm::dvec3> directions;
-      const int n = 64;
-      for (int j = 0; j <= n; ++j) {
-        for (int i = 0; i <= n; ++i) {
-          const glm::dvec2 q{double(i) / n * warp.output_size.x,
-                             double(j) / n * warp.output_size.y};
-          if (auto inverted = inverse.invert(q)) directions.push_back(inverted->v_eye);
-        }
-      }
-      if (directions.empty())
-        throw InputError(warp_path, "coverage", "expected a warp that covers some output pixels");
-      CoverOptions cover;
-      cover.max_perspective_half_angle_rad = glm::radians(80.0);
-      cover.up_eye = warp.R_eye_base * glm::dvec3(0, 1, 0);
-      const BaseCover covered = cover_directions(directions, cover);
-      if (covered.base.kind != BaseKind::perspective) {
-        throw InputError(warp_path, "base",
-                         "expected a projector footprint within 80° of its centre, so that one "
-                         "MPCDI frustum holds it");
-      }
-      frustum = frustum_from_base(covered.base, covered.R_eye_base);
-    }
+    const MpcdiFrustum frustum = a3 ? MpcdiFrustum{} : covering_frustum(warp, warp_path);
     if (!a3) {
       region.frustum = frustum;
       const BaseProjection base = frustum_base(frustum);
@@ -616,13 +600,13 @@ MpcdiFiles export_mpcdi(const projection_io::DisplayConfig& display,
       const auto map = projection_io::read_blend_map(display.resolve(*projector.blend).string(),
                                                      warp.output_size);
       region.alpha = MpcdiMap{projector.name + "_alpha.png", 1.0, map.channels};
-      files[region.alpha->path] = encode_png16(map);
+      files[region.alpha->path] = encode_png(map, 16);
     }
     if (projector.black) {
       const auto map = projection_io::read_blend_map(display.resolve(*projector.black).string(),
                                                      warp.output_size);
       region.beta = MpcdiMap{projector.name + "_beta.png", 1.0, map.channels};
-      files[region.beta->path] = encode_png16(map);
+      files[region.beta->path] = encode_png(map, 16);
     }
     document.regions.push_back(region);
   }

@@ -450,27 +450,40 @@ SgcMesh parse_simcad(std::string_view xml, const SgcMesh& frustum, const std::st
   return mesh;
 }
 
-std::string format_sgc(const SgcMesh& mesh) {
+std::string format_sgc(const SgcMesh& mesh, glm::ivec2 grid) {
+  FACET_ASSERT(grid.x >= 2 && grid.y >= 2);
+  FACET_ASSERT(mesh.vertices.size() == std::size_t(grid.x) * grid.y);
   std::string bytes = "SGC";
   const auto put = [&](auto value) {
     char raw[sizeof value];
     std::memcpy(raw, &value, sizeof value);
     bytes.append(raw, sizeof value);
   };
-  put(std::uint8_t(2));
+  put(std::uint8_t(1));
   put(std::uint32_t(0));
   const glm::dquat& q = mesh.q_world_frustum;
   for (double v : {q.x, q.y, q.z, q.w, mesh.position.x, mesh.position.y, mesh.position.z,
                    mesh.up_deg, mesh.down_deg, mesh.left_deg, mesh.right_deg}) {
     put(float(v));
   }
-  put(std::uint32_t(4));
-  put(std::uint32_t(mesh.vertices.size()));
+  put(std::uint32_t(grid.x));
+  put(std::uint32_t(grid.y));
   for (const SgcVertex& v : mesh.vertices) {
     for (double f : {v.q_norm.x, v.q_norm.y, 0.0, v.st.x, 1 - v.st.y, 0.0}) put(float(f));
   }
-  put(std::uint32_t(3 * mesh.triangles.size()));
-  for (const glm::uvec3& t : mesh.triangles) put(t.x), put(t.y), put(t.z);
+  // Row pairs alternately rightwards and leftwards: each row starts with the index the previous
+  // one ended with, which joins them by degenerate triangles.
+  std::vector<std::uint32_t> strip;
+  for (int r = 0; r + 1 < grid.y; ++r) {
+    const bool rightwards = r % 2 == 0;
+    for (int k = 0; k < grid.x; ++k) {
+      const int c = rightwards ? k : grid.x - 1 - k;
+      strip.push_back(std::uint32_t(r * grid.x + c));
+      strip.push_back(std::uint32_t((r + 1) * grid.x + c));
+    }
+  }
+  put(std::uint32_t(strip.size()));
+  for (std::uint32_t index : strip) put(index);
   return bytes;
 }
 

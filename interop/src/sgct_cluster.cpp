@@ -9,8 +9,12 @@
 #include <set>
 #include <sstream>
 
+#include "facet/interop/inverse_grid.hpp"
 #include "facet/interop/mpcdi.hpp"
 #include "facet/projection/errors.hpp"
+#include "facet/projection/warp_inverse.hpp"
+#include "facet/projection_io/blend_file.hpp"
+#include "facet/projection_io/warp_file.hpp"
 #include "image_map.hpp"
 #include "xml_document.hpp"
 
@@ -256,6 +260,86 @@ ImportedDisplay import_sgct_cluster(const std::filesystem::path& config,
         "left to right on one desktop");
   }
   return display;
+}
+
+std::map<std::string, std::string> export_sgct(const projection_io::DisplayConfig& display,
+                                               const SgctExportOptions& options) {
+  FACET_ASSERT(options.node_spacing_px >= 1 && options.node_spacing_px <= 1024);
+  FACET_ASSERT(options.mask_gamma > 0);
+  std::map<std::string, std::string> files;
+  pugi::xml_document document;
+  pugi::xml_node cluster = document.append_child("Cluster");
+  cluster.append_attribute("masterAddress") = "127.0.0.1";
+  int port = 20401;
+  for (const projection_io::DisplayProjector& projector : display.projectors) {
+    const std::string warp_path = display.resolve(projector.warp).string();
+    const Warp warp = read_warp(warp_path);
+    const MpcdiFrustum frustum = covering_frustum(warp, warp_path);
+    const BaseProjection base = frustum_base(frustum);
+    const glm::dmat3 R_frustum_eye = glm::transpose(R_eye_frustum(frustum));
+    const glm::ivec2 nodes{int(std::ceil(warp.output_size.x / options.node_spacing_px)) + 1,
+                           int(std::ceil(warp.output_size.y / options.node_spacing_px)) + 1};
+    const NodeDirections directions = node_directions(warp, nodes, std::max(nodes.x, nodes.y));
+    std::vector<glm::dvec2> st(directions.v_eye.size(),
+                               glm::dvec2(std::numeric_limits<double>::quiet_NaN()));
+    for (std::size_t k = 0; k < st.size(); ++k) {
+      if (!directions.v_eye[k]) continue;
+      if (auto found = base.st_from_direction(R_frustum_eye * *directions.v_eye[k])) st[k] = *found;
+    }
+    fill_missing(st, nodes, warp_path);
+    SgcMesh mesh;
+    mesh.q_world_frustum = glm::normalize(glm::quat_cast(R_eye_frustum(frustum)));
+    mesh.up_deg = frustum.up_deg, mesh.down_deg = frustum.down_deg;
+    mesh.left_deg = frustum.left_deg, mesh.right_deg = frustum.right_deg;
+    mesh.vertices.resize(st.size());
+    for (int j = 0; j < nodes.y; ++j) {
+      for (int i = 0; i < nodes.x; ++i) {
+        const std::size_t k = std::size_t(j) * nodes.x + i;
+        mesh.vertices[k].q_norm = {double(i) / (nodes.x - 1), double(j) / (nodes.y - 1)};
+        mesh.vertices[k].st = st[k];
+      }
+    }
+    files[projector.name + ".sgc"] = format_sgc(mesh, nodes);
+
+    projection_io::BlendMap mask =
+        projector.blend ? projection_io::read_blend_map(display.resolve(*projector.blend).string(),
+                                                        warp.output_size)
+                        : projection_io::BlendMap::constant(warp.output_size, 1.0f);
+    const std::vector<glm::dvec2> st_at_pixels = WarpInverse(warp).st_at_pixel_centres();
+    for (int y = 0; y < mask.size.y; ++y) {
+      for (int x = 0; x < mask.size.x; ++x) {
+        const bool covered = std::isfinite(st_at_pixels[std::size_t(y) * mask.size.x + x].x);
+        for (int c = 0; c < mask.channels; ++c) {
+          mask.at(x, y, c) = covered
+                                 ? float(std::pow(std::clamp(double(mask.at(x, y, c)), 0.0, 1.0),
+                                                  1 / options.mask_gamma))
+                                 : 0.0f;
+        }
+      }
+    }
+    files[projector.name + "_mask.png"] = encode_png(mask, 8);
+
+    pugi::xml_node node = cluster.append_child("Node");
+    node.append_attribute("address") = "127.0.0.1";
+    node.append_attribute("port") = port++;
+    pugi::xml_node window = node.append_child("Window");
+    window.append_attribute("fullScreen") = "true";
+    pugi::xml_node size = window.append_child("Size");
+    size.append_attribute("x") = warp.output_size.x;
+    size.append_attribute("y") = warp.output_size.y;
+    pugi::xml_node viewport = window.append_child("Viewport");
+    viewport.append_attribute("name") = projector.name.c_str();
+    viewport.append_attribute("mesh") = (projector.name + ".sgc").c_str();
+    viewport.append_attribute("mask") = (projector.name + "_mask.png").c_str();
+  }
+  pugi::xml_node user_pos = cluster.append_child("User").append_child("Pos");
+  user_pos.append_attribute("x") = display.eye.x;
+  user_pos.append_attribute("y") = display.eye.y;
+  user_pos.append_attribute("z") = display.eye.z;
+  std::ostringstream xml;
+  document.save(xml, "  ");
+  files["cluster.xml"] = xml.str();
+  return files;
 }
 
 }  // namespace facet::interop

@@ -141,6 +141,9 @@ TEST(InteropCli, BadFilesExitWithStatus2AndLeaveNothingBehind) {
       "sgct import " + kWarps + "sgct-dome/sciss/channel1_planar.sgc " +
           (scratch.path / "bad.data").string(),
       "sgct import " + kWarps + "sgct-dome/sciss/channel1_planar.sgc --size 0x10",
+      "sgct export " + (scratch.path / "missing.json").string(),
+      "sgct export " + std::string(FACET_SOURCE_DIR) +
+          "/configs/displays/wall2x2/display.json --node-spacing 0",
   };
   for (const std::string& command : commands) {
     const fs::path out = scratch.path / "out";
@@ -195,6 +198,23 @@ TEST(InteropCli, AnSgctDomeConfigurationAndBareSgcMeshesImport) {
   ASSERT_EQ(bare.projectors.size(), 2u);
   EXPECT_EQ(bare.projectors[1].output.window, glm::ivec4(1024, 0, 1024, 640));
   EXPECT_FALSE(bare.projectors[0].blend);
+
+  // A facet display out to SGCT and back.
+  const fs::path exported = scratch.path / "exported";
+  r = run("sgct export " + std::string(FACET_SOURCE_DIR) +
+              "/configs/displays/wall2x2/display.json --node-spacing 8 --out " + exported.string(),
+          scratch.path);
+  ASSERT_EQ(r.status, 0) << r.output;
+  for (const char* name : {"cluster.xml", "wall_r0c0.sgc", "wall_r1c1_mask.png"}) {
+    EXPECT_TRUE(fs::exists(exported / name)) << name;
+  }
+  r = run("sgct import " + (exported / "cluster.xml").string() + " --out " +
+              (scratch.path / "back").string(),
+          scratch.path);
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_EQ(
+      projection_io::read_display_config(scratch.path / "back" / "display.json").projectors.size(),
+      4u);
 }
 
 TEST(InteropCli, ProfileA3ThroughTheCommands) {

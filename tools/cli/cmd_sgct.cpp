@@ -1,5 +1,5 @@
-// facet sgct: SGCT cluster configurations with SCISS .sgc meshes, or bare .sgc meshes, into a
-// display folder.
+// facet sgct: SGCT cluster configurations with SCISS .sgc or SimCAD meshes, or bare .sgc meshes,
+// into a display folder; and a display out as an SGCT cluster.
 #include <fstream>
 #include <iostream>
 #include <sstream>
@@ -8,6 +8,7 @@
 #include "display_flags.hpp"
 #include "facet/interop/sgct_cluster.hpp"
 #include "facet/projection/errors.hpp"
+#include "facet/projection_io/display_config.hpp"
 
 namespace facet::cli {
 namespace {
@@ -22,8 +23,41 @@ bool ends_with_sgc(const std::string& path) {
 const Registration registration{
     61, [](CLI::App& app) {
       auto* command = app.add_subcommand(
-          "sgct", "Import SGCT cluster configurations with SCISS .sgc meshes and masks");
+          "sgct", "Import or export SGCT cluster configurations with SCISS .sgc meshes and masks");
       command->require_subcommand(1);
+
+      struct ExportOptions {
+        std::string display, out;
+        double spacing = 4, gamma = 2.2;
+      };
+      auto exporting = std::make_shared<ExportOptions>();
+      auto* export_command = command->add_subcommand(
+          "export",
+          "Write a display.json as an SGCT cluster: cluster.xml, a SCISS .sgc mesh and a mask "
+          "PNG per projector, into DIR");
+      export_command->add_option("display", exporting->display, "display.json (or its folder)")
+          ->required();
+      export_command->add_option("--out", exporting->out, "The folder to create")->required();
+      export_command->add_option("--node-spacing", exporting->spacing,
+                                 "Spacing of the mesh vertices in output pixels (default 4)");
+      export_command->add_option("--mask-gamma", exporting->gamma,
+                                 "mask = blend^(1/gamma), 8 bits (default 2.2)");
+      export_command->callback([exporting] {
+        if (!(exporting->spacing >= 1 && exporting->spacing <= 1024)) {
+          throw InputError("--node-spacing", "", "expected a spacing in [1, 1024] pixels");
+        }
+        if (!(exporting->gamma > 0 && exporting->gamma <= 10)) {
+          throw InputError("--mask-gamma", "", "expected a gamma in (0, 10]");
+        }
+        const auto display = projection_io::read_display_config(exporting->display);
+        interop::SgctExportOptions options;
+        options.node_spacing_px = exporting->spacing;
+        options.mask_gamma = exporting->gamma;
+        interop::write_files_folder(interop::export_sgct(display, options), exporting->out);
+        std::cout << "wrote " << exporting->out << "/cluster.xml (" << display.projectors.size()
+                  << " projectors)\n";
+      });
+
       struct Options {
         std::vector<std::string> files;
         std::string out, size = "1920x1200", grid;

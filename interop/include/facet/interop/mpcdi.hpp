@@ -53,6 +53,10 @@ glm::dmat3 R_eye_frustum(const MpcdiFrustum& frustum);
 BaseProjection frustum_base(const MpcdiFrustum& frustum);
 // The frustum of a perspective base and its rotation (the inverse of the two functions above).
 MpcdiFrustum frustum_from_base(const BaseProjection& perspective, const glm::dmat3& R_eye_base);
+// A perspective frustum that holds everything the warp shows: the warp's own base when it is
+// perspective, else one around the directions of its covered output (exact inversion). Throws
+// InputError naming `source` when it covers nothing or reaches more than 80° from its centre.
+MpcdiFrustum covering_frustum(const Warp& warp, const std::string& source);
 
 struct MpcdiMap {
   std::string path;

@@ -68,9 +68,11 @@ SgcMesh parse_sgc(std::string_view bytes, const std::string& source);
 // counts that differ or are not a square of at least 2², and non-finite numbers.
 SgcMesh parse_simcad(std::string_view xml, const SgcMesh& frustum, const std::string& source);
 
-// The mesh as a version-2 file with a triangle list (size values 4 and the vertex count), for
-// tools that read SCISS meshes; parse_sgc reads it back exactly (floats).
-std::string format_sgc(const SgcMesh& mesh);
+// A version-1 file of a grid mesh: `mesh`'s header and its vertices, row-major over `grid`
+// (nx·ny of them, mesh.triangles unused), drawn as one serpentine triangle strip (rows joined by
+// a repeated index), the layout of the SCISS files SGCT reads; SGCT draws every file as a strip.
+// parse_sgc reads it back (floats).
+std::string format_sgc(const SgcMesh& mesh, glm::ivec2 grid);
 
 // The frustum's image as a base projection (perspective, tan_extent = tan of the edge angles).
 BaseProjection sgc_frustum_base(const SgcMesh& mesh);

@@ -17,10 +17,12 @@
 // Mesh and mask paths are often absolute paths of the machine that wrote the file; a path that
 // does not exist is looked up by its file name in the configuration's folder, with a note.
 #include <filesystem>
+#include <map>
 #include <string>
 
 #include "facet/interop/display_folder.hpp"
 #include "facet/interop/sgc.hpp"
+#include "facet/projection_io/display_config.hpp"
 
 namespace facet::interop {
 
@@ -35,5 +37,21 @@ struct SgctImportOptions {
 // viewport with a mesh, and every error of parse_sgc, parse_simcad and import_sgc.
 ImportedDisplay import_sgct_cluster(const std::filesystem::path& config,
                                     const SgctImportOptions& options);
+
+struct SgctExportOptions {
+  double node_spacing_px = 4;  // between mesh vertices, output px, in [1, 1024]
+  double mask_gamma = 2.2;     // the mask holds α^(1/gamma), 8 bits
+};
+
+// A display as SGCT reads it: file name → bytes, "cluster.xml" (one node per projector, each on
+// 127.0.0.1 with its own port, a fullscreen window of the projector's size holding one
+// viewport), "<projector>.sgc" and "<projector>_mask.png". Each mesh is a version-1 SCISS grid
+// regular over the output with vertices every `node_spacing_px`, its frustum the perspective one
+// that holds what the projector shows (covering_frustum, as the MPCDI export); a vertex the warp
+// does not cover continues the warp's map (or, beyond its reach, its neighbours), and the mask,
+// the blend weight where the warp covers a pixel centre and 0 elsewhere, hides it. Throws
+// InputError naming the warp file for a footprint no frustum holds.
+std::map<std::string, std::string> export_sgct(const projection_io::DisplayConfig& display,
+                                               const SgctExportOptions& options);
 
 }  // namespace facet::interop
