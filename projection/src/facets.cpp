@@ -54,22 +54,24 @@ std::array<glm::dvec3, 3> guarded_corners(const FacetMesh& mesh, std::uint32_t f
   const Facet& facet = mesh.facets[f];
   std::array<glm::dvec3, 3> p = mesh.corners(f);
   if (guard_px <= 0) return p;
-  // Scaling about the centroid on the chord plane is the same affine scaling in q, where the
-  // distance from the centroid to edge k is a third of the triangle's height over that edge.
+  // On the chord plane the facet's projection is affine, so a scaling there is the same scaling
+  // in q. Scaling about the incentre by (r + guard) / r, r the inradius in q, moves every edge
+  // outwards by exactly guard_px. (About the centroid, the scale that moved the farthest edge by
+  // guard_px moved the long edges of a thin facet by a few thousandths of a pixel, less than the
+  // rasterizer's subpixel snapping: pixel centres on such a seam were drawn by neither facet.)
   std::array<glm::dvec2, 3> q;
   for (int k = 0; k < 3; ++k) q[k] = mesh.vertices[facet.vertex[k]].q;
   const double twice_area =
       std::abs((q[1].x - q[0].x) * (q[2].y - q[0].y) - (q[1].y - q[0].y) * (q[2].x - q[0].x));
-  double largest_centroid_distance = 0;
-  for (int k = 0; k < 3; ++k) {
-    const double edge = glm::length(q[(k + 1) % 3] - q[k]);
-    if (edge > 0)
-      largest_centroid_distance = std::max(largest_centroid_distance, twice_area / edge / 3);
-  }
-  if (!(largest_centroid_distance > 0)) return p;
-  const double scale = 1 + guard_px / largest_centroid_distance;
-  const glm::dvec3 centroid = (p[0] + p[1] + p[2]) / 3.0;
-  for (auto& corner : p) corner = centroid + scale * (corner - centroid);
+  std::array<double, 3> opposite_edge;
+  for (int k = 0; k < 3; ++k) opposite_edge[k] = glm::length(q[(k + 2) % 3] - q[(k + 1) % 3]);
+  const double perimeter = opposite_edge[0] + opposite_edge[1] + opposite_edge[2];
+  if (!(twice_area > 0 && perimeter > 0)) return p;
+  const double inradius = twice_area / perimeter;
+  const double scale = 1 + guard_px / inradius;
+  const glm::dvec3 incentre =
+      (opposite_edge[0] * p[0] + opposite_edge[1] * p[1] + opposite_edge[2] * p[2]) / perimeter;
+  for (auto& corner : p) corner = incentre + scale * (corner - incentre);
   return p;
 }
 

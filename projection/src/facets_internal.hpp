@@ -39,8 +39,8 @@ FacetMesh build_adaptive_layout(const Warp& warp, double target_px, int max_cell
 // into (a, b, c). nullopt when the chord plane passes through (or nearly through) the eye.
 std::optional<Facet> make_facet(const FacetVertex& a, const FacetVertex& b, const FacetVertex& c);
 
-// Corners of facet f scaled about their centroid on the chord plane so that each edge moves
-// outwards by at most guard_px output pixels.
+// Corners of facet f scaled about their incentre on the chord plane so that every edge moves
+// outwards by exactly guard_px output pixels.
 std::array<glm::dvec3, 3> guarded_corners(const FacetMesh& mesh, std::uint32_t f, double guard_px);
 
 // Output-pixel distance between the facet and the exact warp, with s wrapped for 360° bases.

@@ -17,8 +17,8 @@
 
 namespace facet {
 
-// Facets may overlap their neighbours by this much (output pixels) so that no pixel on a seam is
-// lost to rounding; DESIGN.md allows at most 0.05 px.
+// Every facet reaches this far (output pixels) past each of its edges, so that no pixel on a seam
+// is lost to rounding; DESIGN.md allows at most 0.05 px.
 inline constexpr double kDefaultGuardPx = 0.03;
 
 struct FacetVertex {
@@ -55,8 +55,9 @@ struct FacetMesh {
   std::vector<std::uint32_t> cell_first_facet;
 
   // Guarded clip planes of facet f for gl_ClipDistance: the edge planes of the facet's corners
-  // scaled about its centroid on the chord plane so that each edge moves outwards by at most
-  // guard_px output pixels. X is inside when plane[k]·X >= 0.
+  // scaled about its incentre on the chord plane so that every edge moves outwards by exactly
+  // guard_px output pixels (the facet's projection is affine on its chord plane, so the move is
+  // the same all along each edge). X is inside when plane[k]·X >= 0.
   std::array<glm::dvec3, 3> clip_planes(std::uint32_t f, double guard_px = kDefaultGuardPx) const;
   // The three corner points of facet f.
   std::array<glm::dvec3, 3> corners(std::uint32_t f) const;
