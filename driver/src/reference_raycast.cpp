@@ -200,9 +200,17 @@ EdgeDisplacement ReferenceRaycaster::edge_displacement(
     if (options.wrap_x) q.x -= std::floor(q.x / size.x) * size.x;
     return inverse.invert(q).has_value();
   };
+  // Where edges lie is the warp's map, which goes on past its coverage (the offsets are defined
+  // there, and facets straddling the coverage's edge follow it). Searching covered positions only
+  // measured a pixel on the coverage's edge (dome4 at 1 px, output 1, (88, 0)) as 1.74 px from
+  // where its triangle is seen, which lay just outside the coverage; with the map continued the
+  // worst pixel of that run is 0.90 px, within its facet error of 0.97 px.
+  Warp continued_warp = inverse.warp();
+  continued_warp.coverage.assign(continued_warp.coverage.size(), 1.0f);
+  const WarpInverse continued(std::move(continued_warp));
   auto id_at = [&](glm::dvec2 q) -> std::uint32_t {
     if (options.wrap_x) q.x -= std::floor(q.x / size.x) * size.x;
-    const auto found = inverse.invert(q);
+    const auto found = continued.invert(q);
     return found ? id_along(p_eye_world, R_world_eye * found->v_eye) : 0u;
   };
 
@@ -223,7 +231,7 @@ EdgeDisplacement ReferenceRaycaster::edge_displacement(
   // pixels. Empty without a preimage or with a corner 90° or more from the anchor's direction.
   auto corners_around = [&](glm::dvec2 anchor,
                             std::uint32_t id) -> std::optional<std::array<glm::dvec2, 3>> {
-    const auto at_anchor = inverse.invert(anchor);
+    const auto at_anchor = continued.invert(anchor);
     if (!at_anchor) return std::nullopt;
     const glm::dvec3 v = glm::normalize(at_anchor->v_eye);
     constexpr double kEpsPx = 1.0 / 64;
@@ -231,7 +239,8 @@ EdgeDisplacement ReferenceRaycaster::edge_displacement(
     for (int axis = 0; axis < 2; ++axis) {
       glm::dvec2 offset(0.0);
       offset[axis] = kEpsPx;
-      const auto plus = inverse.invert(anchor + offset), minus = inverse.invert(anchor - offset);
+      const auto plus = continued.invert(anchor + offset),
+                 minus = continued.invert(anchor - offset);
       if (!plus || !minus) return std::nullopt;
       dv_dq[axis] =
           (plus->v_eye / glm::dot(plus->v_eye, v) - minus->v_eye / glm::dot(minus->v_eye, v)) /

@@ -301,6 +301,39 @@ TEST(EdgeDisplacement, ShiftedRectangleIsMeasuredAgainstTheExactEdges) {
 // reference image shows few of its pixel centres; a tested image that gives the diagonal's
 // pixels to the other triangle, as a renderer moving the diagonal by a fraction of a pixel
 // does, is tens of pixels off by the image-based distance and within a pixel by the exact one.
+// A triangle drawn one pixel past its edge where that edge lies just outside the warp's coverage
+// (as where facets straddle the coverage's edge): the warp's map goes on there, and the distance
+// is measured through it. Searching covered positions only found the triangle nowhere.
+TEST(EdgeDisplacement, EdgesJustPastTheCoverageAreFound) {
+  Scene scene;
+  // tan_x = x/100 − 1 at z = −2: the rectangles meet at x = 49.5 px.
+  add_rectangle(scene, {-2, -1}, {-1.01f, 1}, -2);  // IDs 1, 2: x < 49.5
+  add_rectangle(scene, {-1.01f, -1}, {2, 1}, -2);   // IDs 3, 4
+  Warp warp = square_view();
+  warp.grid_size = {3, 3};
+  warp.offset_px.assign(9, glm::vec2(0));
+  warp.coverage.assign(9, 1.0f);
+  // The left column of nodes uncovered: coverage crosses 0.5 at x = 50 px.
+  for (int j = 0; j < 3; ++j) warp.coverage[warp.node_index(0, j)] = 0;
+  const ReferenceRaycaster raycaster(scene);
+  const WarpInverse inverse(warp);
+  const std::vector<std::uint32_t> reference = raycaster.ids(inverse, glm::dmat4(1));
+  std::vector<std::uint32_t> tested = reference;
+  for (int y = 60; y < 140; ++y) {
+    const std::size_t at = std::size_t(y) * 200 + 50;
+    ASSERT_GE(reference[at], 3u);
+    ASSERT_EQ(reference[at - 1], 0u);  // uncovered
+    // The left rectangle's triangle that the ray through (49, y + 0.5) meets.
+    tested[at] = raycaster.id_along(glm::dvec3(0), {49.0 / 100 - 1, 1 - (y + 0.5) / 100, -1});
+    ASSERT_TRUE(tested[at] == 1u || tested[at] == 2u);
+  }
+  const EdgeDisplacement e =
+      raycaster.edge_displacement(inverse, glm::dmat4(1), reference, tested, {});
+  EXPECT_EQ(e.differing_pixels, 80u);
+  EXPECT_EQ(e.beyond_window, 0u);
+  EXPECT_NEAR(e.max_px, 1.0, 1e-3);  // from the pixel centre 50.5 to the edge at 49.5
+}
+
 TEST(EdgeDisplacement, SliverIsMeasuredWhereItLies) {
   Scene scene;
   // tan_y in (0.0035, 0.0055) · 2 m: output rows y ∈ (99.45, 99.65), so only row 99's centres
