@@ -357,7 +357,8 @@ NodeDirections node_directions(const Warp& warp, glm::ivec2 grid_size, int conti
     for (int i = 0; i < grid_size.x; ++i) {
       const std::size_t k = std::size_t(j) * grid_size.x + i;
       if (nodes.shown[k]) continue;
-      bool near_shown = false;
+      // Rings as wide as the grid take every node without looking.
+      bool near_shown = continued_rings >= std::max(grid_size.x, grid_size.y);
       for (int dj = -continued_rings; dj <= continued_rings && !near_shown; ++dj) {
         for (int di = -continued_rings; di <= continued_rings && !near_shown; ++di) {
           const int i1 = i + di, j1 = j + dj;

@@ -1,4 +1,5 @@
-// SGCT cluster configurations with SCISS meshes and masks into an imported display.
+// SGCT cluster configurations with SCISS or SimCAD meshes and masks: import into a display, and
+// a display exported as one.
 #include "facet/interop/sgct_cluster.hpp"
 
 #include <algorithm>
@@ -105,8 +106,8 @@ SgcMesh planar_projection(const pugi::xml_node& viewport, const std::string& sou
         std::abs(frustum.up_deg) < 89 && std::abs(frustum.down_deg) < 89 &&
         frustum.left_deg < frustum.right_deg && frustum.down_deg < frustum.up_deg)) {
     throw InputError(source, fov_path,
-                     "expected edge angles within (−89°, 89°) that enclose the axis' side "
-                     "(left + right > 0, up + down > 0)");
+                     "expected left, right, up and down within (−89°, 89°) with the left edge "
+                     "left of the right one and the bottom edge below the top one");
   }
   const pugi::xml_node orientation = projection.child("Orientation");
   const std::string orientation_path = projection_path + "/Orientation";
