@@ -56,6 +56,20 @@ fs::path fresh_folder(const std::string& name) {
   return folder;
 }
 
+// Runs `import_command` with --out FOLDER/display, then renders one headless frame of the
+// imported display.json into FOLDER/frames (with `run_options`).
+void import_then_run(const fs::path& folder, const std::string& import_command,
+                     const std::string& run_options = "") {
+  ASSERT_EQ(run(import_command + " --out " + (folder / "display").string(), folder / "import.log"),
+            0)
+      << slurp(folder / "import.log");
+  ASSERT_EQ(run("run " + (folder / "display" / "display.json").string() + " --headless --frames 1" +
+                    run_options + " --out " + (folder / "frames").string(),
+                folder / "run.log"),
+            0)
+      << slurp(folder / "run.log");
+}
+
 TEST(RunCli, HeadlessSessionRendersTheSamePixelsAsRender) {
   const fs::path folder = fresh_folder("same");
   const std::string common =
@@ -120,17 +134,9 @@ TEST(RunCli, AnImportedSphericalMirrorMeshRendersAtItsDefaultTolerance) {
   // A real Paul Bourke mesh from another tool, imported as is: display.json asks for 0.25 px, which
   // only the bisection builder reaches at the mirror's crowded top corners.
   const fs::path folder = fresh_folder("mirror");
-  ASSERT_EQ(run("bourke import " + std::string(FACET_SHARED_DATA_DIR) +
-                    "/warps/sgct-mesh/standard_16x9.data --size 480x270 --out " +
-                    (folder / "display").string(),
-                folder / "import.log"),
-            0)
-      << slurp(folder / "import.log");
-  ASSERT_EQ(run("run " + (folder / "display" / "display.json").string() +
-                    " --headless --frames 1 --out " + (folder / "frames").string(),
-                folder / "run.log"),
-            0)
-      << slurp(folder / "run.log");
+  ASSERT_NO_FATAL_FAILURE(
+      import_then_run(folder, "bourke import " + std::string(FACET_SHARED_DATA_DIR) +
+                                  "/warps/sgct-mesh/standard_16x9.data --size 480x270"));
   const Png png = read_png(folder / "frames" / "standard_16x9" / "00000.png");
   ASSERT_EQ(png.width, 480);
   // The city fills most of the mirror's image; its black sky the rest.
@@ -140,17 +146,10 @@ TEST(RunCli, AnImportedSphericalMirrorMeshRendersAtItsDefaultTolerance) {
 TEST(RunCli, AnImportedMpcdiFileOfAnotherToolRenders) {
   // SGCT's real MPCDI 3d container: one 512×540 region whose frustum looks up and to the left.
   const fs::path folder = fresh_folder("mpcdi");
-  ASSERT_EQ(
-      run("mpcdi import " + std::string(FACET_SHARED_DATA_DIR) +
-              "/warps/sgct-mpcdi/correction_mesh.mpcdi --out " + (folder / "display").string(),
-          folder / "import.log"),
-      0)
-      << slurp(folder / "import.log");
-  ASSERT_EQ(run("run " + (folder / "display" / "display.json").string() +
-                    " --headless --frames 1 --scale 0.5 --out " + (folder / "frames").string(),
-                folder / "run.log"),
-            0)
-      << slurp(folder / "run.log");
+  ASSERT_NO_FATAL_FAILURE(import_then_run(folder,
+                                          "mpcdi import " + std::string(FACET_SHARED_DATA_DIR) +
+                                              "/warps/sgct-mpcdi/correction_mesh.mpcdi",
+                                          " --scale 0.5"));
   const fs::path frames = folder / "frames";
   fs::path frame;
   for (const auto& entry : fs::directory_iterator(frames)) {
@@ -178,16 +177,8 @@ TEST(RunCli, AnImportedScissDomeRendersEveryChannel) {
     xml.replace(at, full_size.size(), small_size);
   }
   std::ofstream(folder / "config" / "dome_alpha.xml") << xml;
-  ASSERT_EQ(run("sgct import " + (folder / "config" / "dome_alpha.xml").string() + " --out " +
-                    (folder / "display").string(),
-                folder / "import.log"),
-            0)
-      << slurp(folder / "import.log");
-  ASSERT_EQ(run("run " + (folder / "display" / "display.json").string() +
-                    " --headless --frames 1 --out " + (folder / "frames").string(),
-                folder / "run.log"),
-            0)
-      << slurp(folder / "run.log");
+  ASSERT_NO_FATAL_FAILURE(
+      import_then_run(folder, "sgct import " + (folder / "config" / "dome_alpha.xml").string()));
   for (int channel = 1; channel <= 6; ++channel) {
     const Png png =
         read_png(folder / "frames" / ("Channel_" + std::to_string(channel)) / "00000.png");
