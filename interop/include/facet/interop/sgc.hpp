@@ -90,7 +90,8 @@ struct SgcImportOptions {
   glm::ivec2 output_size{1920, 1200};
   // 0: automatic: the mesh's node counts where one side is regular (else one node per 8 output
   // pixels), doubled (up to 1025 per side) while the mesh is followed worse than
-  // `follow_bound_px` (worst over a barycentric lattice of sevenths in every triangle).
+  // `follow_bound_px` (worst over a barycentric lattice of sevenths in every triangle). A
+  // bilinear grid (SimCAD) is taken node for node whatever this says.
   glm::ivec2 warp_grid{0, 0};
   double follow_bound_px = 0.25;
 };
