@@ -350,9 +350,7 @@ NodeDirections node_directions(const Warp& warp, glm::ivec2 grid_size, int conti
     }
   }
   if (continued_rings == 0) return nodes;
-  Warp continued = warp;
-  continued.coverage.assign(continued.coverage.size(), 1.0f);
-  const WarpInverse continued_inverse(std::move(continued));
+  const WarpInverse continued = continued_inverse(warp);
   for (int j = 0; j < grid_size.y; ++j) {
     for (int i = 0; i < grid_size.x; ++i) {
       const std::size_t k = std::size_t(j) * grid_size.x + i;
@@ -367,7 +365,7 @@ NodeDirections node_directions(const Warp& warp, glm::ivec2 grid_size, int conti
         }
       }
       if (!near_shown) continue;
-      if (auto inverted = continued_inverse.invert(q_of(i, j))) nodes.v_eye[k] = inverted->v_eye;
+      if (auto inverted = continued.invert(q_of(i, j))) nodes.v_eye[k] = inverted->v_eye;
     }
   }
   return nodes;

@@ -16,24 +16,11 @@ glm::dmat3 rotation_about(glm::dvec3 axis, double degrees) {
   return glm::dmat3(glm::rotate(glm::dmat4(1.0), glm::radians(degrees), axis));
 }
 
-double number(const std::string& text, const std::string& source, const std::string& field) {
-  const char* begin = text.c_str();
-  while (*begin == ' ' || *begin == '\t' || *begin == '\n' || *begin == '\r') ++begin;
-  char* end = nullptr;
-  const double value = std::strtod(begin, &end);
-  while (end && (*end == ' ' || *end == '\t' || *end == '\n' || *end == '\r')) ++end;
-  if (end == begin || !end || *end != '\0' || !std::isfinite(value)) {
-    throw InputError(source, field,
-                     "expected a finite number, found \"" + text.substr(0, 40) + "\"");
-  }
-  return value;
-}
-
 double attribute_number(const pugi::xml_node& node, const char* name, const std::string& source,
                         const std::string& path) {
   const pugi::xml_attribute attribute = node.attribute(name);
   if (!attribute) throw InputError(source, path + "@" + name, "expected this attribute");
-  return number(attribute.value(), source, path + "@" + name);
+  return parse_number(attribute.value(), source, path + "@" + name);
 }
 
 int attribute_resolution(const pugi::xml_node& node, const char* name, const std::string& source,
@@ -49,7 +36,7 @@ double child_number(const pugi::xml_node& node, const char* name, const std::str
                     const std::string& path) {
   const pugi::xml_node child = node.child(name);
   if (!child) throw InputError(source, path + "/" + name, "expected this element");
-  return number(child.text().get(), source, path + "/" + name);
+  return parse_number(child.text().get(), source, path + "/" + name);
 }
 
 std::optional<MpcdiMap> read_map(const pugi::xml_node& fileset, const char* name,

@@ -59,9 +59,9 @@ class TriangleLocator {
     buckets_ = {n, n};
     cells_.resize(std::size_t(n) * n);
     for (std::uint32_t k = 0; k < mesh.triangles.size(); ++k) {
+      if (!proper[k]) continue;
       const glm::uvec3 t = mesh.triangles[k];
       const glm::dvec2 a = point(t.x), b = point(t.y), c = point(t.z);
-      if (!proper[k]) continue;
       const glm::ivec2 b0 = bucket(glm::min(a, glm::min(b, c)));
       const glm::ivec2 b1 = bucket(glm::max(a, glm::max(b, c)));
       for (int j = b0.y; j <= b1.y; ++j) {
@@ -76,14 +76,10 @@ class TriangleLocator {
     if (p.x < lo_.x || p.y < lo_.y || p.x > hi_.x || p.y > hi_.y) return std::nullopt;
     const glm::ivec2 b = bucket(p);
     for (std::uint32_t k : cells_[std::size_t(b.y) * buckets_.x + b.x]) {
-      const glm::uvec3 t = mesh_.triangles[k];
-      const glm::dvec2 a = point(t.x), e1 = point(t.y) - a, e2 = point(t.z) - a;
-      const double area = cross(e1, e2);
-      const double w1 = cross(p - a, e2) / area, w2 = cross(e1, p - a) / area;
-      const double w0 = 1 - w1 - w2;
+      const glm::dvec3 w = barycentric(k, p);
       constexpr double slack = -1e-9;
-      if (w0 < slack || w1 < slack || w2 < slack) continue;
-      return w0 * other(t.x) + w1 * other(t.y) + w2 * other(t.z);
+      if (w.x < slack || w.y < slack || w.z < slack) continue;
+      return interpolate(k, w);
     }
     return std::nullopt;
   }
@@ -111,14 +107,23 @@ class TriangleLocator {
       if (nearest && last_ring > ring + 1) last_ring = ring + 1;
     }
     if (!nearest) return std::nullopt;
-    const glm::uvec3 t = mesh_.triangles[*nearest];
-    const glm::dvec2 a = point(t.x), e1 = point(t.y) - a, e2 = point(t.z) - a;
-    const double area = cross(e1, e2);
-    const double w1 = cross(p - a, e2) / area, w2 = cross(e1, p - a) / area;
-    return (1 - w1 - w2) * other(t.x) + w1 * other(t.y) + w2 * other(t.z);
+    return interpolate(*nearest, barycentric(*nearest, p));
   }
 
  private:
+  // Barycentric coordinates of p in triangle k of this space (any sign: outside it too).
+  glm::dvec3 barycentric(std::uint32_t k, glm::dvec2 p) const {
+    const glm::uvec3 t = mesh_.triangles[k];
+    const glm::dvec2 a = point(t.x), e1 = point(t.y) - a, e2 = point(t.z) - a;
+    const double area = cross(e1, e2);
+    const double w1 = cross(p - a, e2) / area, w2 = cross(e1, p - a) / area;
+    return {1 - w1 - w2, w1, w2};
+  }
+  // The other space's position at barycentric coordinates w of triangle k.
+  glm::dvec2 interpolate(std::uint32_t k, glm::dvec3 w) const {
+    const glm::uvec3 t = mesh_.triangles[k];
+    return w.x * other(t.x) + w.y * other(t.y) + w.z * other(t.z);
+  }
   glm::dvec2 at(const SgcVertex& v) const { return in_output_ ? v.q_norm : v.st; }
   glm::dvec2 point(std::uint32_t i) const { return at(mesh_.vertices[i]); }
   glm::dvec2 other(std::uint32_t i) const {
@@ -404,15 +409,10 @@ SgcMesh parse_simcad(std::string_view xml, const SgcMesh& frustum, const std::st
     std::istringstream numbers(node.text().get());
     std::string token;
     while (numbers >> token) {
-      std::size_t used = 0;
-      double value = std::numeric_limits<double>::quiet_NaN();
-      try {
-        value = std::stod(token, &used);
-      } catch (const std::exception&) {
-      }
-      if (used != token.size() || !std::isfinite(value) || std::abs(value) > 100 * axis.range) {
+      const double value = parse_number(token, source, field);
+      if (std::abs(value) > 100 * axis.range) {
         throw InputError(source, field,
-                         "expected finite pixel offsets, found \"" + token.substr(0, 40) + "\"");
+                         "expected pixel offsets within 100 ranges, found " + token.substr(0, 40));
       }
       axis.values.push_back(value);
       if (axis.values.size() > kMaxCount) {
@@ -530,18 +530,18 @@ SgcImport import_sgc(const SgcMesh& mesh, const SgcImportOptions& options,
   };
   ImportedProjector& projector = result.projector;
   projector.name = name;
-  glm::ivec2 grid = options.warp_grid.x >= 2 ? options.warp_grid : *mesh_grid;
+  projector.output.kind = projection_io::DisplayOutput::Kind::window;
+  projector.output.window = {0, 0, options.output_size.x, options.output_size.y};
+  char text[240];
   if (mesh.bilinear_grid && result.side == SgcGridSide::texture) {
     projector.warp = build(*mesh_grid);
     projector.warp.validate(source);
-    char text[160];
     std::snprintf(text, sizeof text, "a %d×%d node grid over the frustum image, taken as it is",
                   mesh_grid->x, mesh_grid->y);
     projector.notes.push_back(text);
-    projector.output.kind = projection_io::DisplayOutput::Kind::window;
-    projector.output.window = {0, 0, options.output_size.x, options.output_size.y};
     return result;
   }
+  glm::ivec2 grid = options.warp_grid.x >= 2 ? options.warp_grid : *mesh_grid;
   for (;;) {
     projector.warp = build(grid);
     result.worst_follow_px = worst_follow_px(mesh, proper, projector.warp);
@@ -553,7 +553,6 @@ SgcImport import_sgc(const SgcMesh& mesh, const SgcImportOptions& options,
     grid = finer;
   }
   projector.warp.validate(source);
-  char text[240];
   std::snprintf(text, sizeof text,
                 "%zu vertices, regular over the %s; warp grid %d×%d follows the mesh within "
                 "%.3f px (worst over a lattice of sevenths in every triangle)",
@@ -570,8 +569,6 @@ SgcImport import_sgc(const SgcMesh& mesh, const SgcImportOptions& options,
                   mesh.position.x, mesh.position.y, mesh.position.z);
     projector.notes.push_back(text);
   }
-  projector.output.kind = projection_io::DisplayOutput::Kind::window;
-  projector.output.window = {0, 0, options.output_size.x, options.output_size.y};
   return result;
 }
 

@@ -34,20 +34,7 @@ std::string read_file(const std::filesystem::path& path, const std::string& sour
 double number_attribute(const pugi::xml_node& node, const char* name, double fallback,
                         const std::string& source, const std::string& path) {
   const pugi::xml_attribute attribute = node.attribute(name);
-  if (!attribute) return fallback;
-  const std::string text = attribute.value();
-  std::size_t used = 0;
-  double value = 0;
-  try {
-    value = std::stod(text, &used);
-  } catch (const std::exception&) {
-    used = 0;
-  }
-  if (used == 0 || used != text.size() || !std::isfinite(value)) {
-    throw InputError(source, path + "@" + name,
-                     "expected a number, found \"" + text.substr(0, 40) + "\"");
-  }
-  return value;
+  return attribute ? parse_number(attribute.value(), source, path + "@" + name) : fallback;
 }
 
 // The first of `names` the element has, or "".
@@ -78,6 +65,16 @@ std::filesystem::path resolve(const std::string& written, const std::filesystem:
                        "\" next to the configuration exists");
 }
 
+// A mesh header (no vertices) holding `frustum`: its edge angles, and its rotation as the
+// quaternion of R_eye_frustum.
+SgcMesh sgc_header(const MpcdiFrustum& frustum) {
+  SgcMesh header;
+  header.q_world_frustum = glm::normalize(glm::quat_cast(R_eye_frustum(frustum)));
+  header.up_deg = frustum.up_deg, header.down_deg = frustum.down_deg;
+  header.left_deg = frustum.left_deg, header.right_deg = frustum.right_deg;
+  return header;
+}
+
 // The frustum of a viewport's <PlanarProjection>: <FOV left right up down> (degrees, each positive
 // outwards from the axis, so down="-7.7" puts the bottom edge above it) and <Orientation> as
 // heading, pitch, roll (degrees, R = Ry(−heading)·Rx(pitch)·Rz(−roll), as facet reads MPCDI
@@ -97,7 +94,7 @@ SgcMesh planar_projection(const pugi::xml_node& viewport, const std::string& sou
     if (!node.attribute(name)) throw InputError(source, at + "@" + name, "expected this attribute");
     return number_attribute(node, name, 0, source, at);
   };
-  SgcMesh frustum;
+  MpcdiFrustum frustum;
   frustum.left_deg = -required(fov, "left", fov_path);
   frustum.right_deg = required(fov, "right", fov_path);
   frustum.up_deg = required(fov, "up", fov_path);
@@ -118,15 +115,14 @@ SgcMesh planar_projection(const pugi::xml_node& viewport, const std::string& sou
     if (!(glm::length(q) > 0.5 && glm::length(q) < 2)) {
       throw InputError(source, orientation_path, "expected a unit quaternion x, y, z, w");
     }
-    frustum.q_world_frustum = glm::normalize(q);
-  } else {
-    MpcdiFrustum angles;
-    angles.yaw_deg = number_attribute(orientation, "heading", 0, source, orientation_path);
-    angles.pitch_deg = number_attribute(orientation, "pitch", 0, source, orientation_path);
-    angles.roll_deg = number_attribute(orientation, "roll", 0, source, orientation_path);
-    frustum.q_world_frustum = glm::normalize(glm::quat_cast(R_eye_frustum(angles)));
+    SgcMesh header = sgc_header(frustum);
+    header.q_world_frustum = glm::normalize(q);
+    return header;
   }
-  return frustum;
+  frustum.yaw_deg = number_attribute(orientation, "heading", 0, source, orientation_path);
+  frustum.pitch_deg = number_attribute(orientation, "pitch", 0, source, orientation_path);
+  frustum.roll_deg = number_attribute(orientation, "roll", 0, source, orientation_path);
+  return sgc_header(frustum);
 }
 
 bool has_extension(const std::string& path, const std::string& extension) {
@@ -195,12 +191,11 @@ ImportedDisplay import_sgct_cluster(const std::filesystem::path& config,
                            "expected a SCISS .sgc or SimCAD .simcad mesh, found \"" + mesh_written +
                                "\" (MPCDI and Paul Bourke meshes have their own import commands)");
         }
-        glm::dvec2 fraction_pos{0.0}, fraction_size{1.0};
         const pugi::xml_node vp_pos = viewport.child("Pos"), vp_size = viewport.child("Size");
-        fraction_pos = {number_attribute(vp_pos, "x", 0, source, path + "/Pos"),
-                        number_attribute(vp_pos, "y", 0, source, path + "/Pos")};
-        fraction_size = {number_attribute(vp_size, "x", 1, source, path + "/Size"),
-                         number_attribute(vp_size, "y", 1, source, path + "/Size")};
+        const glm::dvec2 fraction_pos{number_attribute(vp_pos, "x", 0, source, path + "/Pos"),
+                                      number_attribute(vp_pos, "y", 0, source, path + "/Pos")};
+        const glm::dvec2 fraction_size{number_attribute(vp_size, "x", 1, source, path + "/Size"),
+                                       number_attribute(vp_size, "y", 1, source, path + "/Size")};
         if (!(fraction_pos.x >= 0 && fraction_pos.y >= 0 && fraction_size.x > 0 &&
               fraction_size.y > 0 && fraction_pos.x + fraction_size.x <= 1 + 1e-9 &&
               fraction_pos.y + fraction_size.y <= 1 + 1e-9)) {
@@ -263,6 +258,33 @@ ImportedDisplay import_sgct_cluster(const std::filesystem::path& config,
   return display;
 }
 
+ImportedDisplay import_sgc_files(const std::vector<std::filesystem::path>& meshes,
+                                 glm::ivec2 output_size, glm::ivec2 warp_grid) {
+  FACET_ASSERT(!meshes.empty());
+  ImportedDisplay display;
+  display.name = meshes.front().stem().string();
+  SgcImportOptions import;
+  import.output_size = output_size;
+  import.warp_grid = warp_grid;
+  int x = 0;
+  for (const std::filesystem::path& path : meshes) {
+    const std::string source = path.string();
+    ImportedProjector projector = import_sgc(parse_sgc(read_file(path, source, ""), source), import,
+                                             source, sanitize_name(path.stem().string()))
+                                      .projector;
+    for (const ImportedProjector& other : display.projectors) {
+      if (other.name == projector.name) {
+        throw InputError(source, "",
+                         "expected file names that differ: two are \"" + projector.name + "\"");
+      }
+    }
+    projector.output.window = {x, 0, output_size.x, output_size.y};
+    x += output_size.x;
+    display.projectors.push_back(std::move(projector));
+  }
+  return display;
+}
+
 std::map<std::string, std::string> export_sgct(const projection_io::DisplayConfig& display,
                                                const SgctExportOptions& options) {
   FACET_ASSERT(options.node_spacing_px >= 1 && options.node_spacing_px <= 1024);
@@ -280,18 +302,15 @@ std::map<std::string, std::string> export_sgct(const projection_io::DisplayConfi
     const glm::dmat3 R_frustum_eye = glm::transpose(R_eye_frustum(frustum));
     const glm::ivec2 nodes{int(std::ceil(warp.output_size.x / options.node_spacing_px)) + 1,
                            int(std::ceil(warp.output_size.y / options.node_spacing_px)) + 1};
-    const NodeDirections directions = node_directions(warp, nodes, std::max(nodes.x, nodes.y));
-    std::vector<glm::dvec2> st(directions.v_eye.size(),
-                               glm::dvec2(std::numeric_limits<double>::quiet_NaN()));
-    for (std::size_t k = 0; k < st.size(); ++k) {
-      if (!directions.v_eye[k]) continue;
-      if (auto found = base.st_from_direction(R_frustum_eye * *directions.v_eye[k])) st[k] = *found;
-    }
+    // Every vertex, covered or not: rings as wide as the grid continue the map everywhere it
+    // reaches, and neighbours fill in the rest.
+    InverseGrid grid = inverse_grid_from_warp(
+        warp, nodes,
+        [&](const glm::dvec3& v_eye) { return base.st_from_direction(R_frustum_eye * v_eye); },
+        std::max(nodes.x, nodes.y));
+    std::vector<glm::dvec2>& st = grid.st;
     fill_missing(st, nodes, warp_path);
-    SgcMesh mesh;
-    mesh.q_world_frustum = glm::normalize(glm::quat_cast(R_eye_frustum(frustum)));
-    mesh.up_deg = frustum.up_deg, mesh.down_deg = frustum.down_deg;
-    mesh.left_deg = frustum.left_deg, mesh.right_deg = frustum.right_deg;
+    SgcMesh mesh = sgc_header(frustum);
     mesh.vertices.resize(st.size());
     for (int j = 0; j < nodes.y; ++j) {
       for (int i = 0; i < nodes.x; ++i) {

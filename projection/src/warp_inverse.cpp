@@ -257,4 +257,9 @@ std::int32_t WarpInverse::cell_at_pixel(glm::ivec2 pixel) const {
   return cell_of_pixel_[std::size_t(pixel.y) * warp_.output_size.x + pixel.x];
 }
 
+WarpInverse continued_inverse(Warp warp) {
+  warp.coverage.assign(warp.coverage.size(), 1.0f);
+  return WarpInverse(std::move(warp));
+}
+
 }  // namespace facet

@@ -38,29 +38,6 @@ double max_difference_px(const Warp& a, const Warp& b, int samples = 101, int in
   return worst;
 }
 
-// Where `original` sends eye directions against where `back` sends them (bases may differ):
-// worst case in output pixels over an st lattice of `original`, skipping directions `back` does
-// not cover and output positions within `margin_px` of the image edge.
-double max_direction_difference_px(const Warp& original, const Warp& back, double margin_px,
-                                   int samples = 81) {
-  double worst = 0;
-  for (int j = 0; j < samples; ++j) {
-    for (int i = 0; i < samples; ++i) {
-      const glm::dvec2 st{double(i) / (samples - 1), double(j) / (samples - 1)};
-      if (original.coverage_at(st) < 0.5) continue;
-      const glm::dvec2 q = original.q_from_st(st);
-      if (q.x < margin_px || q.y < margin_px || q.x > original.output_size.x - margin_px ||
-          q.y > original.output_size.y - margin_px) {
-        continue;
-      }
-      const auto p = back.project(original.v_eye_from_st(st));
-      if (!p || !p->covered) continue;
-      worst = std::max(worst, glm::length(p->q - q));
-    }
-  }
-  return worst;
-}
-
 // Fraction of an st lattice covered by `original` whose output lies at least `margin_px` inside
 // the image and which `back` covers too.
 double covered_fraction(const Warp& original, const Warp& back, double margin_px) {
@@ -249,7 +226,7 @@ TEST(MpcdiA3, OtherToolsFilesImportOnABaseOfTheirOwn) {
   MpcdiImportOptions options;
   options.warp_grid = glm::ivec2(65, 41);
   const Warp back = import_mpcdi(files, "nohint.mpcdi", options).projectors[0].warp;
-  const double worst = max_direction_difference_px(warp, back, 4);
+  const double worst = test::direction_difference(warp, back, 4).worst_px;
   std::printf("a3 without facet.json: max %.5f px\n", worst);
   EXPECT_LT(worst, 0.05);
   // The chosen base's margin and grid decide coverage near the image edge: measured 0.9986.
@@ -291,14 +268,14 @@ TEST(MpcdiA3, TheEyeOptionSetsWhereDirectionsStart) {
   EXPECT_NEAR(display.eye.x, -0.3, 1e-12);
   EXPECT_NEAR(display.eye.y, 1.2, 1e-12);
   EXPECT_NEAR(display.eye.z, 0.5, 1e-12);
-  const double worst = max_direction_difference_px(truth, display.projectors[0].warp, 4);
+  const double worst = test::direction_difference(truth, display.projectors[0].warp, 4).worst_px;
   std::printf("a3 plane seen from --eye: max %.5f px\n", worst);
   EXPECT_LT(worst, 0.05);
   // Without the eye, the origin is a guess the import says it made, and the directions are off.
   const ImportedDisplay guessed = import_mpcdi(files, "eye.mpcdi");
   ASSERT_EQ(guessed.notes.size(), 1u);
   EXPECT_NE(guessed.notes[0].find("--eye"), std::string::npos);
-  EXPECT_GT(max_direction_difference_px(truth, guessed.projectors[0].warp, 4), 5.0);
+  EXPECT_GT(test::direction_difference(truth, guessed.projectors[0].warp, 4).worst_px, 5.0);
 }
 
 std::string a3_xml(const std::string& warp_children, const std::string& second_region = "") {

@@ -2,6 +2,7 @@
 // Shared helpers of the interop tests: scratch folders and small synthetic warps.
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <glm/glm.hpp>
@@ -47,6 +48,39 @@ inline Warp calibrated_like_warp(glm::ivec2 output_size = {640, 400}, glm::ivec2
     }
   }
   return warp;
+}
+
+// Where `original` sends eye directions against where `back` sends them (their bases may differ),
+// over a `samples`² st lattice of `original`, skipping directions it does not cover and output
+// positions within `margin_px` of the image edge: the worst distance, output px, among directions
+// `back` covers; how many were compared; how many `back` does not cover.
+struct DirectionDifference {
+  double worst_px = 0;
+  int compared = 0;
+  int uncovered = 0;
+};
+inline DirectionDifference direction_difference(const Warp& original, const Warp& back,
+                                                double margin_px, int samples = 81) {
+  DirectionDifference d;
+  for (int j = 0; j < samples; ++j) {
+    for (int i = 0; i < samples; ++i) {
+      const glm::dvec2 st{double(i) / (samples - 1), double(j) / (samples - 1)};
+      if (original.coverage_at(st) < 0.5) continue;
+      const glm::dvec2 q = original.q_from_st(st);
+      if (q.x < margin_px || q.y < margin_px || q.x > original.output_size.x - margin_px ||
+          q.y > original.output_size.y - margin_px) {
+        continue;
+      }
+      const auto p = back.project(original.v_eye_from_st(st));
+      if (!p || !p->covered) {
+        ++d.uncovered;
+        continue;
+      }
+      d.worst_px = std::max(d.worst_px, glm::length(p->q - q));
+      ++d.compared;
+    }
+  }
+  return d;
 }
 
 }  // namespace facet::interop::test

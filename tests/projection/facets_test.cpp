@@ -157,8 +157,9 @@ TEST(Facets, ClipMatrixAgreesWithTheProjection) {
 }
 
 TEST(Facets, GuardBandIsTheRequestedPixelsOnEveryEdge) {
-  // 40 strips of 25×800 px: thin facets, whose long edges a scaling about the centroid moved by
-  // 0.003 px for a 0.05 px guard.
+  // 40 strips of 25×800 px: thin facets. A scaling about the centroid sized for the short edge
+  // (266.7 px from the centroid) moved the long ones (8.3 px from it) by 0.05·8.3/266.7 = 0.0016
+  // px for a 0.05 px guard.
   const Warp warp = Warp::analytic(BaseProjection::cylindrical(-90, 90, 1, -1), {1000, 800});
   const FacetMesh mesh = build_facets(warp, {FacetStrips{40}});
   const double guard_px = 0.05;

@@ -1,8 +1,8 @@
 // facet sgct: SGCT cluster configurations with SCISS .sgc or SimCAD meshes, or bare .sgc meshes,
 // into a display folder; and a display out as an SGCT cluster.
-#include <fstream>
+#include <cctype>
+#include <filesystem>
 #include <iostream>
-#include <sstream>
 
 #include "command.hpp"
 #include "display_flags.hpp"
@@ -13,11 +13,11 @@
 namespace facet::cli {
 namespace {
 
-bool ends_with_sgc(const std::string& path) {
-  if (path.size() < 4) return false;
-  std::string tail = path.substr(path.size() - 4);
-  for (char& c : tail) c = char(std::tolower(static_cast<unsigned char>(c)));
-  return tail == ".sgc";
+// ".sgc" for "D/Channel1.SGC".
+std::string lowercase_extension(const std::string& file) {
+  std::string extension = std::filesystem::path(file).extension().string();
+  for (char& c : extension) c = char(std::tolower(static_cast<unsigned char>(c)));
+  return extension;
 }
 
 const Registration registration{
@@ -93,49 +93,27 @@ const Registration registration{
           }
         }
         for (const std::string& file : options->files) {
-          if (file.size() >= 7 && file.compare(file.size() - 7, 7, ".simcad") == 0) {
+          if (lowercase_extension(file) == ".simcad") {
             throw InputError(file, "",
                              "a .simcad mesh holds no frustum: import the SGCT cluster file whose "
                              "viewport names it with a <PlanarProjection>");
           }
         }
-        const bool meshes = ends_with_sgc(options->files.front());
+        const bool meshes = lowercase_extension(options->files.front()) == ".sgc";
         if (!meshes && options->files.size() != 1) {
           throw InputError(options->files[1], "",
                            "expected either one cluster configuration or .sgc meshes only");
         }
         interop::ImportedDisplay display;
         if (meshes) {
-          const glm::ivec2 size = parse_size(options->size, "--size");
-          display.name = std::filesystem::path(options->files.front()).stem().string();
-          int x = 0;
+          std::vector<std::filesystem::path> paths;
           for (const std::string& file : options->files) {
-            if (!ends_with_sgc(file)) {
+            if (lowercase_extension(file) != ".sgc") {
               throw InputError(file, "", "expected a .sgc mesh like the other files");
             }
-            std::ifstream stream(file, std::ios::binary);
-            if (!stream) throw InputError(file, "", "cannot open the file");
-            std::ostringstream bytes;
-            bytes << stream.rdbuf();
-            interop::SgcImportOptions import;
-            import.output_size = size;
-            import.warp_grid = grid;
-            interop::ImportedProjector projector =
-                interop::import_sgc(
-                    interop::parse_sgc(bytes.str(), file), import, file,
-                    interop::sanitize_name(std::filesystem::path(file).stem().string()))
-                    .projector;
-            for (const auto& other : display.projectors) {
-              if (other.name == projector.name) {
-                throw InputError(
-                    file, "",
-                    "expected file names that differ: two are \"" + projector.name + "\"");
-              }
-            }
-            projector.output.window = {x, 0, size.x, size.y};
-            x += size.x;
-            display.projectors.push_back(std::move(projector));
+            paths.emplace_back(file);
           }
+          display = interop::import_sgc_files(paths, parse_size(options->size, "--size"), grid);
         } else {
           interop::SgctImportOptions import;
           import.mask_gamma = options->gamma;

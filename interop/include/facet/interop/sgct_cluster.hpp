@@ -19,6 +19,7 @@
 #include <filesystem>
 #include <map>
 #include <string>
+#include <vector>
 
 #include "facet/interop/display_folder.hpp"
 #include "facet/interop/sgc.hpp"
@@ -37,6 +38,12 @@ struct SgctImportOptions {
 // viewport with a mesh, and every error of parse_sgc, parse_simcad and import_sgc.
 ImportedDisplay import_sgct_cluster(const std::filesystem::path& config,
                                     const SgctImportOptions& options);
+
+// Bare `.sgc` meshes, one projector each at `output_size`, named by file stem and placed left to
+// right. Throws InputError naming a file that cannot be read, does not parse or import, or
+// shares another's name.
+ImportedDisplay import_sgc_files(const std::vector<std::filesystem::path>& meshes,
+                                 glm::ivec2 output_size, glm::ivec2 warp_grid = {0, 0});
 
 struct SgctExportOptions {
   double node_spacing_px = 4;  // between mesh vertices, output px, in [1, 1024]

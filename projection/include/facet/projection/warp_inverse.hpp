@@ -71,4 +71,8 @@ class WarpInverse {
   std::vector<std::int32_t> bin_cells_;
 };
 
+// The inverse of the warp's map over its whole base image, coverage ignored: output positions
+// just past the coverage's edge invert too, the offsets being defined there.
+WarpInverse continued_inverse(Warp warp);
+
 }  // namespace facet
