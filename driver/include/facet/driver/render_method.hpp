@@ -95,6 +95,10 @@ struct RenderStats {
   // triangle's first on a 360° base (seam copies, included in replicas).
   std::uint64_t dropped_triangles = 0;
   std::uint64_t seam_copies = 0;
+  // GPU memory the method holds for this frame beyond the scene itself, bytes: the facet methods'
+  // pair, staging, scan and triangle-list buffers and facet tables; the cube map's faces; the
+  // seed paper's Vbuf column.
+  std::uint64_t gpu_buffer_bytes = 0;
   // replicas / triangles_in; the seed paper's replication ratio.
   double replication_ratio() const {
     return triangles_in == 0 ? 0.0 : double(replicas) / double(triangles_in);
