@@ -1,6 +1,7 @@
 #include "facet/driver/facet_gpu.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 
 #include "facet/projection/errors.hpp"
@@ -74,6 +75,32 @@ std::vector<GpuCoverageNode> pack_coverage_nodes(const CoverageIndex& index) {
   return packed;
 }
 
+std::vector<std::uint32_t> pack_coverage_grid(const CoverageGrid& grid) {
+  std::vector<std::uint32_t> words(kGridHeaderWords, 0);
+  const auto bits = [](double value) { return std::bit_cast<std::uint32_t>(float(value)); };
+  words[0] = std::uint32_t(grid.chart());
+  words[1] = grid.periodic() ? 1u : 0u;
+  words[2] = grid.columns();
+  words[3] = grid.rows();
+  words[4] = bits(grid.p0());
+  words[5] = bits(grid.q0());
+  words[6] = bits(grid.dp());
+  words[7] = bits(grid.dq());
+  words[8] = bits(grid.radius_cap());
+  const glm::dmat3& R = grid.R_base_eye();
+  for (int c = 0; c < 3; ++c)
+    for (int r = 0; r < 3; ++r) words[12 + 3 * c + r] = bits(R[c][r]);
+  words[9] = std::uint32_t(words.size());
+  words.insert(words.end(), grid.bucket_first().begin(), grid.bucket_first().end());
+  words[10] = std::uint32_t(words.size());
+  words.insert(words.end(), grid.bucket_facets().begin(), grid.bucket_facets().end());
+  words[11] = std::uint32_t(words.size());
+  for (const BucketRange& r : grid.facet_buckets()) {
+    words.insert(words.end(), {r.first_column, r.first_row, r.columns, r.rows});
+  }
+  return words;
+}
+
 std::vector<GpuRecord> make_records(const Scene& scene) {
   std::vector<GpuRecord> records;
   std::uint32_t next_id = 1;
@@ -97,7 +124,8 @@ std::vector<GpuRecord> make_records(const Scene& scene) {
 FacetSet FacetSet::build(const Warp& warp, const FacetBuildOptions& options, double z_near) {
   FacetMesh mesh = build_facets(warp, options);
   CoverageIndex index(mesh);
-  FacetSet set{std::move(mesh), std::move(index), {}, {}, {}, {}};
+  CoverageGrid grid(mesh, warp.base, warp.R_eye_base);
+  FacetSet set{std::move(mesh), std::move(index), std::move(grid), {}, {}, {}, {}, {}};
   set.gpu_facets = pack_facets(set.mesh, z_near);
   const auto nodes = pack_coverage_nodes(set.index);
   // Empty buffers cannot be bound; keep one dummy element so that every binding is valid.
@@ -107,6 +135,7 @@ FacetSet FacetSet::build(const Warp& warp, const FacetBuildOptions& options, dou
   set.facets = set.gpu_facets.empty() ? Buffer::create(sizeof no_facet, &no_facet)
                                       : Buffer::create_from(set.gpu_facets);
   set.nodes = nodes.empty() ? Buffer::create(sizeof no_node, &no_node) : Buffer::create_from(nodes);
+  set.grid_words = Buffer::create_from(pack_coverage_grid(set.grid));
   set.order = set.index.order().empty() ? Buffer::create(sizeof no_order, &no_order)
                                         : Buffer::create_from(set.index.order());
   return set;
@@ -116,6 +145,7 @@ void FacetSet::bind() const {
   facets.bind_base(GL_SHADER_STORAGE_BUFFER, binding::facets);
   nodes.bind_base(GL_SHADER_STORAGE_BUFFER, binding::nodes);
   order.bind_base(GL_SHADER_STORAGE_BUFFER, binding::order);
+  grid_words.bind_base(GL_SHADER_STORAGE_BUFFER, binding::grid);
 }
 
 bool sphere_may_meet_cone(const glm::dvec3& centre, double radius, const glm::dvec3* planes,

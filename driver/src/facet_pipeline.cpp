@@ -2,6 +2,8 @@
 // a scatter of (triangle, facet) pairs with the indirect arguments, and one glDrawArraysIndirect
 // per material with vertex pulling (DESIGN.md, "The replication pipeline").
 #include <algorithm>
+#include <limits>
+#include <string>
 #include <optional>
 
 #include "facet/driver/facet_gpu.hpp"
@@ -43,55 +45,81 @@ class FacetPipeline final : public FacetMethodBase {
     const bool changed = update_view(T_eye_world);
     RenderStats stats;
     stats.reused_replication = !outputs_.empty();
+    std::vector<std::size_t> replicated;
     for (std::size_t i = 0; i < outputs_.size(); ++i) {
       OutputState& out = outputs_[i];
       targets[i].clear();
-      stats.facets += out.facets.mesh.facets.size();
-      stats.triangles_in += out.triangles;
-      if (out.triangles == 0 || out.facets.mesh.facets.empty()) {
-        targets[i].resolve();
-        continue;
-      }
+      if (out.triangles == 0 || out.facets.mesh.facets.empty()) continue;
       if (changed || !out.replication_valid) {
         stats.reused_replication = false;
         replicate(i, timer);
+        replicated.push_back(i);
       }
+      draw(i, targets[i], timer);
+    }
+    // One read of each replicated output's statistics, after every output's passes are queued:
+    // pair count, visible triangles, and whether the pairs overflowed their buffers. An output
+    // that overflowed is replicated and drawn again with room for its pairs (sized from this
+    // frame, so the next frames do not overflow unless the view covers more).
+    for (std::size_t i : replicated) {
+      if (!read_replication(i)) {
+        targets[i].clear();
+        replicate(i, timer);
+        draw(i, targets[i], timer);
+        const bool fits = read_replication(i);
+        FACET_ASSERT(fits);
+      }
+    }
+    for (std::size_t i = 0; i < outputs_.size(); ++i) {
+      const OutputState& out = outputs_[i];
+      stats.facets += out.facets.mesh.facets.size();
+      stats.triangles_in += out.triangles;
+      stats.gpu_buffer_bytes += buffer_bytes(out);
+      targets[i].resolve();
+      if (out.triangles == 0 || out.facets.mesh.facets.empty()) continue;
       stats.replicas += out.replicas;
       stats.triangles_visible += out.visible;
-
-      TimedPass scope(timer, "pass3 draw");
-      bind_output(i);
-      targets[i].bind();
-      begin_facet_drawing(false);
-      set_list_uniforms(draw_, i);
-      draw_.use();
-      glBindVertexArray(empty_vao_.id());
-      glBindBuffer(GL_DRAW_INDIRECT_BUFFER, out.draw_args.id());
-      glMemoryBarrier(GL_COMMAND_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
-      for (std::uint32_t m = 0; m < material_count(); ++m) {
-        if (out.material_ranges[2 * m] == out.material_ranges[2 * m + 1]) continue;
-        set_material(draw_, m);
-        glDrawArraysIndirect(GL_TRIANGLES, reinterpret_cast<const void*>(std::uintptr_t(m) * 16u));
-      }
-      glBindBuffer(GL_DRAW_INDIRECT_BUFFER, 0);
-      glBindVertexArray(0);
-      end_facet_drawing();
-      targets[i].resolve();
     }
     if (timer) timer->end_frame();
     return stats;
   }
 
  private:
-  // Passes 1 and 2 for output i: counts, scan, pairs, indirect arguments.
+  void draw(std::size_t i, OutputTarget& target, GpuTimer* timer) {
+    OutputState& out = outputs_[i];
+    TimedPass scope(timer, "pass3 draw");
+    bind_output(i);
+    target.bind();
+    begin_facet_drawing(false);
+    set_list_uniforms(draw_, i);
+    draw_.use();
+    glBindVertexArray(empty_vao_.id());
+    glBindBuffer(GL_DRAW_INDIRECT_BUFFER, out.draw_args.id());
+    glMemoryBarrier(GL_COMMAND_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
+    for (std::uint32_t m = 0; m < material_count(); ++m) {
+      if (out.material_ranges[2 * m] == out.material_ranges[2 * m + 1]) continue;
+      set_material(draw_, m);
+      glDrawArraysIndirect(GL_TRIANGLES, reinterpret_cast<const void*>(std::uintptr_t(m) * 16u));
+    }
+    glBindBuffer(GL_DRAW_INDIRECT_BUFFER, 0);
+    glBindVertexArray(0);
+    end_facet_drawing();
+  }
+
+  // Passes 1 and 2 for output i: coverage with staged facets, scan, the pairs' copy and the
+  // indirect arguments, all without reading anything back.
   void replicate(std::size_t i, GpuTimer* timer) {
     OutputState& out = outputs_[i];
     const std::uint32_t n = out.triangles;
     ensure_capacity(out.scan, (std::size_t(n) + 1) * sizeof(std::uint32_t));
+    ensure_capacity(out.stage_offsets, std::max<std::size_t>(n, 1) * sizeof(std::uint32_t));
+    if (out.pair_capacity == 0) out.pair_capacity = std::max<std::uint32_t>(n, 4096);
+    ensure_capacity(out.staged, std::size_t(out.pair_capacity) * sizeof(std::uint32_t));
+    ensure_capacity(out.pairs, std::size_t(out.pair_capacity) * 2 * sizeof(std::uint32_t));
     {
       TimedPass scope(timer, "pass1 coverage");
-      const std::uint32_t zero = 0;
-      out.stats.sub_data(0, sizeof zero, &zero);
+      const std::uint32_t zero[4] = {0, 0, 0, 0};
+      out.stats.sub_data(0, sizeof zero, zero);
       bind_output(i);
       set_list_uniforms(count_, i);
       count_.use();
@@ -99,14 +127,7 @@ class FacetPipeline final : public FacetMethodBase {
     }
     TimedPass scope(timer, "pass2 replicate");
     scan_.run(out.scan, n + 1);
-    glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
-    // The pair count sizes the pair buffer: one small read-back per output and frame.
-    std::uint32_t total = 0, visible = 0;
-    out.scan.get_sub_data(std::size_t(n) * sizeof(std::uint32_t), sizeof total, &total);
-    out.stats.get_sub_data(0, sizeof visible, &visible);
-    out.replicas = total;
-    out.visible = visible;
-    ensure_capacity(out.pairs, std::max<std::size_t>(total, 1) * 2 * sizeof(std::uint32_t));
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
     bind_output(i);
     set_list_uniforms(scatter_, i);
     scatter_.use();
@@ -116,6 +137,25 @@ class FacetPipeline final : public FacetMethodBase {
     glDispatchCompute((material_count() + 63) / 64, 1, 1);
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_COMMAND_BARRIER_BIT);
     out.replication_valid = true;
+  }
+
+  // Reads output i's statistics after its passes; false when its pairs overflowed, after making
+  // room for them (the caller replicates again).
+  bool read_replication(std::size_t i) {
+    OutputState& out = outputs_[i];
+    std::uint32_t values[3] = {0, 0, 0};
+    out.stats.get_sub_data(0, sizeof values, values);
+    out.visible = values[0];
+    out.replicas = values[1];
+    if (values[2] == 0) return true;
+    const std::uint64_t wanted = std::uint64_t(values[1]) + values[1] / 4 + 4096;
+    if (wanted > std::uint64_t(std::numeric_limits<std::int32_t>::max()))
+      throw InputError("scene", "pairs",
+                       "at most 2^31 (triangle, facet) pairs per output and frame; this view needs " +
+                           std::to_string(values[1]));
+    out.pair_capacity = std::uint32_t(wanted);
+    out.replication_valid = false;
+    return false;
   }
 
   friend std::vector<std::vector<std::uint32_t>> facet::driver::gpu_triangle_coverage(
@@ -161,6 +201,11 @@ std::vector<std::vector<std::uint32_t>> gpu_triangle_coverage(
   auto& out = pipeline.outputs_[0];
   if (out.triangles == 0 || out.facets.mesh.facets.empty()) return result;
   pipeline.replicate(0, nullptr);
+  if (!pipeline.read_replication(0)) {
+    pipeline.replicate(0, nullptr);
+    const bool fits = pipeline.read_replication(0);
+    FACET_ASSERT(fits);
+  }
   std::vector<std::uint32_t> pairs(2 * out.replicas);
   if (!pairs.empty()) out.pairs.get_sub_data(0, pairs.size() * sizeof(std::uint32_t), pairs.data());
   for (std::size_t k = 0; k < out.replicas; ++k)

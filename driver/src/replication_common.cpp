@@ -92,7 +92,8 @@ void FacetMethodBase::prepare(const Scene& scene, const GpuScene& gpu_scene,
   outputs_.clear();
   for (const OutputSpec& output : outputs) {
     OutputState state(FacetSet::build(output.warp, settings.facets, settings.z_near));
-    state.stats = Buffer::create(sizeof(std::uint32_t));
+    const std::uint32_t no_stats[4] = {0, 0, 0, 0};
+    state.stats = Buffer::create(sizeof no_stats, no_stats);
     state.draw_args = Buffer::create(records_by_material_.size() * 4 * sizeof(std::uint32_t));
     outputs_.push_back(std::move(state));
   }
@@ -166,6 +167,9 @@ void FacetMethodBase::bind_output(std::size_t i) const {
   out.stats.bind_base(GL_SHADER_STORAGE_BUFFER, binding::stats);
   if (out.scan) out.scan.bind_base(GL_SHADER_STORAGE_BUFFER, binding::scan);
   if (out.pairs) out.pairs.bind_base(GL_SHADER_STORAGE_BUFFER, binding::pairs);
+  if (out.staged) out.staged.bind_base(GL_SHADER_STORAGE_BUFFER, binding::staged);
+  if (out.stage_offsets)
+    out.stage_offsets.bind_base(GL_SHADER_STORAGE_BUFFER, binding::stage_offsets);
   out.draw_args.bind_base(GL_SHADER_STORAGE_BUFFER, binding::draw_args);
 }
 
@@ -176,11 +180,23 @@ void FacetMethodBase::set_list_uniforms(const Program& program, std::size_t i) c
       {"list_entries", std::uint32_t(out.list.size())},
       {"cull_back_faces", settings_.cull_back_faces ? 1u : 0u},
       {"triangle_count", out.triangles},
-      {"material_count", material_count()}};
+      {"material_count", material_count()},
+      {"coverage_by_grid", settings_.coverage == FacetCoverage::grid ? 1u : 0u},
+      {"pair_capacity", out.pair_capacity}};
   for (const auto& [uniform, value] : values) {
     const GLint location = program.uniform_location(uniform);
     if (location >= 0) glProgramUniform1ui(program.id(), location, value);
   }
+}
+
+std::uint64_t FacetMethodBase::buffer_bytes(const OutputState& out) const {
+  const FacetSet& set = out.facets;
+  std::uint64_t bytes = set.facets.size() + set.nodes.size() + set.order.size() +
+                        set.grid_words.size();
+  for (const Buffer* b : {&out.list_buffer, &out.ranges_buffer, &out.scan, &out.pairs, &out.stats,
+                          &out.draw_args, &out.staged, &out.stage_offsets})
+    bytes += b->size();
+  return bytes;
 }
 
 void FacetMethodBase::set_material(const Program& program, std::uint32_t m) const {

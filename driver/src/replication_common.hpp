@@ -73,7 +73,11 @@ class FacetMethodBase : public RenderMethod {
     std::uint32_t triangles = 0;                 // list triangles
     Buffer list_buffer, ranges_buffer;
     // Replication results, reused while neither view nor scene changes.
+    // stats: visible triangles, pairs, overflow (std430 uints, replication/count.comp).
     Buffer scan, pairs, stats, draw_args;
+    // Pass 1's facets per triangle (facets only), and where each triangle's run starts.
+    Buffer staged, stage_offsets;
+    std::uint32_t pair_capacity = 0;  // pairs that pairs and staged hold
     bool replication_valid = false;
     std::uint64_t replicas = 0, visible = 0;
   };
@@ -89,6 +93,9 @@ class FacetMethodBase : public RenderMethod {
   static void begin_facet_drawing(bool cull_back_faces);
   static void end_facet_drawing();
   std::uint32_t material_count() const { return std::uint32_t(records_by_material_.size()); }
+  // GPU bytes of output state `out`: facet tables, coverage grid and hierarchy, triangle list,
+  // scan, staging, pairs, statistics and draw arguments.
+  std::uint64_t buffer_bytes(const OutputState& out) const;
   // Program uniforms of replication_lib.comp for output i.
   void set_list_uniforms(const Program& program, std::size_t i) const;
 

@@ -9,7 +9,7 @@ layout(xfb_buffer = 0, xfb_offset = 0) out uint tf_count;
 layout(std430, binding = 12) buffer Stats { uint visible_triangles; };
 
 void triangle_eye(uint t, out vec3 p[3]);
-uint walk_coverage(vec3 p[3], uint t, uint pair_base, uint wanted, out uint wanted_facet);
+uint cover(vec3 p[3], uint t, uint pair_base, uint wanted, out uint wanted_facet);
 void write_pair(uint at, uint t, uint facet) {}
 
 void main() {
@@ -17,7 +17,7 @@ void main() {
   vec3 p[3];
   triangle_eye(t, p);
   uint unused;
-  tf_count = walk_coverage(p, t, 0xffffffffu, 0xffffffffu, unused);
+  tf_count = cover(p, t, 0xffffffffu, 0xffffffffu, unused);
   if (tf_count > 0u) atomicAdd(visible_triangles, 1u);
   EmitVertex();
   EndPrimitive();

@@ -22,7 +22,7 @@ vec2 vertex_uv(uint v);
 vec4 facet_clip(uint f, vec3 p_eye);
 float facet_clip_distance(uint f, int k, vec3 p_eye);
 void triangle_eye(uint t, out vec3 p[3]);
-uint walk_coverage(vec3 p[3], uint t, uint pair_base, uint wanted, out uint wanted_facet);
+uint cover(vec3 p[3], uint t, uint pair_base, uint wanted, out uint wanted_facet);
 void write_pair(uint at, uint t, uint facet) {}
 
 void main() {
@@ -31,7 +31,7 @@ void main() {
   vec3 p[3];
   triangle_eye(t, p);
   uint f;
-  walk_coverage(p, t, 0xffffffffu, replica.y, f);
+  cover(p, t, 0xffffffffu, replica.y, f);
   if (f == 0xffffffffu) return;
   uint e = entry_of_triangle(t);
   uint object = object_of(e);

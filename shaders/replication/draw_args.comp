@@ -15,13 +15,18 @@ struct DrawArraysIndirectCommand {
   uint base_instance;
 };
 layout(std430, binding = 14) writeonly buffer DrawArgs { DrawArraysIndirectCommand args[]; };
+layout(std430, binding = 12) readonly buffer Stats {
+  uint visible_triangles;
+  uint pair_total;
+  uint overflow;  // the pairs are incomplete: draw nothing, the frame runs again
+};
 layout(location = 43) uniform uint material_count;
 
 void main() {
   uint m = gl_GlobalInvocationID.x;
   if (m >= material_count) return;
   uint first = scan[material_ranges[m].x];
-  uint end = scan[material_ranges[m].y];
+  uint end = overflow != 0u ? first : scan[material_ranges[m].y];
   args[m] = DrawArraysIndirectCommand(VERTICES_PER_REPLICA * (end - first), 1u,
                                       VERTICES_PER_REPLICA * first, 0u);
 }

@@ -270,3 +270,225 @@ uint walk_coverage(vec3 p[3], uint t, uint pair_base, uint wanted, out uint want
   }
   return found;
 }
+
+// ---- Coverage grid (projection/coverage_grid.hpp, CoverageGrid: the same arithmetic in float,
+// with the padding float rounding needs) ----
+layout(std430, binding = 16) readonly buffer Grid { uint grid[]; };
+layout(location = 44) uniform uint coverage_by_grid;  // 0: the hierarchy walk for every triangle
+
+const uint kChartCylindrical = 0u, kChartEquirectangular = 1u, kChartFisheye = 2u,
+           kChartPerspective = 3u;                      // CoverageChart
+const uint kGridMaxBuckets = 64u;                       // CoverageGrid::kMaxBuckets
+const uint kGridMaxCandidates = 96u;                    // CoverageGrid::kMaxCandidates
+const float kPi = 3.14159265358979;
+const float kPoleMargin = 1e-3;
+const float kShortArc = 1e-2;
+
+float grid_float(uint i) { return uintBitsToFloat(grid[i]); }
+
+float wrap_pi(float angle) { return angle - 2.0 * kPi * round(angle / (2.0 * kPi)); }
+
+// The (θ, φ) box of the spherical triangle with unit base-frame corners b: x = θ_lo, y = θ_hi,
+// z = φ_lo, w = φ_hi; full_phi: every azimuth; false when the walk must take the triangle.
+bool direction_box(vec3 b[3], uint chart, out vec4 box, out bool full_phi) {
+  bool is_polar = chart <= kChartEquirectangular;
+  vec3 A = is_polar ? vec3(0, 1, 0) : vec3(0, 0, -1);
+  vec3 e1 = is_polar ? vec3(0, 0, -1) : vec3(1, 0, 0);
+  vec3 e2 = is_polar ? vec3(1, 0, 0) : vec3(0, 1, 0);
+  float theta[3], phi[3], sin_theta[3];
+  for (int c = 0; c < 3; ++c) {
+    sin_theta[c] = length(cross(b[c], A));
+    theta[c] = atan(sin_theta[c], dot(b[c], A));
+    phi[c] = atan(dot(b[c], e2), dot(b[c], e1));
+  }
+  const float vertex_pad = 4e-6;
+  float lo = min(theta[0], min(theta[1], theta[2])) - vertex_pad;
+  float hi = max(theta[0], max(theta[1], theta[2])) + vertex_pad;
+  full_phi = false;
+  box = vec4(0.0);
+  for (int i = 0; i < 3; ++i) {
+    int j = i < 2 ? i + 1 : 0;
+    vec3 n = cross(b[i], b[j]);
+    float len = length(n);
+    if (len < kShortArc) {
+      if (dot(b[i], b[j]) < 0.0) return false;
+      float chord = length(b[i] - b[j]);
+      lo = min(lo, min(theta[i], theta[j]) - chord - vertex_pad);
+      hi = max(hi, max(theta[i], theta[j]) + chord + vertex_pad);
+      continue;
+    }
+    n /= len;
+    float an = dot(A, n);
+    vec3 p = A - an * n;
+    float circle_min = atan(abs(an), length(cross(A, n)));
+    float arc_pad = 2e-6 / len + vertex_pad;
+    const float on = -1e-5;
+    if (dot(cross(b[i], p), n) >= on && dot(cross(p, b[j]), n) >= on)
+      lo = min(lo, circle_min - arc_pad);
+    if (dot(cross(b[i], -p), n) >= on && dot(cross(-p, b[j]), n) >= on)
+      hi = max(hi, kPi - circle_min + arc_pad);
+  }
+  float d01 = wrap_pi(phi[1] - phi[0]), d12 = wrap_pi(phi[2] - phi[1]),
+        d20 = wrap_pi(phi[0] - phi[2]);
+  float winding = d01 + d12 + d20;
+  if (!(abs(winding) < 0.5 || abs(abs(winding) - 2.0 * kPi) < 0.5)) return false;
+  if (abs(winding) > kPi) {
+    vec3 normal = cross(b[1] - b[0], b[2] - b[0]);
+    if (dot(A, normal) * dot(normal, b[0]) > 0.0) lo = 0.0; else hi = kPi;
+    full_phi = true;
+  }
+  if (lo < kPoleMargin) {
+    lo = 0.0;
+    full_phi = true;
+  }
+  if (hi > kPi - kPoleMargin) {
+    hi = kPi;
+    full_phi = true;
+  }
+  box.x = lo;
+  box.y = hi;
+  if (!full_phi) {
+    float c1 = d01, c2 = d01 + d12;
+    float min_sin = min(sin_theta[0], min(sin_theta[1], sin_theta[2]));
+    float phi_pad = 2e-6 / max(min_sin, 1e-9) + 4e-6;
+    box.z = phi[0] + min(0.0, min(c1, c2)) - phi_pad;
+    box.w = phi[0] + max(0.0, max(c1, c2)) + phi_pad;
+    if (box.w - box.z >= 2.0 * kPi) full_phi = true;
+  }
+  if (full_phi) box.zw = vec2(-kPi, kPi);
+  return true;
+}
+
+// The chart box (p_lo, p_hi, q_lo, q_hi) of a direction box; false when nothing can be seen.
+bool chart_box(uint chart, vec4 d, bool full_phi, out vec4 box) {
+  box = vec4(0.0);
+  if (chart <= kChartEquirectangular) {
+    if (chart == kChartEquirectangular) {
+      box.zw = vec2(kPi / 2.0 - d.y, kPi / 2.0 - d.x);
+    } else {
+      box.z = cos(d.y) / max(sin(d.y), 1e-6);
+      box.w = cos(d.x) / max(sin(d.x), 1e-6);
+    }
+    box.xy = d.zw;
+    return true;
+  }
+  float rho_lo = d.x, rho_hi = d.y;
+  if (chart == kChartPerspective) {
+    if (d.x >= kPi / 2.0) return false;
+    float cap = grid_float(8u);
+    rho_lo = tan(d.x);
+    rho_hi = d.y >= kPi / 2.0 - 1e-6 ? cap : min(tan(d.y), cap);
+  }
+  if (full_phi) {
+    box = vec4(-rho_hi, rho_hi, -rho_hi, rho_hi);
+    return true;
+  }
+  vec2 lo = vec2(1e30), hi = vec2(-1e30);
+  for (int k = 0; k < 2; ++k) {
+    float phi = k == 0 ? d.z : d.w;
+    vec2 dir = vec2(cos(phi), sin(phi));
+    lo = min(lo, min(rho_lo * dir, rho_hi * dir));
+    hi = max(hi, max(rho_lo * dir, rho_hi * dir));
+  }
+  for (int k = 0; k < 4; ++k) {
+    float offset = mod(float(k) * kPi / 2.0 - d.z, 2.0 * kPi);
+    if (d.z + offset <= d.w) {
+      vec2 axis = k == 0 ? vec2(1, 0) : k == 1 ? vec2(0, 1) : k == 2 ? vec2(-1, 0) : vec2(0, -1);
+      lo = min(lo, rho_hi * axis);
+      hi = max(hi, rho_hi * axis);
+    }
+  }
+  box = vec4(lo.x, hi.x, lo.y, hi.y);
+  return true;
+}
+
+// The buckets a chart box touches: (first column, first row, columns, rows); false when none.
+bool bucket_range(vec4 box, bool full_p, out uvec4 range) {
+  range = uvec4(0u);
+  uint columns = grid[2], rows = grid[3];
+  float p0 = grid_float(4u), q0 = grid_float(5u), dp = grid_float(6u), dq = grid_float(7u);
+  float j_lo = max(clamp(floor((box.z - q0) / dq), -1.0, float(rows)), 0.0);
+  float j_hi = min(clamp(floor((box.w - q0) / dq), -1.0, float(rows)), float(rows) - 1.0);
+  if (j_hi < j_lo) return false;
+  range.y = uint(j_lo);
+  range.w = uint(j_hi - j_lo) + 1u;
+  if (grid[1] != 0u) {
+    range.z = columns;
+    if (full_p) return true;
+    float i_lo = floor((box.x - p0) / dp), i_hi = floor((box.y - p0) / dp);
+    if (i_hi - i_lo + 1.0 >= float(columns)) return true;
+    float first = i_lo - float(columns) * floor(i_lo / float(columns));
+    range.x = min(uint(first), columns - 1u);
+    range.z = uint(i_hi - i_lo) + 1u;
+    return true;
+  }
+  float i_lo = max(clamp(floor((box.x - p0) / dp), -1.0, float(columns)), 0.0);
+  float i_hi = min(clamp(floor((box.y - p0) / dp), -1.0, float(columns)), float(columns) - 1.0);
+  if (i_hi < i_lo) return false;
+  range.x = uint(i_lo);
+  range.z = uint(i_hi - i_lo) + 1u;
+  return true;
+}
+
+// walk_coverage's contract, answered from the grid when the triangle is small enough for it.
+uint cover(vec3 p[3], uint t, uint pair_base, uint wanted, out uint wanted_facet) {
+  if (coverage_by_grid == 0u) return walk_coverage(p, t, pair_base, wanted, wanted_facet);
+  wanted_facet = kNone;
+  if (!triangle_may_cover(p)) return 0u;
+  vec3 u[3] = vec3[3](normalize(p[0]), normalize(p[1]), normalize(p[2]));
+  mat3 R_base_eye = mat3(grid_float(12u), grid_float(13u), grid_float(14u), grid_float(15u),
+                         grid_float(16u), grid_float(17u), grid_float(18u), grid_float(19u),
+                         grid_float(20u));
+  vec3 b[3] = vec3[3](R_base_eye * u[0], R_base_eye * u[1], R_base_eye * u[2]);
+  uint chart = grid[0];
+  vec4 angles;
+  bool full_phi;
+  if (!direction_box(b, chart, angles, full_phi))
+    return walk_coverage(p, t, pair_base, wanted, wanted_facet);
+  vec4 box;
+  if (!chart_box(chart, angles, full_phi, box)) return 0u;
+  uvec4 range;
+  if (!bucket_range(box, full_phi && chart <= kChartEquirectangular, range)) return 0u;
+  if (range.z * range.w > kGridMaxBuckets)
+    return walk_coverage(p, t, pair_base, wanted, wanted_facet);
+  uint columns = grid[2];
+  bool periodic = grid[1] != 0u;
+  uint first_offset = grid[9], facets_offset = grid[10], boxes_offset = grid[11];
+  // Listed facets, row by row from at most two runs of buckets.
+  uint listed = 0u;
+  uint end = range.x + range.z;
+  for (uint j = range.y; j < range.y + range.w; ++j) {
+    uint row = first_offset + j * columns;
+    listed += grid[row + min(end, columns)] - grid[row + range.x];
+    if (end > columns) listed += grid[row + end - columns] - grid[row];
+  }
+  if (listed > kGridMaxCandidates) return walk_coverage(p, t, pair_base, wanted, wanted_facet);
+  uint found = 0u;
+  for (uint j = range.y; j < range.y + range.w; ++j) {
+    for (uint k = 0u; k < range.z; ++k) {
+      uint i = periodic ? (range.x + k) % columns : range.x + k;
+      uint bucket = first_offset + j * columns + i;
+      for (uint m = grid[bucket]; m < grid[bucket + 1u]; ++m) {
+        uint f = grid[facets_offset + m];
+        uvec4 fb = uvec4(grid[boxes_offset + 4u * f], grid[boxes_offset + 4u * f + 1u],
+                         grid[boxes_offset + 4u * f + 2u], grid[boxes_offset + 4u * f + 3u]);
+        // Taken once: in the first bucket, in visiting order, that both ranges share.
+        uint first_row = max(range.y, fb.y);
+        uint first_column = max(range.x, fb.x);
+        if (periodic)
+          first_column = (range.x + columns - fb.x) % columns < fb.z ? range.x : fb.x;
+        if (i != first_column || j != first_row) continue;
+        vec4 planes[4] = vec4[4](facets[f].clip_planes[0], facets[f].clip_planes[1],
+                                 facets[f].clip_planes[2], vec4(0.0));
+        if (!meets_cone(u, planes, 3)) continue;
+        if (found == wanted) {
+          wanted_facet = f;
+          return found + 1u;
+        }
+        if (pair_base != kNone) write_pair(pair_base + found, t, f);
+        ++found;
+      }
+    }
+  }
+  return found;
+}

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <random>
 #include <vector>
 
@@ -150,6 +151,17 @@ TEST(Pipeline, GpuCoverageMatchesCpuReference) {
   triangles.push_back({glm::vec3(-1, -1, 0), glm::vec3(1, -1, 0), glm::vec3(0, 1, 0)});  // eye
   triangles.push_back({glm::vec3(-1e4f, -1, -1e4f), glm::vec3(1e4f, -1, -1e4f),
                        glm::vec3(0, -1, 1e4f)});  // huge ground
+  // Across the cylinder's 360° seam (behind the eye, +z), through its vertical axis, around the
+  // dome's pole (+y) and at it, small and large.
+  for (float size : {0.01f, 0.3f, 3.0f}) {
+    triangles.push_back({glm::vec3(-size, -0.2f, 2), glm::vec3(size, -0.2f, 2),
+                         glm::vec3(0, size, 2)});
+    triangles.push_back({glm::vec3(0, -size, -size), glm::vec3(0, size, -size),
+                         glm::vec3(0, 0, size)});
+    triangles.push_back({glm::vec3(-size, 3, -size), glm::vec3(size, 3, -size),
+                         glm::vec3(0, 3, size)});
+    triangles.push_back({glm::vec3(0, 3, 0), glm::vec3(size, 3, 0), glm::vec3(0, 3, size)});
+  }
   // Dense facets: large triangles cover thousands of them (up to 26,060 here), far more than
   // llvmpipe's loop budget per shader invocation would allow one test each.
   RenderSettings dense;
@@ -157,9 +169,12 @@ TEST(Pipeline, GpuCoverageMatchesCpuReference) {
   for (const auto& [name, outputs, settings] : {std::tuple{"cylinder", cylinder(), strips(40)},
                                                 std::tuple{"dome", dome(), RenderSettings{}},
                                                 std::tuple{"dome, 28,800 facets", dome(), dense}}) {
-    for (bool cull : {false, true}) {
+    for (const auto& [coverage, cull] :
+         {std::pair{FacetCoverage::grid, false}, std::pair{FacetCoverage::grid, true},
+          std::pair{FacetCoverage::walk, true}}) {
       RenderSettings s = settings;
       s.cull_back_faces = cull;
+      s.coverage = coverage;
       const auto gpu = gpu_triangle_coverage(outputs[0].warp, s, triangles);
       const FacetMesh mesh = build_facets(outputs[0].warp, s.facets);
       const CoverageIndex tight(mesh);
@@ -191,6 +206,9 @@ TEST(Pipeline, GpuCoverageMatchesCpuReference) {
       EXPECT_GT(cpu_pairs, triangles.size());
       // Extra pairs from the float slack: at most 1% of the reference's.
       EXPECT_LE(gpu_pairs, cpu_pairs + cpu_pairs / 100) << name;
+      std::printf("%s, %s coverage%s: %zu pairs, %.5f of the reference's\n", name,
+                  coverage == FacetCoverage::grid ? "grid" : "walk", cull ? ", culled" : "",
+                  gpu_pairs, double(gpu_pairs) / double(cpu_pairs));
     }
   }
 }

@@ -35,6 +35,7 @@ struct RenderOptions {
   std::optional<int> face_size;
   int frames = 1, msaa = 0;
   float anisotropy = kAutomaticAnisotropy;
+  std::string coverage = "grid";
   bool ids = false, depth = false, reference = false, json = false;
 };
 
@@ -133,6 +134,12 @@ void run(const RenderOptions& options) {
     settings.cube_face_size = *options.face_size;
   }
   settings.msaa_samples = options.msaa;
+  if (options.coverage == "walk") {
+    settings.coverage = FacetCoverage::walk;
+  } else if (options.coverage != "grid") {
+    throw InputError("command line", "--coverage", "expected grid or walk; got '" +
+                                                       options.coverage + "'");
+  }
   if (options.anisotropy != kAutomaticAnisotropy && !(options.anisotropy >= 1.0f)) {
     throw InputError("command line", "--anisotropy", "expected 0 (automatic) or a level >= 1");
   }
@@ -284,6 +291,9 @@ const Registration registration{
           "Compare the IDs with the CPU ray-cast reference (with --ids: also write it)");
       command->add_option("--anisotropy", options->anisotropy,
                           "Texture anisotropy level (0: automatic, 8 on GPUs, off on llvmpipe)");
+      command->add_option("--coverage", options->coverage,
+                          "Facet methods' pass 1: grid (default) or walk (the hierarchy "
+                          "reference)");
       command->add_flag("--json", options->json, "Print one JSON object");
       command->callback([options] { run(*options); });
     }};

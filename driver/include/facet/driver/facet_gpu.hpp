@@ -11,6 +11,7 @@
 //   9 triangle list of the frame (record, first triangle)  10 counts / exclusive scan
 //   11 pairs (modern: triangle, facet; seed: triangle, replica)  12 stats
 //   13 material ranges of the triangle list   14 indirect draw arguments   15 scan block sums
+//   16 coverage grid (GpuFacetSet, per output)   17 staged facets of pass 1   18 their offsets
 #include <epoxy/gl.h>
 
 #include <array>
@@ -22,6 +23,7 @@
 #include "facet/driver/render_method.hpp"
 #include "facet/driver/scene.hpp"
 #include "facet/projection/coverage.hpp"
+#include "facet/projection/coverage_grid.hpp"
 #include "facet/projection/facets.hpp"
 
 namespace facet::driver {
@@ -30,7 +32,7 @@ namespace binding {
 inline constexpr GLuint positions = 0, normals = 1, uvs = 2, indices = 3, records = 4,
                         object_frames = 5, facets = 6, nodes = 7, order = 8, list = 9, scan = 10,
                         pairs = 11, stats = 12, material_ranges = 13, draw_args = 14,
-                        block_sums = 15;
+                        block_sums = 15, grid = 16, staged = 17, stage_offsets = 18;
 }  // namespace binding
 
 // std430, one per facet. Eye-frame X is inside the facet's guarded pyramid when
@@ -76,6 +78,13 @@ static_assert(sizeof(GpuObjectFrame) == 128);
 std::vector<GpuFacet> pack_facets(const FacetMesh& mesh, double z_near,
                                   double guard_px = kDefaultGuardPx);
 std::vector<GpuCoverageNode> pack_coverage_nodes(const CoverageIndex& index);
+
+// The coverage grid as one uint array, the layout replication_lib.comp reads: a header of
+// kGridHeaderWords words (chart, periodic, columns, rows, then as float bits p0, q0, dp, dq,
+// radius_cap, then the offsets of bucket_first, bucket_facets and the per-facet bucket ranges,
+// then R_base_eye column-major), then those three arrays.
+inline constexpr std::uint32_t kGridHeaderWords = 24;
+std::vector<std::uint32_t> pack_coverage_grid(const CoverageGrid& grid);
 // Records of every object's primitives, in Scene::objects order, then primitive order.
 std::vector<GpuRecord> make_records(const Scene& scene);
 
@@ -83,8 +92,9 @@ std::vector<GpuRecord> make_records(const Scene& scene);
 struct FacetSet {
   FacetMesh mesh;
   CoverageIndex index;
+  CoverageGrid grid;
   std::vector<GpuFacet> gpu_facets;  // kept for the naive baseline's per-facet culling
-  Buffer facets, nodes, order;       // bind at binding::facets, nodes, order
+  Buffer facets, nodes, order, grid_words;  // bind at binding::facets, nodes, order, grid
 
   // Builds the facets of `warp` (InputError when the layout cannot be met) and uploads them.
   // Needs a current context.

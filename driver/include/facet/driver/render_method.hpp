@@ -32,9 +32,15 @@ struct OutputSpec {
   Warp warp;
 };
 
+// How pass 1 of the facet methods finds the facets a triangle may cover: the bucket grid
+// (CoverageGrid; the hierarchy walk for huge triangles), or the hierarchy walk for every triangle
+// (CoverageIndex), kept as the reference the grid is measured and tested against.
+enum class FacetCoverage { grid, walk };
+
 struct RenderSettings {
-  // Facet methods: how the warp is cut into facets.
+  // Facet methods: how the warp is cut into facets, and how pass 1 finds a triangle's facets.
   FacetBuildOptions facets;
+  FacetCoverage coverage = FacetCoverage::grid;
   // Cube-map baseline: edge length of a cube face in pixels.
   int cube_face_size = 1024;
   // Per-vertex baseline: tessellation level cap (1 = no tessellation).
