@@ -98,6 +98,9 @@ std::vector<std::uint32_t> pack_coverage_grid(const CoverageGrid& grid) {
   for (const BucketRange& r : grid.facet_buckets()) {
     words.insert(words.end(), {r.first_column, r.first_row, r.columns, r.rows});
   }
+  words[21] = std::uint32_t(words.size());
+  for (const auto& corners : grid.pyramid_corners())
+    for (const glm::dvec3& c : corners) words.insert(words.end(), {bits(c.x), bits(c.y), bits(c.z)});
   return words;
 }
 

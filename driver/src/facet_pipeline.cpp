@@ -63,6 +63,7 @@ class FacetPipeline final : public FacetMethodBase {
     // frame, so the next frames do not overflow unless the view covers more).
     for (std::size_t i : replicated) {
       if (!read_replication(i)) {
+        ++stats.overflow_reruns;
         targets[i].clear();
         replicate(i, timer);
         draw(i, targets[i], timer);

@@ -239,6 +239,7 @@ CoverageGrid::CoverageGrid(const FacetMesh& mesh, const BaseProjection& base,
       R_base_eye_(glm::transpose(R_eye_base)) {
   const std::size_t facet_count = mesh.facets.size();
   planes_.resize(facet_count);
+  corners_.resize(facet_count);
   std::vector<ChartBox> boxes(facet_count);
   for (std::uint32_t f = 0; f < facet_count; ++f) {
     planes_[f] = mesh.clip_planes(f, guard_px);
@@ -249,6 +250,7 @@ CoverageGrid::CoverageGrid(const FacetMesh& mesh, const BaseProjection& base,
       const glm::dvec3& c = planes_[f][(k + 2) % 3];
       glm::dvec3 corner = glm::normalize(glm::cross(a, b));
       if (glm::dot(corner, c) < 0) corner = -corner;
+      corners_[f][k] = corner;
       corners[k] = R_base_eye_ * corner;
     }
     DirectionBox d = direction_box(corners, chart_, 1e-9);

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <glm/gtc/matrix_transform.hpp>
 #include <random>
 #include <vector>
 
@@ -280,6 +281,80 @@ TEST(Pipeline, BackgroundSphereLeavesNoHoles) {
       EXPECT_EQ(holes, 0u) << name << " " << method;
     }
   }
+}
+
+// The grid must draw what the hierarchy walk draws: the same IDs on every base, and at most 1%
+// more replicas (clipped to nothing) from its candidate reject without clipping.
+TEST(Pipeline, GridCoverageGivesTheWalksIds) {
+  test::shared_context();
+  const Scene scene = small_city();
+  RenderSettings quarter_px;
+  quarter_px.facets.layout = FacetTolerance{0.25};
+  Warp deformation = Warp::analytic(BaseProjection::perspective(-1, 1, 0.75, -0.75), {256, 192},
+                                    {21, 16});
+  for (int j = 0; j < deformation.grid_size.y; ++j)
+    for (int i = 0; i < deformation.grid_size.x; ++i) {
+      const double s = double(i) / 20, t = double(j) / 15;
+      deformation.offset_px[deformation.node_index(i, j)] =
+          glm::vec2(float(8 * std::sin(6 * s) * std::cos(5 * t)), float(6 * std::sin(4 * t + s)));
+    }
+  RenderSettings grid_20x15;
+  grid_20x15.facets.layout = FacetGrid{20, 15};
+  const glm::dmat4 tilted = glm::dmat4(glm::rotate(glm::dmat4(1.0), -1.2, glm::dvec3(1, 0, 0))) *
+                            city_view(2.0);
+  for (const auto& [name, outputs, settings, view] :
+       {std::tuple{"cylinder 0.25 px", cylinder(), quarter_px, city_view(3.0)},
+        std::tuple{"cylinder strips", cylinder(), strips(160), city_view(5.0)},
+        std::tuple{"dome 0.25 px", dome(), quarter_px, tilted},
+        std::tuple{"deformation", std::vector<OutputSpec>{{"deformation", deformation}},
+                   grid_20x15, city_view(4.0)}}) {
+    RenderSettings walk = settings;
+    walk.coverage = FacetCoverage::walk;
+    const Rendered by_grid = render("facets", scene, outputs, settings, view);
+    const Rendered by_walk = render("facets", scene, outputs, walk, view);
+    const Rendered seed = render("facets-gs", scene, outputs, settings, view);
+    std::size_t differing = 0, differing_seed = 0;
+    for (std::size_t k = 0; k < by_grid.ids[0].size(); ++k) {
+      differing += by_grid.ids[0][k] != by_walk.ids[0][k];
+      differing_seed += by_grid.ids[0][k] != seed.ids[0][k];
+    }
+    EXPECT_EQ(differing, 0u) << name;
+    EXPECT_EQ(differing_seed, 0u) << name;
+    EXPECT_GT(by_walk.ids[0].size() - count_value(by_walk.ids[0], 0), by_walk.ids[0].size() / 4)
+        << name;
+    EXPECT_GE(by_grid.stats.replicas, by_walk.stats.replicas) << name;
+    EXPECT_LE(double(by_grid.stats.replicas), 1.01 * double(by_walk.stats.replicas)) << name;
+    EXPECT_EQ(seed.stats.replicas, by_grid.stats.replicas) << name;
+    std::printf("%s: grid %llu replicas, walk %llu (%.4f)\n", name,
+                static_cast<unsigned long long>(by_grid.stats.replicas),
+                static_cast<unsigned long long>(by_walk.stats.replicas),
+                double(by_grid.stats.replicas) / double(by_walk.stats.replicas));
+  }
+}
+
+// The pair buffers start at one pair per triangle: a view that needs more overflows them, the
+// frame is replicated again with room, and its image is the one a roomy frame gives.
+TEST(Pipeline, AnOverflowingPairBufferRerunsToTheSameImage) {
+  test::shared_context();
+  const Scene scene = background_sphere(96, 48, 50.0f);  // 9,216 triangles, all in view
+  const auto outputs = cylinder();
+  const GpuScene gpu = upload_scene(scene);
+  auto renderer = make_render_method("facets");
+  renderer->prepare(scene, gpu, outputs, strips(160));
+  std::vector<OutputTarget> targets;
+  targets.push_back(OutputTarget::create(kCylinderSize));
+  const glm::dmat4 view_a(1.0);
+  const glm::dmat4 view_b = glm::dmat4(glm::rotate(glm::dmat4(1.0), 0.3, glm::dvec3(0, 1, 0)));
+  const RenderStats first = renderer->render(view_a, targets);
+  const auto ids_first = targets[0].read_ids();
+  EXPECT_EQ(first.overflow_reruns, 1u);
+  EXPECT_GT(first.replicas, scene.triangle_count());
+  renderer->render(view_b, targets);
+  const RenderStats roomy = renderer->render(view_a, targets);
+  EXPECT_EQ(roomy.overflow_reruns, 0u);
+  EXPECT_EQ(roomy.replicas, first.replicas);
+  EXPECT_EQ(targets[0].read_ids(), ids_first);
+  EXPECT_EQ(count_value(ids_first, 0), 0u);
 }
 
 TEST(Pipeline, ReplicationIsReusedWhileTheViewStands) {

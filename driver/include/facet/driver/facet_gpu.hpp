@@ -82,7 +82,8 @@ std::vector<GpuCoverageNode> pack_coverage_nodes(const CoverageIndex& index);
 // The coverage grid as one uint array, the layout replication_lib.comp reads: a header of
 // kGridHeaderWords words (chart, periodic, columns, rows, then as float bits p0, q0, dp, dq,
 // radius_cap, then the offsets of bucket_first, bucket_facets and the per-facet bucket ranges,
-// then R_base_eye column-major), then those three arrays.
+// then R_base_eye column-major, then the offset of the pyramid corners), then those arrays and
+// the facets' guarded pyramid corners (3 × 3 floats per facet).
 inline constexpr std::uint32_t kGridHeaderWords = 24;
 std::vector<std::uint32_t> pack_coverage_grid(const CoverageGrid& grid);
 // Records of every object's primitives, in Scene::objects order, then primitive order.

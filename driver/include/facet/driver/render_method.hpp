@@ -105,6 +105,9 @@ struct RenderStats {
   // pair, staging, scan and triangle-list buffers and facet tables; the cube map's faces; the
   // seed paper's Vbuf column.
   std::uint64_t gpu_buffer_bytes = 0;
+  // Facet pipeline: outputs replicated a second time this frame because their pairs outgrew the
+  // buffers sized from the frames before.
+  std::uint64_t overflow_reruns = 0;
   // replicas / triangles_in; the seed paper's replication ratio.
   double replication_ratio() const {
     return triangles_in == 0 ? 0.0 : double(replicas) / double(triangles_in);

@@ -16,8 +16,10 @@
 // Buckets. Each facet's guarded pyramid is itself a spherical triangle (its corners are where
 // adjacent clip planes meet), so it gets a chart box by the same function and is listed in every
 // bucket that box touches. A triangle's candidates are the facets of the buckets its box touches,
-// each taken once: from the first bucket, in visiting order, that both boxes share. Candidates are
-// then tested exactly (triangle_meets_cone), so the result equals CoverageIndex::query.
+// each taken once: from the first bucket, in visiting order, that both boxes share. Here
+// candidates are tested exactly (triangle_meets_cone), so the result equals CoverageIndex::query;
+// the GPU rejects them by separating planes instead (the pyramid's three, the triangle's three),
+// which keeps a few more facets and no clipping loop.
 // Triangles whose box touches more than kMaxBuckets buckets or kMaxCandidates listed facets, or
 // whose corners are nearly opposite seen from the eye, take the hierarchy walk instead.
 #include <array>
@@ -104,6 +106,10 @@ class CoverageGrid {
   // Per facet: the bucket range of its guarded pyramid (for taking each candidate once).
   const std::vector<BucketRange>& facet_buckets() const { return facet_buckets_; }
   const std::vector<std::array<glm::dvec3, 3>>& planes() const { return planes_; }
+  // Per facet: the unit corner directions of its guarded pyramid (eye frame), where adjacent
+  // clip planes meet. A triangle's cone misses the pyramid when they all lie outside one of the
+  // triangle's edge planes.
+  const std::vector<std::array<glm::dvec3, 3>>& pyramid_corners() const { return corners_; }
 
   // Candidate facets of a triangle box, each once, in the GPU's visiting order; nullopt when the
   // box is too large for the grid (the walk takes it).
@@ -118,6 +124,7 @@ class CoverageGrid {
   std::vector<std::uint32_t> bucket_first_, bucket_facets_;
   std::vector<BucketRange> facet_buckets_;
   std::vector<std::array<glm::dvec3, 3>> planes_;
+  std::vector<std::array<glm::dvec3, 3>> corners_;
 };
 
 // The chart of a base kind.
