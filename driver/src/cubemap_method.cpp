@@ -104,6 +104,14 @@ class CubemapMethod final : public RenderMethod {
     glTextureParameteri(id_cube_.id(), GL_TEXTURE_MIN_FILTER, GL_NEAREST);
     glTextureParameteri(id_cube_.id(), GL_TEXTURE_MAG_FILTER, GL_NEAREST);
     face_depth_ = Texture::create_2d(GL_DEPTH_COMPONENT32F, n, n);
+    // Held for every frame: the lookup textures (RGBA32F per output pixel), both cube maps (six
+    // n x n faces of SRGB8_ALPHA8 and of R32UI) and the face depth buffer (DEPTH32F).
+    buffer_bytes_ = 6ull * std::uint64_t(n) * std::uint64_t(n) * (4 + 4) +
+                    std::uint64_t(n) * std::uint64_t(n) * 4;
+    for (const OutputSpec& output : outputs) {
+      buffer_bytes_ += 16ull * std::uint64_t(output.warp.output_size.x) *
+                       std::uint64_t(output.warp.output_size.y);
+    }
     face_framebuffer_ = Framebuffer::create();
     const GLenum buffers[2] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
     glNamedFramebufferDrawBuffers(face_framebuffer_.id(), 2, buffers);
@@ -132,6 +140,7 @@ class CubemapMethod final : public RenderMethod {
     RenderStats stats;
     stats.triangles_in = scene.triangle_count();
     stats.triangles_visible = stats.triangles_in;
+    stats.gpu_buffer_bytes = buffer_bytes_;
 
     if (timer) timer->begin("faces");
     glEnable(GL_TEXTURE_CUBE_MAP_SEAMLESS);
@@ -249,6 +258,7 @@ class CubemapMethod final : public RenderMethod {
   std::array<bool, 6> face_needed_{};
   std::vector<Texture> lookups_;
   Texture colour_cube_, id_cube_, face_depth_;
+  std::uint64_t buffer_bytes_ = 0;  // RenderStats::gpu_buffer_bytes
   Framebuffer face_framebuffer_;
   VertexArray empty_vao_;
   Program face_program_, lookup_program_;

@@ -40,12 +40,16 @@ class NaiveMethod final : public FacetMethodBase {
       radius[o] = 0.5 * glm::length(p_max - p_min) * 1.0001;
     }
     RenderStats stats;
+    // The record table and object frames, shared by the outputs.
+    stats.gpu_buffer_bytes = records_buffer_.size() + object_frames_.size();
     TimedPass scope(timer, "draw");
     for (std::size_t i = 0; i < outputs_.size(); ++i) {
       OutputState& out = outputs_[i];
       targets[i].clear();
       stats.facets += out.facets.mesh.facets.size();
       stats.triangles_in += out.triangles;
+      // The facet tables and coverage structures it binds (and any list buffers prepare made).
+      stats.gpu_buffer_bytes += buffer_bytes(out);
       bind_output(i);
       targets[i].bind();
       begin_facet_drawing(settings_.cull_back_faces);

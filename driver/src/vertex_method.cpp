@@ -60,6 +60,7 @@ struct OutputState {
   bool wraps = false;
   Texture node_offsets;   // RGBA32F Gw×Gh: dx, dy, A
   Texture coverage_mask;  // R8, output-sized, GL rows; empty when every pixel is covered
+  std::uint64_t texture_bytes = 0;  // node_offsets and coverage_mask, for gpu_buffer_bytes
   // The cone of eye directions through covered pixel centres, widened by one pixel: objects
   // whose bounding sphere misses it are not drawn. half_angle = π when it is every direction.
   glm::dvec3 axis{0, 0, -1};
@@ -111,6 +112,7 @@ OutputState make_output_state(const OutputSpec& output) {
   out.node_offsets = Texture::create_2d(GL_RGBA32F, warp.grid_size.x, warp.grid_size.y);
   glTextureSubImage2D(out.node_offsets.id(), 0, 0, 0, warp.grid_size.x, warp.grid_size.y, GL_RGBA,
                       GL_FLOAT, nodes.data());
+  out.texture_bytes = 16ull * std::uint64_t(warp.grid_size.x) * std::uint64_t(warp.grid_size.y);
 
   const WarpInverse inverse(warp);
   const auto st = inverse.st_at_pixel_centres();
@@ -131,6 +133,7 @@ OutputState make_output_state(const OutputSpec& output) {
   }
   if (covered < st.size()) {
     out.coverage_mask = Texture::create_2d(GL_R8, size.x, size.y);
+    out.texture_bytes += std::uint64_t(size.x) * std::uint64_t(size.y);
     glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
     glTextureSubImage2D(out.coverage_mask.id(), 0, 0, 0, size.x, size.y, GL_RED, GL_UNSIGNED_BYTE,
                         mask.data());
@@ -213,6 +216,9 @@ class VertexMethod final : public RenderMethod {
     FACET_ASSERT(scene_ && targets.size() == outputs_.size());
     const Scene& scene = *scene_;
     RenderStats stats;
+    // Per output its warp's node texture and coverage mask, and the shared counters.
+    stats.gpu_buffer_bytes = counters_.size();
+    for (const OutputState& out : outputs_) stats.gpu_buffer_bytes += out.texture_bytes;
     const bool tessellated = settings_.max_tessellation > 1;
     const Program& draw = tessellated ? tess_program_ : plain_program_;
 
