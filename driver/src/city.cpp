@@ -756,9 +756,22 @@ std::vector<Material> city_materials() {
   return materials;
 }
 
-}  // namespace
+// Grass around the box [x0, x1] x [z0, z1] (the outer sidewalks' edge) out to `margin` beyond
+// it, as add_countryside does around one city.
+void add_countryside_around(CityBuilder& city, float x0, float x1, float z0, float z1,
+                            float margin) {
+  const float gx0 = x0 - margin, gx1 = x1 + margin, gz0 = z0 - margin, gz1 = z1 + margin;
+  const std::array<std::array<float, 4>, 4> strips = {
+      {{gx0, gx1, gz0, z0}, {gx0, gx1, z1, gz1}, {gx0, x0, z0, z1}, {x1, gx1, z0, z1}}};
+  int index = 0;
+  for (const auto& s : strips) {
+    city.begin_object("countryside " + std::to_string(index++));
+    city.ground(CityMaterial::grass, s[0], s[1], s[2], s[3], 0.0f, 62.0f, 4.0f);
+    city.end_object();
+  }
+}
 
-Scene build_city(const CityOptions& options) {
+void check_city_options(const CityOptions& options) {
   if (options.blocks_per_side < 1 || options.blocks_per_side > 16)
     throw std::invalid_argument("build_city: blocks_per_side must be in [1, 16], got " +
                                 std::to_string(options.blocks_per_side));
@@ -766,16 +779,88 @@ Scene build_city(const CityOptions& options) {
   if (t < 8 || t > 1024 || (t & (t - 1)) != 0)
     throw std::invalid_argument(
         "build_city: texture_size must be a power of two in [8, 1024], got " + std::to_string(t));
+}
+
+// The city without its countryside: streets, blocks, buildings, trees and lamps.
+CityBuilder city_core(const CityOptions& options) {
+  check_city_options(options);
   CityBuilder city;
   city.scene.name = "facet city (seed " + std::to_string(options.seed) + ")";
   city.scene.materials = city_materials();
-  city.scene.images = city_textures(t);
+  city.scene.images = city_textures(options.texture_size);
   Pcg32 rng(options.seed);
   const int n = options.blocks_per_side;
   add_streets(city, rng, n);
   for (int bx = -n; bx < n; ++bx)
     for (int bz = -n; bz < n; ++bz) add_block(city, rng, bx, bz);
-  add_countryside(city, n);
+  return city;
+}
+
+}  // namespace
+
+Scene build_city(const CityOptions& options) {
+  CityBuilder city = city_core(options);
+  add_countryside(city, options.blocks_per_side);
+  return std::move(city.scene);
+}
+
+double city_tile_period_m(const CityOptions& options) {
+  return 2.0 * (double(options.blocks_per_side) * pitch + street_half);
+}
+
+int city_tile_offset(int i, int k) { return i - (k - 1) / 2; }
+
+std::uint64_t city_tiles_triangle_count(int k, const CityOptions& options) {
+  if (k < 1 || k > 64)
+    throw std::invalid_argument("city_tiles_triangle_count: k must be in [1, 64], got " +
+                                std::to_string(k));
+  if (k == 1) return build_city(options).triangle_count();
+  const std::uint64_t tile = city_core(options).scene.triangle_count();
+  CityBuilder countryside;
+  const float period = static_cast<float>(city_tile_period_m(options));
+  const float e1 = 0.5f * period;
+  const float lo = static_cast<float>(city_tile_offset(0, k)) * period - e1;
+  const float hi = static_cast<float>(city_tile_offset(k - 1, k)) * period + e1;
+  const float n_extent = static_cast<float>(options.blocks_per_side) * pitch + street_half;
+  add_countryside_around(countryside, lo, hi, lo, hi,
+                         std::max(600.0f, n_extent + 4.0f * pitch) - n_extent);
+  return tile * std::uint64_t(k) * std::uint64_t(k) + countryside.scene.triangle_count();
+}
+
+Scene build_city_tiles(int k, const CityOptions& options) {
+  if (k < 1 || k > 64)
+    throw std::invalid_argument("build_city_tiles: k must be in [1, 64], got " + std::to_string(k));
+  if (k == 1) return build_city(options);
+  CityBuilder city = city_core(options);
+  const std::vector<Object> tile = std::move(city.scene.objects);
+  city.scene.objects.clear();
+  city.scene.objects.reserve(tile.size() * std::size_t(k) * std::size_t(k) + 4);
+  const float period = static_cast<float>(city_tile_period_m(options));  // exact: 2 (n 62 + 7)
+  for (int i = 0; i < k; ++i)
+    for (int j = 0; j < k; ++j) {
+      const glm::vec3 offset(static_cast<float>(city_tile_offset(i, k)) * period, 0.0f,
+                             static_cast<float>(city_tile_offset(j, k)) * period);
+      const std::string prefix =
+          "tile " + std::to_string(city_tile_offset(i, k)) + "," +
+          std::to_string(city_tile_offset(j, k)) + " ";
+      for (const Object& original : tile) {
+        Object object = original;
+        object.name = prefix + original.name;
+        object.T_world_object[3] = glm::vec4(offset, 1.0f);
+        // Translations by whole metres move every vertex by exactly the offset's rounding, so
+        // the moved box is the box of the moved vertices.
+        object.bounds_world.p_min += offset;
+        object.bounds_world.p_max += offset;
+        city.scene.objects.push_back(std::move(object));
+      }
+    }
+  const float e1 = 0.5f * period;
+  const float lo = static_cast<float>(city_tile_offset(0, k)) * period - e1;
+  const float hi = static_cast<float>(city_tile_offset(k - 1, k)) * period + e1;
+  const float n_extent = static_cast<float>(options.blocks_per_side) * pitch + street_half;
+  const float margin = std::max(600.0f, n_extent + 4.0f * pitch) - n_extent;
+  add_countryside_around(city, lo, hi, lo, hi, margin);
+  city.scene.name += ", " + std::to_string(k) + "x" + std::to_string(k) + " tiles";
   return std::move(city.scene);
 }
 

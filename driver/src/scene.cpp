@@ -2,6 +2,10 @@
 
 #include <cstring>
 #include <glm/common.hpp>
+#include <glm/geometric.hpp>
+#include <stdexcept>
+#include <string>
+#include <type_traits>
 
 namespace facet::driver {
 
@@ -47,6 +51,84 @@ void Scene::update_bounds() {
     }
     object.bounds_world = box;
   }
+}
+
+Scene subdivide_triangles(const Scene& scene, int n) {
+  if (n < 1 || n > 64)
+    throw std::invalid_argument("subdivide_triangles: n must be in [1, 64], got " +
+                                std::to_string(n));
+  Scene out;
+  out.name = scene.name;
+  out.objects = scene.objects;
+  out.materials = scene.materials;
+  out.images = scene.images;
+  const std::uint64_t pieces = std::uint64_t(n) * std::uint64_t(n);
+  const std::uint64_t corners = std::uint64_t(n + 1) * std::uint64_t(n + 2) / 2;
+  std::uint64_t triangles = 0;
+  for (const Primitive& p : scene.primitives) triangles += p.index_count / 3;
+  const std::uint64_t max32 = std::numeric_limits<std::uint32_t>::max();
+  if (triangles * pieces * 3 > max32 || triangles * corners > max32)
+    throw std::invalid_argument("subdivide_triangles: " + std::to_string(triangles) +
+                                " triangles cut " + std::to_string(pieces) +
+                                " ways need more than 2^32 - 1 indices");
+  out.positions.reserve(triangles * corners);
+  out.normals.reserve(triangles * corners);
+  out.uvs.reserve(triangles * corners);
+  out.indices.reserve(triangles * pieces * 3);
+  const bool has_normals = scene.normals.size() == scene.positions.size();
+  const bool has_uvs = scene.uvs.size() == scene.positions.size();
+  // Row j (0..n) of a triangle's corner grid starts at this offset and holds n + 1 - j corners.
+  auto corner = [n](int i, int j) {
+    return std::uint32_t(j * (n + 1) - j * (j - 1) / 2 + i);
+  };
+  for (const Primitive& primitive : scene.primitives) {
+    Primitive p = primitive;
+    p.first_index = static_cast<std::uint32_t>(out.indices.size());
+    for (std::uint32_t t = 0; t + 2 < primitive.index_count; t += 3) {
+      const std::uint32_t a = scene.indices[primitive.first_index + t];
+      const std::uint32_t b = scene.indices[primitive.first_index + t + 1];
+      const std::uint32_t c = scene.indices[primitive.first_index + t + 2];
+      const std::uint32_t base = static_cast<std::uint32_t>(out.positions.size());
+      // Corner (i, j) = a + (b - a) i/n + (c - a) j/n, i + j <= n.
+      for (int j = 0; j <= n; ++j)
+        for (int i = 0; i + j <= n; ++i) {
+          // Weights k / n in double, rounded to float once: a point on an edge comes out on it
+          // (the weights sum to 1 within 1e-16) and bit-identical from both triangles that share
+          // the edge (the same two products, added in either order).
+          const double u = double(i) / n, v = double(j) / n, w = double(n - i - j) / n;
+          auto mix = [&](const auto& values) {
+            using Vec = std::decay_t<decltype(values[a])>;
+            if (i == 0 && j == 0) return values[a];
+            if (i == n) return values[b];
+            if (j == n) return values[c];
+            using Dvec = glm::vec<Vec::length(), double>;
+            return Vec(w * Dvec(values[a]) + u * Dvec(values[b]) + v * Dvec(values[c]));
+          };
+          out.positions.push_back(mix(scene.positions));
+          if (has_normals) {
+            const glm::vec3 normal = mix(scene.normals);
+            const float length = glm::length(normal);
+            out.normals.push_back(length > 0 ? normal / length : scene.normals[a]);
+          }
+          if (has_uvs) out.uvs.push_back(mix(scene.uvs));
+        }
+      // Upright pieces (i, j) (i+1, j) (i, j+1) and inverted ones (i+1, j) (i+1, j+1) (i, j+1):
+      // the original winding.
+      for (int j = 0; j < n; ++j)
+        for (int i = 0; i + j < n; ++i) {
+          out.indices.insert(out.indices.end(), {base + corner(i, j), base + corner(i + 1, j),
+                                                 base + corner(i, j + 1)});
+          if (i + j + 1 < n)
+            out.indices.insert(out.indices.end(),
+                               {base + corner(i + 1, j), base + corner(i + 1, j + 1),
+                                base + corner(i, j + 1)});
+        }
+    }
+    p.index_count = static_cast<std::uint32_t>(out.indices.size()) - p.first_index;
+    out.primitives.push_back(p);
+  }
+  out.update_bounds();
+  return out;
 }
 
 namespace {

@@ -1,5 +1,6 @@
 // `facet render` end to end: bad input exits 2 with a message, --json reports the fields that
-// `facet bench` and the paper comparison read, --out writes the images.
+// `facet bench` and the paper comparison read, --out writes the images, the view moves every
+// frame unless --static-view.
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -8,8 +9,10 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
 
 namespace {
 
@@ -30,6 +33,73 @@ Result run_cli(const std::string& arguments) {
   return result;
 }
 
+// Two unit-metre squares 5 m in front of and behind the bounds' centre (the origin), facing it:
+// FILE.gltf beside FILE.bin.
+void write_two_walls_gltf(const std::filesystem::path& gltf) {
+  const float positions[8][3] = {{-1, -1, -5}, {1, -1, -5}, {1, 1, -5}, {-1, 1, -5},
+                                 {1, -1, 5},   {-1, -1, 5}, {-1, 1, 5}, {1, 1, 5}};
+  const std::uint16_t indices[12] = {0, 1, 2, 0, 2, 3, 4, 5, 6, 4, 6, 7};
+  std::filesystem::path bin = gltf;
+  bin.replace_extension(".bin");
+  std::ofstream out(bin, std::ios::binary);
+  out.write(reinterpret_cast<const char*>(positions), sizeof positions);
+  out.write(reinterpret_cast<const char*>(indices), sizeof indices);
+  out.close();
+  std::ofstream json(gltf);
+  json << R"({"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}],
+  "nodes": [{"mesh": 0}],
+  "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1}]}],
+  "accessors": [
+    {"bufferView": 0, "componentType": 5126, "count": 8, "type": "VEC3",
+     "min": [-1, -1, -5], "max": [1, 1, 5]},
+    {"bufferView": 1, "componentType": 5123, "count": 12, "type": "SCALAR"}],
+  "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 96},
+                  {"buffer": 0, "byteOffset": 96, "byteLength": 24}],
+  "buffers": [{"byteLength": 120, "uri": ")"
+       << bin.filename().string() << R"("}]})";
+}
+
+// A glTF scene's view turns every frame, so the facet pipeline replicates every frame; with
+// --static-view it keeps frame 1's view and reuses passes 1 and 2 on the frames after it.
+TEST(RenderCli, TheViewMovesUnlessStatic) {
+  const std::filesystem::path folder =
+      std::filesystem::temp_directory_path() / ("facet_render_view_" + std::to_string(getpid()));
+  std::filesystem::remove_all(folder);
+  std::filesystem::create_directories(folder);
+  const std::filesystem::path gltf = folder / "walls.gltf";
+  write_two_walls_gltf(gltf);
+  const std::string common = "render --display builtin:cylinder360 --size 64x48 --pieces 8 "
+                             "--frames 3 --json --scene " + gltf.string();
+  const Result moving = run_cli(common);
+  ASSERT_EQ(moving.status, 0) << moving.output;
+  const nlohmann::json m = nlohmann::json::parse(moving.output);
+  EXPECT_EQ(m["triangles_scene"].get<int>(), 4);
+  EXPECT_FALSE(m["reused_replication"].get<bool>());
+  EXPECT_EQ(m["reused_frames"].get<int>(), 0);
+  EXPECT_FALSE(m["static_view"].get<bool>());
+  EXPECT_GT(m["gpu_buffer_bytes"].get<std::uint64_t>(), 0u);
+  const Result still = run_cli(common + " --static-view");
+  ASSERT_EQ(still.status, 0) << still.output;
+  const nlohmann::json s = nlohmann::json::parse(still.output);
+  EXPECT_TRUE(s["reused_replication"].get<bool>());
+  EXPECT_EQ(s["reused_frames"].get<int>(), 2);
+  EXPECT_TRUE(s["static_view"].get<bool>());
+  std::filesystem::remove_all(folder);
+}
+
+// The cube map reports the memory of its faces and lookup textures: two 32-pixel cube maps
+// (colour and IDs, 4 bytes a texel each), their depth face and one RGBA32F lookup texel per
+// output pixel.
+TEST(RenderCli, CubemapReportsItsGpuBufferBytes) {
+  const Result result = run_cli(
+      "render --display builtin:dome180 --size 40x40 --method cubemap --face-size 32 --json");
+  ASSERT_EQ(result.status, 0) << result.output;
+  const nlohmann::json report = nlohmann::json::parse(result.output);
+  ASSERT_TRUE(report.contains("gpu_buffer_bytes")) << result.output;
+  EXPECT_EQ(report["gpu_buffer_bytes"].get<std::uint64_t>(),
+            6u * 32 * 32 * 8 + 32 * 32 * 4 + 40 * 40 * 16);
+}
+
 TEST(RenderCli, BadInputExitsWithStatus2) {
   for (const std::string& arguments :
        {std::string("render --display builtin:nothing"),
@@ -38,6 +108,9 @@ TEST(RenderCli, BadInputExitsWithStatus2) {
         std::string("render --display builtin:cylinder360 --size 0x10"),
         std::string("render --display builtin:cylinder360 --frames 0"),
         std::string("render --display builtin:cylinder360 --scene missing.gltf"),
+        std::string("render --display builtin:cylinder360 --scene builtin:town"),
+        std::string("render --display builtin:cylinder360 --scene builtin:city:0"),
+        std::string("render --display builtin:cylinder360 --scene builtin:city-fine:60"),
         std::string("render --display builtin:cylinder360 --anisotropy 0.5")}) {
     const Result result = run_cli(arguments);
     EXPECT_EQ(result.status, 2) << arguments << "\n" << result.output;

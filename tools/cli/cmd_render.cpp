@@ -10,15 +10,14 @@
 
 #include "command.hpp"
 #include "display_flags.hpp"
-#include "facet/driver/city.hpp"
 #include "facet/driver/display_outputs.hpp"
 #include "facet/driver/gl_context.hpp"
-#include "facet/driver/gltf_loader.hpp"
 #include "facet/driver/gpu_scene.hpp"
 #include "facet/driver/gpu_timer.hpp"
 #include "facet/driver/output_images.hpp"
 #include "facet/driver/reference.hpp"
 #include "facet/driver/render_method.hpp"
+#include "facet/driver/scene_names.hpp"
 #include "facet/projection/errors.hpp"
 
 namespace facet::cli {
@@ -26,7 +25,8 @@ namespace {
 
 using namespace facet::driver;
 
-// Frame k shows the city camera path at k times this step (seconds): 30 frames per second.
+// Frame k shows the city camera path at k times this step (seconds): 30 frames per second. Other
+// scenes turn 3 degrees a frame (FrameViews).
 constexpr double kFrameStepS = 1.0 / 30.0;
 
 struct RenderOptions {
@@ -36,7 +36,7 @@ struct RenderOptions {
   int frames = 1, msaa = 0;
   float anisotropy = kAutomaticAnisotropy;
   std::string coverage = "grid";
-  bool ids = false, depth = false, reference = false, json = false;
+  bool ids = false, depth = false, reference = false, json = false, static_view = false;
 };
 
 double median(std::vector<double> values) {
@@ -44,17 +44,6 @@ double median(std::vector<double> values) {
   std::sort(values.begin(), values.end());
   const std::size_t n = values.size();
   return n % 2 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
-}
-
-Scene load_scene(const std::string& name) {
-  if (name == "builtin:city") return build_city();
-  const std::filesystem::path path(name);
-  const std::string ext = path.extension().string();
-  if (ext != ".gltf" && ext != ".glb") {
-    throw InputError("command line", "--scene",
-                     "expected builtin:city or a .gltf/.glb file; got '" + name + "'");
-  }
-  return load_gltf(path);
 }
 
 // The last frame's IDs against the Embree ray cast of the same view, pooled over the outputs:
@@ -143,7 +132,8 @@ void run(const RenderOptions& options) {
   if (options.anisotropy != kAutomaticAnisotropy && !(options.anisotropy >= 1.0f)) {
     throw InputError("command line", "--anisotropy", "expected 0 (automatic) or a level >= 1");
   }
-  const Scene scene = load_scene(options.scene);
+  const SceneName scene_name = parse_scene_name(options.scene);
+  const Scene scene = load_scene(scene_name);
 
   auto context = create_headless_context();
   auto method = make_render_method(options.method);
@@ -154,19 +144,15 @@ void run(const RenderOptions& options) {
     targets.push_back(OutputTarget::create(output.warp.output_size, settings.msaa_samples));
   }
 
-  // The view follows the city's camera path; for other scenes it starts from the bounds' centre.
-  const CityCameraPath path;
-  const bool city = options.scene == "builtin:city";
-  const glm::dvec3 centre(scene.bounds_world().empty() ? glm::vec3(0)
-                                                       : scene.bounds_world().centre());
+  // The view moves every frame (unless --static-view): along the city's camera path, or for
+  // other scenes turning about the bounds' centre.
+  const FrameViews views(scene, scene_name.builtin_city(), kFrameStepS, options.static_view);
   GpuTimer timer;
   std::vector<double> frame_ms;
   std::vector<RenderStats> stats;
   glm::dmat4 T_eye_world(1.0);
   for (int k = 0; k < options.frames; ++k) {
-    glm::dmat4 T_world_eye = city ? path.T_world_eye(k * kFrameStepS) : glm::dmat4(1.0);
-    if (!city) T_world_eye[3] = glm::dvec4(centre, 1.0);
-    T_eye_world = glm::inverse(T_world_eye);
+    T_eye_world = views.T_eye_world(k);
     const auto start = std::chrono::steady_clock::now();
     stats.push_back(method->render(T_eye_world, targets, &timer));
     glFinish();
@@ -228,6 +214,9 @@ void run(const RenderOptions& options) {
                            {"replication_ratio", last.replication_ratio()},
                            {"replication_ratio_mean", ratio_sum / options.frames},
                            {"reused_frames", reused},
+                           {"reused_replication", last.reused_replication},
+                           {"static_view", options.static_view},
+                           {"gpu_buffer_bytes", last.gpu_buffer_bytes},
                            {"dropped_triangles", last.dropped_triangles},
                            {"seam_copies", last.seam_copies},
                            {"frame_ms", median(frame_ms)},
@@ -272,8 +261,14 @@ const Registration registration{
           ->add_option("--display", options->display,
                        "builtin:cylinder360 | builtin:dome180 | FILE.warp.exr | display.json")
           ->required();
-      command->add_option("--scene", options->scene, "builtin:city | FILE.gltf")
+      command
+          ->add_option("--scene", options->scene,
+                       "builtin:city | builtin:city:K (KxK tiles) | builtin:city-fine:N (each "
+                       "triangle in N^2) | FILE.gltf")
           ->capture_default_str();
+      command->add_flag("--static-view", options->static_view,
+                        "Keep frame 1's view on every frame (the facet methods then reuse "
+                        "passes 1 and 2); by default the view moves every frame");
       command
           ->add_option("--method", options->method, "facets | facets-gs | cubemap | naive | vertex")
           ->capture_default_str();

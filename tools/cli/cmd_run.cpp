@@ -7,9 +7,8 @@
 
 #include "command.hpp"
 #include "display_flags.hpp"
-#include "facet/driver/city.hpp"
 #include "facet/driver/gl_context.hpp"
-#include "facet/driver/gltf_loader.hpp"
+#include "facet/driver/scene_names.hpp"
 #include "facet/driver/monitors.hpp"
 #include "facet/driver/session.hpp"
 #include "facet/driver/session_runner.hpp"
@@ -33,13 +32,6 @@ struct RunOptions {
   bool monitors = false;
 };
 
-driver::Scene load_scene(const std::string& scene) {
-  if (scene == "builtin:city") return driver::build_city();
-  if (scene.starts_with("builtin:"))
-    throw InputError("command line", "--scene", "builtin:city or a .gltf/.glb file");
-  return driver::load_gltf(scene);
-}
-
 void run(const RunOptions& options) {
   if (options.monitors) {
     // Names and geometry to put in display.json outputs.
@@ -61,9 +53,9 @@ void run(const RunOptions& options) {
   }
   // Check the method name before any scene work.
   driver::check_render_method(display.method);
-  const driver::Scene scene = load_scene(options.scene);
-  const driver::CameraPath path =
-      driver::default_camera_path(scene, options.scene == "builtin:city");
+  const driver::SceneName scene_name = driver::parse_scene_name(options.scene);
+  const driver::Scene scene = driver::load_scene(scene_name);
+  const driver::CameraPath path = driver::default_camera_path(scene, scene_name.builtin_city());
 
   const char* x_display = std::getenv("DISPLAY");
   const char* wayland_display = std::getenv("WAYLAND_DISPLAY");
@@ -110,7 +102,9 @@ const Registration registration{
       command->add_option("display", options->display,
                           "builtin:dome180 (default), builtin:cylinder360, a .warp.exr or a "
                           "display.json");
-      command->add_option("--scene", options->scene, "builtin:city (default) or a glTF 2.0 file");
+      command->add_option("--scene", options->scene,
+                          "builtin:city (default), builtin:city:K (KxK tiles), "
+                          "builtin:city-fine:N (each triangle in N^2) or a glTF 2.0 file");
       command->add_option("--size", options->size, "Output size WxH of a built-in display");
       command->add_option("--method", options->method,
                           "facets, facets-gs, naive, cubemap or vertex (default: the display's)");

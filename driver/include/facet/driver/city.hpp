@@ -50,6 +50,21 @@ enum class CityMaterial : std::uint32_t {
 // power of two in [8, 1024].
 Scene build_city(const CityOptions& options = {});
 
+// The city's streets, blocks and buildings (every object but the countryside) as k × k tiles side
+// by side, one Object per tile and original object, sharing the original primitives (offset by
+// T_world_object only), and one countryside around them all. Tiles repeat every
+// city_tile_period_m(options) metres along x and z; the tile at the origin is the original
+// city, so CityCameraPath drives through it, and the tiles' avenues line up along x and z, so
+// the view down a street sees many tiles. k = 1 is build_city(options) itself.
+// Throws std::invalid_argument when k is not in [1, 64] (and as build_city does).
+Scene build_city_tiles(int k, const CityOptions& options = {});
+// Triangles of build_city_tiles(k, options), counted without building the tiles.
+std::uint64_t city_tiles_triangle_count(int k, const CityOptions& options = {});
+// Tile period of build_city_tiles: the city's width out to its outer sidewalks, metres.
+double city_tile_period_m(const CityOptions& options = {});
+// Offset, in tiles, of tile index i in [0, k): i - (k - 1) / 2, so tile (k - 1) / 2 is at the origin.
+int city_tile_offset(int i, int k);
+
 // A looping drive along the streets around the central blocks at eye height 1.7 m and a
 // constant 8 m/s, turning through the intersections on smooth curves.
 class CityCameraPath {

@@ -77,6 +77,15 @@ struct Scene {
   void update_bounds();
 };
 
+// The scene with every triangle cut into n² (regular subdivision: each edge in n equal parts,
+// the pieces of one triangle sharing their vertices), positions, texture coordinates and normals
+// interpolated linearly (normals renormalised). Primitives, objects, materials and images keep
+// their order, so primitive p of the result holds n² times the triangles of primitive p, in the
+// original triangles' order; object bounds are recomputed (update_bounds). Throws
+// std::invalid_argument when n is not in [1, 64] or the result would need more than 2^32 - 1
+// vertices or indices.
+Scene subdivide_triangles(const Scene& scene, int n);
+
 // 64-bit FNV-1a over the vertex, index and primitive data (exact bits): equal scenes hash equal.
 std::uint64_t geometry_hash(const Scene& scene);
 

@@ -1,0 +1,67 @@
+#pragma once
+// The scene names of `facet render`, `facet run` and `facet bench` (--scene), and the view that
+// render and bench move through them frame by frame.
+//
+//   builtin:city          the built-in city (build_city): 34,642 triangles
+//   builtin:city:K        the city as K x K tiles side by side (build_city_tiles), K in [1, 64]:
+//                         :2 has 136,864 triangles, :4 545,008, :8 2,175,976, :18 11,005,920
+//   builtin:city-fine:N   the city with every triangle cut into N² (subdivide_triangles), N in
+//                         [1, 64]: 34,642 N² triangles; :4 has 554,272, :8 2,217,088,
+//                         :17 10,011,538
+//   FILE.gltf, FILE.glb   a glTF 2.0 file (load_gltf)
+// Names that would give more than kMaxSceneTriangles triangles are refused before anything is
+// built.
+#include <cstdint>
+#include <filesystem>
+#include <glm/mat4x4.hpp>
+#include <string>
+#include <string_view>
+
+#include "facet/driver/city.hpp"
+#include "facet/driver/scene.hpp"
+
+namespace facet::driver {
+
+inline constexpr std::uint64_t kMaxSceneTriangles = 64'000'000;
+
+struct SceneName {
+  enum class Kind { city, city_tiles, city_fine, file };
+  Kind kind = Kind::city;
+  int count = 1;               // K of builtin:city:K, N of builtin:city-fine:N, else 1
+  std::filesystem::path file;  // Kind::file only
+  std::string text;            // as given
+  // The built-in city in any form: its camera path applies.
+  bool builtin_city() const { return kind != Kind::file; }
+};
+
+// Parses a --scene value. InputError("command line", "--scene", what was expected) for an unknown
+// builtin: name, a count that is not a whole number in range, a file that is not .gltf/.glb, or a
+// built-in scene of more than kMaxSceneTriangles triangles.
+SceneName parse_scene_name(std::string_view text);
+
+// Triangles of a built-in scene, counted without building it (0 for files).
+std::uint64_t builtin_scene_triangles(const SceneName& name);
+
+// Builds or loads the scene (load_gltf's InputError for a bad file).
+Scene load_scene(const SceneName& name);
+inline Scene load_scene(std::string_view text) { return load_scene(parse_scene_name(text)); }
+
+// The eye pose of frame k of `facet render` and `facet bench`: on the built-in city the city
+// camera path at k · city_step_s seconds; on other scenes the eye at the scene bounds' centre,
+// turning about world up (y) by 360° every kTurnFrames frames. A static view keeps frame 0's pose
+// on every frame (so the facet pipelines reuse passes 1 and 2).
+class FrameViews {
+ public:
+  static constexpr int kTurnFrames = 120;
+  FrameViews(const Scene& scene, bool builtin_city, double city_step_s, bool static_view = false);
+  glm::dmat4 T_world_eye(int frame) const;
+  glm::dmat4 T_eye_world(int frame) const;
+
+ private:
+  bool city_ = false, static_ = false;
+  double step_s_ = 0;
+  glm::dvec3 centre_{0.0};
+  CityCameraPath path_;
+};
+
+}  // namespace facet::driver

@@ -1,0 +1,113 @@
+#include "facet/driver/scene_names.hpp"
+
+#include <charconv>
+#include <glm/gtc/matrix_transform.hpp>
+#include <numbers>
+
+#include "facet/driver/gltf_loader.hpp"
+#include "facet/projection/errors.hpp"
+
+namespace facet::driver {
+namespace {
+
+constexpr const char* kExpected =
+    "builtin:city, builtin:city:K (K x K tiles, K in 1..64), builtin:city-fine:N (every "
+    "triangle cut into N², N in 1..64) or a .gltf/.glb file";
+
+[[noreturn]] void refuse(std::string_view text, const std::string& why) {
+  throw InputError("command line", "--scene",
+                   "expected " + std::string(kExpected) + "; got '" + std::string(text) + "'" +
+                       (why.empty() ? "" : " (" + why + ")"));
+}
+
+int parse_count(std::string_view text, std::string_view digits) {
+  int value = 0;
+  const auto [end, error] = std::from_chars(digits.data(), digits.data() + digits.size(), value);
+  if (digits.empty() || error != std::errc() || end != digits.data() + digits.size())
+    refuse(text, "the count must be a whole number");
+  if (value < 1 || value > 64) refuse(text, "the count must be in 1..64");
+  return value;
+}
+
+std::uint64_t city_triangles() {
+  static const std::uint64_t count = build_city().triangle_count();
+  return count;
+}
+
+}  // namespace
+
+SceneName parse_scene_name(std::string_view text) {
+  SceneName name;
+  name.text = std::string(text);
+  if (text.starts_with("builtin:")) {
+    const std::string_view rest = text.substr(8);
+    if (rest == "city") {
+      name.kind = SceneName::Kind::city;
+    } else if (rest.starts_with("city:")) {
+      name.kind = SceneName::Kind::city_tiles;
+      name.count = parse_count(text, rest.substr(5));
+    } else if (rest.starts_with("city-fine:")) {
+      name.kind = SceneName::Kind::city_fine;
+      name.count = parse_count(text, rest.substr(10));
+    } else {
+      refuse(text, "unknown built-in scene");
+    }
+    // Refused up front: a scene this size needs gigabytes before the first frame.
+    const std::uint64_t triangles = builtin_scene_triangles(name);
+    if (triangles > kMaxSceneTriangles)
+      refuse(text, std::to_string(triangles) + " triangles; at most " +
+                       std::to_string(kMaxSceneTriangles) + " are allowed");
+    return name;
+  }
+  const std::filesystem::path path(text);
+  const std::string ext = path.extension().string();
+  if (ext != ".gltf" && ext != ".glb") refuse(text, "");
+  name.kind = SceneName::Kind::file;
+  name.file = path;
+  return name;
+}
+
+std::uint64_t builtin_scene_triangles(const SceneName& name) {
+  switch (name.kind) {
+    case SceneName::Kind::city:
+      return city_triangles();
+    case SceneName::Kind::city_tiles:
+      return city_tiles_triangle_count(name.count);
+    case SceneName::Kind::city_fine:
+      return city_triangles() * std::uint64_t(name.count) * std::uint64_t(name.count);
+    case SceneName::Kind::file:
+      break;
+  }
+  return 0;
+}
+
+Scene load_scene(const SceneName& name) {
+  switch (name.kind) {
+    case SceneName::Kind::city:
+      return build_city();
+    case SceneName::Kind::city_tiles:
+      return build_city_tiles(name.count);
+    case SceneName::Kind::city_fine:
+      return name.count == 1 ? build_city() : subdivide_triangles(build_city(), name.count);
+    case SceneName::Kind::file:
+      break;
+  }
+  return load_gltf(name.file);
+}
+
+FrameViews::FrameViews(const Scene& scene, bool builtin_city, double city_step_s, bool static_view)
+    : city_(builtin_city), static_(static_view), step_s_(city_step_s) {
+  const Aabb bounds = scene.bounds_world();
+  if (!bounds.empty()) centre_ = glm::dvec3(bounds.centre());
+}
+
+glm::dmat4 FrameViews::T_world_eye(int frame) const {
+  const int k = static_ ? 0 : frame;
+  if (city_) return path_.T_world_eye(k * step_s_);
+  const double yaw = 2 * std::numbers::pi * double(k % kTurnFrames) / kTurnFrames;
+  return glm::rotate(glm::translate(glm::dmat4(1.0), centre_), yaw, glm::dvec3(0, 1, 0));
+}
+
+glm::dmat4 FrameViews::T_eye_world(int frame) const { return glm::inverse(T_world_eye(frame)); }
+
+}  // namespace facet::driver
