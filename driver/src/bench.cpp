@@ -14,6 +14,7 @@
 #include "facet/driver/gpu_scene.hpp"
 #include "facet/driver/gpu_timer.hpp"
 #include "facet/driver/reference.hpp"
+#include "facet/driver/scene_names.hpp"
 #include "facet/projection/errors.hpp"
 #include "facet/projection/facet_error.hpp"
 #include "facet/projection/rig.hpp"
@@ -196,17 +197,18 @@ std::vector<BenchScenario> make_bench_scenarios(const BenchOptions& options) {
   // "deformation" and "dome" are groups; their parts can be run alone.
   static const std::set<std::string> known = {
       "cylinder",    "deformation", "deformation-80x60", "deformation-128x128", "dome",
-      "dome-master", "dome4"};
+      "dome-master", "dome4",       "scale"};
   std::vector<std::string> names = options.scenarios;
   if (names.empty()) names = {"cylinder", "deformation", "dome"};
   for (const std::string& name : names) {
     if (!known.contains(name)) {
       throw InputError("command line", "--scenario",
                        "expected cylinder, deformation, deformation-80x60, deformation-128x128, "
-                       "dome, dome-master, dome4 or all; got '" +
+                       "dome, dome-master, dome4, scale or all; got '" +
                            name + "'");
     }
   }
+  parse_scene_name(options.scene);  // InputError for a bad --scene before any work
   if (!(options.size_scale > 0) || options.size_scale > 4) {
     throw InputError("command line", "--size-scale", "expected a scale in (0, 4]");
   }
@@ -241,6 +243,32 @@ std::vector<BenchScenario> make_bench_scenarios(const BenchOptions& options) {
                   faces_sweep, tess);
       }
       scenarios.push_back(std::move(s));
+    } else if (name == "scale") {
+      // Frame cost against scene size: every method at one setting each, on the cylinder and the
+      // dome master, over growing tiled cities (scene names and counts: scene_names.hpp). Ordered
+      // by scene, so run_bench builds each scene once.
+      const std::vector<std::string> scenes =
+          quick ? std::vector<std::string>{"builtin:city", "builtin:city:2"}
+                : std::vector<std::string>{"builtin:city", "builtin:city:4", "builtin:city:8"};
+      for (const std::string& scene : scenes) {
+        const std::uint64_t triangles = builtin_scene_triangles(parse_scene_name(scene));
+        for (const bool cylinder : {true, false}) {
+          BenchScenario s;
+          s.scale_group = cylinder ? "scale-cylinder" : "scale-dome";
+          s.name = s.scale_group + ":" + scene.substr(std::string("builtin:").size());
+          s.scene = scene;
+          s.outputs =
+              cylinder ? load_display_outputs("builtin:cylinder360", scaled({1600, 1200}, scale))
+                       : load_display_outputs("builtin:dome180", scaled({2048, 2048}, scale));
+          s.description = std::string(cylinder ? "the 360x90 cylinder" : "the 180-degree dome") +
+                          " at " + size_text(s.outputs[0].warp.output_size) + ", " + scene +
+                          " (" + std::to_string(triangles) + " triangles)";
+          s.settings =
+              sweep({FacetTolerance{0.25}}, FacetTolerance{0.25}, {FacetTolerance{0.25}},
+                    faces({512}), {1});
+          scenarios.push_back(std::move(s));
+        }
+      }
     } else if (name.starts_with("deformation")) {
       for (const glm::ivec2 cells : {glm::ivec2(80, 60), glm::ivec2(128, 128)}) {
         if (quick && cells.x == 128) continue;
@@ -313,18 +341,44 @@ BenchReport run_bench(const BenchOptions& options, const std::string& renderer,
   report.size_scale = options.size_scale;
   report.quick = options.quick;
 
-  const Scene scene = build_city();
-  const GpuScene gpu_scene = upload_scene(scene);
-  const ReferenceRaycaster raycaster(scene);
-  const CityCameraPath path;
-  auto T_eye_world_at = [&](double t) { return glm::inverse(path.T_world_eye(t)); };
+  // The scene of the scenarios run so far; scenarios with one scene follow each other (the scale
+  // scenarios) or share options.scene, so each scene is built once.
+  struct LoadedScene {
+    std::string name;
+    Scene scene;
+    GpuScene gpu;
+    std::unique_ptr<ReferenceRaycaster> raycaster;
+    std::unique_ptr<FrameViews> views;
+  };
+  std::unique_ptr<LoadedScene> loaded;
 
   for (const BenchScenario& scenario : scenarios) {
+    const std::string scene_text = scenario.scene.empty() ? options.scene : scenario.scene;
+    if (!loaded || loaded->name != scene_text) {
+      loaded.reset();  // the last scene's GPU and CPU memory first
+      const auto start = std::chrono::steady_clock::now();
+      const SceneName scene_name = parse_scene_name(scene_text);
+      auto next = std::make_unique<LoadedScene>();
+      next->name = scene_text;
+      next->scene = load_scene(scene_name);
+      next->gpu = upload_scene(next->scene);
+      next->raycaster = std::make_unique<ReferenceRaycaster>(next->scene);
+      next->views = std::make_unique<FrameViews>(next->scene, scene_name.builtin_city(),
+                                                 kBenchFrameStepS, options.static_view);
+      loaded = std::move(next);
+      say(format("scene %s: %zu triangles, %zu objects, ready in %.0f ms", scene_text.c_str(),
+                 loaded->scene.triangle_count(), loaded->scene.objects.size(),
+                 wall_ms_since(start)));
+    }
+    const Scene& scene = loaded->scene;
+    const GpuScene& gpu_scene = loaded->gpu;
+    const ReferenceRaycaster& raycaster = *loaded->raycaster;
+    const FrameViews& views = *loaded->views;
     say("scenario " + scenario.name + ": " + scenario.description);
     const bool wrap_x = scenario.outputs[0].warp.base.wraps_horizontally();
     std::vector<WarpInverse> inverses;
     std::vector<std::vector<std::uint32_t>> reference;
-    const glm::dmat4 T0 = T_eye_world_at(0);
+    const glm::dmat4 T0 = views.T_eye_world(0);
     for (const OutputSpec& output : scenario.outputs) {
       inverses.emplace_back(output.warp);
       reference.push_back(raycaster.ids(inverses.back(), T0));
@@ -361,6 +415,9 @@ BenchReport run_bench(const BenchOptions& options, const std::string& renderer,
       runner.setting = setting;
       BenchRow& row = runner.row;
       row.scenario = scenario.name;
+      row.scene = scene_text;
+      row.scale_group = scenario.scale_group;
+      row.triangles_scene = scene.triangle_count();
       row.method = setting.method;
       row.setting = setting.label;
       row.outputs = int(scenario.outputs.size());
@@ -455,7 +512,7 @@ BenchReport run_bench(const BenchOptions& options, const std::string& renderer,
 
     // Timed frames, interleaved: every setting once per frame, the starting setting rotating.
     for (int k = 1; k <= options.frames; ++k) {
-      const glm::dmat4 T = T_eye_world_at(k * kBenchFrameStepS);
+      const glm::dmat4 T = views.T_eye_world(k);
       for (std::size_t j = 0; j < runners.size(); ++j) {
         Runner& runner = runners[(j + std::size_t(k)) % runners.size()];
         if (!runner.method) continue;
@@ -515,12 +572,15 @@ BenchReport run_bench(const BenchOptions& options, const std::string& renderer,
       row.replicas = last.replicas;
       row.dropped_triangles = last.dropped_triangles;
       row.seam_copies = last.seam_copies;
-      say(format("  %-9s %-12s %9.2f ms/frame (median of %d), GPU %8.2f ms, ratio %.3f",
+      row.gpu_buffer_bytes = last.gpu_buffer_bytes;
+      say(format("  %-9s %-12s %9.2f ms/frame (median of %d), GPU %8.2f ms, ratio %.3f, "
+                 "%.1f MiB buffers",
                  row.method.c_str(), row.setting.c_str(), row.frame_ms, options.frames, row.gpu_ms,
-                 row.replication_ratio));
+                 row.replication_ratio, double(row.gpu_buffer_bytes) / (1024.0 * 1024.0)));
       report.rows.push_back(row);
     }
   }
+  report.scale_fits = bench_scale_fits(report.rows);
   report.notes = bench_notes(report.rows, renderer);
   return report;
 }

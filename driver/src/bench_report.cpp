@@ -3,7 +3,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
@@ -69,8 +71,11 @@ nlohmann::json row_json(const BenchRow& row) {
   nlohmann::json j = {{"scenario", row.scenario},
                       {"method", row.method},
                       {"setting", row.setting},
+                      {"scene", row.scene},
+                      {"triangles_scene", row.triangles_scene},
                       {"outputs", row.outputs},
                       {"output_size", row.output_size}};
+  if (!row.scale_group.empty()) j["scale_group"] = row.scale_group;
   if (!row.error.empty()) {
     j["error"] = row.error;
     return j;
@@ -90,6 +95,8 @@ nlohmann::json row_json(const BenchRow& row) {
             {"replicas", row.replicas},
             {"dropped_triangles", row.dropped_triangles},
             {"seam_copies", row.seam_copies},
+            {"gpu_buffer_bytes", row.gpu_buffer_bytes},
+            {"gpu_buffer_mib", double(row.gpu_buffer_bytes) / (1024.0 * 1024.0)},
             {"replication_ratio", row.replication_ratio},
             {"id_mismatch", row.id_mismatch},
             {"max_edge_px", row.max_edge_px},
@@ -109,6 +116,23 @@ nlohmann::json row_json(const BenchRow& row) {
   return j;
 }
 
+nlohmann::json scale_fits_json(const std::vector<BenchScaleFit>& fits) {
+  nlohmann::json list = nlohmann::json::array();
+  for (const BenchScaleFit& fit : fits) {
+    list.push_back({{"scale_group", fit.scale_group},
+                    {"method", fit.method},
+                    {"setting", fit.setting},
+                    {"rows", fit.rows},
+                    {"triangles_exponent", optional_json(fit.triangles_exponent)},
+                    {"facets_exponent", optional_json(fit.facets_exponent)},
+                    {"width_exponent", optional_json(fit.width_exponent)},
+                    {"triangles", {fit.triangles_min, fit.triangles_max}},
+                    {"facets", {fit.facets_min, fit.facets_max}},
+                    {"output_width", {fit.width_min, fit.width_max}}});
+  }
+  return list;
+}
+
 std::string csv_text(const BenchReport& report) {
   std::string text;
   const std::vector<std::string> columns = bench_csv_columns();
@@ -126,6 +150,8 @@ std::string csv_text(const BenchReport& report) {
         row.scenario,
         row.method,
         row.setting,
+        row.scene,
+        std::to_string(row.triangles_scene),
         std::to_string(row.outputs),
         row.output_size,
         ok ? std::to_string(row.frames) : "",
@@ -143,6 +169,8 @@ std::string csv_text(const BenchReport& report) {
         count(row.replicas),
         count(row.dropped_triangles),
         count(row.seam_copies),
+        count(row.gpu_buffer_bytes),
+        number(double(row.gpu_buffer_bytes) / (1024.0 * 1024.0)),
         number(row.replication_ratio),
         number(row.id_mismatch),
         number(row.max_edge_px),
@@ -305,6 +333,8 @@ std::vector<std::string> bench_csv_columns() {
   return {"scenario",
           "method",
           "setting",
+          "scene",
+          "triangles_scene",
           "outputs",
           "output_size",
           "frames",
@@ -322,6 +352,8 @@ std::vector<std::string> bench_csv_columns() {
           "replicas",
           "dropped_triangles",
           "seam_copies",
+          "gpu_buffer_bytes",
+          "gpu_buffer_mib",
           "replication_ratio",
           "id_mismatch",
           "max_edge_px",
@@ -335,6 +367,74 @@ std::vector<std::string> bench_csv_columns() {
           "geometric_source",
           "id_pixels_differing_from_facets",
           "error"};
+}
+
+std::optional<double> fit_power_exponent(const std::vector<double>& x,
+                                         const std::vector<double>& y) {
+  std::vector<std::pair<double, double>> points;
+  for (std::size_t k = 0; k < std::min(x.size(), y.size()); ++k) {
+    if (x[k] > 0 && y[k] > 0 && std::isfinite(x[k]) && std::isfinite(y[k])) {
+      points.emplace_back(std::log(x[k]), std::log(y[k]));
+    }
+  }
+  if (points.size() < 2) return std::nullopt;
+  double mx = 0, my = 0;
+  for (const auto& [lx, ly] : points) {
+    mx += lx;
+    my += ly;
+  }
+  mx /= double(points.size());
+  my /= double(points.size());
+  double sxx = 0, sxy = 0;
+  for (const auto& [lx, ly] : points) {
+    sxx += (lx - mx) * (lx - mx);
+    sxy += (lx - mx) * (ly - my);
+  }
+  // All x equal (to rounding): no slope to fit.
+  if (!(sxx > 1e-18 * double(points.size()))) return std::nullopt;
+  return sxy / sxx;
+}
+
+std::vector<BenchScaleFit> bench_scale_fits(const std::vector<BenchRow>& rows) {
+  std::vector<BenchScaleFit> fits;
+  std::vector<std::vector<const BenchRow*>> members;
+  for (const BenchRow& row : rows) {
+    if (row.scale_group.empty() || !row.error.empty()) continue;
+    std::size_t k = 0;
+    while (k < fits.size() && !(fits[k].scale_group == row.scale_group &&
+                                fits[k].method == row.method && fits[k].setting == row.setting)) {
+      ++k;
+    }
+    if (k == fits.size()) {
+      fits.push_back({row.scale_group, row.method, row.setting, 0, {}, {}, {}, 0, 0, 0, 0, 0, 0});
+      members.emplace_back();
+    }
+    members[k].push_back(&row);
+  }
+  for (std::size_t k = 0; k < fits.size(); ++k) {
+    BenchScaleFit& fit = fits[k];
+    std::vector<double> ms, triangles, facets, width;
+    fit.rows = members[k].size();
+    fit.triangles_min = fit.facets_min = UINT64_MAX;
+    fit.width_min = INT32_MAX;
+    for (const BenchRow* row : members[k]) {
+      const int w = std::atoi(row->output_size.c_str());  // "WxH"
+      ms.push_back(row->frame_ms);
+      triangles.push_back(double(row->triangles_scene));
+      facets.push_back(double(row->facets));
+      width.push_back(double(w));
+      fit.triangles_min = std::min(fit.triangles_min, row->triangles_scene);
+      fit.triangles_max = std::max(fit.triangles_max, row->triangles_scene);
+      fit.facets_min = std::min(fit.facets_min, row->facets);
+      fit.facets_max = std::max(fit.facets_max, row->facets);
+      fit.width_min = std::min(fit.width_min, w);
+      fit.width_max = std::max(fit.width_max, w);
+    }
+    fit.triangles_exponent = fit_power_exponent(triangles, ms);
+    if (fit.facets_max > fit.facets_min) fit.facets_exponent = fit_power_exponent(facets, ms);
+    if (fit.width_max > fit.width_min) fit.width_exponent = fit_power_exponent(width, ms);
+  }
+  return fits;
 }
 
 std::vector<std::string> bench_notes(const std::vector<BenchRow>& rows,
@@ -426,8 +526,40 @@ std::vector<std::string> bench_notes(const std::vector<BenchRow>& rows,
     }
     notes.push_back(line);
   }
+  // Frame cost against scene size, per scale group and method.
+  const std::vector<BenchScaleFit> fits = bench_scale_fits(rows);
+  std::string group;
+  std::string line;
+  auto flush = [&] {
+    if (!line.empty()) notes.push_back(line);
+    line.clear();
+  };
+  for (const BenchScaleFit& fit : fits) {
+    if (fit.scale_group != group) {
+      flush();
+      group = fit.scale_group;
+      line = format(
+          "%s: exponent b of median frame ms ~ triangles^b (least squares over %zu scene sizes, "
+          "%llu to %llu triangles, view moving):",
+          group.c_str(), fit.rows, static_cast<unsigned long long>(fit.triangles_min),
+          static_cast<unsigned long long>(fit.triangles_max));
+    }
+    line += fit.triangles_exponent
+                ? format(" %s %s %.3f;", fit.method.c_str(), fit.setting.c_str(),
+                         *fit.triangles_exponent)
+                : format(" %s %s n/a;", fit.method.c_str(), fit.setting.c_str());
+    if (fit.method == "facets") {
+      line += fit.facets_exponent
+                  ? format(" (facets exponent %.3f)", *fit.facets_exponent)
+                  : format(" (facet count fixed at %llu and output width at %d px in these rows: "
+                           "no exponent against them)",
+                           static_cast<unsigned long long>(fit.facets_max), fit.width_max);
+      if (fit.width_exponent) line += format(" (width exponent %.3f)", *fit.width_exponent);
+    }
+  }
+  flush();
   for (const char* scenario : {"deformation-80x60", "deformation-128x128"}) {
-    std::string line;
+    line.clear();
     for (const BenchRow* f : rows_of(rows, scenario, "facets")) {
       line += format(" %s %.3f (%llu facets);", f->setting.c_str(), f->replication_ratio,
                      static_cast<unsigned long long>(f->facets));
@@ -465,6 +597,7 @@ void write_bench_files(const BenchReport& report, const std::filesystem::path& f
                                  {"frame_step_s", kBenchFrameStepS},
                                  {"methods", methods},
                                  {"rows", rows},
+                                 {"scale_fits", scale_fits_json(report.scale_fits)},
                                  {"notes", report.notes}};
     write_text(temporary / "bench.json", json.dump(2) + "\n");
     write_text(temporary / "bench.csv", csv_text(report));

@@ -74,6 +74,8 @@ TEST(BenchCli, QuickWritesJsonCsvAndPlotWithEveryMethod) {
   const nlohmann::json json = nlohmann::json::parse(slurp(out / "bench.json"));
   ASSERT_TRUE(json.contains("rows"));
   ASSERT_TRUE(json.contains("notes"));
+  ASSERT_TRUE(json.contains("scale_fits"));
+  EXPECT_TRUE(json["scale_fits"].empty());  // no scale scenario ran
   EXPECT_FALSE(json["notes"].empty());
   const std::vector<std::string> methods = {"facets", "facets-gs", "cubemap", "naive", "vertex"};
   std::set<std::string> seen;
@@ -83,8 +85,14 @@ TEST(BenchCli, QuickWritesJsonCsvAndPlotWithEveryMethod) {
     for (const char* field :
          {"scenario", "setting", "frames", "frame_ms", "gpu_ms", "pass_ms", "facets",
           "triangles_in", "replicas", "replication_ratio", "id_mismatch", "max_edge_px",
-          "p99_edge_px", "geometric_max_px", "geometric_rms_px", "geometric_source"}) {
+          "p99_edge_px", "geometric_max_px", "geometric_rms_px", "geometric_source", "scene",
+          "triangles_scene", "gpu_buffer_bytes", "gpu_buffer_mib"}) {
       EXPECT_TRUE(row.contains(field)) << field << " missing in " << row.dump();
+    }
+    EXPECT_EQ(row["scene"], "builtin:city");
+    EXPECT_EQ(row["triangles_scene"].get<int>(), 34642);
+    if (row["method"] != "vertex") {
+      EXPECT_GT(row["gpu_buffer_bytes"].get<std::uint64_t>(), 0u);
     }
     EXPECT_GT(row["frame_ms"].get<double>(), 0.0);
     const double mismatch = row["id_mismatch"].get<double>();
@@ -208,6 +216,111 @@ TEST(BenchScenarios, EveryScenarioHasValidOutputsAndEveryMethod) {
   EXPECT_LT(largest, 0.05 * 1024);
   options.scenarios = {"moon"};
   EXPECT_THROW(driver::make_bench_scenarios(options), InputError);
+}
+
+// --scenario scale: every method at one setting on the cylinder and the dome, over growing
+// tiled cities, ordered by scene; "all" leaves it out. Rows only: running it at the quick size
+// takes minutes on llvmpipe.
+TEST(BenchScenarios, ScaleBuildsItsRowsOverTheSceneSizes) {
+  driver::BenchOptions options;
+  options.quick = true;
+  options.scenarios = {"scale"};
+  const auto quick = driver::make_bench_scenarios(options);
+  ASSERT_EQ(quick.size(), 4u);  // builtin:city and builtin:city:2, each on both displays
+  const std::vector<std::string> scenes = {"builtin:city", "builtin:city", "builtin:city:2",
+                                           "builtin:city:2"};
+  for (std::size_t k = 0; k < quick.size(); ++k) {
+    EXPECT_EQ(quick[k].scene, scenes[k]);
+    EXPECT_EQ(quick[k].scale_group, k % 2 ? "scale-dome" : "scale-cylinder");
+    EXPECT_EQ(quick[k].name, quick[k].scale_group + ":" + scenes[k].substr(8));
+    std::vector<std::string> methods, labels;
+    for (const auto& setting : quick[k].settings) {
+      methods.push_back(setting.method);
+      labels.push_back(setting.label);
+    }
+    EXPECT_EQ(methods,
+              (std::vector<std::string>{"facets", "facets-gs", "naive", "cubemap", "vertex"}));
+    EXPECT_EQ(labels, (std::vector<std::string>{"tol=0.25px", "tol=0.25px", "tol=0.25px",
+                                                "face=64", "tess=1"}));
+  }
+  EXPECT_EQ(quick[0].outputs.at(0).warp.output_size, glm::ivec2(200, 150));
+  EXPECT_EQ(quick[1].outputs.at(0).warp.output_size, glm::ivec2(256, 256));
+  options.quick = false;
+  options.size_scale = 0.125;
+  const auto full = driver::make_bench_scenarios(options);
+  ASSERT_EQ(full.size(), 6u);
+  EXPECT_EQ(full[4].scene, "builtin:city:8");
+  EXPECT_NE(full[4].description.find("2175976 triangles"), std::string::npos)
+      << full[4].description;
+  options.scenarios.clear();
+  for (const auto& scenario : driver::make_bench_scenarios(options))
+    EXPECT_TRUE(scenario.scale_group.empty()) << scenario.name;
+  options.scene = "builtin:village";
+  EXPECT_THROW(driver::make_bench_scenarios(options), InputError);
+}
+
+TEST(BenchScaleFit, ExponentOfAPowerLaw) {
+  std::vector<double> n, ms;
+  for (const double x : {3.5e4, 5.5e5, 2.2e6, 1e7}) {
+    n.push_back(x);
+    ms.push_back(3 * std::pow(x, 0.9));
+  }
+  const auto b = driver::fit_power_exponent(n, ms);
+  ASSERT_TRUE(b);
+  EXPECT_NEAR(*b, 0.9, 1e-9);
+  // A least-squares slope through noisy points: (1, 1), (10, 20), (100, 100) in logs.
+  const auto noisy = driver::fit_power_exponent({1, 10, 100}, {1, 20, 100});
+  ASSERT_TRUE(noisy);
+  EXPECT_NEAR(*noisy, 1.0, 1e-12);  // symmetric about the middle point
+  EXPECT_FALSE(driver::fit_power_exponent({5, 5, 5}, {1, 2, 3}));  // x does not vary
+  EXPECT_FALSE(driver::fit_power_exponent({5}, {1}));
+  EXPECT_FALSE(driver::fit_power_exponent({0, 10}, {1, 2}));  // only one usable point
+}
+
+TEST(BenchScaleFit, FitsEachGroupAndMethodAndSaysWhatDoesNotVary) {
+  std::vector<driver::BenchRow> rows;
+  for (const std::uint64_t triangles : {34642u, 545008u, 2175976u}) {
+    for (const char* method : {"facets", "cubemap"}) {
+      driver::BenchRow row;
+      row.scenario = "scale-cylinder:" + std::to_string(triangles);
+      row.scale_group = "scale-cylinder";
+      row.method = method;
+      row.setting = "s";
+      row.output_size = "1600x1200";
+      row.triangles_scene = triangles;
+      row.facets = row.method == "facets" ? 400 : 0;
+      row.frames = 5;
+      row.frame_ms = (row.method == "facets" ? 2.0 : 0.5) *
+                     std::pow(double(triangles), row.method == "facets" ? 0.8 : 1.1);
+      rows.push_back(row);
+    }
+  }
+  driver::BenchRow other;  // not in a scale group: left out
+  other.scenario = "cylinder";
+  other.method = "facets";
+  other.frame_ms = 1;
+  rows.push_back(other);
+  const auto fits = driver::bench_scale_fits(rows);
+  ASSERT_EQ(fits.size(), 2u);
+  EXPECT_EQ(fits[0].method, "facets");
+  EXPECT_EQ(fits[0].rows, 3u);
+  ASSERT_TRUE(fits[0].triangles_exponent);
+  EXPECT_NEAR(*fits[0].triangles_exponent, 0.8, 1e-9);
+  EXPECT_NEAR(*fits[1].triangles_exponent, 1.1, 1e-9);
+  EXPECT_FALSE(fits[0].facets_exponent);  // 400 facets in every row
+  EXPECT_FALSE(fits[0].width_exponent);   // 1600 px in every row
+  EXPECT_EQ(fits[0].triangles_min, 34642u);
+  EXPECT_EQ(fits[0].triangles_max, 2175976u);
+  bool noted = false;
+  for (const std::string& note : driver::bench_notes(rows, "test")) {
+    if (note.starts_with("scale-cylinder: exponent")) {
+      noted = true;
+      EXPECT_NE(note.find("facets s 0.800"), std::string::npos) << note;
+      EXPECT_NE(note.find("cubemap s 1.100"), std::string::npos) << note;
+      EXPECT_NE(note.find("no exponent against them"), std::string::npos) << note;
+    }
+  }
+  EXPECT_TRUE(noted);
 }
 
 }  // namespace

@@ -8,6 +8,7 @@
 #include "command.hpp"
 #include "facet/driver/bench.hpp"
 #include "facet/driver/gl_context.hpp"
+#include "facet/driver/scene_names.hpp"
 #include "facet/projection/errors.hpp"
 
 namespace facet::cli {
@@ -21,7 +22,8 @@ struct BenchCommandOptions {
   double size_scale = 1.0;
   std::string out = "out/bench";
   std::string rig = "configs/rigs/dome4.json";
-  bool quick = false;
+  std::string scene = "builtin:city";
+  bool quick = false, static_view = false;
 };
 
 void run(const BenchCommandOptions& command) {
@@ -31,6 +33,9 @@ void run(const BenchCommandOptions& command) {
   options.size_scale = command.size_scale;
   options.quick = command.quick;
   options.dome_rig = command.rig;
+  options.scene = command.scene;
+  options.static_view = command.static_view;
+  parse_scene_name(command.scene);  // exit 2 before any GL work
   if (command.quick && command.frames == BenchCommandOptions{}.frames) options.frames = 3;
   if (command.out.empty()) throw InputError("command line", "--out", "expected a folder");
 
@@ -55,7 +60,9 @@ const Registration registration{
       auto options = std::make_shared<BenchCommandOptions>();
       command
           ->add_option("--scenario", options->scenario,
-                       "cylinder | deformation[-80x60|-128x128] | dome | dome-master | dome4 | all")
+                       "cylinder | deformation[-80x60|-128x128] | dome | dome-master | dome4 | "
+                       "scale | all (all: cylinder, deformation, dome; scale: every method over "
+                       "builtin:city, :4, :8 on the cylinder and the dome)")
           ->capture_default_str();
       command
           ->add_option("--frames", options->frames,
@@ -67,6 +74,13 @@ const Registration registration{
           ->capture_default_str();
       command->add_option("--rig", options->rig, "The multi-projector dome rig (dome scenario)")
           ->capture_default_str();
+      command
+          ->add_option("--scene", options->scene,
+                       "Scene of every scenario but scale: builtin:city | builtin:city:K | "
+                       "builtin:city-fine:N | FILE.gltf")
+          ->capture_default_str();
+      command->add_flag("--static-view", options->static_view,
+                        "Keep the accuracy frame's view on every timed frame (default: it moves)");
       command->add_flag("--quick", options->quick,
                         "Small sizes (1/8), 3 frames, fewer settings: for tests");
       command->callback([options] { run(*options); });

@@ -27,8 +27,13 @@ namespace facet::driver {
 inline constexpr double kBenchFrameStepS = 0.25;
 
 struct BenchOptions {
-  // Any of "cylinder", "deformation", "dome"; empty means all three.
+  // Any of "cylinder", "deformation", "dome", "scale" and their parts; empty means "all":
+  // cylinder, deformation and dome ("scale" only when named).
   std::vector<std::string> scenarios;
+  // The scene of every scenario but "scale"'s (which sets its own): a parse_scene_name name.
+  std::string scene = "builtin:city";
+  // Keep frame 0's view on every timed frame (FrameViews); by default the view moves.
+  bool static_view = false;
   int frames = 5;           // timed frames per setting (>= 1)
   double size_scale = 1.0;  // multiplies every output size (and the rig's projector sizes)
   // Small sizes (size_scale · 1/8 unless set otherwise), fewer settings; for tests.
@@ -49,12 +54,20 @@ struct BenchSetting {
 struct BenchScenario {
   std::string name;         // "cylinder", "deformation-80x60", "dome", "dome4", ...
   std::string description;  // one line
+  std::string scene;        // parse_scene_name name; BenchOptions::scene when empty
+  // Scale scenarios: the display they share ("scale-cylinder", "scale-dome"); the exponent fits
+  // (bench_scale_fits) run over the rows of one group, method and setting.
+  std::string scale_group;
   std::vector<OutputSpec> outputs;
   std::vector<BenchSetting> settings;
 };
 
 struct BenchRow {
   std::string scenario, method, setting;
+  std::string scene;                 // its --scene name
+  std::string scale_group;           // BenchScenario::scale_group
+  std::uint64_t triangles_scene = 0;  // Scene::triangle_count()
+  std::uint64_t gpu_buffer_bytes = 0;  // RenderStats::gpu_buffer_bytes of the last timed frame
   std::string error;  // non-empty when the setting could not be prepared (then nothing else)
   int outputs = 0;
   std::string output_size;  // "WxH" of the first output
@@ -99,12 +112,32 @@ struct BenchRow {
   std::optional<std::uint64_t> id_pixels_differing_from_facets;
 };
 
+// Least-squares slope of log(y) against log(x): the exponent b of y = a · x^b. nullopt when fewer
+// than two points have x > 0 and y > 0, or those x are all equal.
+std::optional<double> fit_power_exponent(const std::vector<double>& x, const std::vector<double>& y);
+
+// How the frame time of one method and setting grows over a scale group's rows.
+struct BenchScaleFit {
+  std::string scale_group, method, setting;
+  std::size_t rows = 0;
+  // Exponents of median frame ms against the scene's triangles, the facet count and the output
+  // width; nullopt where the rows do not vary that quantity (or too few rows ran).
+  std::optional<double> triangles_exponent, facets_exponent, width_exponent;
+  std::uint64_t triangles_min = 0, triangles_max = 0;
+  std::uint64_t facets_min = 0, facets_max = 0;
+  int width_min = 0, width_max = 0;
+};
+
+// The fits of every scale group in `rows` (rows without a scale group are left out).
+std::vector<BenchScaleFit> bench_scale_fits(const std::vector<BenchRow>& rows);
+
 struct BenchReport {
   std::string renderer;  // GL_RENDERER
   int frames = 0;
   double size_scale = 1;
   bool quick = false;
   std::vector<BenchRow> rows;
+  std::vector<BenchScaleFit> scale_fits;  // bench_scale_fits(rows)
   std::vector<std::string> notes;  // the closing note: ratios at matched error, shares, ratios
 };
 
