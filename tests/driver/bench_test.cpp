@@ -225,6 +225,7 @@ TEST(BenchScenarios, ScaleBuildsItsRowsOverTheSceneSizes) {
   driver::BenchOptions options;
   options.quick = true;
   options.scenarios = {"scale"};
+  options.dome_rig = std::string(FACET_SOURCE_DIR) + "/configs/rigs/dome4.json";
   const auto quick = driver::make_bench_scenarios(options);
   ASSERT_EQ(quick.size(), 4u);  // builtin:city and builtin:city:2, each on both displays
   const std::vector<std::string> scenes = {"builtin:city", "builtin:city", "builtin:city:2",
