@@ -2,8 +2,12 @@
 // file and the line of the original file, whatever preamble the builder added.
 #include <gtest/gtest.h>
 
+#include <regex>
+#include <string>
+
 #include "facet/driver/program.hpp"
 #include "facet/driver/shader_library.hpp"
+#include "facet/projection/coverage_grid.hpp"
 #include "gl_test_context.hpp"
 
 namespace facet::driver {
@@ -17,6 +21,23 @@ TEST(Shaders, LibraryHoldsTheShaderFiles) {
   const EmbeddedShader& fill = embedded_shader("test/fill_ssbo.comp");
   EXPECT_NE(fill.text.find("values[i] = i * i + offset"), std::string_view::npos);
   EXPECT_THROW(embedded_shader("test/no_such_shader.frag"), std::out_of_range);
+}
+
+// The coverage grid's constants exist twice, in CoverageGrid and in the GLSL that mirrors it.
+TEST(Shaders, CoverageGridConstantsMatchTheCpp) {
+  const std::string text(embedded_shader("replication/replication_lib.comp").text);
+  const auto value = [&](const std::string& name) {
+    std::smatch match;
+    const std::regex pattern(name + R"( = (\d+)u)");
+    EXPECT_TRUE(std::regex_search(text, match, pattern)) << name;
+    return match.empty() ? -1L : std::stol(match[1]);
+  };
+  EXPECT_EQ(value("kGridMaxBuckets"), long(CoverageGrid::kMaxBuckets));
+  EXPECT_EQ(value("kGridMaxCandidates"), long(CoverageGrid::kMaxCandidates));
+  EXPECT_EQ(value("kChartCylindrical"), long(CoverageChart::cylindrical));
+  EXPECT_EQ(value("kChartEquirectangular"), long(CoverageChart::equirectangular));
+  EXPECT_EQ(value("kChartFisheye"), long(CoverageChart::fisheye));
+  EXPECT_EQ(value("kChartPerspective"), long(CoverageChart::perspective));
 }
 
 TEST(Shaders, EveryEmbeddedShaderCompiles) {
