@@ -1,7 +1,8 @@
 #pragma once
 // Which facets an eye-frame triangle may cover, without a hierarchy walk: a uniform bucket grid
-// over a chart of the base's directions (DESIGN.md, "Coverage grid"). Pass 1 on the GPU runs the
-// same arithmetic in float (shaders/replication/replication_lib.comp); this is its reference.
+// over a chart of the base's directions (driver/README.md, "The coverage grid"). Pass 1 on the
+// GPU runs the same arithmetic in float (shaders/replication/replication_lib.comp); this is its
+// reference.
 //
 // Chart. Directions b (base frame) are measured about the base's axis A: polar angle θ from A
 // and azimuth φ about it.
