@@ -3,8 +3,8 @@
 // per material with vertex pulling (DESIGN.md, "The replication pipeline").
 #include <algorithm>
 #include <limits>
-#include <string>
 #include <optional>
+#include <string>
 
 #include "facet/driver/facet_gpu.hpp"
 #include "facet/projection/errors.hpp"
