@@ -58,22 +58,7 @@ class FacetGsPipeline final : public FacetMethodBase {
       stats.triangles_visible += out.visible;
 
       TimedPass scope(timer, "pass3 draw");
-      bind_output(i);
-      targets[i].bind();
-      begin_facet_drawing(false);
-      set_list_uniforms(draw_, i);
-      draw_.use();
-      glBindVertexArray(empty_vao_.id());
-      glBindBuffer(GL_DRAW_INDIRECT_BUFFER, out.draw_args.id());
-      glMemoryBarrier(GL_COMMAND_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
-      for (std::uint32_t m = 0; m < material_count(); ++m) {
-        if (out.material_ranges[2 * m] == out.material_ranges[2 * m + 1]) continue;
-        set_material(draw_, m);
-        glDrawArraysIndirect(GL_POINTS, reinterpret_cast<const void*>(std::uintptr_t(m) * 16u));
-      }
-      glBindBuffer(GL_DRAW_INDIRECT_BUFFER, 0);
-      glBindVertexArray(0);
-      end_facet_drawing();
+      draw_replicas(i, targets[i], draw_, GL_POINTS);
       targets[i].resolve();
     }
     if (timer) timer->end_frame();

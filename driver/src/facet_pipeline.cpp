@@ -87,24 +87,8 @@ class FacetPipeline final : public FacetMethodBase {
 
  private:
   void draw(std::size_t i, OutputTarget& target, GpuTimer* timer) {
-    OutputState& out = outputs_[i];
     TimedPass scope(timer, "pass3 draw");
-    bind_output(i);
-    target.bind();
-    begin_facet_drawing(false);
-    set_list_uniforms(draw_, i);
-    draw_.use();
-    glBindVertexArray(empty_vao_.id());
-    glBindBuffer(GL_DRAW_INDIRECT_BUFFER, out.draw_args.id());
-    glMemoryBarrier(GL_COMMAND_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
-    for (std::uint32_t m = 0; m < material_count(); ++m) {
-      if (out.material_ranges[2 * m] == out.material_ranges[2 * m + 1]) continue;
-      set_material(draw_, m);
-      glDrawArraysIndirect(GL_TRIANGLES, reinterpret_cast<const void*>(std::uintptr_t(m) * 16u));
-    }
-    glBindBuffer(GL_DRAW_INDIRECT_BUFFER, 0);
-    glBindVertexArray(0);
-    end_facet_drawing();
+    draw_replicas(i, target, draw_, GL_TRIANGLES);
   }
 
   // Passes 1 and 2 for output i: coverage with staged facets, scan, the pairs' copy and the

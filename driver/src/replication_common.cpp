@@ -212,6 +212,27 @@ void FacetMethodBase::set_material(const Program& program, std::uint32_t m) cons
   gpu_->bind_material_texture(m, 0);
 }
 
+void FacetMethodBase::draw_replicas(std::size_t i, const OutputTarget& target,
+                                    const Program& program, GLenum mode) const {
+  const OutputState& out = outputs_[i];
+  bind_output(i);
+  target.bind();
+  begin_facet_drawing(false);
+  set_list_uniforms(program, i);
+  program.use();
+  glBindVertexArray(empty_vao_.id());
+  glBindBuffer(GL_DRAW_INDIRECT_BUFFER, out.draw_args.id());
+  glMemoryBarrier(GL_COMMAND_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
+  for (std::uint32_t m = 0; m < material_count(); ++m) {
+    if (out.material_ranges[2 * m] == out.material_ranges[2 * m + 1]) continue;
+    set_material(program, m);
+    glDrawArraysIndirect(mode, reinterpret_cast<const void*>(std::uintptr_t(m) * 16u));
+  }
+  glBindBuffer(GL_DRAW_INDIRECT_BUFFER, 0);
+  glBindVertexArray(0);
+  end_facet_drawing();
+}
+
 void FacetMethodBase::begin_facet_drawing(bool cull_back_faces) {
   glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE);
   glEnable(GL_DEPTH_TEST);

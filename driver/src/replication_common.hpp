@@ -89,6 +89,10 @@ class FacetMethodBase : public RenderMethod {
   void bind_output(std::size_t i) const;
   // Sets scene/material.frag's uniforms and texture for material m on `program`.
   void set_material(const Program& program, std::uint32_t m) const;
+  // Pass 3 for output i into `target`: one glDrawArraysIndirect of `mode` per material with
+  // `program`, from output i's draw arguments.
+  void draw_replicas(std::size_t i, const OutputTarget& target, const Program& program,
+                     GLenum mode) const;
   // Depth, clip-control and clip-distance state of pass 3, and its undoing.
   static void begin_facet_drawing(bool cull_back_faces);
   static void end_facet_drawing();

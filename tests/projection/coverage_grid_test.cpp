@@ -13,6 +13,7 @@
 
 #include "facet/projection/coverage.hpp"
 #include "facet/projection/facets.hpp"
+#include "random_geometry.hpp"
 #include "test_displays.hpp"
 
 namespace facet {
@@ -20,17 +21,8 @@ namespace {
 
 using Triangle = std::array<glm::dvec3, 3>;
 
-glm::dvec3 random_unit(std::mt19937_64& random) {
-  std::normal_distribution<double> normal;
-  glm::dvec3 v;
-  do v = {normal(random), normal(random), normal(random)};
-  while (glm::length(v) < 1e-6);
-  return glm::normalize(v);
-}
-
-double log_uniform(std::mt19937_64& random, double lo, double hi) {
-  return std::exp(std::uniform_real_distribution<double>(std::log(lo), std::log(hi))(random));
-}
+using test::log_uniform;
+using test::random_unit;
 
 // Directions that stress the chart: the base's poles and seam, and the eye-frame axes.
 std::vector<glm::dvec3> special_directions(const Warp& warp) {

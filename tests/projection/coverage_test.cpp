@@ -9,24 +9,15 @@
 
 #include "facet/projection/errors.hpp"
 #include "facet/projection/facets.hpp"
+#include "random_geometry.hpp"
 
 namespace facet {
 namespace {
 
 using Triangle = std::array<glm::dvec3, 3>;
 
-glm::dvec3 random_unit(std::mt19937_64& random) {
-  std::normal_distribution<double> normal;
-  glm::dvec3 v;
-  do v = {normal(random), normal(random), normal(random)};
-  while (glm::length(v) < 1e-6);
-  return glm::normalize(v);
-}
-
-double log_uniform(std::mt19937_64& random, double lo, double hi) {
-  std::uniform_real_distribution<double> u(std::log(lo), std::log(hi));
-  return std::exp(u(random));
-}
+using test::log_uniform;
+using test::random_unit;
 
 // Sizes 1e-4..1e3 m at distances 1e-3..1e6 m; one in 16 through the eye, one in 16 through the
 // vertical (cylinder) axis.
