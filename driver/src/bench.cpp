@@ -196,8 +196,8 @@ double median(std::vector<double> values) {
 std::vector<BenchScenario> make_bench_scenarios(const BenchOptions& options) {
   // "deformation" and "dome" are groups; their parts can be run alone.
   static const std::set<std::string> known = {
-      "cylinder",    "deformation", "deformation-80x60", "deformation-128x128", "dome",
-      "dome-master", "dome4",       "scale"};
+      "cylinder", "deformation", "deformation-80x60", "deformation-128x128", "dome", "dome-master",
+      "dome4",    "scale"};
   std::vector<std::string> names = options.scenarios;
   if (names.empty()) names = {"cylinder", "deformation", "dome"};
   for (const std::string& name : names) {
@@ -257,15 +257,14 @@ std::vector<BenchScenario> make_bench_scenarios(const BenchOptions& options) {
           s.scale_group = cylinder ? "scale-cylinder" : "scale-dome";
           s.name = s.scale_group + ":" + scene.substr(std::string("builtin:").size());
           s.scene = scene;
-          s.outputs =
-              cylinder ? load_display_outputs("builtin:cylinder360", scaled({1600, 1200}, scale))
-                       : load_display_outputs("builtin:dome180", scaled({2048, 2048}, scale));
+          s.outputs = cylinder
+                          ? load_display_outputs("builtin:cylinder360", scaled({1600, 1200}, scale))
+                          : load_display_outputs("builtin:dome180", scaled({2048, 2048}, scale));
           s.description = std::string(cylinder ? "the 360x90 cylinder" : "the 180-degree dome") +
-                          " at " + size_text(s.outputs[0].warp.output_size) + ", " + scene +
-                          " (" + std::to_string(triangles) + " triangles)";
-          s.settings =
-              sweep({FacetTolerance{0.25}}, FacetTolerance{0.25}, {FacetTolerance{0.25}},
-                    faces({512}), {1});
+                          " at " + size_text(s.outputs[0].warp.output_size) + ", " + scene + " (" +
+                          std::to_string(triangles) + " triangles)";
+          s.settings = sweep({FacetTolerance{0.25}}, FacetTolerance{0.25}, {FacetTolerance{0.25}},
+                             faces({512}), {1});
           scenarios.push_back(std::move(s));
         }
       }
@@ -573,7 +572,8 @@ BenchReport run_bench(const BenchOptions& options, const std::string& renderer,
       row.dropped_triangles = last.dropped_triangles;
       row.seam_copies = last.seam_copies;
       row.gpu_buffer_bytes = last.gpu_buffer_bytes;
-      say(format("  %-9s %-12s %9.2f ms/frame (median of %d), GPU %8.2f ms, ratio %.3f, "
+      say(
+          format("  %-9s %-12s %9.2f ms/frame (median of %d), GPU %8.2f ms, ratio %.3f, "
                  "%.1f MiB buffers",
                  row.method.c_str(), row.setting.c_str(), row.frame_ms, options.frames, row.gpu_ms,
                  row.replication_ratio, double(row.gpu_buffer_bytes) / (1024.0 * 1024.0)));

@@ -544,16 +544,16 @@ std::vector<std::string> bench_notes(const std::vector<BenchRow>& rows,
           group.c_str(), fit.rows, static_cast<unsigned long long>(fit.triangles_min),
           static_cast<unsigned long long>(fit.triangles_max));
     }
-    line += fit.triangles_exponent
-                ? format(" %s %s %.3f;", fit.method.c_str(), fit.setting.c_str(),
-                         *fit.triangles_exponent)
-                : format(" %s %s n/a;", fit.method.c_str(), fit.setting.c_str());
+    line += fit.triangles_exponent ? format(" %s %s %.3f;", fit.method.c_str(), fit.setting.c_str(),
+                                            *fit.triangles_exponent)
+                                   : format(" %s %s n/a;", fit.method.c_str(), fit.setting.c_str());
     if (fit.method == "facets") {
       line += fit.facets_exponent
                   ? format(" (facets exponent %.3f)", *fit.facets_exponent)
-                  : format(" (facet count fixed at %llu and output width at %d px in these rows: "
-                           "no exponent against them)",
-                           static_cast<unsigned long long>(fit.facets_max), fit.width_max);
+                  : format(
+                        " (facet count fixed at %llu and output width at %d px in these rows: "
+                        "no exponent against them)",
+                        static_cast<unsigned long long>(fit.facets_max), fit.width_max);
       if (fit.width_exponent) line += format(" (width exponent %.3f)", *fit.width_exponent);
     }
   }

@@ -840,9 +840,8 @@ Scene build_city_tiles(int k, const CityOptions& options) {
     for (int j = 0; j < k; ++j) {
       const glm::vec3 offset(static_cast<float>(city_tile_offset(i, k)) * period, 0.0f,
                              static_cast<float>(city_tile_offset(j, k)) * period);
-      const std::string prefix =
-          "tile " + std::to_string(city_tile_offset(i, k)) + "," +
-          std::to_string(city_tile_offset(j, k)) + " ";
+      const std::string prefix = "tile " + std::to_string(city_tile_offset(i, k)) + "," +
+                                 std::to_string(city_tile_offset(j, k)) + " ";
       for (const Object& original : tile) {
         Object object = original;
         object.name = prefix + original.name;

@@ -100,7 +100,8 @@ std::vector<std::uint32_t> pack_coverage_grid(const CoverageGrid& grid) {
   }
   words[21] = std::uint32_t(words.size());
   for (const auto& corners : grid.pyramid_corners())
-    for (const glm::dvec3& c : corners) words.insert(words.end(), {bits(c.x), bits(c.y), bits(c.z)});
+    for (const glm::dvec3& c : corners)
+      words.insert(words.end(), {bits(c.x), bits(c.y), bits(c.z)});
   return words;
 }
 

@@ -135,9 +135,10 @@ class FacetPipeline final : public FacetMethodBase {
     if (values[2] == 0) return true;
     const std::uint64_t wanted = std::uint64_t(values[1]) + values[1] / 4 + 4096;
     if (wanted > std::uint64_t(std::numeric_limits<std::int32_t>::max()))
-      throw InputError("scene", "pairs",
-                       "at most 2^31 (triangle, facet) pairs per output and frame; this view needs " +
-                           std::to_string(values[1]));
+      throw InputError(
+          "scene", "pairs",
+          "at most 2^31 (triangle, facet) pairs per output and frame; this view needs " +
+              std::to_string(values[1]));
     out.pair_capacity = std::uint32_t(wanted);
     out.replication_valid = false;
     return false;

@@ -191,8 +191,8 @@ void FacetMethodBase::set_list_uniforms(const Program& program, std::size_t i) c
 
 std::uint64_t FacetMethodBase::buffer_bytes(const OutputState& out) const {
   const FacetSet& set = out.facets;
-  std::uint64_t bytes = set.facets.size() + set.nodes.size() + set.order.size() +
-                        set.grid_words.size();
+  std::uint64_t bytes =
+      set.facets.size() + set.nodes.size() + set.order.size() + set.grid_words.size();
   for (const Buffer* b : {&out.list_buffer, &out.ranges_buffer, &out.scan, &out.pairs, &out.stats,
                           &out.draw_args, &out.staged, &out.stage_offsets})
     bytes += b->size();

@@ -78,9 +78,7 @@ Scene subdivide_triangles(const Scene& scene, int n) {
   const bool has_normals = scene.normals.size() == scene.positions.size();
   const bool has_uvs = scene.uvs.size() == scene.positions.size();
   // Row j (0..n) of a triangle's corner grid starts at this offset and holds n + 1 - j corners.
-  auto corner = [n](int i, int j) {
-    return std::uint32_t(j * (n + 1) - j * (j - 1) / 2 + i);
-  };
+  auto corner = [n](int i, int j) { return std::uint32_t(j * (n + 1) - j * (j - 1) / 2 + i); };
   for (const Primitive& primitive : scene.primitives) {
     Primitive p = primitive;
     p.first_index = static_cast<std::uint32_t>(out.indices.size());
@@ -119,9 +117,9 @@ Scene subdivide_triangles(const Scene& scene, int n) {
           out.indices.insert(out.indices.end(), {base + corner(i, j), base + corner(i + 1, j),
                                                  base + corner(i, j + 1)});
           if (i + j + 1 < n)
-            out.indices.insert(out.indices.end(),
-                               {base + corner(i + 1, j), base + corner(i + 1, j + 1),
-                                base + corner(i, j + 1)});
+            out.indices.insert(
+                out.indices.end(),
+                {base + corner(i + 1, j), base + corner(i + 1, j + 1), base + corner(i, j + 1)});
         }
     }
     p.index_count = static_cast<std::uint32_t>(out.indices.size()) - p.first_index;

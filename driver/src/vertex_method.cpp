@@ -58,8 +58,8 @@ struct OutputState {
   float s_period = 0;
   float fisheye_rho_limit = 0;
   bool wraps = false;
-  Texture node_offsets;   // RGBA32F Gw×Gh: dx, dy, A
-  Texture coverage_mask;  // R8, output-sized, GL rows; empty when every pixel is covered
+  Texture node_offsets;             // RGBA32F Gw×Gh: dx, dy, A
+  Texture coverage_mask;            // R8, output-sized, GL rows; empty when every pixel is covered
   std::uint64_t texture_bytes = 0;  // node_offsets and coverage_mask, for gpu_buffer_bytes
   // The cone of eye directions through covered pixel centres, widened by one pixel: objects
   // whose bounding sphere misses it are not drawn. half_angle = π when it is every direction.

@@ -136,10 +136,6 @@ DirectionBox CoverageGrid::direction_box(const std::array<glm::dvec3, 3>& u, Cov
 
 ChartBox CoverageGrid::chart_box(const DirectionBox& d) const {
   ChartBox box;
-  if (d.empty) {
-    box.empty = true;
-    return box;
-  }
   switch (chart_) {
     case CoverageChart::cylindrical:
     case CoverageChart::equirectangular: {
@@ -164,7 +160,7 @@ ChartBox CoverageGrid::chart_box(const DirectionBox& d) const {
         }
         rho_lo = std::tan(d.theta_lo);
         rho_hi = d.theta_hi >= kPi / 2 - 1e-6 ? radius_cap_
-                                               : std::min(std::tan(d.theta_hi), radius_cap_);
+                                              : std::min(std::tan(d.theta_hi), radius_cap_);
       }
       if (d.full_phi) {
         box.p_lo = box.q_lo = -rho_hi;
@@ -254,7 +250,7 @@ CoverageGrid::CoverageGrid(const FacetMesh& mesh, const BaseProjection& base,
       corners[k] = R_base_eye_ * corner;
     }
     DirectionBox d = direction_box(corners, chart_, 1e-9);
-    if (d.walk) d = {false, false, 0, kPi, -kPi, kPi, true};  // cannot happen below 180°
+    if (d.walk) d = {false, 0, kPi, -kPi, kPi, true};  // cannot happen below 180°
     boxes[f] = chart_box(d);
   }
   // The grid spans every facet box; periodic charts span every azimuth.
@@ -303,7 +299,8 @@ CoverageGrid::CoverageGrid(const FacetMesh& mesh, const BaseProjection& base,
   dp_ = periodic_ ? 2 * kPi / columns_ : extent_p * (1 + 1e-9) / columns_;
   dq_ = extent_q * (1 + 1e-9) / rows_;
   if (chart_ == CoverageChart::perspective) {
-    radius_cap_ = 2 * std::max({std::abs(p_lo), std::abs(p_hi), std::abs(q_lo), std::abs(q_hi)}) + 1;
+    radius_cap_ =
+        2 * std::max({std::abs(p_lo), std::abs(p_hi), std::abs(q_lo), std::abs(q_hi)}) + 1;
   }
 
   facet_buckets_.assign(facet_count, BucketRange{});
@@ -377,8 +374,8 @@ bool CoverageGrid::query(const std::array<glm::dvec3, 3>& triangle, const Covera
   if (cull_back_faces && !(glm::dot(normal, triangle[0]) < 0)) return true;
   // A plane through the eye: the corner directions need not bound the cone (the triangle may
   // surround the eye), and the GPU culls such triangles; the walk answers.
-  const double scale = std::max(
-      {glm::length(triangle[0]), glm::length(triangle[1]), glm::length(triangle[2])});
+  const double scale =
+      std::max({glm::length(triangle[0]), glm::length(triangle[1]), glm::length(triangle[2])});
   if (!(std::abs(glm::dot(normal, triangle[0])) > 1e-9 * glm::length(normal) * scale))
     return take_walk();
   std::array<glm::dvec3, 3> u;

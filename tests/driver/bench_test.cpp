@@ -83,10 +83,11 @@ TEST(BenchCli, QuickWritesJsonCsvAndPlotWithEveryMethod) {
     ASSERT_FALSE(row.contains("error")) << row.dump();
     seen.insert(row["method"].get<std::string>());
     for (const char* field :
-         {"scenario", "setting", "frames", "frame_ms", "gpu_ms", "pass_ms", "facets",
-          "triangles_in", "replicas", "replication_ratio", "id_mismatch", "max_edge_px",
-          "p99_edge_px", "geometric_max_px", "geometric_rms_px", "geometric_source", "scene",
-          "triangles_scene", "gpu_buffer_bytes", "gpu_buffer_mib"}) {
+         {"scenario",    "setting",           "frames",           "frame_ms",
+          "gpu_ms",      "pass_ms",           "facets",           "triangles_in",
+          "replicas",    "replication_ratio", "id_mismatch",      "max_edge_px",
+          "p99_edge_px", "geometric_max_px",  "geometric_rms_px", "geometric_source",
+          "scene",       "triangles_scene",   "gpu_buffer_bytes", "gpu_buffer_mib"}) {
       EXPECT_TRUE(row.contains(field)) << field << " missing in " << row.dump();
     }
     EXPECT_EQ(row["scene"], "builtin:city");
@@ -241,8 +242,8 @@ TEST(BenchScenarios, ScaleBuildsItsRowsOverTheSceneSizes) {
     }
     EXPECT_EQ(methods,
               (std::vector<std::string>{"facets", "facets-gs", "naive", "cubemap", "vertex"}));
-    EXPECT_EQ(labels, (std::vector<std::string>{"tol=0.25px", "tol=0.25px", "tol=0.25px",
-                                                "face=64", "tess=1"}));
+    EXPECT_EQ(labels, (std::vector<std::string>{"tol=0.25px", "tol=0.25px", "tol=0.25px", "face=64",
+                                                "tess=1"}));
   }
   EXPECT_EQ(quick[0].outputs.at(0).warp.output_size, glm::ivec2(200, 150));
   EXPECT_EQ(quick[1].outputs.at(0).warp.output_size, glm::ivec2(256, 256));

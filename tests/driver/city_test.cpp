@@ -5,13 +5,13 @@
 
 #include <gtest/gtest.h>
 
-#include "facet/driver/scene_names.hpp"
-#include "facet/projection/errors.hpp"
-
 #include <cmath>
 #include <glm/geometric.hpp>
 #include <numbers>
 #include <set>
+
+#include "facet/driver/scene_names.hpp"
+#include "facet/projection/errors.hpp"
 
 namespace facet::driver {
 namespace {
@@ -218,7 +218,8 @@ TEST(CityTiles, TilesSitSideBySideWithTightBounds) {
     const glm::vec3 offset(object.T_world_object[3]);
     const int i = static_cast<int>(std::lround(offset.x / period));
     const int j = static_cast<int>(std::lround(offset.z / period));
-    ASSERT_EQ(offset, glm::vec3(static_cast<float>(i) * period, 0.0f, static_cast<float>(j) * period));
+    ASSERT_EQ(offset,
+              glm::vec3(static_cast<float>(i) * period, 0.0f, static_cast<float>(j) * period));
     ASSERT_TRUE(i >= -1 && i <= 1 && j >= -1 && j <= 1) << object.name;
     seen.insert({i, j});
     Aabb moved = core;
@@ -258,7 +259,8 @@ TEST(Subdivide, CutsEveryTriangleIntoNSquaredPiecesOfTheSameArea) {
   ASSERT_EQ(fine.uvs.size(), fine.positions.size());
   double total = 0, total_fine = 0;
   for (std::size_t k = 0; k < fine.primitives.size(); ++k) {
-    ASSERT_EQ(fine.primitives[k].index_count, city().primitives[k].index_count * std::uint32_t(n * n));
+    ASSERT_EQ(fine.primitives[k].index_count,
+              city().primitives[k].index_count * std::uint32_t(n * n));
     ASSERT_EQ(fine.primitives[k].material, city().primitives[k].material);
     const double original = area_of(city(), city().primitives[k]);
     const double cut = area_of(fine, fine.primitives[k]);

@@ -155,12 +155,12 @@ TEST(Pipeline, GpuCoverageMatchesCpuReference) {
   // Across the cylinder's 360° seam (behind the eye, +z), through its vertical axis, around the
   // dome's pole (+y) and at it, small and large.
   for (float size : {0.01f, 0.3f, 3.0f}) {
-    triangles.push_back({glm::vec3(-size, -0.2f, 2), glm::vec3(size, -0.2f, 2),
-                         glm::vec3(0, size, 2)});
-    triangles.push_back({glm::vec3(0, -size, -size), glm::vec3(0, size, -size),
-                         glm::vec3(0, 0, size)});
-    triangles.push_back({glm::vec3(-size, 3, -size), glm::vec3(size, 3, -size),
-                         glm::vec3(0, 3, size)});
+    triangles.push_back(
+        {glm::vec3(-size, -0.2f, 2), glm::vec3(size, -0.2f, 2), glm::vec3(0, size, 2)});
+    triangles.push_back(
+        {glm::vec3(0, -size, -size), glm::vec3(0, size, -size), glm::vec3(0, 0, size)});
+    triangles.push_back(
+        {glm::vec3(-size, 3, -size), glm::vec3(size, 3, -size), glm::vec3(0, 3, size)});
     triangles.push_back({glm::vec3(0, 3, 0), glm::vec3(size, 3, 0), glm::vec3(0, 3, size)});
   }
   // Dense facets: large triangles cover thousands of them (up to 26,060 here), far more than
@@ -290,8 +290,8 @@ TEST(Pipeline, GridCoverageGivesTheWalksIds) {
   const Scene scene = small_city();
   RenderSettings quarter_px;
   quarter_px.facets.layout = FacetTolerance{0.25};
-  Warp deformation = Warp::analytic(BaseProjection::perspective(-1, 1, 0.75, -0.75), {256, 192},
-                                    {21, 16});
+  Warp deformation =
+      Warp::analytic(BaseProjection::perspective(-1, 1, 0.75, -0.75), {256, 192}, {21, 16});
   for (int j = 0; j < deformation.grid_size.y; ++j)
     for (int i = 0; i < deformation.grid_size.x; ++i) {
       const double s = double(i) / 20, t = double(j) / 15;
@@ -300,14 +300,14 @@ TEST(Pipeline, GridCoverageGivesTheWalksIds) {
     }
   RenderSettings grid_20x15;
   grid_20x15.facets.layout = FacetGrid{20, 15};
-  const glm::dmat4 tilted = glm::dmat4(glm::rotate(glm::dmat4(1.0), -1.2, glm::dvec3(1, 0, 0))) *
-                            city_view(2.0);
+  const glm::dmat4 tilted =
+      glm::dmat4(glm::rotate(glm::dmat4(1.0), -1.2, glm::dvec3(1, 0, 0))) * city_view(2.0);
   for (const auto& [name, outputs, settings, view] :
        {std::tuple{"cylinder 0.25 px", cylinder(), quarter_px, city_view(3.0)},
         std::tuple{"cylinder strips", cylinder(), strips(160), city_view(5.0)},
         std::tuple{"dome 0.25 px", dome(), quarter_px, tilted},
-        std::tuple{"deformation", std::vector<OutputSpec>{{"deformation", deformation}},
-                   grid_20x15, city_view(4.0)}}) {
+        std::tuple{"deformation", std::vector<OutputSpec>{{"deformation", deformation}}, grid_20x15,
+                   city_view(4.0)}}) {
     RenderSettings walk = settings;
     walk.coverage = FacetCoverage::walk;
     const Rendered by_grid = render("facets", scene, outputs, settings, view);

@@ -68,8 +68,10 @@ TEST(RenderCli, TheViewMovesUnlessStatic) {
   std::filesystem::create_directories(folder);
   const std::filesystem::path gltf = folder / "walls.gltf";
   write_two_walls_gltf(gltf);
-  const std::string common = "render --display builtin:cylinder360 --size 64x48 --pieces 8 "
-                             "--frames 3 --json --scene " + gltf.string();
+  const std::string common =
+      "render --display builtin:cylinder360 --size 64x48 --pieces 8 "
+      "--frames 3 --json --scene " +
+      gltf.string();
   const Result moving = run_cli(common);
   ASSERT_EQ(moving.status, 0) << moving.output;
   const nlohmann::json m = nlohmann::json::parse(moving.output);

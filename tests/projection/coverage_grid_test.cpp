@@ -52,7 +52,7 @@ Triangle hostile_triangle(std::mt19937_64& random, const std::vector<glm::dvec3>
   Triangle t;
   for (auto& p : t) p = centre + size * random_unit(random);
   if (k % 8 == 3) t[2] = -(t[0] + t[1]) * (0.5 + unit(random));  // surrounds or passes the eye
-  if (k % 8 == 4) t[0] = glm::dvec3(0.0);                       // a corner at the eye
+  if (k % 8 == 4) t[0] = glm::dvec3(0.0);                        // a corner at the eye
   return t;
 }
 
@@ -125,9 +125,10 @@ TEST(CoverageGrid, EqualsTheWalkOnEveryBaseAndLayout) {
     if (named.name.find("offsets") != std::string::npos)
       cases.push_back({named.name, named.warp, FacetTolerance{0.5}});
   }
-  cases.push_back({"perspective 100x70 tilted",
-                   Warp::analytic(BaseProjection::perspective_fov(100, 70), {400, 300}, {2, 2}, tilt),
-                   FacetGrid{8, 6}});
+  cases.push_back(
+      {"perspective 100x70 tilted",
+       Warp::analytic(BaseProjection::perspective_fov(100, 70), {400, 300}, {2, 2}, tilt),
+       FacetGrid{8, 6}});
   std::uint64_t seed = 1;
   for (const Case& c : cases) {
     const FacetMesh mesh = build_facets(c.warp, {c.layout});
@@ -149,8 +150,8 @@ TEST(CoverageGrid, BoxesContainEveryDirectionOfTheTriangle) {
       for (auto& p : t) p = glm::normalize(centre + size * random_unit(random));
       const DirectionBox box = CoverageGrid::direction_box(t, chart, 0);
       if (box.walk) continue;
-      const glm::dvec3 axis = chart == CoverageChart::fisheye ? glm::dvec3(0, 0, -1)
-                                                              : glm::dvec3(0, 1, 0);
+      const glm::dvec3 axis =
+          chart == CoverageChart::fisheye ? glm::dvec3(0, 0, -1) : glm::dvec3(0, 1, 0);
       for (int s = 0; s < 32; ++s) {
         double a = unit(random), b = unit(random);
         if (a + b > 1) a = 1 - a, b = 1 - b;
@@ -159,8 +160,8 @@ TEST(CoverageGrid, BoxesContainEveryDirectionOfTheTriangle) {
         ASSERT_GE(theta, box.theta_lo - 1e-12) << k;
         ASSERT_LE(theta, box.theta_hi + 1e-12) << k;
         if (box.full_phi) continue;
-        const double phi = chart == CoverageChart::fisheye ? std::atan2(v.y, v.x)
-                                                           : std::atan2(v.x, -v.z);
+        const double phi =
+            chart == CoverageChart::fisheye ? std::atan2(v.y, v.x) : std::atan2(v.x, -v.z);
         const double shifted = box.phi_lo + std::fmod(phi - box.phi_lo + 8 * M_PI, 2 * M_PI);
         ASSERT_LE(shifted, box.phi_hi + 1e-12) << k;
       }

@@ -126,8 +126,8 @@ void run(const RenderOptions& options) {
   if (options.coverage == "walk") {
     settings.coverage = FacetCoverage::walk;
   } else if (options.coverage != "grid") {
-    throw InputError("command line", "--coverage", "expected grid or walk; got '" +
-                                                       options.coverage + "'");
+    throw InputError("command line", "--coverage",
+                     "expected grid or walk; got '" + options.coverage + "'");
   }
   if (options.anisotropy != kAutomaticAnisotropy && !(options.anisotropy >= 1.0f)) {
     throw InputError("command line", "--anisotropy", "expected 0 (automatic) or a level >= 1");

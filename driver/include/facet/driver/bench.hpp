@@ -64,9 +64,9 @@ struct BenchScenario {
 
 struct BenchRow {
   std::string scenario, method, setting;
-  std::string scene;                 // its --scene name
-  std::string scale_group;           // BenchScenario::scale_group
-  std::uint64_t triangles_scene = 0;  // Scene::triangle_count()
+  std::string scene;                   // its --scene name
+  std::string scale_group;             // BenchScenario::scale_group
+  std::uint64_t triangles_scene = 0;   // Scene::triangle_count()
   std::uint64_t gpu_buffer_bytes = 0;  // RenderStats::gpu_buffer_bytes of the last timed frame
   std::string error;  // non-empty when the setting could not be prepared (then nothing else)
   int outputs = 0;
@@ -114,7 +114,8 @@ struct BenchRow {
 
 // Least-squares slope of log(y) against log(x): the exponent b of y = a · x^b. nullopt when fewer
 // than two points have x > 0 and y > 0, or those x are all equal.
-std::optional<double> fit_power_exponent(const std::vector<double>& x, const std::vector<double>& y);
+std::optional<double> fit_power_exponent(const std::vector<double>& x,
+                                         const std::vector<double>& y);
 
 // How the frame time of one method and setting grows over a scale group's rows.
 struct BenchScaleFit {

@@ -62,7 +62,8 @@ Scene build_city_tiles(int k, const CityOptions& options = {});
 std::uint64_t city_tiles_triangle_count(int k, const CityOptions& options = {});
 // Tile period of build_city_tiles: the city's width out to its outer sidewalks, metres.
 double city_tile_period_m(const CityOptions& options = {});
-// Offset, in tiles, of tile index i in [0, k): i - (k - 1) / 2, so tile (k - 1) / 2 is at the origin.
+// Offset, in tiles, of tile index i in [0, k): i - (k - 1) / 2, so tile (k - 1) / 2 is at the
+// origin.
 int city_tile_offset(int i, int k);
 
 // A looping drive along the streets around the central blocks at eye height 1.7 m and a

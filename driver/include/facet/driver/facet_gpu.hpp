@@ -94,7 +94,7 @@ struct FacetSet {
   FacetMesh mesh;
   CoverageIndex index;
   CoverageGrid grid;
-  std::vector<GpuFacet> gpu_facets;  // kept for the naive baseline's per-facet culling
+  std::vector<GpuFacet> gpu_facets;         // kept for the naive baseline's per-facet culling
   Buffer facets, nodes, order, grid_words;  // bind at binding::facets, nodes, order, grid
 
   // Builds the facets of `warp` (InputError when the layout cannot be met) and uploads them.

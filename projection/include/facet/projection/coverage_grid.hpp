@@ -45,8 +45,7 @@ enum class CoverageChart : std::uint32_t {
 
 // A box in (θ, φ) about the chart's axis. φ_lo <= φ_hi; full_phi: every azimuth.
 struct DirectionBox {
-  bool empty = false;  // nothing (cannot happen for a valid spherical triangle)
-  bool walk = false;   // the arithmetic cannot bound it well: corners nearly opposite
+  bool walk = false;  // the arithmetic cannot bound it well: corners nearly opposite
   double theta_lo = 0, theta_hi = 0;
   double phi_lo = 0, phi_hi = 0;
   bool full_phi = false;
