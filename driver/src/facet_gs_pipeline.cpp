@@ -99,13 +99,12 @@ class FacetGsPipeline final : public FacetMethodBase {
     out.replicas = total;
     out.visible = visible;
     ensure_capacity(out.pairs, std::max<std::size_t>(total, 1) * 2 * sizeof(std::uint32_t));
+    size_draw_commands(out, total);
     bind_output(i);
     set_list_uniforms(replicate_, i);
     replicate_.use();
     glDispatchCompute((n + 63) / 64, 1, 1);
-    set_list_uniforms(args_, i);
-    args_.use();
-    glDispatchCompute((material_count() + 63) / 64, 1, 1);
+    write_draw_commands(i, args_);
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_COMMAND_BARRIER_BIT);
     out.replication_valid = true;
   }

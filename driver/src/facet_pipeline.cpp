@@ -101,6 +101,7 @@ class FacetPipeline final : public FacetMethodBase {
     if (out.pair_capacity == 0) out.pair_capacity = std::max<std::uint32_t>(n, 4096);
     ensure_capacity(out.staged, std::size_t(out.pair_capacity) * sizeof(std::uint32_t));
     ensure_capacity(out.pairs, std::size_t(out.pair_capacity) * 2 * sizeof(std::uint32_t));
+    size_draw_commands(out, out.pair_capacity);
     {
       TimedPass scope(timer, "pass1 coverage");
       const std::uint32_t zero[4] = {0, 0, 0, 0};
@@ -117,9 +118,7 @@ class FacetPipeline final : public FacetMethodBase {
     set_list_uniforms(scatter_, i);
     scatter_.use();
     glDispatchCompute((n + kLocalSize - 1) / kLocalSize, 1, 1);
-    set_list_uniforms(args_, i);
-    args_.use();
-    glDispatchCompute((material_count() + 63) / 64, 1, 1);
+    write_draw_commands(i, args_);
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_COMMAND_BARRIER_BIT);
     out.replication_valid = true;
   }

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <glm/gtc/type_ptr.hpp>
 
+#include "facet/driver/gpu_scene.hpp"
 #include "facet/driver/shader_library.hpp"
 #include "facet/projection/errors.hpp"
 
@@ -89,12 +90,13 @@ void FacetMethodBase::prepare(const Scene& scene, const GpuScene& gpu_scene,
   object_frames_ =
       Buffer::create(std::max<std::size_t>(scene.objects.size(), 1) * sizeof(GpuObjectFrame));
   if (!empty_vao_) empty_vao_ = VertexArray::create();
+  chunked_draws_ = is_software_renderer() && (epoxy_gl_version() >= 46 ||
+                                              epoxy_has_gl_extension("GL_ARB_indirect_parameters"));
   outputs_.clear();
   for (const OutputSpec& output : outputs) {
     OutputState state(FacetSet::build(output.warp, settings.facets, settings.z_near));
     const std::uint32_t no_stats[4] = {0, 0, 0, 0};
     state.stats = Buffer::create(sizeof no_stats, no_stats);
-    state.draw_args = Buffer::create(records_by_material_.size() * 4 * sizeof(std::uint32_t));
     outputs_.push_back(std::move(state));
   }
   have_view_ = false;
@@ -170,7 +172,7 @@ void FacetMethodBase::bind_output(std::size_t i) const {
   if (out.staged) out.staged.bind_base(GL_SHADER_STORAGE_BUFFER, binding::staged);
   if (out.stage_offsets)
     out.stage_offsets.bind_base(GL_SHADER_STORAGE_BUFFER, binding::stage_offsets);
-  out.draw_args.bind_base(GL_SHADER_STORAGE_BUFFER, binding::draw_args);
+  if (out.draw_args) out.draw_args.bind_base(GL_SHADER_STORAGE_BUFFER, binding::draw_args);
 }
 
 void FacetMethodBase::set_list_uniforms(const Program& program, std::size_t i) const {
@@ -194,7 +196,7 @@ std::uint64_t FacetMethodBase::buffer_bytes(const OutputState& out) const {
   std::uint64_t bytes =
       set.facets.size() + set.nodes.size() + set.order.size() + set.grid_words.size();
   for (const Buffer* b : {&out.list_buffer, &out.ranges_buffer, &out.scan, &out.pairs, &out.stats,
-                          &out.draw_args, &out.staged, &out.stage_offsets})
+                          &out.draw_args, &out.draw_counts, &out.staged, &out.stage_offsets})
     bytes += b->size();
   return bytes;
 }
@@ -212,6 +214,30 @@ void FacetMethodBase::set_material(const Program& program, std::uint32_t m) cons
   gpu_->bind_material_texture(m, 0);
 }
 
+void FacetMethodBase::size_draw_commands(OutputState& out, std::uint64_t replica_capacity) const {
+  const std::uint64_t capacity = std::max<std::uint64_t>(replica_capacity, 1);
+  std::uint64_t per_draw = chunked_draws_ ? kSoftwareReplicasPerDraw : capacity;
+  if ((capacity + per_draw - 1) / per_draw > kMaxDrawsPerMaterial)
+    per_draw = (capacity + kMaxDrawsPerMaterial - 1) / kMaxDrawsPerMaterial;
+  out.replicas_per_draw = std::uint32_t(std::min<std::uint64_t>(per_draw, UINT32_MAX));
+  out.draws_per_material = std::uint32_t((capacity + per_draw - 1) / per_draw);
+  ensure_capacity(out.draw_args,
+                  std::size_t(material_count()) * out.draws_per_material * kDrawCommandBytes);
+  ensure_capacity(out.draw_counts, std::size_t(material_count()) * sizeof(std::uint32_t));
+}
+
+void FacetMethodBase::write_draw_commands(std::size_t i, const Program& args_program) const {
+  const OutputState& out = outputs_[i];
+  out.draw_counts.bind_base(GL_SHADER_STORAGE_BUFFER, binding::draw_counts);
+  set_list_uniforms(args_program, i);
+  glProgramUniform1ui(args_program.id(), args_program.uniform_location("draws_per_material"),
+                      out.draws_per_material);
+  glProgramUniform1ui(args_program.id(), args_program.uniform_location("replicas_per_draw"),
+                      out.replicas_per_draw);
+  args_program.use();
+  glDispatchCompute((out.draws_per_material + 63) / 64, material_count(), 1);
+}
+
 void FacetMethodBase::draw_replicas(std::size_t i, const OutputTarget& target,
                                     const Program& program, GLenum mode) const {
   const OutputState& out = outputs_[i];
@@ -222,12 +248,22 @@ void FacetMethodBase::draw_replicas(std::size_t i, const OutputTarget& target,
   program.use();
   glBindVertexArray(empty_vao_.id());
   glBindBuffer(GL_DRAW_INDIRECT_BUFFER, out.draw_args.id());
+  if (out.draws_per_material > 1) glBindBuffer(GL_PARAMETER_BUFFER_ARB, out.draw_counts.id());
   glMemoryBarrier(GL_COMMAND_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
   for (std::uint32_t m = 0; m < material_count(); ++m) {
     if (out.material_ranges[2 * m] == out.material_ranges[2 * m + 1]) continue;
     set_material(program, m);
-    glDrawArraysIndirect(mode, reinterpret_cast<const void*>(std::uintptr_t(m) * 16u));
+    const std::uintptr_t first_command = std::uintptr_t(m) * out.draws_per_material;
+    const auto* commands = reinterpret_cast<const void*>(first_command * kDrawCommandBytes);
+    if (out.draws_per_material == 1) {
+      glDrawArraysIndirect(mode, commands);
+    } else {
+      glMultiDrawArraysIndirectCountARB(mode, commands,
+                                        GLintptr(m) * GLintptr(sizeof(std::uint32_t)),
+                                        GLsizei(out.draws_per_material), 0);
+    }
   }
+  if (out.draws_per_material > 1) glBindBuffer(GL_PARAMETER_BUFFER_ARB, 0);
   glBindBuffer(GL_DRAW_INDIRECT_BUFFER, 0);
   glBindVertexArray(0);
   end_facet_drawing();

@@ -54,6 +54,16 @@ class PrefixScan {
   std::vector<Buffer> block_sums_;
 };
 
+// Replicas per pass-3 draw command on a software rasterizer. llvmpipe's draw module (Mesa 22.3)
+// runs a draw in batches of up to 4096 vertices, and for a batch with clipping resets the vertex
+// IDs of the whole batch at every flush of its small vertex buffer: a batch costs time quadratic
+// in its size. Commands of 128 triangles made the dome master's pass 3 1.5x faster (see
+// driver/README.md); a GPU takes one command per material.
+inline constexpr std::uint32_t kSoftwareReplicasPerDraw = 128;
+// Commands per material at most: one draw_args.comp work group row holds 64 each.
+inline constexpr std::uint64_t kMaxDrawsPerMaterial = 65535u * 64u;
+inline constexpr std::size_t kDrawCommandBytes = 16;  // DrawArraysIndirectCommand
+
 struct ListEntry {  // std430 uvec2 of replication_lib.comp's List
   std::uint32_t record, first_triangle;
 };
@@ -75,6 +85,10 @@ class FacetMethodBase : public RenderMethod {
     // Replication results, reused while neither view nor scene changes.
     // stats: visible triangles, pairs, overflow (std430 uints, replication/count.comp).
     Buffer scan, pairs, stats, draw_args;
+    // Pass 3's commands: draws_per_material per material, each of at most replicas_per_draw
+    // replicas, and how many of them each material uses (replication/draw_args.comp).
+    Buffer draw_counts;
+    std::uint32_t draws_per_material = 1, replicas_per_draw = 1;
     // Pass 1's facets per triangle (facets only), and where each triangle's run starts.
     Buffer staged, stage_offsets;
     std::uint32_t pair_capacity = 0;  // pairs that pairs and staged hold
@@ -89,8 +103,12 @@ class FacetMethodBase : public RenderMethod {
   void bind_output(std::size_t i) const;
   // Sets scene/material.frag's uniforms and texture for material m on `program`.
   void set_material(const Program& program, std::uint32_t m) const;
-  // Pass 3 for output i into `target`: one glDrawArraysIndirect of `mode` per material with
-  // `program`, from output i's draw arguments.
+  // Sizes output i's draw commands for `replica_capacity` replicas (see kSoftwareReplicasPerDraw).
+  void size_draw_commands(OutputState& out, std::uint64_t replica_capacity) const;
+  // Pass 2c for output i: draw_args.comp writes the commands and their counts.
+  void write_draw_commands(std::size_t i, const Program& args_program) const;
+  // Pass 3 for output i into `target`: the commands of each material, drawn with `program` as
+  // `mode` (one glDrawArraysIndirect, or a glMultiDrawArraysIndirectCount of chunks).
   void draw_replicas(std::size_t i, const OutputTarget& target, const Program& program,
                      GLenum mode) const;
   // Depth, clip-control and clip-distance state of pass 3, and its undoing.
@@ -109,6 +127,8 @@ class FacetMethodBase : public RenderMethod {
   std::vector<GpuRecord> records_;
   std::vector<std::vector<std::uint32_t>> records_by_material_;
   Buffer records_buffer_, object_frames_;
+  // Pass 3 splits each material's replicas into draws of kSoftwareReplicasPerDraw (see there).
+  bool chunked_draws_ = false;
   VertexArray empty_vao_;  // core profile draws need a vertex array; attributes are pulled
   std::vector<OutputState> outputs_;
   glm::dmat4 last_T_eye_world_{0.0};

@@ -32,7 +32,8 @@ namespace binding {
 inline constexpr GLuint positions = 0, normals = 1, uvs = 2, indices = 3, records = 4,
                         object_frames = 5, facets = 6, nodes = 7, order = 8, list = 9, scan = 10,
                         pairs = 11, stats = 12, material_ranges = 13, draw_args = 14,
-                        block_sums = 15, grid = 16, staged = 17, stage_offsets = 18;
+                        block_sums = 15, grid = 16, staged = 17, stage_offsets = 18,
+                        draw_counts = 19;
 }  // namespace binding
 
 // std430, one per facet. Eye-frame X is inside the facet's guarded pyramid when
