@@ -300,9 +300,10 @@ std::vector<BenchScenario> make_bench_scenarios(const BenchOptions& options) {
           s.settings = sweep({FacetTolerance{1}, FacetGrid{4, 4}}, FacetGrid{4, 4},
                              {FacetGrid{4, 4}}, faces_sweep, tess);
         } else {
-          s.settings = sweep(
-              {FacetTolerance{0.25}, FacetGrid{16, 16}, FacetTolerance{1}, FacetTolerance{0.1}},
-              FacetGrid{16, 16}, {FacetGrid{16, 16}, FacetTolerance{1}}, faces_sweep, tess);
+          s.settings =
+              sweep({FacetTolerance{0.25}, FacetGrid{16, 16}, FacetTolerance{1},
+                     FacetTolerance{0.5}, FacetTolerance{0.1}},
+                    FacetGrid{16, 16}, {FacetGrid{16, 16}, FacetTolerance{1}}, faces_sweep, tess);
         }
         scenarios.push_back(std::move(s));
       }
@@ -317,9 +318,9 @@ std::vector<BenchScenario> make_bench_scenarios(const BenchOptions& options) {
           s.settings =
               sweep({FacetTolerance{1}}, FacetTolerance{1}, {FacetTolerance{1}}, faces_sweep, tess);
         } else {
-          s.settings = sweep({FacetTolerance{0.25}, FacetTolerance{1}, FacetTolerance{0.1}},
-                             FacetTolerance{1}, {FacetTolerance{1}, FacetTolerance{0.25}},
-                             faces_sweep, tess);
+          s.settings = sweep(
+              {FacetTolerance{0.25}, FacetTolerance{1}, FacetTolerance{0.5}, FacetTolerance{0.1}},
+              FacetTolerance{1}, {FacetTolerance{1}, FacetTolerance{0.25}}, faces_sweep, tess);
         }
         scenarios.push_back(std::move(s));
       }
