@@ -528,7 +528,7 @@ bool grid_coverage(vec3 p[3], uint t, uint pair_base, uint wanted, out uint want
 
 // The facets triangle t with eye-frame corners p may cover: walk_coverage's contract, from the
 // grid where it takes the triangle. The walk has one call site: inlined at each of several, it
-// made the whole pass 1 slower on llvmpipe (cylinder 400x300: 99 against 64 ms a frame).
+// made the whole pass 1 slower on llvmpipe (cylinder 400x300: 99 against 71-76 ms a frame).
 uint cover(vec3 p[3], uint t, uint pair_base, uint wanted, out uint wanted_facet) {
   uint found = 0u;
   if (coverage_by_grid != 0u && grid_coverage(p, t, pair_base, wanted, wanted_facet, found))
