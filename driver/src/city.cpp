@@ -717,18 +717,33 @@ void add_streets(CityBuilder& city, Pcg32& rng, int n) {
       }
 }
 
-void add_countryside(CityBuilder& city, int n) {
-  // Grass beyond the outer sidewalk, out to a horizon ring at 10 blocks.
-  const float e = static_cast<float>(n) * pitch + street_half;
-  const float r = std::max(600.0f, e + 4.0f * pitch);
+// Grass between the box [x0, x1] x [z0, z1] (the outer sidewalks' edge) and the box
+// [gx0, gx1] x [gz0, gz1] around it, as four strips.
+void add_grass_frame(CityBuilder& city, float x0, float x1, float z0, float z1, float gx0,
+                     float gx1, float gz0, float gz1) {
   const std::array<std::array<float, 4>, 4> strips = {
-      {{-r, r, -r, -e}, {-r, r, e, r}, {-r, -e, -e, e}, {e, r, -e, e}}};
+      {{gx0, gx1, gz0, z0}, {gx0, gx1, z1, gz1}, {gx0, x0, z0, z1}, {x1, gx1, z0, z1}}};
   int index = 0;
   for (const auto& s : strips) {
     city.begin_object("countryside " + std::to_string(index++));
     city.ground(CityMaterial::grass, s[0], s[1], s[2], s[3], 0.0f, 62.0f, 4.0f);
     city.end_object();
   }
+}
+
+// Half the width of a city of n blocks per side out to its outer sidewalks, and how far its
+// countryside reaches beyond that (out to a horizon ring at 10 blocks, at least 600 m from the
+// centre), metres.
+float city_half_extent(int n) { return static_cast<float>(n) * pitch + street_half; }
+float countryside_margin(int n) {
+  const float e = city_half_extent(n);
+  return std::max(600.0f, e + 4.0f * pitch) - e;
+}
+
+void add_countryside(CityBuilder& city, int n) {
+  const float e = city_half_extent(n);
+  const float r = std::max(600.0f, e + 4.0f * pitch);
+  add_grass_frame(city, -e, e, -e, e, -r, r, -r, r);
 }
 
 std::vector<Material> city_materials() {
@@ -756,19 +771,15 @@ std::vector<Material> city_materials() {
   return materials;
 }
 
-// Grass around the box [x0, x1] x [z0, z1] (the outer sidewalks' edge) out to `margin` beyond
-// it, as add_countryside does around one city.
-void add_countryside_around(CityBuilder& city, float x0, float x1, float z0, float z1,
-                            float margin) {
-  const float gx0 = x0 - margin, gx1 = x1 + margin, gz0 = z0 - margin, gz1 = z1 + margin;
-  const std::array<std::array<float, 4>, 4> strips = {
-      {{gx0, gx1, gz0, z0}, {gx0, gx1, z1, gz1}, {gx0, x0, z0, z1}, {x1, gx1, z0, z1}}};
-  int index = 0;
-  for (const auto& s : strips) {
-    city.begin_object("countryside " + std::to_string(index++));
-    city.ground(CityMaterial::grass, s[0], s[1], s[2], s[3], 0.0f, 62.0f, 4.0f);
-    city.end_object();
-  }
+// The countryside of k x k tiles: as wide a margin beyond the outer tiles' sidewalks as one
+// city has beyond its own.
+void add_tiles_countryside(CityBuilder& city, int k, const CityOptions& options) {
+  const float period = static_cast<float>(city_tile_period_m(options));
+  const float e1 = 0.5f * period;
+  const float lo = static_cast<float>(city_tile_offset(0, k)) * period - e1;
+  const float hi = static_cast<float>(city_tile_offset(k - 1, k)) * period + e1;
+  const float margin = countryside_margin(options.blocks_per_side);
+  add_grass_frame(city, lo, hi, lo, hi, lo - margin, hi + margin, lo - margin, hi + margin);
 }
 
 void check_city_options(const CityOptions& options) {
@@ -817,13 +828,7 @@ std::uint64_t city_tiles_triangle_count(int k, const CityOptions& options) {
   if (k == 1) return build_city(options).triangle_count();
   const std::uint64_t tile = city_core(options).scene.triangle_count();
   CityBuilder countryside;
-  const float period = static_cast<float>(city_tile_period_m(options));
-  const float e1 = 0.5f * period;
-  const float lo = static_cast<float>(city_tile_offset(0, k)) * period - e1;
-  const float hi = static_cast<float>(city_tile_offset(k - 1, k)) * period + e1;
-  const float n_extent = static_cast<float>(options.blocks_per_side) * pitch + street_half;
-  add_countryside_around(countryside, lo, hi, lo, hi,
-                         std::max(600.0f, n_extent + 4.0f * pitch) - n_extent);
+  add_tiles_countryside(countryside, k, options);
   return tile * std::uint64_t(k) * std::uint64_t(k) + countryside.scene.triangle_count();
 }
 
@@ -853,12 +858,7 @@ Scene build_city_tiles(int k, const CityOptions& options) {
         city.scene.objects.push_back(std::move(object));
       }
     }
-  const float e1 = 0.5f * period;
-  const float lo = static_cast<float>(city_tile_offset(0, k)) * period - e1;
-  const float hi = static_cast<float>(city_tile_offset(k - 1, k)) * period + e1;
-  const float n_extent = static_cast<float>(options.blocks_per_side) * pitch + street_half;
-  const float margin = std::max(600.0f, n_extent + 4.0f * pitch) - n_extent;
-  add_countryside_around(city, lo, hi, lo, hi, margin);
+  add_tiles_countryside(city, k, options);
   city.scene.name += ", " + std::to_string(k) + "x" + std::to_string(k) + " tiles";
   return std::move(city.scene);
 }

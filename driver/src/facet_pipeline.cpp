@@ -1,6 +1,7 @@
 // The modern replication pipeline ("facets"): compute-shader coverage, a parallel exclusive scan,
-// a scatter of (triangle, facet) pairs with the indirect arguments, and one glDrawArraysIndirect
-// per material with vertex pulling (DESIGN.md, "The replication pipeline").
+// a scatter of (triangle, facet) pairs with the indirect arguments, and indirect draws per
+// material with vertex pulling (FacetMethodBase::draw_replicas; DESIGN.md, "The replication
+// pipeline").
 #include <algorithm>
 #include <limits>
 #include <optional>

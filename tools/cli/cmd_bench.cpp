@@ -76,8 +76,7 @@ const Registration registration{
           ->capture_default_str();
       command
           ->add_option("--scene", options->scene,
-                       "Scene of every scenario but scale: builtin:city | builtin:city:K | "
-                       "builtin:city-fine:N | FILE.gltf")
+                       std::string("Scene of every scenario but scale: ") + kSceneNameSyntax)
           ->capture_default_str();
       command->add_flag("--static-view", options->static_view,
                         "Keep the accuracy frame's view on every timed frame (default: it moves)");

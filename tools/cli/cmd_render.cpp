@@ -261,11 +261,7 @@ const Registration registration{
           ->add_option("--display", options->display,
                        "builtin:cylinder360 | builtin:dome180 | FILE.warp.exr | display.json")
           ->required();
-      command
-          ->add_option("--scene", options->scene,
-                       "builtin:city | builtin:city:K (KxK tiles) | builtin:city-fine:N (each "
-                       "triangle in N^2) | FILE.gltf")
-          ->capture_default_str();
+      command->add_option("--scene", options->scene, kSceneNameSyntax)->capture_default_str();
       command->add_flag("--static-view", options->static_view,
                         "Keep frame 1's view on every frame (the facet methods then reuse "
                         "passes 1 and 2); by default the view moves every frame");

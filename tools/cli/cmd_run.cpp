@@ -102,9 +102,8 @@ const Registration registration{
       command->add_option("display", options->display,
                           "builtin:dome180 (default), builtin:cylinder360, a .warp.exr or a "
                           "display.json");
-      command->add_option("--scene", options->scene,
-                          "builtin:city (default), builtin:city:K (KxK tiles), "
-                          "builtin:city-fine:N (each triangle in N^2) or a glTF 2.0 file");
+      command->add_option("--scene", options->scene, driver::kSceneNameSyntax)
+          ->capture_default_str();
       command->add_option("--size", options->size, "Output size WxH of a built-in display");
       command->add_option("--method", options->method,
                           "facets, facets-gs, naive, cubemap or vertex (default: the display's)");

@@ -12,6 +12,7 @@
 //   11 pairs (modern: triangle, facet; seed: triangle, replica)  12 stats
 //   13 material ranges of the triangle list   14 indirect draw arguments   15 scan block sums
 //   16 coverage grid (GpuFacetSet, per output)   17 staged facets of pass 1   18 their offsets
+//   19 draw commands used per material (pass 3's glMultiDrawArraysIndirectCountARB)
 #include <epoxy/gl.h>
 
 #include <array>

@@ -23,6 +23,10 @@
 namespace facet::driver {
 
 inline constexpr std::uint64_t kMaxSceneTriangles = 64'000'000;
+// The --scene values, for command-line help.
+inline constexpr const char* kSceneNameSyntax =
+    "builtin:city | builtin:city:K (KxK tiles) | builtin:city-fine:N (each triangle in N^2) | "
+    "FILE.gltf";
 
 struct SceneName {
   enum class Kind { city, city_tiles, city_fine, file };
