@@ -278,8 +278,8 @@ layout(location = 44) uniform uint coverage_by_grid;  // 0: the hierarchy walk f
 
 const uint kChartCylindrical = 0u, kChartEquirectangular = 1u, kChartFisheye = 2u,
            kChartPerspective = 3u;                      // CoverageChart
-const uint kGridMaxBuckets = 64u;                       // CoverageGrid::kMaxBuckets
-const uint kGridMaxCandidates = 96u;                    // CoverageGrid::kMaxCandidates
+const uint kGridMaxBuckets = 256u;                      // CoverageGrid::kMaxBuckets
+const uint kGridMaxCandidates = 512u;                   // CoverageGrid::kMaxCandidates
 const float kPi = 3.14159265358979;
 const float kPoleMargin = 1e-3;
 const float kShortArc = 1e-2;
@@ -455,6 +455,17 @@ bool may_meet_facet(vec3 u[3], vec4 edge[3], uint f) {
   return true;
 }
 
+// True when facet f's guarded pyramid lies in the open hemisphere about `middle`.
+bool in_hemisphere(vec3 middle, uint f) {
+  uint at = grid[21] + 9u * f;
+  for (uint m = 0u; m < 3u; ++m) {
+    vec3 c =
+        vec3(grid_float(at + 3u * m), grid_float(at + 3u * m + 1u), grid_float(at + 3u * m + 2u));
+    if (!(dot(middle, c) > 0.0)) return false;
+  }
+  return true;
+}
+
 // walk_coverage's contract, answered from the grid into `found` when the triangle is small
 // enough for it (else false): conservative like the walk, with the few extra facets
 // may_meet_facet keeps.
@@ -498,6 +509,13 @@ bool grid_coverage(vec3 p[3], uint t, uint pair_base, uint wanted, out uint want
     float len = length(normal);
     edge[k] = len > 1e-6 ? vec4(normal / len, kCoverageSlack + 4e-7 / len) : vec4(0, 0, 0, 1);
   }
+  // The reject above is exact where the triangle and the facet lie in a common open hemisphere;
+  // a candidate beyond the one about the triangle's mean direction sends the triangle to the
+  // walk. The loop always runs to its end (no early return at the wanted facet), so that a
+  // triangle takes the same path in every pass that covers it.
+  vec3 middle = normalize(u[0] + u[1] + u[2]);
+  if (!(dot(middle, u[0]) > 0.0 && dot(middle, u[1]) > 0.0 && dot(middle, u[2]) > 0.0))
+    return false;
   for (uint j = range.y; j < range.y + range.w; ++j) {
     for (uint k = 0u; k < range.z; ++k) {
       uint i = periodic ? (range.x + k) % columns : range.x + k;
@@ -513,11 +531,8 @@ bool grid_coverage(vec3 p[3], uint t, uint pair_base, uint wanted, out uint want
           first_column = (range.x + columns - fb.x) % columns < fb.z ? range.x : fb.x;
         if (i != first_column || j != first_row) continue;
         if (!may_meet_facet(u, edge, f)) continue;
-        if (found == wanted) {
-          wanted_facet = f;
-          ++found;
-          return true;
-        }
+        if (!in_hemisphere(middle, f)) return false;
+        if (found == wanted) wanted_facet = f;
         if (pair_base != kNone) write_pair(pair_base + found, t, f);
         ++found;
       }

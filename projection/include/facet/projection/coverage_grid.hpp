@@ -67,8 +67,8 @@ struct BucketRange {
 
 class CoverageGrid {
  public:
-  static constexpr std::uint32_t kMaxBuckets = 64;     // shared with replication_lib.comp
-  static constexpr std::uint32_t kMaxCandidates = 96;  // shared with replication_lib.comp
+  static constexpr std::uint32_t kMaxBuckets = 256;    // shared with replication_lib.comp
+  static constexpr std::uint32_t kMaxCandidates = 512;  // shared with replication_lib.comp
 
   // Lists the guarded pyramids of `mesh` (the facets of a warp with base `base` and rotation
   // R_eye_base) in buckets about the size of the median facet.
