@@ -731,18 +731,13 @@ void add_grass_frame(CityBuilder& city, float x0, float x1, float z0, float z1, 
   }
 }
 
-// Half the width of a city of n blocks per side out to its outer sidewalks, and how far its
-// countryside reaches beyond that (out to a horizon ring at 10 blocks, at least 600 m from the
-// centre), metres.
+// Half the width of a city of n blocks per side out to its outer sidewalks, and how far from the
+// centre its countryside reaches (a horizon ring 4 blocks further, at least 600 m), metres.
 float city_half_extent(int n) { return static_cast<float>(n) * pitch + street_half; }
-float countryside_margin(int n) {
-  const float e = city_half_extent(n);
-  return std::max(600.0f, e + 4.0f * pitch) - e;
-}
+float countryside_reach(int n) { return std::max(600.0f, city_half_extent(n) + 4.0f * pitch); }
 
 void add_countryside(CityBuilder& city, int n) {
-  const float e = city_half_extent(n);
-  const float r = std::max(600.0f, e + 4.0f * pitch);
+  const float e = city_half_extent(n), r = countryside_reach(n);
   add_grass_frame(city, -e, e, -e, e, -r, r, -r, r);
 }
 
@@ -778,7 +773,8 @@ void add_tiles_countryside(CityBuilder& city, int k, const CityOptions& options)
   const float e1 = 0.5f * period;
   const float lo = static_cast<float>(city_tile_offset(0, k)) * period - e1;
   const float hi = static_cast<float>(city_tile_offset(k - 1, k)) * period + e1;
-  const float margin = countryside_margin(options.blocks_per_side);
+  const int n = options.blocks_per_side;
+  const float margin = countryside_reach(n) - city_half_extent(n);
   add_grass_frame(city, lo, hi, lo, hi, lo - margin, hi + margin, lo - margin, hi + margin);
 }
 

@@ -67,7 +67,7 @@ struct BucketRange {
 
 class CoverageGrid {
  public:
-  static constexpr std::uint32_t kMaxBuckets = 256;    // shared with replication_lib.comp
+  static constexpr std::uint32_t kMaxBuckets = 256;     // shared with replication_lib.comp
   static constexpr std::uint32_t kMaxCandidates = 512;  // shared with replication_lib.comp
 
   // Lists the guarded pyramids of `mesh` (the facets of a warp with base `base` and rotation
