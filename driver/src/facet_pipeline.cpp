@@ -32,7 +32,7 @@ class FacetPipeline final : public FacetMethodBase {
     FacetMethodBase::prepare(scene, gpu_scene, outputs, settings);
     if (!count_) {
       count_ = link_replication_program({"replication/count.comp"});
-      scatter_ = link_replication_program({"replication/scatter.comp"});
+      scatter_ = build_program({"replication/scatter.comp"});
       args_ = build_program({"replication/draw_args.comp"}, {{"VERTICES_PER_REPLICA", "3"}});
       draw_ = link_replication_program({"replication/draw.vert", "scene/material.frag"},
                                        {{"WRITE_TRIANGLE_ID", "1"}});
@@ -92,7 +92,7 @@ class FacetPipeline final : public FacetMethodBase {
     draw_replicas(i, target, draw_, GL_TRIANGLES);
   }
 
-  // Passes 1 and 2 for output i: coverage with staged facets, scan, the pairs' copy and the
+  // Passes 1 and 2 for output i: coverage with every facet staged, scan, the pairs' copy and the
   // indirect arguments, all without reading anything back.
   void replicate(std::size_t i, GpuTimer* timer) {
     OutputState& out = outputs_[i];
@@ -100,7 +100,7 @@ class FacetPipeline final : public FacetMethodBase {
     ensure_capacity(out.scan, (std::size_t(n) + 1) * sizeof(std::uint32_t));
     ensure_capacity(out.stage_offsets, std::max<std::size_t>(n, 1) * sizeof(std::uint32_t));
     if (out.pair_capacity == 0) out.pair_capacity = std::max<std::uint32_t>(n, 4096);
-    ensure_capacity(out.staged, std::size_t(out.pair_capacity) * sizeof(std::uint32_t));
+    ensure_capacity(out.staged, staged_words(out.pair_capacity) * sizeof(std::uint32_t));
     ensure_capacity(out.pairs, std::size_t(out.pair_capacity) * 2 * sizeof(std::uint32_t));
     size_draw_commands(out, out.pair_capacity);
     {
@@ -134,7 +134,7 @@ class FacetPipeline final : public FacetMethodBase {
     out.replicas = values[1];
     if (values[2] == 0) return true;
     const std::uint64_t wanted = std::uint64_t(values[1]) + values[1] / 4 + 4096;
-    if (wanted > std::uint64_t(std::numeric_limits<std::int32_t>::max()))
+    if (staged_words(wanted) > std::uint64_t(std::numeric_limits<std::int32_t>::max()))
       throw InputError(
           "scene", "pairs",
           "at most 2^31 (triangle, facet) pairs per output and frame; this view needs " +

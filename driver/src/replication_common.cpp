@@ -184,7 +184,8 @@ void FacetMethodBase::set_list_uniforms(const Program& program, std::size_t i) c
       {"triangle_count", out.triangles},
       {"material_count", material_count()},
       {"coverage_by_grid", settings_.coverage == FacetCoverage::grid ? 1u : 0u},
-      {"pair_capacity", out.pair_capacity}};
+      {"pair_capacity", out.pair_capacity},
+      {"staged_capacity", std::uint32_t(staged_words(out.pair_capacity))}};
   for (const auto& [uniform, value] : values) {
     const GLint location = program.uniform_location(uniform);
     if (location >= 0) glProgramUniform1ui(program.id(), location, value);

@@ -1,9 +1,12 @@
 // Modern pipeline, pass 1: per triangle of the frame's list, the facets it may cover (none when
 // culled: back face, non-finite, outside every facet). Counts go to scan[t] (scan[N] = 0 so that
-// the exclusive scan leaves the total there). The facets of a triangle that covers at most kKept
-// are staged, as one run at stage_offset[t], so that the scatter copies them instead of finding
-// them again; runs are placed by one global atomic per work group. A frame whose pairs exceed
-// pair_capacity sets `overflow`, writes nothing past it, and is run again with more room.
+// the exclusive scan leaves the total there). Every facet found is staged, so that the scatter
+// copies them and nothing is covered twice: a triangle with at most kKept facets as one run, placed
+// by one global atomic per work group; a triangle with more as a chain of chunks (kKept facets and
+// the next chunk's offset), each placed by an atomic of its own. Either way stage_offset[t] says
+// where (chains with kChained set). A frame whose pairs exceed
+// pair_capacity, or whose staged words exceed staged_capacity, sets `overflow` and is run again
+// with more room.
 #ifndef LOCAL_SIZE
 #define LOCAL_SIZE 64
 #endif
@@ -16,21 +19,45 @@ layout(std430, binding = 12) buffer Stats {
   uint overflow;
   uint staged_total;
 };
-layout(std430, binding = 17) writeonly buffer Staged { uint staged[]; };
+layout(std430, binding = 17) buffer Staged { uint staged[]; };
 layout(std430, binding = 18) writeonly buffer StageOffsets { uint stage_offset[]; };
 layout(location = 42) uniform uint triangle_count;
 layout(location = 45) uniform uint pair_capacity;
+layout(location = 48) uniform uint staged_capacity;  // words of Staged (staged_words in C++)
 
 void triangle_eye(uint t, out vec3 p[3]);
 uint cover(vec3 p[3], uint t, uint pair_base, uint wanted, out uint wanted_facet);
 
-// Most triangles cover a few facets: those are kept here while counting and staged once their
-// run is placed. A triangle with more is left to the scatter, which covers it again in an
-// invocation of its own (llvmpipe's loop budget is per invocation).
-const uint kKept = 8u;
+const uint kKept = 8u;               // kStagedChunkFacets
+const uint kChained = 0x80000000u;   // kStagedChained
+const uint kNoChunk = 0xffffffffu;
+// The first kKept facets stay here; from the (kKept + 1)-th on, facets go straight to chunks of
+// the chain (chain_second onwards), each taken by one atomic when its first facet arrives. The
+// first chunk, holding kept[], is placed when the count is known.
 uint kept[kKept];
+uint chain_second = kNoChunk, chain_tail = kNoChunk;
+
+// A chunk of kKept facets and a link, or kNoChunk (and an overflowing frame) when none is left.
+uint new_chunk() {
+  uint at = atomicAdd(staged_total, kKept + 1u);
+  if (at + kKept + 1u <= staged_capacity) return at;
+  overflow = 1u;
+  return kNoChunk;
+}
+
 void write_pair(uint at, uint t, uint facet) {
-  if (at < kKept) kept[at] = facet;
+  if (at < kKept) {
+    kept[at] = facet;
+    return;
+  }
+  uint slot = at % kKept;
+  if (slot == 0u) {
+    uint chunk = new_chunk();
+    if (at == kKept) chain_second = chunk;
+    else if (chain_tail != kNoChunk) staged[chain_tail + kKept] = chunk;
+    chain_tail = chunk;
+  }
+  if (chain_tail != kNoChunk) staged[chain_tail + slot] = facet;
 }
 
 shared uint group_pairs, group_staged, group_visible, group_base;
@@ -53,13 +80,13 @@ void main() {
   } else if (t == triangle_count) {
     scan[t] = 0u;
   }
-  bool staging = count > 0u && count <= kKept;
+  bool run = count > 0u && count <= kKept;
   uint offset = 0u;
   if (count > 0u) {
     atomicAdd(group_pairs, count);
     atomicAdd(group_visible, 1u);
   }
-  if (staging) offset = atomicAdd(group_staged, count);
+  if (run) offset = atomicAdd(group_staged, count);
   barrier();
   if (gl_LocalInvocationIndex == 0u) {
     uint before = atomicAdd(pair_total, group_pairs);
@@ -69,14 +96,20 @@ void main() {
   }
   barrier();
   if (t >= triangle_count || count == 0u) return;
-  if (!staging) {
-    stage_offset[t] = 0xffffffffu;
+  if (!run) {
+    uint head = new_chunk();
+    if (head == kNoChunk) return;
+    for (uint k = 0u; k < kKept; ++k) staged[head + k] = kept[k];
+    staged[head + kKept] = chain_second;
+    stage_offset[t] = head | kChained;
     return;
   }
-  // Staged pairs never outnumber all pairs, so they fit whenever the frame does not overflow.
   uint base = group_base + offset;
   stage_offset[t] = base;
-  if (base + count > pair_capacity) return;
+  if (base + count > staged_capacity) {
+    overflow = 1u;
+    return;
+  }
   for (uint k = 0u; k < kKept; ++k) {
     if (k < count) staged[base + k] = kept[k];
   }

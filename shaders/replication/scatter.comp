@@ -1,7 +1,8 @@
 // Modern pipeline, pass 2b: writes each triangle's (triangle, facet) pairs at its offset from the
-// exclusive scan, in the order pass 1 found them: a copy of the facets pass 1 staged, or, for a
-// triangle that covers more than pass 1 keeps, its coverage found again. The list's order,
-// grouped by material, is the draw order. Nothing is written for a frame that overflowed.
+// exclusive scan, in the order pass 1 found them, by copying what pass 1 staged: one run, or a
+// chain of chunks (kKept facets, then the next chunk's offset) where stage_offset has kChained
+// set. The list's order, grouped by material, is the draw order. Nothing is written for a frame
+// that overflowed.
 #ifndef LOCAL_SIZE
 #define LOCAL_SIZE 64
 #endif
@@ -18,13 +19,9 @@ layout(std430, binding = 12) readonly buffer Stats {
 layout(std430, binding = 17) readonly buffer Staged { uint staged[]; };
 layout(std430, binding = 18) readonly buffer StageOffsets { uint stage_offset[]; };
 layout(location = 42) uniform uint triangle_count;
-layout(location = 45) uniform uint pair_capacity;
 
-void triangle_eye(uint t, out vec3 p[3]);
-uint cover(vec3 p[3], uint t, uint pair_base, uint wanted, out uint wanted_facet);
-void write_pair(uint at, uint t, uint facet) {
-  if (at < pair_capacity) pairs[at] = uvec2(t, facet);
-}
+const uint kKept = 8u;              // kStagedChunkFacets
+const uint kChained = 0x80000000u;  // kStagedChained
 
 void main() {
   uint t = gl_GlobalInvocationID.x;
@@ -32,18 +29,14 @@ void main() {
   uint first = scan[t], count = scan[t + 1u] - first;
   if (count == 0u) return;
   uint source = stage_offset[t];
-  if (source == 0xffffffffu) {
-    vec3 p[3];
-    triangle_eye(t, p);
-    uint unused;
-    cover(p, t, first, 0xffffffffu, unused);
-    return;
-  }
+  bool chained = (source & kChained) != 0u;
+  source &= ~kChained;
   // Eight pairs per iteration: a triangle over thousands of facets stays within llvmpipe's loop
   // budget per invocation.
-  for (uint k = 0u; k < count; k += 8u) {
-    for (uint m = 0u; m < 8u; ++m) {
-      if (k + m < count) pairs[first + k + m] = uvec2(t, staged[source + k + m]);
+  for (uint k = 0u; k < count; k += kKept) {
+    for (uint m = 0u; m < kKept; ++m) {
+      if (k + m < count) pairs[first + k + m] = uvec2(t, staged[source + m]);
     }
+    source = chained ? staged[source + kKept] : source + kKept;
   }
 }

@@ -5,6 +5,7 @@
 #include <regex>
 #include <string>
 
+#include "facet/driver/facet_gpu.hpp"
 #include "facet/driver/program.hpp"
 #include "facet/driver/shader_library.hpp"
 #include "facet/projection/coverage_grid.hpp"
@@ -38,6 +39,19 @@ TEST(Shaders, CoverageGridConstantsMatchTheCpp) {
   EXPECT_EQ(value("kChartEquirectangular"), long(CoverageChart::equirectangular));
   EXPECT_EQ(value("kChartFisheye"), long(CoverageChart::fisheye));
   EXPECT_EQ(value("kChartPerspective"), long(CoverageChart::perspective));
+}
+
+// Pass 1's staging layout exists three times: facet_gpu.hpp, count.comp and scatter.comp.
+TEST(Shaders, StagingConstantsMatchTheCpp) {
+  for (const char* name : {"replication/count.comp", "replication/scatter.comp"}) {
+    SCOPED_TRACE(name);
+    const std::string text(embedded_shader(name).text);
+    std::smatch match;
+    ASSERT_TRUE(std::regex_search(text, match, std::regex(R"(kKept = (\d+)u)")));
+    EXPECT_EQ(std::stoul(match[1]), kStagedChunkFacets);
+    ASSERT_TRUE(std::regex_search(text, match, std::regex(R"(kChained = 0x([0-9a-f]+)u)")));
+    EXPECT_EQ(std::stoul(match[1], nullptr, 16), kStagedChained);
+  }
 }
 
 TEST(Shaders, EveryEmbeddedShaderCompiles) {

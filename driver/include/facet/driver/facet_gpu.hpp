@@ -88,6 +88,17 @@ std::vector<GpuCoverageNode> pack_coverage_nodes(const CoverageIndex& index);
 // the facets' guarded pyramid corners (3 × 3 floats per facet).
 inline constexpr std::uint32_t kGridHeaderWords = 24;
 std::vector<std::uint32_t> pack_coverage_grid(const CoverageGrid& grid);
+// Pass 1 of `facets` stages every facet it finds (binding::staged; replication/count.comp, kKept
+// and kChained there), so that the scatter copies them: a triangle with at most
+// kStagedChunkFacets facets as one run, one with more as a chain of chunks of kStagedChunkFacets
+// facets and the offset of the next chunk. binding::stage_offsets holds each triangle's offset,
+// with kStagedChained set for a chain.
+inline constexpr std::uint32_t kStagedChunkFacets = 8;
+inline constexpr std::uint32_t kStagedChained = 0x80000000u;
+// Staging words that hold the facets of `pairs` pairs: a word a facet in runs, and for a chain of
+// c > kStagedChunkFacets facets ceil(c / 8) chunks of 9 words, fewer than 2c.
+constexpr std::uint64_t staged_words(std::uint64_t pairs) { return 2 * pairs + 16; }
+
 // Records of every object's primitives, in Scene::objects order, then primitive order.
 std::vector<GpuRecord> make_records(const Scene& scene);
 
