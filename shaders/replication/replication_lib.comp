@@ -430,17 +430,20 @@ bool bucket_range(vec4 box, bool full_p, out uvec4 range) {
   return true;
 }
 
-// False when the triangle with unit corners u and facet f's guarded pyramid are separated by one
-// of the pyramid's three planes or one of the triangle's three edge planes (edge[k], with their
-// rounding slack in w): all three corners of one lie outside a plane of the other. Without the
-// clipping of meets_cone, which made the cylinder's frame 30% slower; what it keeps beyond the
-// exact answer is clipped to nothing in pass 3.
-bool may_meet_facet(vec3 u[3], vec4 edge[3], uint f) {
+// Candidate facet f against the triangle with unit corners u: kSeparated when one of the facet's
+// three guarded planes or one of the triangle's three edge planes (edge[k], with their rounding
+// slack in w) has all three corners of the other outside it; kBeyondHemisphere when they may meet
+// but a pyramid corner lies outside the open hemisphere about `middle`, where that test is not
+// exact (the walk must take the triangle); else kMayMeet. Without the clipping of meets_cone,
+// which made the cylinder's frame 30% slower; what it keeps beyond the exact answer is clipped to
+// nothing in pass 3.
+const uint kSeparated = 0u, kMayMeet = 1u, kBeyondHemisphere = 2u;
+uint test_candidate(vec3 u[3], vec4 edge[3], vec3 middle, uint f) {
   for (int k = 0; k < 3; ++k) {
     vec3 n = facets[f].clip_planes[k].xyz;
     if (dot(n, u[0]) + kCoverageSlack < 0.0 && dot(n, u[1]) + kCoverageSlack < 0.0 &&
         dot(n, u[2]) + kCoverageSlack < 0.0)
-      return false;
+      return kSeparated;
   }
   uint at = grid[21] + 9u * f;
   vec3 c[3];
@@ -450,25 +453,16 @@ bool may_meet_facet(vec3 u[3], vec4 edge[3], uint f) {
   for (int k = 0; k < 3; ++k) {
     if (dot(edge[k].xyz, c[0]) + edge[k].w < 0.0 && dot(edge[k].xyz, c[1]) + edge[k].w < 0.0 &&
         dot(edge[k].xyz, c[2]) + edge[k].w < 0.0)
-      return false;
+      return kSeparated;
   }
-  return true;
-}
-
-// True when facet f's guarded pyramid lies in the open hemisphere about `middle`.
-bool in_hemisphere(vec3 middle, uint f) {
-  uint at = grid[21] + 9u * f;
-  for (uint m = 0u; m < 3u; ++m) {
-    vec3 c =
-        vec3(grid_float(at + 3u * m), grid_float(at + 3u * m + 1u), grid_float(at + 3u * m + 2u));
-    if (!(dot(middle, c) > 0.0)) return false;
-  }
-  return true;
+  if (!(dot(middle, c[0]) > 0.0 && dot(middle, c[1]) > 0.0 && dot(middle, c[2]) > 0.0))
+    return kBeyondHemisphere;
+  return kMayMeet;
 }
 
 // walk_coverage's contract, answered from the grid into `found` when the triangle is small
 // enough for it (else false): conservative like the walk, with the few extra facets
-// may_meet_facet keeps.
+// test_candidate keeps.
 bool grid_coverage(vec3 p[3], uint t, uint pair_base, uint wanted, out uint wanted_facet,
                    out uint found) {
   wanted_facet = kNone;
@@ -516,22 +510,27 @@ bool grid_coverage(vec3 p[3], uint t, uint pair_base, uint wanted, out uint want
   vec3 middle = normalize(u[0] + u[1] + u[2]);
   if (!(dot(middle, u[0]) > 0.0 && dot(middle, u[1]) > 0.0 && dot(middle, u[2]) > 0.0))
     return false;
+  // A facet is listed at most once in a bucket, so a one-bucket box needs no de-duplication.
+  bool one_bucket = range.z * range.w == 1u;
   for (uint j = range.y; j < range.y + range.w; ++j) {
     for (uint k = 0u; k < range.z; ++k) {
       uint i = periodic ? (range.x + k) % columns : range.x + k;
       uint bucket = first_offset + j * columns + i;
       for (uint m = grid[bucket]; m < grid[bucket + 1u]; ++m) {
         uint f = grid[facets_offset + m];
-        uvec4 fb = uvec4(grid[boxes_offset + 4u * f], grid[boxes_offset + 4u * f + 1u],
-                         grid[boxes_offset + 4u * f + 2u], grid[boxes_offset + 4u * f + 3u]);
-        // Taken once: in the first bucket, in visiting order, that both ranges share.
-        uint first_row = max(range.y, fb.y);
-        uint first_column = max(range.x, fb.x);
-        if (periodic)
-          first_column = (range.x + columns - fb.x) % columns < fb.z ? range.x : fb.x;
-        if (i != first_column || j != first_row) continue;
-        if (!may_meet_facet(u, edge, f)) continue;
-        if (!in_hemisphere(middle, f)) return false;
+        if (!one_bucket) {
+          uvec4 fb = uvec4(grid[boxes_offset + 4u * f], grid[boxes_offset + 4u * f + 1u],
+                           grid[boxes_offset + 4u * f + 2u], grid[boxes_offset + 4u * f + 3u]);
+          // Taken once: in the first bucket, in visiting order, that both ranges share.
+          uint first_row = max(range.y, fb.y);
+          uint first_column = max(range.x, fb.x);
+          if (periodic)
+            first_column = (range.x + columns - fb.x) % columns < fb.z ? range.x : fb.x;
+          if (i != first_column || j != first_row) continue;
+        }
+        uint verdict = test_candidate(u, edge, middle, f);
+        if (verdict == kSeparated) continue;
+        if (verdict == kBeyondHemisphere) return false;
         if (found == wanted) wanted_facet = f;
         if (pair_base != kNone) write_pair(pair_base + found, t, f);
         ++found;
