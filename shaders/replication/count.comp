@@ -4,9 +4,8 @@
 // copies them and nothing is covered twice: a triangle with at most kKept facets as one run, placed
 // by one global atomic per work group; a triangle with more as a chain of chunks (kKept facets and
 // the next chunk's offset), each placed by an atomic of its own. Either way stage_offset[t] says
-// where (chains with kChained set). A frame whose pairs exceed
-// pair_capacity, or whose staged words exceed staged_capacity, sets `overflow` and is run again
-// with more room.
+// where (chains with kChained set). A frame whose pairs exceed pair_capacity, or whose staged
+// words exceed staged_capacity, sets `overflow` and is run again with more room.
 #ifndef LOCAL_SIZE
 #define LOCAL_SIZE 64
 #endif
