@@ -137,7 +137,8 @@ class FacetPipeline final : public FacetMethodBase {
     if (staged_words(wanted) > std::uint64_t(std::numeric_limits<std::int32_t>::max()))
       throw InputError(
           "scene", "pairs",
-          "at most 2^31 (triangle, facet) pairs per output and frame; this view needs " +
+          "fewer than 2^30 (triangle, facet) pairs per output and frame (pass 1 stages up to two "
+          "words a pair); this view needs " +
               std::to_string(values[1]));
     out.pair_capacity = std::uint32_t(wanted);
     out.replication_valid = false;

@@ -95,8 +95,8 @@ std::vector<std::uint32_t> pack_coverage_grid(const CoverageGrid& grid);
 // with kStagedChained set for a chain.
 inline constexpr std::uint32_t kStagedChunkFacets = 8;
 inline constexpr std::uint32_t kStagedChained = 0x80000000u;
-// Staging words that hold the facets of `pairs` pairs: a word a facet in runs, and for a chain of
-// c > kStagedChunkFacets facets ceil(c / 8) chunks of 9 words, fewer than 2c.
+// Staging words that hold the facets of `pairs` pairs: one word per facet in runs, and for a chain
+// of c > kStagedChunkFacets facets ceil(c / 8) chunks of 9 words, at most 2c.
 constexpr std::uint64_t staged_words(std::uint64_t pairs) { return 2 * pairs + 16; }
 
 // Records of every object's primitives, in Scene::objects order, then primitive order.
