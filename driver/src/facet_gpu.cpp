@@ -3,24 +3,145 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <optional>
 
 #include "facet/projection/errors.hpp"
 
 namespace facet::driver {
 
-std::vector<GpuFacet> pack_facets(const FacetMesh& mesh, double z_near, double guard_px) {
-  std::vector<GpuFacet> packed(mesh.facets.size());
-  for (std::uint32_t f = 0; f < mesh.facets.size(); ++f) {
-    const glm::dmat4 clip = mesh.facets[f].clip_from_eye(mesh.output_size, z_near);
+namespace {
+
+// Where pyramid planes a and b meet: the unit direction on the inner side of `inside`.
+glm::dvec3 pyramid_corner(const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& inside) {
+  const glm::dvec3 corner = glm::normalize(glm::cross(a, b));
+  return glm::dot(corner, inside) < 0 ? -corner : corner;
+}
+
+// Equal chord planes and M_q_eye up to rounding: either facet's projection draws the other's
+// pixels within 1e-9 of its size (1e-6 px on a 1000 px output).
+bool same_projection(const Facet& a, const Facet& b) {
+  double scale = 0, difference = 0;
+  for (int c = 0; c < 3; ++c)
+    for (int r = 0; r < 3; ++r) {
+      scale = std::max(scale, std::abs(a.M_q_eye[c][r]));
+      difference = std::max(difference, std::abs(a.M_q_eye[c][r] - b.M_q_eye[c][r]));
+    }
+  return difference <= 1e-9 * scale && glm::length(a.n - b.n) <= 1e-9 &&
+         std::abs(a.h - b.h) <= 1e-9 * a.h;
+}
+
+double cross2(const glm::dvec2& a, const glm::dvec2& b) { return a.x * b.y - a.y * b.x; }
+
+// The quad of facets a and b when they share an edge and a projection and their four corners are
+// strictly convex in q: its guarded planes in order around it (a's two outer edges, then b's).
+std::optional<std::array<glm::dvec3, 4>> quad_planes(const FacetMesh& mesh, std::uint32_t a,
+                                                     std::uint32_t b, double guard_px) {
+  const Facet& A = mesh.facets[a];
+  const Facet& B = mesh.facets[b];
+  if (!same_projection(A, B)) return std::nullopt;
+  // The diagonal: a's edge k, from corner k to k + 1, is b's edge m reversed.
+  int k = -1, m = -1;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j)
+      if (A.vertex[i] == B.vertex[(j + 1) % 3] && A.vertex[(i + 1) % 3] == B.vertex[j]) k = i, m = j;
+  if (k < 0) return std::nullopt;
+  // Around the quad: a's corners k + 1, k + 2, k, then b's corner m + 2.
+  const std::uint32_t around[4] = {A.vertex[(k + 1) % 3], A.vertex[(k + 2) % 3], A.vertex[k],
+                                   B.vertex[(m + 2) % 3]};
+  glm::dvec2 q[4];
+  for (int i = 0; i < 4; ++i) q[i] = mesh.vertices[around[i]].q;
+  double turn[4], size = 0;
+  for (int i = 0; i < 4; ++i) {
+    turn[i] = cross2(q[(i + 1) % 4] - q[i], q[(i + 2) % 4] - q[(i + 1) % 4]);
+    size = std::max(size, glm::length(q[(i + 1) % 4] - q[i]));
+  }
+  for (int i = 0; i < 4; ++i)
+    if (!(turn[i] * turn[0] > 0 && std::abs(turn[i]) > 1e-9 * size * size)) return std::nullopt;
+  const auto pa = mesh.clip_planes(a, guard_px);
+  const auto pb = mesh.clip_planes(b, guard_px);
+  return std::array<glm::dvec3, 4>{pa[(k + 1) % 3], pa[(k + 2) % 3], pb[(m + 1) % 3],
+                                   pb[(m + 2) % 3]};
+}
+
+// The smallest range that holds both; periodic: the shorter way round.
+BucketRange range_union(const BucketRange& a, const BucketRange& b, bool periodic,
+                        std::uint32_t columns) {
+  if (a.rows == 0) return b;
+  if (b.rows == 0) return a;
+  BucketRange u;
+  u.first_row = std::min(a.first_row, b.first_row);
+  u.rows = std::max(a.first_row + a.rows, b.first_row + b.rows) - u.first_row;
+  if (!periodic) {
+    u.first_column = std::min(a.first_column, b.first_column);
+    u.columns = std::max(a.first_column + a.columns, b.first_column + b.columns) - u.first_column;
+    return u;
+  }
+  const auto span_from = [columns](const BucketRange& from, const BucketRange& to) {
+    return std::max(from.columns,
+                    (to.first_column + columns - from.first_column) % columns + to.columns);
+  };
+  const std::uint32_t from_a = span_from(a, b), from_b = span_from(b, a);
+  if (std::min(from_a, from_b) >= columns) {
+    u.first_column = 0;
+    u.columns = columns;
+  } else if (from_a <= from_b) {
+    u.first_column = a.first_column;
+    u.columns = from_a;
+  } else {
+    u.first_column = b.first_column;
+    u.columns = from_b;
+  }
+  return u;
+}
+
+}  // namespace
+
+FacetPieces make_facet_pieces(const FacetMesh& mesh, bool merge_coplanar, double guard_px) {
+  FacetPieces pieces;
+  pieces.facet_count = std::uint32_t(mesh.facets.size());
+  pieces.piece_of_facet.resize(mesh.facets.size());
+  for (std::uint32_t f = 0; f < pieces.facet_count; ++f) {
+    pieces.piece_of_facet[f] = f;
+    const auto p = mesh.clip_planes(f, guard_px);
+    pieces.planes.push_back({p[0], p[1], p[2], p[0]});
+    std::array<glm::dvec3, 4> corners;
+    for (int k = 0; k < 3; ++k) corners[k] = pyramid_corner(p[k], p[(k + 1) % 3], p[(k + 2) % 3]);
+    corners[3] = corners[0];
+    pieces.corners.push_back(corners);
+  }
+  if (!merge_coplanar) return pieces;
+  for (const std::uint32_t first : mesh.cell_first_facet) {
+    if (first == UINT32_MAX) continue;
+    const auto planes = quad_planes(mesh, first, first + 1, guard_px);
+    if (!planes) continue;
+    const std::uint32_t piece = pieces.size();
+    pieces.piece_of_facet[first] = pieces.piece_of_facet[first + 1] = piece;
+    pieces.quads.push_back({first, first + 1});
+    pieces.planes.push_back(*planes);
+    std::array<glm::dvec3, 4> corners;
+    for (int k = 0; k < 4; ++k)
+      corners[k] = pyramid_corner((*planes)[k], (*planes)[(k + 1) % 4], (*planes)[(k + 2) % 4]);
+    pieces.corners.push_back(corners);
+  }
+  return pieces;
+}
+
+std::vector<GpuFacet> pack_facets(const FacetMesh& mesh, const FacetPieces& pieces,
+                                  double z_near) {
+  std::vector<GpuFacet> packed(pieces.size());
+  for (std::uint32_t p = 0; p < pieces.size(); ++p) {
+    // A facet in a quad takes the quad's projection too (equal up to rounding), so that the walk,
+    // which lists facets, writes the same depths as the grid.
+    const std::uint32_t source = pieces.facet(p < pieces.facet_count ? pieces.piece_of_facet[p] : p);
+    const glm::dmat4 clip = mesh.facets[source].clip_from_eye(mesh.output_size, z_near);
     for (int c = 0; c < 4; ++c)
-      for (int r = 0; r < 4; ++r) packed[f].clip_from_eye[c * 4 + r] = float(clip[c][r]);
-    const auto planes = mesh.clip_planes(f, guard_px);
-    for (int k = 0; k < 3; ++k) {
-      const glm::dvec3 n = glm::normalize(planes[k]);
-      packed[f].clip_planes[k][0] = float(n.x);
-      packed[f].clip_planes[k][1] = float(n.y);
-      packed[f].clip_planes[k][2] = float(n.z);
-      packed[f].clip_planes[k][3] = 0.0f;
+      for (int r = 0; r < 4; ++r) packed[p].clip_from_eye[c * 4 + r] = float(clip[c][r]);
+    for (int k = 0; k < 4; ++k) {
+      const glm::dvec3 n = glm::normalize(pieces.planes[p][k]);
+      packed[p].clip_planes[k][0] = float(n.x);
+      packed[p].clip_planes[k][1] = float(n.y);
+      packed[p].clip_planes[k][2] = float(n.z);
+      packed[p].clip_planes[k][3] = 0.0f;
     }
   }
   return packed;
@@ -75,7 +196,7 @@ std::vector<GpuCoverageNode> pack_coverage_nodes(const CoverageIndex& index) {
   return packed;
 }
 
-std::vector<std::uint32_t> pack_coverage_grid(const CoverageGrid& grid) {
+std::vector<std::uint32_t> pack_coverage_grid(const CoverageGrid& grid, const FacetPieces& pieces) {
   std::vector<std::uint32_t> words(kGridHeaderWords, 0);
   const auto bits = [](double value) { return std::bit_cast<std::uint32_t>(float(value)); };
   words[0] = std::uint32_t(grid.chart());
@@ -90,18 +211,47 @@ std::vector<std::uint32_t> pack_coverage_grid(const CoverageGrid& grid) {
   const glm::dmat3& R = grid.R_base_eye();
   for (int c = 0; c < 3; ++c)
     for (int r = 0; r < 3; ++r) words[12 + 3 * c + r] = bits(R[c][r]);
+  // Bucket ranges per piece: a facet's own where it is drawn, a quad's both facets'.
+  const auto& facet_ranges = grid.facet_buckets();
+  std::vector<BucketRange> ranges(pieces.size());
+  for (std::uint32_t p = 0; p < pieces.size(); ++p) {
+    if (!pieces.drawn(p)) continue;
+    if (p < pieces.facet_count) {
+      ranges[p] = facet_ranges[p];
+    } else {
+      const auto& quad = pieces.quads[p - pieces.facet_count];
+      ranges[p] = range_union(facet_ranges[quad[0]], facet_ranges[quad[1]], grid.periodic(),
+                              grid.columns());
+    }
+  }
+  const std::uint32_t columns = grid.columns();
+  const auto for_each_bucket = [&](const BucketRange& r, auto&& visit) {
+    for (std::uint32_t j = r.first_row; j < r.first_row + r.rows; ++j)
+      for (std::uint32_t k = 0; k < r.columns; ++k) {
+        const std::uint32_t i = grid.periodic() ? (r.first_column + k) % columns : r.first_column + k;
+        visit(std::size_t(j) * columns + i);
+      }
+  };
+  std::vector<std::uint32_t> first(std::size_t(columns) * grid.rows() + 1, 0);
+  for (const BucketRange& r : ranges) for_each_bucket(r, [&](std::size_t b) { ++first[b + 1]; });
+  for (std::size_t b = 1; b < first.size(); ++b) first[b] += first[b - 1];
+  std::vector<std::uint32_t> listed(first.back());
+  std::vector<std::uint32_t> next(first.begin(), first.end() - 1);
+  for (std::uint32_t p = 0; p < pieces.size(); ++p)
+    for_each_bucket(ranges[p], [&](std::size_t b) { listed[next[b]++] = p; });
   words[9] = std::uint32_t(words.size());
-  words.insert(words.end(), grid.bucket_first().begin(), grid.bucket_first().end());
+  words.insert(words.end(), first.begin(), first.end());
   words[10] = std::uint32_t(words.size());
-  words.insert(words.end(), grid.bucket_facets().begin(), grid.bucket_facets().end());
+  words.insert(words.end(), listed.begin(), listed.end());
   words[11] = std::uint32_t(words.size());
-  for (const BucketRange& r : grid.facet_buckets()) {
+  for (const BucketRange& r : ranges) {
     words.insert(words.end(), {r.first_column, r.first_row, r.columns, r.rows});
   }
   words[21] = std::uint32_t(words.size());
-  for (const auto& corners : grid.pyramid_corners())
-    for (const glm::dvec3& c : corners)
-      words.insert(words.end(), {bits(c.x), bits(c.y), bits(c.z)});
+  for (const auto& corners : pieces.corners)
+    for (const glm::dvec3& c : corners) words.insert(words.end(), {bits(c.x), bits(c.y), bits(c.z)});
+  words[22] = std::uint32_t(words.size());
+  words.insert(words.end(), pieces.piece_of_facet.begin(), pieces.piece_of_facet.end());
   return words;
 }
 
@@ -125,21 +275,24 @@ std::vector<GpuRecord> make_records(const Scene& scene) {
   return records;
 }
 
-FacetSet FacetSet::build(const Warp& warp, const FacetBuildOptions& options, double z_near) {
+FacetSet FacetSet::build(const Warp& warp, const FacetBuildOptions& options, double z_near,
+                         bool merge_coplanar) {
   FacetMesh mesh = build_facets(warp, options);
   CoverageIndex index(mesh);
   CoverageGrid grid(mesh, warp.base, warp.R_eye_base);
-  FacetSet set{std::move(mesh), std::move(index), std::move(grid), {}, {}, {}, {}, {}};
-  set.gpu_facets = pack_facets(set.mesh, z_near);
+  FacetPieces pieces = make_facet_pieces(mesh, merge_coplanar);
+  FacetSet set{std::move(mesh), std::move(index), std::move(grid), std::move(pieces),
+               {},              {},               {},              {}};
+  const std::vector<GpuFacet> gpu_facets = pack_facets(set.mesh, set.pieces, z_near);
   const auto nodes = pack_coverage_nodes(set.index);
   // Empty buffers cannot be bound; keep one dummy element so that every binding is valid.
   const GpuFacet no_facet{};
   const GpuCoverageNode no_node{};
   const std::uint32_t no_order = 0;
-  set.facets = set.gpu_facets.empty() ? Buffer::create(sizeof no_facet, &no_facet)
-                                      : Buffer::create_from(set.gpu_facets);
+  set.facets = gpu_facets.empty() ? Buffer::create(sizeof no_facet, &no_facet)
+                                  : Buffer::create_from(gpu_facets);
   set.nodes = nodes.empty() ? Buffer::create(sizeof no_node, &no_node) : Buffer::create_from(nodes);
-  set.grid_words = Buffer::create_from(pack_coverage_grid(set.grid));
+  set.grid_words = Buffer::create_from(pack_coverage_grid(set.grid, set.pieces));
   set.order = set.index.order().empty() ? Buffer::create(sizeof no_order, &no_order)
                                         : Buffer::create_from(set.index.order());
   return set;

@@ -1,6 +1,7 @@
-// The naive multi-pass baseline ("naive"): for every facet, one draw of each object run whose
-// bounds may meet that facet's pyramid, with the facet's matrix and clip planes. No coverage
-// pass, no replication: the rasterizer's clipping does all the work.
+// The naive multi-pass baseline ("naive"): for every piece (FacetPieces: a facet, or the quad of
+// a cell's two facets that share a projection, as the replication pipelines draw them), one draw
+// of each object run whose bounds may meet that piece's pyramid, with its matrix and clip planes.
+// No coverage pass, no replication: the rasterizer's clipping does all the work.
 #include <glm/gtc/type_ptr.hpp>
 #include <optional>
 
@@ -55,16 +56,17 @@ class NaiveMethod final : public FacetMethodBase {
       begin_facet_drawing(settings_.cull_back_faces);
       draw_.use();
       glBindVertexArray(empty_vao_.id());
-      const auto& planes = out.facets.index.planes();
+      const FacetPieces& pieces = out.facets.pieces;
       std::uint32_t bound_material = UINT32_MAX;
-      for (std::uint32_t f = 0; f < out.facets.mesh.facets.size(); ++f) {
+      for (std::uint32_t f = 0; f < pieces.size(); ++f) {
+        if (!pieces.drawn(f)) continue;
         glUniform1ui(44, f);
         for (std::uint32_t m = 0; m < material_count(); ++m) {
           for (std::uint32_t r : records_by_material_[m]) {
             const GpuRecord& record = records_[r];
             if (!out.object_visible[record.object]) continue;
             if (!sphere_may_meet_cone(centre[record.object], radius[record.object],
-                                      planes[f].data(), 3)) {
+                                      pieces.planes[f].data(), 4)) {
               continue;
             }
             if (m != bound_material) {

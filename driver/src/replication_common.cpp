@@ -94,7 +94,8 @@ void FacetMethodBase::prepare(const Scene& scene, const GpuScene& gpu_scene,
                                               epoxy_has_gl_extension("GL_ARB_indirect_parameters"));
   outputs_.clear();
   for (const OutputSpec& output : outputs) {
-    OutputState state(FacetSet::build(output.warp, settings.facets, settings.z_near));
+    OutputState state(
+        FacetSet::build(output.warp, settings.facets, settings.z_near, settings.merge_coplanar_facets));
     const std::uint32_t no_stats[4] = {0, 0, 0, 0};
     state.stats = Buffer::create(sizeof no_stats, no_stats);
     outputs_.push_back(std::move(state));
@@ -275,7 +276,7 @@ void FacetMethodBase::begin_facet_drawing(bool cull_back_faces) {
   glEnable(GL_DEPTH_TEST);
   glDepthFunc(GL_GREATER);
   glDepthMask(GL_TRUE);
-  for (int k = 0; k < 3; ++k) glEnable(GL_CLIP_DISTANCE0 + k);
+  for (int k = 0; k < 4; ++k) glEnable(GL_CLIP_DISTANCE0 + k);
   if (cull_back_faces) {
     glEnable(GL_CULL_FACE);
     glCullFace(GL_BACK);
@@ -286,7 +287,7 @@ void FacetMethodBase::begin_facet_drawing(bool cull_back_faces) {
 }
 
 void FacetMethodBase::end_facet_drawing() {
-  for (int k = 0; k < 3; ++k) glDisable(GL_CLIP_DISTANCE0 + k);
+  for (int k = 0; k < 4; ++k) glDisable(GL_CLIP_DISTANCE0 + k);
   glDisable(GL_CULL_FACE);
   glDepthFunc(GL_LESS);
   glDisable(GL_DEPTH_TEST);

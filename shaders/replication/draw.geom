@@ -10,7 +10,7 @@ flat in uint v_index[];
 out vec3 v_n_world;
 out vec2 v_uv;
 flat out uint v_triangle_id;
-out float gl_ClipDistance[3];
+out float gl_ClipDistance[4];
 
 uint entry_of_triangle(uint t);
 uint vertex_of(uint e, uint t, uint c);
@@ -39,7 +39,7 @@ void main() {
     uint v = vertex_of(e, t, c);
     vec3 p_eye = eye_position(object, v);
     gl_Position = facet_clip(f, p_eye);
-    for (int k = 0; k < 3; ++k) gl_ClipDistance[k] = facet_clip_distance(f, k, p_eye);
+    for (int k = 0; k < 4; ++k) gl_ClipDistance[k] = facet_clip_distance(f, k, p_eye);
     v_n_world = world_normal(object, v);
     v_uv = vertex_uv(v);
     v_triangle_id = triangle_id(e, t);

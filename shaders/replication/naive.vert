@@ -6,7 +6,7 @@ layout(location = 45) uniform uint record;
 out vec3 v_n_world;
 out vec2 v_uv;
 flat out uint v_triangle_id;
-out float gl_ClipDistance[3];
+out float gl_ClipDistance[4];
 
 uint record_vertex(uint r, uint i);
 uint record_object(uint r);
@@ -22,7 +22,7 @@ void main() {
   uint v = record_vertex(record, uint(gl_VertexID));
   vec3 p_eye = eye_position(object, v);
   gl_Position = facet_clip(facet, p_eye);
-  for (int k = 0; k < 3; ++k) gl_ClipDistance[k] = facet_clip_distance(facet, k, p_eye);
+  for (int k = 0; k < 4; ++k) gl_ClipDistance[k] = facet_clip_distance(facet, k, p_eye);
   v_n_world = world_normal(object, v);
   v_uv = vertex_uv(v);
   v_triangle_id = record_first_id(record) + uint(gl_VertexID) / 3u;

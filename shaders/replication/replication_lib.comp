@@ -27,9 +27,9 @@ struct ObjectFrame {  // GpuObjectFrame
 };
 layout(std430, binding = 5) readonly buffer ObjectFrames { ObjectFrame object_frames[]; };
 
-struct Facet {  // GpuFacet
+struct Facet {  // GpuFacet: one per piece (FacetPieces); a triangle repeats its first plane
   mat4 clip_from_eye;
-  vec4 clip_planes[3];
+  vec4 clip_planes[4];
 };
 layout(std430, binding = 6) readonly buffer Facets { Facet facets[]; };
 
@@ -105,7 +105,7 @@ vec3 world_normal(uint object, uint v) {
 
 vec2 vertex_uv(uint v) { return vec2(uvs[2u * v], uvs[2u * v + 1u]); }
 
-// GL clip coordinates of an eye-frame point in facet f, and its three clip distances.
+// GL clip coordinates of an eye-frame point in piece f, and its four clip distances.
 vec4 facet_clip(uint f, vec3 p_eye) {
   precise vec4 clip = facets[f].clip_from_eye * vec4(p_eye, 1.0);
   return clip;
@@ -204,10 +204,15 @@ bool triangle_may_cover(vec3 p[3]) {
   return abs(facing) > 1e-6 * length(normal) * scale;
 }
 
+// The piece that draws facet f (FacetPieces::piece_of_facet, at grid[22]).
+layout(std430, binding = 16) readonly buffer Grid { uint grid[]; };
+uint piece_of_facet(uint f) { return grid[grid[22] + f]; }
+
 // Walks the facets that triangle p may cover, in the hierarchy's fixed order, and returns how
-// many there are. When pair_base != kNone, writes uvec2(t, facet) to pairs[pair_base + k] for the
-// k-th (through write_pair). When wanted != kNone, stops at the wanted-th facet and returns it in
-// wanted_facet (kNone when there are fewer).
+// many there are. When pair_base != kNone, writes uvec2(t, piece of the facet) to
+// pairs[pair_base + k] for the k-th (through write_pair). When wanted != kNone, stops at the
+// wanted-th facet and returns its piece in wanted_facet (kNone when there are fewer). A quad's two
+// facets both write it, and pass 3 draws it twice with the same depths.
 void write_pair(uint at, uint t, uint facet);
 uint walk_coverage(vec3 p[3], uint t, uint pair_base, uint wanted, out uint wanted_facet) {
   wanted_facet = kNone;
@@ -232,7 +237,7 @@ uint walk_coverage(vec3 p[3], uint t, uint pair_base, uint wanted, out uint want
     if (node.bounded != 0u && !meets_cone(u, node.pyramid, 4)) continue;
     if (node.bounded != 0u && cone_inside(e, node.cone)) {
       if (wanted != kNone && wanted < found + node.range_count) {
-        wanted_facet = facet_order[node.range_first + (wanted - found)];
+        wanted_facet = piece_of_facet(facet_order[node.range_first + (wanted - found)]);
         return wanted + 1u;
       }
       if (pair_base != kNone) {
@@ -240,7 +245,8 @@ uint walk_coverage(vec3 p[3], uint t, uint pair_base, uint wanted, out uint want
         for (uint k = 0u; k < node.range_count; k += 8u) {
           for (uint m = 0u; m < 8u; ++m) {
             if (k + m < node.range_count)
-              write_pair(pair_base + found + k + m, t, facet_order[node.range_first + k + m]);
+              write_pair(pair_base + found + k + m, t,
+                         piece_of_facet(facet_order[node.range_first + k + m]));
           }
         }
       }
@@ -256,10 +262,10 @@ uint walk_coverage(vec3 p[3], uint t, uint pair_base, uint wanted, out uint want
                                  facets[f].clip_planes[2], vec4(0.0));
         if (!meets_cone(u, planes, 3)) continue;
         if (found == wanted) {
-          wanted_facet = f;
+          wanted_facet = piece_of_facet(f);
           return found + 1u;
         }
-        if (pair_base != kNone) write_pair(pair_base + found, t, f);
+        if (pair_base != kNone) write_pair(pair_base + found, t, piece_of_facet(f));
         ++found;
       }
     } else if (top + 2 <= 64) {
@@ -273,7 +279,6 @@ uint walk_coverage(vec3 p[3], uint t, uint pair_base, uint wanted, out uint want
 
 // ---- Coverage grid (projection/coverage_grid.hpp, CoverageGrid: the same arithmetic in float,
 // with the padding float rounding needs) ----
-layout(std430, binding = 16) readonly buffer Grid { uint grid[]; };
 layout(location = 44) uniform uint coverage_by_grid;  // 0: the hierarchy walk for every triangle
 
 const uint kChartCylindrical = 0u, kChartEquirectangular = 1u, kChartFisheye = 2u,
@@ -430,32 +435,33 @@ bool bucket_range(vec4 box, bool full_p, out uvec4 range) {
   return true;
 }
 
-// Candidate facet f against the triangle with unit corners u: kSeparated when one of the facet's
-// three guarded planes or one of the triangle's three edge planes (edge[k], with their rounding
-// slack in w) has all three corners of the other outside it; kBeyondHemisphere when they may meet
-// but a pyramid corner lies outside the open hemisphere about `middle`, where that test is not
-// exact (the walk must take the triangle); else kMayMeet. Without the clipping of meets_cone,
-// which made the cylinder's frame 30% slower; what it keeps beyond the exact answer is clipped to
+// Candidate piece f against the triangle with unit corners u: kSeparated when one of the piece's
+// four guarded planes or one of the triangle's three edge planes (edge[k], with their rounding
+// slack in w) has all corners of the other outside it; kBeyondHemisphere when they may meet but a
+// pyramid corner lies outside the open hemisphere about `middle`, where that test is not exact
+// (the walk must take the triangle); else kMayMeet. Without the clipping of meets_cone, which
+// made the cylinder's frame 30% slower; what it keeps beyond the exact answer is clipped to
 // nothing in pass 3.
 const uint kSeparated = 0u, kMayMeet = 1u, kBeyondHemisphere = 2u;
 uint test_candidate(vec3 u[3], vec4 edge[3], vec3 middle, uint f) {
-  for (int k = 0; k < 3; ++k) {
+  for (int k = 0; k < 4; ++k) {
     vec3 n = facets[f].clip_planes[k].xyz;
     if (dot(n, u[0]) + kCoverageSlack < 0.0 && dot(n, u[1]) + kCoverageSlack < 0.0 &&
         dot(n, u[2]) + kCoverageSlack < 0.0)
       return kSeparated;
   }
-  uint at = grid[21] + 9u * f;
-  vec3 c[3];
-  for (int m = 0; m < 3; ++m)
+  uint at = grid[21] + 12u * f;
+  vec3 c[4];
+  for (int m = 0; m < 4; ++m)
     c[m] = vec3(grid_float(at + 3u * uint(m)), grid_float(at + 3u * uint(m) + 1u),
                 grid_float(at + 3u * uint(m) + 2u));
   for (int k = 0; k < 3; ++k) {
     if (dot(edge[k].xyz, c[0]) + edge[k].w < 0.0 && dot(edge[k].xyz, c[1]) + edge[k].w < 0.0 &&
-        dot(edge[k].xyz, c[2]) + edge[k].w < 0.0)
+        dot(edge[k].xyz, c[2]) + edge[k].w < 0.0 && dot(edge[k].xyz, c[3]) + edge[k].w < 0.0)
       return kSeparated;
   }
-  if (!(dot(middle, c[0]) > 0.0 && dot(middle, c[1]) > 0.0 && dot(middle, c[2]) > 0.0))
+  if (!(dot(middle, c[0]) > 0.0 && dot(middle, c[1]) > 0.0 && dot(middle, c[2]) > 0.0 &&
+        dot(middle, c[3]) > 0.0))
     return kBeyondHemisphere;
   return kMayMeet;
 }

@@ -37,14 +37,43 @@ inline constexpr GLuint positions = 0, normals = 1, uvs = 2, indices = 3, record
                         draw_counts = 19;
 }  // namespace binding
 
-// std430, one per facet. Eye-frame X is inside the facet's guarded pyramid when
-// dot(clip_planes[k].xyz, X) >= 0 for k = 0..2; these are also its gl_ClipDistance values.
+// What pass 3 draws: pieces. Piece f < F is facet f of the mesh (F facets); piece F + k, a quad,
+// is the two facets of a tensor cell that share one projection (the same chord plane and M_q_eye
+// up to rounding, as every cell of an ideal cylinder or a flat wall does) and form a convex quad. A
+// triangle that crosses such a cell's diagonal is then one replica instead of two, and nothing is
+// clipped along the diagonal. The coverage grid lists pieces; the hierarchy walk finds facets
+// (as the CPU reference, CoverageIndex, does) and writes their pieces, a quad once per facet.
+struct FacetPieces {
+  std::uint32_t facet_count = 0;
+  std::vector<std::uint32_t> piece_of_facet;          // the piece that draws facet f
+  std::vector<std::array<std::uint32_t, 2>> quads;    // the facets of piece facet_count + k
+  // Per piece: unit normals of its guarded clip planes (X is inside when planes[k]·X >= 0, the
+  // facets' FacetMesh::clip_planes) and the unit corner directions of its guarded pyramid, where
+  // adjacent planes meet. A triangle repeats its first plane and its first corner.
+  std::vector<std::array<glm::dvec3, 4>> planes, corners;
+
+  std::uint32_t size() const { return std::uint32_t(planes.size()); }
+  // True when the piece is drawn: a quad, or a facet no quad holds.
+  bool drawn(std::uint32_t piece) const {
+    return piece >= facet_count || piece_of_facet[piece] == piece;
+  }
+  // The facet whose projection the piece uses.
+  std::uint32_t facet(std::uint32_t piece) const {
+    return piece < facet_count ? piece : quads[piece - facet_count][0];
+  }
+};
+// merge_coplanar = false: one piece per facet.
+FacetPieces make_facet_pieces(const FacetMesh& mesh, bool merge_coplanar,
+                              double guard_px = kDefaultGuardPx);
+
+// std430, one per piece. Eye-frame X is inside the piece's guarded pyramid when
+// dot(clip_planes[k].xyz, X) >= 0 for k = 0..3; these are also its gl_ClipDistance values.
 struct GpuFacet {
   float clip_from_eye[16];  // column-major Facet::clip_from_eye(output_size, z_near): GL clip
                             // coordinates with the y flip and reversed-Z depth z_near / (n·X)
-  float clip_planes[3][4];  // FacetMesh::clip_planes(f, guard_px): unit normals, w = 0
+  float clip_planes[4][4];  // FacetPieces::planes: unit normals, w = 0
 };
-static_assert(sizeof(GpuFacet) == 112);
+static_assert(sizeof(GpuFacet) == 128);
 
 // std430, one per node of CoverageIndex::nodes(), in the same order. A bounded node holds the
 // four planes through the eye of the pyramid around its cone (as CoverageIndex::query uses them);
@@ -77,17 +106,20 @@ struct GpuObjectFrame {
 };
 static_assert(sizeof(GpuObjectFrame) == 128);
 
-std::vector<GpuFacet> pack_facets(const FacetMesh& mesh, double z_near,
-                                  double guard_px = kDefaultGuardPx);
+std::vector<GpuFacet> pack_facets(const FacetMesh& mesh, const FacetPieces& pieces,
+                                  double z_near);
 std::vector<GpuCoverageNode> pack_coverage_nodes(const CoverageIndex& index);
 
 // The coverage grid as one uint array, the layout replication_lib.comp reads: a header of
 // kGridHeaderWords words (chart, periodic, columns, rows, then as float bits p0, q0, dp, dq,
-// radius_cap, then the offsets of bucket_first, bucket_facets and the per-facet bucket ranges,
-// then R_base_eye column-major, then the offset of the pyramid corners), then those arrays and
-// the facets' guarded pyramid corners (3 × 3 floats per facet).
+// radius_cap, then the offsets of bucket_first, bucket_pieces and the per-piece bucket ranges,
+// then R_base_eye column-major, then the offsets of the pyramid corners and of piece_of_facet),
+// then those arrays, the pieces' guarded pyramid corners (4 × 3 floats per piece) and
+// FacetPieces::piece_of_facet. Buckets list pieces: a quad in every bucket of the smallest range
+// holding both its facets' ranges (its guarded pyramid lies in the union of theirs), a facet no
+// quad holds where the grid lists it.
 inline constexpr std::uint32_t kGridHeaderWords = 24;
-std::vector<std::uint32_t> pack_coverage_grid(const CoverageGrid& grid);
+std::vector<std::uint32_t> pack_coverage_grid(const CoverageGrid& grid, const FacetPieces& pieces);
 // Pass 1 of `facets` stages every facet it finds (binding::staged; replication/count.comp, kKept
 // and kChained there), so that the scatter copies them: a triangle with at most
 // kStagedChunkFacets facets as one run, one with more as a chain of chunks of kStagedChunkFacets
@@ -107,12 +139,14 @@ struct FacetSet {
   FacetMesh mesh;
   CoverageIndex index;
   CoverageGrid grid;
-  std::vector<GpuFacet> gpu_facets;         // kept for the naive baseline's per-facet culling
-  Buffer facets, nodes, order, grid_words;  // bind at binding::facets, nodes, order, grid
+  FacetPieces pieces;
+  Buffer facets, nodes, order, grid_words;  // bind at binding::facets (one GpuFacet per piece),
+                                            // nodes, order, grid
 
-  // Builds the facets of `warp` (InputError when the layout cannot be met) and uploads them.
-  // Needs a current context.
-  static FacetSet build(const Warp& warp, const FacetBuildOptions& options, double z_near);
+  // Builds the facets of `warp` (InputError when the layout cannot be met) and their pieces, and
+  // uploads them. Needs a current context.
+  static FacetSet build(const Warp& warp, const FacetBuildOptions& options, double z_near,
+                        bool merge_coplanar = true);
   void bind() const;
 };
 
@@ -123,7 +157,7 @@ bool sphere_may_meet_cone(const glm::dvec3& centre, double radius, const glm::dv
 bool sphere_may_meet_facets(const FacetSet& set, const glm::dvec3& centre, double radius);
 
 // Passes 1 and 2 of the "facets" pipeline on eye-frame triangles (metres, T_eye_world = identity),
-// read back: for each triangle, the facets (sorted) it is replicated into. For tests against
+// read back: for each triangle, the pieces (sorted; FacetPieces) it is replicated into. For tests against
 // CoverageIndex::query. Needs a current context.
 std::vector<std::vector<std::uint32_t>> gpu_triangle_coverage(
     const Warp& warp, const RenderSettings& settings,

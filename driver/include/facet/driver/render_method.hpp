@@ -41,6 +41,9 @@ struct RenderSettings {
   // Facet methods: how the warp is cut into facets, and how pass 1 finds a triangle's facets.
   FacetBuildOptions facets;
   FacetCoverage coverage = FacetCoverage::grid;
+  // Facet methods: draw the two facets of a tensor cell that share one projection as one quad
+  // (FacetPieces); false draws every facet on its own, as the hierarchy walk lists them.
+  bool merge_coplanar_facets = true;
   // Cube-map baseline: edge length of a cube face in pixels.
   int cube_face_size = 1024;
   // Per-vertex baseline: tessellation level cap (1 = no tessellation).
