@@ -252,6 +252,17 @@ std::vector<std::uint32_t> pack_coverage_grid(const CoverageGrid& grid, const Fa
     for (const glm::dvec3& c : corners) words.insert(words.end(), {bits(c.x), bits(c.y), bits(c.z)});
   words[22] = std::uint32_t(words.size());
   words.insert(words.end(), pieces.piece_of_facet.begin(), pieces.piece_of_facet.end());
+  if (grid.cell_buckets()) {
+    // Pads grown by the float rounding of the breaks and of the shader's arithmetic on them.
+    double largest = 0;
+    for (const auto* breaks : {&grid.p_breaks(), &grid.q_breaks()})
+      for (const double x : *breaks) largest = std::max(largest, std::abs(x));
+    const double slack = 1e-5 + 1e-6 * largest;
+    words[23] = std::uint32_t(words.size());
+    words.insert(words.end(), {bits(grid.pad_p() + slack), bits(grid.pad_q() + slack)});
+    for (const double x : grid.p_breaks()) words.push_back(bits(x));
+    for (const double x : grid.q_breaks()) words.push_back(bits(x));
+  }
   return words;
 }
 

@@ -34,6 +34,39 @@ ChartFrame chart_frame(CoverageChart chart) {
 
 double wrap_pi(double angle) { return std::remainder(angle, 2 * kPi); }
 
+// Chart coordinates (p, q) of a unit base-frame direction.
+glm::dvec2 chart_point(const glm::dvec3& b, CoverageChart chart) {
+  const ChartFrame frame = chart_frame(chart);
+  const double sin_theta = glm::length(glm::cross(b, frame.axis));
+  const double theta = std::atan2(sin_theta, glm::dot(b, frame.axis));
+  const double x = glm::dot(b, frame.e1), y = glm::dot(b, frame.e2);
+  switch (chart) {
+    case CoverageChart::cylindrical:
+      return {std::atan2(y, x), std::cos(theta) / std::max(std::sin(theta), 1e-6)};
+    case CoverageChart::equirectangular:
+      return {std::atan2(y, x), kPi / 2 - theta};
+    case CoverageChart::fisheye: {
+      const double scale = sin_theta > 1e-12 ? theta / sin_theta : 1.0;
+      return {scale * x, scale * y};
+    }
+    case CoverageChart::perspective:
+      return {x / -b.z, y / -b.z};
+  }
+  return {0, 0};
+}
+
+// Cells meeting [lo, hi] among those between ascending breaks: first and last index, or
+// nullopt.
+std::optional<std::pair<std::uint32_t, std::uint32_t>> cells_between(
+    const std::vector<double>& breaks, double lo, double hi) {
+  const std::size_t cells = breaks.size() - 1;
+  if (hi < breaks.front() || lo > breaks.back()) return std::nullopt;
+  const auto first = std::lower_bound(breaks.begin(), breaks.end(), lo) - breaks.begin();
+  const auto last = std::upper_bound(breaks.begin(), breaks.end(), hi) - breaks.begin();
+  return std::pair{std::uint32_t(std::clamp<std::ptrdiff_t>(first - 1, 0, std::ptrdiff_t(cells) - 1)),
+                   std::uint32_t(std::clamp<std::ptrdiff_t>(last - 1, 0, std::ptrdiff_t(cells) - 1))};
+}
+
 }  // namespace
 
 CoverageChart coverage_chart(BaseKind kind) {
@@ -194,6 +227,36 @@ ChartBox CoverageGrid::chart_box(const DirectionBox& d) const {
 
 std::optional<BucketRange> CoverageGrid::buckets(const ChartBox& box) const {
   if (box.empty) return std::nullopt;
+  if (cells_) {
+    const auto rows = cells_between(q_breaks_, box.q_lo - pad_q_, box.q_hi + pad_q_);
+    if (!rows) return std::nullopt;
+    BucketRange range;
+    range.first_row = rows->first;
+    range.rows = rows->second - rows->first + 1;
+    const double width = box.p_hi - box.p_lo + 2 * pad_p_;
+    if (periodic_ && (box.full_p || width >= 2 * kPi)) {
+      range.columns = columns_;
+      return range;
+    }
+    double lo = box.p_lo - pad_p_;
+    if (periodic_) lo = p_breaks_.front() + std::fmod(std::fmod(lo - p_breaks_.front(), 2 * kPi) + 2 * kPi, 2 * kPi);
+    const double hi = lo + width;
+    const auto first = cells_between(p_breaks_, lo, lo);
+    if (!periodic_) {
+      const auto columns = cells_between(p_breaks_, lo, hi);
+      if (!columns) return std::nullopt;
+      range.first_column = columns->first;
+      range.columns = columns->second - columns->first + 1;
+      return range;
+    }
+    // Periodic: the breaks span the whole turn, so lo lies in the first turn and hi may wrap.
+    std::uint32_t last = cells_between(p_breaks_, std::min(hi, p_breaks_.back()), std::min(hi, p_breaks_.back()))->second;
+    if (hi > p_breaks_.back()) last = columns_ + cells_between(p_breaks_, hi - 2 * kPi, hi - 2 * kPi)->second;
+    range.first_column = first->first;
+    range.columns = std::min(last - first->first + 1, columns_);
+    if (range.columns == columns_) range.first_column = 0;
+    return range;
+  }
   const auto index = [](double value, double origin, double step, std::uint32_t count) {
     return std::clamp(std::floor((value - origin) / step), -1.0, double(count));
   };
@@ -303,6 +366,13 @@ CoverageGrid::CoverageGrid(const FacetMesh& mesh, const BaseProjection& base,
         2 * std::max({std::abs(p_lo), std::abs(p_hi), std::abs(q_lo), std::abs(q_hi)}) + 1;
   }
 
+  std::vector<std::uint32_t> cell_of_facet;
+  if (fit_cells(mesh, cell_of_facet)) {
+    cells_ = true;
+    columns_ = std::uint32_t(p_breaks_.size() - 1);
+    rows_ = std::uint32_t(q_breaks_.size() - 1);
+  }
+
   facet_buckets_.assign(facet_count, BucketRange{});
   std::vector<std::uint32_t> counts(std::size_t(columns_) * rows_ + 1, 0);
   const auto for_each_bucket = [&](const BucketRange& r, auto&& visit) {
@@ -313,7 +383,13 @@ CoverageGrid::CoverageGrid(const FacetMesh& mesh, const BaseProjection& base,
       }
   };
   for (std::uint32_t f = 0; f < facet_count; ++f) {
-    const auto range = buckets(boxes[f]);
+    std::optional<BucketRange> range;
+    if (cells_) {
+      if (cell_of_facet[f] != UINT32_MAX)
+        range = BucketRange{cell_of_facet[f] % columns_, cell_of_facet[f] / columns_, 1, 1};
+    } else {
+      range = buckets(boxes[f]);
+    }
     if (!range) continue;
     facet_buckets_[f] = *range;
     for_each_bucket(*range, [&](std::size_t b) { ++counts[b + 1]; });
@@ -325,6 +401,116 @@ CoverageGrid::CoverageGrid(const FacetMesh& mesh, const BaseProjection& base,
     if (facet_buckets_[f].rows == 0) continue;
     for_each_bucket(facet_buckets_[f], [&](std::size_t b) { bucket_facets_[counts[b]++] = f; });
   }
+}
+
+bool CoverageGrid::fit_cells(const FacetMesh& mesh, std::vector<std::uint32_t>& cell_of_facet) {
+  if (mesh.s_breaks.size() < 2 || mesh.t_breaks.size() < 2) return false;
+  const std::size_t C = mesh.s_breaks.size() - 1, R = mesh.t_breaks.size() - 1;
+  // The chart coordinate of every break, from the corners that lie on it: s is affine in p and t
+  // in q, so every corner on one break must agree.
+  std::vector<std::optional<double>> p_of(C + 1), q_of(R + 1);
+  bool agree = true;
+  const auto record = [&](std::optional<double>& slot, double value, bool angular) {
+    if (!std::isfinite(value)) agree = false;
+    if (!slot) {
+      slot = value;
+      return;
+    }
+    const double difference = angular ? wrap_pi(value - *slot) : value - *slot;
+    if (std::abs(difference) > 1e-9 * std::max(1.0, std::abs(value))) agree = false;
+  };
+  const auto break_of = [](const std::vector<double>& breaks, std::size_t cell, double value) {
+    const double span = std::abs(breaks[cell + 1] - breaks[cell]);
+    if (std::abs(value - breaks[cell]) <= 1e-9 * span) return int(cell);
+    if (std::abs(value - breaks[cell + 1]) <= 1e-9 * span) return int(cell + 1);
+    return -1;
+  };
+  cell_of_facet.assign(mesh.facets.size(), UINT32_MAX);
+  for (std::size_t r = 0; r < R; ++r)
+    for (std::size_t c = 0; c < C; ++c) {
+      const std::uint32_t first = mesh.cell_first_facet[r * C + c];
+      if (first == UINT32_MAX) continue;
+      for (std::uint32_t f = first; f < first + 2; ++f) {
+        cell_of_facet[f] = std::uint32_t(r * C + c);
+        for (const std::uint32_t v : mesh.facets[f].vertex) {
+          const FacetVertex& vertex = mesh.vertices[v];
+          const int i = break_of(mesh.s_breaks, c, vertex.st.x);
+          const int j = break_of(mesh.t_breaks, r, vertex.st.y);
+          if (i < 0 || j < 0) return false;
+          const glm::dvec2 pq = chart_point(R_base_eye_ * glm::normalize(vertex.p_eye), chart_);
+          record(p_of[std::size_t(i)], pq.x, periodic_);
+          record(q_of[std::size_t(j)], pq.y, false);
+        }
+      }
+    }
+  if (!agree) return false;
+  for (const auto& p : p_of)
+    if (!p) return false;
+  for (const auto& q : q_of)
+    if (!q) return false;
+  // Breaks in order along the chart, unwrapped across the seam of a periodic chart.
+  std::vector<double> p(C + 1), q(R + 1);
+  p[0] = *p_of[0];
+  for (std::size_t i = 1; i <= C; ++i)
+    p[i] = periodic_ ? p[i - 1] + wrap_pi(*p_of[i] - *p_of[i - 1]) : *p_of[i];
+  for (std::size_t j = 0; j <= R; ++j) q[j] = *q_of[j];
+  const auto monotonic = [](const std::vector<double>& x) {
+    bool up = true, down = true;
+    for (std::size_t i = 1; i < x.size(); ++i) {
+      up = up && x[i] > x[i - 1];
+      down = down && x[i] < x[i - 1];
+    }
+    return up ? 1 : down ? -1 : 0;
+  };
+  const int p_order = monotonic(p), q_order = monotonic(q);
+  if (p_order == 0 || q_order == 0) return false;
+  // A periodic chart's cells must go once round: a part of a turn would need its own wrapping.
+  if (periodic_ && std::abs(std::abs(p.back() - p.front()) - 2 * kPi) > 1e-9) return false;
+  if (p_order < 0) std::reverse(p.begin(), p.end());
+  if (q_order < 0) std::reverse(q.begin(), q.end());
+  if (periodic_) {  // the turn starting in [-π, π)
+    const double shift = p.front() - wrap_pi(p.front());
+    for (double& x : p) x -= shift;
+  }
+  // How far any guarded pyramid reaches beyond its cell: its boundary arcs sampled in the chart,
+  // each sample's reach grown by the largest step between samples.
+  constexpr int kSamples = 64;
+  double pad_p = 0, pad_q = 0;
+  for (std::uint32_t f = 0; f < mesh.facets.size(); ++f) {
+    if (cell_of_facet[f] == UINT32_MAX) continue;
+    std::size_t c = cell_of_facet[f] % C, r = cell_of_facet[f] / C;
+    if (p_order < 0) c = C - 1 - c;
+    if (q_order < 0) r = R - 1 - r;
+    cell_of_facet[f] = std::uint32_t(r * C + c);
+    const double cell_middle = 0.5 * (p[c] + p[c + 1]);
+    for (int k = 0; k < 3; ++k) {
+      const glm::dvec3 a = R_base_eye_ * corners_[f][k], b = R_base_eye_ * corners_[f][(k + 1) % 3];
+      const double angle = std::acos(std::clamp(glm::dot(a, b), -1.0, 1.0));
+      glm::dvec2 previous{0.0};
+      double step_p = 0, step_q = 0, reach_p = 0, reach_q = 0;
+      for (int m = 0; m <= kSamples; ++m) {
+        const double w = double(m) / kSamples;
+        const glm::dvec3 d = angle > 1e-12 ? (std::sin((1 - w) * angle) * a + std::sin(w * angle) * b) / std::sin(angle) : a;
+        glm::dvec2 pq = chart_point(glm::normalize(d), chart_);
+        if (!std::isfinite(pq.x) || !std::isfinite(pq.y)) return false;
+        if (periodic_) pq.x = cell_middle + wrap_pi(pq.x - cell_middle);
+        if (m > 0) {
+          step_p = std::max(step_p, std::abs(pq.x - previous.x));
+          step_q = std::max(step_q, std::abs(pq.y - previous.y));
+        }
+        previous = pq;
+        reach_p = std::max({reach_p, p[c] - pq.x, pq.x - p[c + 1]});
+        reach_q = std::max({reach_q, q[r] - pq.y, pq.y - q[r + 1]});
+      }
+      pad_p = std::max(pad_p, reach_p + step_p);
+      pad_q = std::max(pad_q, reach_q + step_q);
+    }
+  }
+  p_breaks_ = std::move(p);
+  q_breaks_ = std::move(q);
+  pad_p_ = pad_p;
+  pad_q_ = pad_q;
+  return true;
 }
 
 std::optional<std::vector<std::uint32_t>> CoverageGrid::candidates(const BucketRange& r) const {

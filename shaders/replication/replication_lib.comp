@@ -407,10 +407,67 @@ bool chart_box(uint chart, vec4 d, bool full_phi, out vec4 box) {
   return true;
 }
 
+// Cells meeting [lo, hi] among `cells` cells between ascending float breaks at grid[at...]:
+// the first and last; false when none (CoverageGrid's cells_between).
+bool cells_between(uint at, uint cells, float lo, float hi, out uint first, out uint last) {
+  first = 0u;
+  last = 0u;
+  if (hi < grid_float(at) || lo > grid_float(at + cells)) return false;
+  // Lower bound of lo and upper bound of hi among the cells + 1 breaks.
+  uint a = 0u, b = cells + 1u;
+  while (a < b) {
+    uint middle = (a + b) / 2u;
+    if (grid_float(at + middle) < lo) a = middle + 1u; else b = middle;
+  }
+  uint c = 0u, d = cells + 1u;
+  while (c < d) {
+    uint middle = (c + d) / 2u;
+    if (grid_float(at + middle) <= hi) c = middle + 1u; else d = middle;
+  }
+  first = uint(clamp(int(a) - 1, 0, int(cells) - 1));
+  last = uint(clamp(int(c) - 1, 0, int(cells) - 1));
+  return true;
+}
+
 // The buckets a chart box touches: (first column, first row, columns, rows); false when none.
 bool bucket_range(vec4 box, bool full_p, out uvec4 range) {
   range = uvec4(0u);
   uint columns = grid[2], rows = grid[3];
+  if (grid[23] != 0u) {
+    // Cell buckets (CoverageGrid::buckets): the box grown by the pads, against the breaks.
+    uint pads = grid[23], p_at = grid[23] + 2u, q_at = p_at + columns + 1u;
+    float pad_p = grid_float(pads), pad_q = grid_float(pads + 1u);
+    uint first_row, last_row;
+    if (!cells_between(q_at, rows, box.z - pad_q, box.w + pad_q, first_row, last_row)) return false;
+    range.y = first_row;
+    range.w = last_row - first_row + 1u;
+    float width = box.y - box.x + 2.0 * pad_p;
+    bool periodic = grid[1] != 0u;
+    if (periodic && (full_p || width >= 2.0 * kPi)) {
+      range.z = columns;
+      return true;
+    }
+    float p0 = grid_float(p_at), p_end = grid_float(p_at + columns);
+    float lo = box.x - pad_p;
+    if (periodic) lo = p0 + mod(lo - p0, 2.0 * kPi);
+    float hi = lo + width;
+    uint first, last;
+    if (!periodic) {
+      if (!cells_between(p_at, columns, lo, hi, first, last)) return false;
+      range.x = first;
+      range.z = last - first + 1u;
+      return true;
+    }
+    uint unused;
+    cells_between(p_at, columns, lo, lo, first, unused);
+    cells_between(p_at, columns, min(hi, p_end), min(hi, p_end), unused, last);
+    if (hi > p_end) cells_between(p_at, columns, hi - 2.0 * kPi, hi - 2.0 * kPi, unused, last);
+    if (hi > p_end) last += columns;
+    range.x = first;
+    range.z = min(last - first + 1u, columns);
+    if (range.z == columns) range.x = 0u;
+    return true;
+  }
   float p0 = grid_float(4u), q0 = grid_float(5u), dp = grid_float(6u), dq = grid_float(7u);
   float j_lo = max(clamp(floor((box.z - q0) / dq), -1.0, float(rows)), 0.0);
   float j_hi = min(clamp(floor((box.w - q0) / dq), -1.0, float(rows)), float(rows) - 1.0);
@@ -516,8 +573,9 @@ bool grid_coverage(vec3 p[3], uint t, uint pair_base, uint wanted, out uint want
   vec3 middle = normalize(u[0] + u[1] + u[2]);
   if (!(dot(middle, u[0]) > 0.0 && dot(middle, u[1]) > 0.0 && dot(middle, u[2]) > 0.0))
     return false;
-  // A facet is listed at most once in a bucket, so a one-bucket box needs no de-duplication.
-  bool one_bucket = range.z * range.w == 1u;
+  // A facet is listed at most once in a bucket, so a one-bucket box needs no de-duplication, and
+  // cell buckets list each facet once, so they need none at all.
+  bool one_bucket = range.z * range.w == 1u || grid[23] != 0u;
   for (uint j = range.y; j < range.y + range.w; ++j) {
     for (uint k = 0u; k < range.z; ++k) {
       uint i = periodic ? (range.x + k) % columns : range.x + k;

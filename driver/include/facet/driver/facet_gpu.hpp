@@ -113,9 +113,10 @@ std::vector<GpuCoverageNode> pack_coverage_nodes(const CoverageIndex& index);
 // The coverage grid as one uint array, the layout replication_lib.comp reads: a header of
 // kGridHeaderWords words (chart, periodic, columns, rows, then as float bits p0, q0, dp, dq,
 // radius_cap, then the offsets of bucket_first, bucket_pieces and the per-piece bucket ranges,
-// then R_base_eye column-major, then the offsets of the pyramid corners and of piece_of_facet),
-// then those arrays, the pieces' guarded pyramid corners (4 × 3 floats per piece) and
-// FacetPieces::piece_of_facet. Buckets list pieces: a quad in every bucket of the smallest range
+// then R_base_eye column-major, then the offsets of the pyramid corners, of piece_of_facet and of
+// the cell breaks, 0 for uniform buckets), then those arrays, the pieces' guarded pyramid corners
+// (4 × 3 floats per piece), FacetPieces::piece_of_facet and, for cell buckets, pad_p and pad_q
+// (grown by the float rounding), then p_breaks and q_breaks as floats. Buckets list pieces: a quad in every bucket of the smallest range
 // holding both its facets' ranges (its guarded pyramid lies in the union of theirs), a facet no
 // quad holds where the grid lists it.
 inline constexpr std::uint32_t kGridHeaderWords = 24;

@@ -14,10 +14,16 @@
 // from the poles, so their extremes lie at the corners, at the one interior extreme of θ along
 // each great-circle arc, or at a pole inside the triangle (then φ spans everything).
 //
-// Buckets. Each facet's guarded pyramid is itself a spherical triangle (its corners are where
-// adjacent clip planes meet), so it gets a chart box by the same function and is listed in every
-// bucket that box touches. A triangle's candidates are the facets of the buckets its box touches,
-// each taken once: from the first bucket, in visiting order, that both boxes share. Here
+// Buckets. For a tensor layout (strips, grids, tensor tolerance builds), st is affine in the
+// chart, so the cells' breaks are lines of the chart: bucket (i, j) is cell (i, j) and lists that
+// cell's facets only, and a triangle's box is grown by the furthest any facet's guarded pyramid
+// reaches beyond its cell (its boundary arcs sampled in the chart, each sample grown by the
+// largest step between samples). Otherwise (bisection layouts, a periodic chart's cells that do
+// not go once round) buckets are uniform, about the size of the median facet box: each facet's
+// guarded pyramid is itself a spherical triangle (its corners are where adjacent clip planes
+// meet), so it gets a chart box by the same function and is listed in every bucket that box
+// touches. A triangle's candidates are the facets of the buckets its box touches, each taken
+// once: from the first bucket, in visiting order, that both boxes share. Here
 // candidates are tested exactly (triangle_meets_cone), so the result equals CoverageIndex::query;
 // the GPU rejects them by separating planes instead (the pyramid's three, the triangle's three),
 // which keeps a few more facets and no clipping loop.
@@ -71,7 +77,7 @@ class CoverageGrid {
   static constexpr std::uint32_t kMaxCandidates = 512;  // shared with replication_lib.comp
 
   // Lists the guarded pyramids of `mesh` (the facets of a warp with base `base` and rotation
-  // R_eye_base) in buckets about the size of the median facet.
+  // R_eye_base) in cell buckets or uniform ones (above).
   CoverageGrid(const FacetMesh& mesh, const BaseProjection& base, const glm::dmat3& R_eye_base,
                double guard_px = kDefaultGuardPx);
 
@@ -100,6 +106,15 @@ class CoverageGrid {
   double dq() const { return dq_; }
   double radius_cap() const { return radius_cap_; }
   const glm::dmat3& R_base_eye() const { return R_base_eye_; }
+  // Cell buckets: for a tensor layout, bucket (i, j) is cell (i, j) of the chart (columns and rows
+  // in ascending p and q), bounded by p_breaks and q_breaks, and holds that cell's facets only; a
+  // triangle's box is grown by pad_p and pad_q, the furthest any guarded pyramid reaches beyond
+  // its cell, instead. Otherwise buckets are uniform, from p0, q0 in steps dp, dq.
+  bool cell_buckets() const { return cells_; }
+  const std::vector<double>& p_breaks() const { return p_breaks_; }
+  const std::vector<double>& q_breaks() const { return q_breaks_; }
+  double pad_p() const { return pad_p_; }
+  double pad_q() const { return pad_q_; }
   // Bucket b = row·columns + column holds bucket_facets[bucket_first[b], bucket_first[b + 1]).
   const std::vector<std::uint32_t>& bucket_first() const { return bucket_first_; }
   const std::vector<std::uint32_t>& bucket_facets() const { return bucket_facets_; }
@@ -116,6 +131,11 @@ class CoverageGrid {
   std::optional<std::vector<std::uint32_t>> candidates(const BucketRange& range) const;
 
  private:
+  // Cell buckets when the mesh is a tensor layout whose breaks are lines of the chart (always, up
+  // to rounding: st is affine in the chart) and, for a periodic chart, go once round; sets the
+  // breaks and pads and each facet's cell (row · columns + column), else returns false.
+  bool fit_cells(const FacetMesh& mesh, std::vector<std::uint32_t>& cell_of_facet);
+
   CoverageChart chart_ = CoverageChart::perspective;
   bool periodic_ = false;
   std::uint32_t columns_ = 1, rows_ = 1;
@@ -123,6 +143,9 @@ class CoverageGrid {
   glm::dmat3 R_base_eye_{1.0};
   std::vector<std::uint32_t> bucket_first_, bucket_facets_;
   std::vector<BucketRange> facet_buckets_;
+  bool cells_ = false;
+  std::vector<double> p_breaks_, q_breaks_;
+  double pad_p_ = 0, pad_q_ = 0;
   std::vector<std::array<glm::dvec3, 3>> planes_;
   std::vector<std::array<glm::dvec3, 3>> corners_;
 };
