@@ -186,6 +186,26 @@ double wall_ms_since(std::chrono::steady_clock::time_point start) {
 
 }  // namespace
 
+std::vector<BenchSetting> with_matched_tolerance(const BenchScenario& scenario,
+                                                 double cube_512_max_px) {
+  std::vector<BenchSetting> settings = scenario.settings;
+  const bool cube_512 = std::any_of(settings.begin(), settings.end(), [](const BenchSetting& s) {
+    return s.method == "cubemap" && s.settings.cube_face_size == 512;
+  });
+  const bool tolerance = std::any_of(settings.begin(), settings.end(), [](const BenchSetting& s) {
+    return s.method == "facets" && std::holds_alternative<FacetTolerance>(s.settings.facets.layout);
+  });
+  const double px = std::floor(cube_512_max_px * 1000) / 1000;
+  if (!cube_512 || !tolerance || !(px > 0)) return settings;
+  const auto last_facets =
+      std::find_if(settings.rbegin(), settings.rend(),
+                   [](const BenchSetting& s) { return s.method == "facets"; });
+  BenchSetting matched{"facets", format("tol=%gpx (cube 512)", px), {}, {}};
+  matched.settings.facets.layout = FacetTolerance{px};
+  settings.insert(last_facets.base(), matched);
+  return settings;
+}
+
 double median(std::vector<double> values) {
   if (values.empty()) return 0;
   std::sort(values.begin(), values.end());
@@ -410,7 +430,12 @@ BenchReport run_bench(const BenchOptions& options, const std::string& renderer,
 
     std::vector<Runner> runners;
     std::map<std::string, std::vector<std::vector<std::uint32_t>>> facet_ids;
-    for (const BenchSetting& setting : scenario.settings) {
+    double cube_512_max_px = 0;
+    for (std::size_t i = 0; i < scenario.outputs.size(); ++i) {
+      cube_512_max_px = std::max(
+          cube_512_max_px, cube_texel_error(scenario.outputs[i].warp, inverses[i], 512).first);
+    }
+    for (const BenchSetting& setting : with_matched_tolerance(scenario, cube_512_max_px)) {
       Runner runner;
       runner.setting = setting;
       BenchRow& row = runner.row;

@@ -219,6 +219,29 @@ TEST(BenchScenarios, EveryScenarioHasValidOutputsAndEveryMethod) {
   EXPECT_THROW(driver::make_bench_scenarios(options), InputError);
 }
 
+// At equal error: the cylinder at quarter size runs 512² faces, so it gains a facets tolerance
+// build at the cube map's error, rounded down; the quick sweep, without 512² faces, does not.
+TEST(BenchScenarios, MatchedToleranceFollowsTheCubeMapsError) {
+  driver::BenchOptions options;
+  options.scenarios = {"cylinder"};
+  options.size_scale = 0.25;
+  const auto scenarios = driver::make_bench_scenarios(options);
+  ASSERT_EQ(scenarios.size(), 1u);
+  const auto settings = driver::with_matched_tolerance(scenarios[0], 0.41378);
+  ASSERT_EQ(settings.size(), scenarios[0].settings.size() + 1);
+  std::size_t last_facets = 0;
+  for (std::size_t k = 0; k < settings.size(); ++k)
+    if (settings[k].method == "facets") last_facets = k;
+  const driver::BenchSetting& matched = settings[last_facets];
+  EXPECT_EQ(matched.label, "tol=0.413px (cube 512)");
+  ASSERT_TRUE(std::holds_alternative<FacetTolerance>(matched.settings.facets.layout));
+  EXPECT_DOUBLE_EQ(std::get<FacetTolerance>(matched.settings.facets.layout).px, 0.413);
+  EXPECT_EQ(settings[last_facets + 1].method, "facets-gs");
+  options.quick = true;
+  const auto quick = driver::make_bench_scenarios(options);
+  EXPECT_EQ(driver::with_matched_tolerance(quick[0], 0.41378).size(), quick[0].settings.size());
+}
+
 // --scenario scale: every method at one setting on the cylinder and the dome, over growing
 // tiled cities, ordered by scene; "all" leaves it out. Rows only: running it at the quick size
 // takes minutes on llvmpipe.

@@ -146,6 +146,13 @@ struct BenchReport {
 // scenario name or a bad rig file.
 std::vector<BenchScenario> make_bench_scenarios(const BenchOptions& options);
 
+// The scenario's settings, plus `facets` at a tolerance of cube_512_max_px (the 512² cube map's
+// geometric max error over the outputs) rounded down to 0.001 px, after the last facets setting,
+// when the scenario runs 512² faces and facet tolerance builds: the facets setting at the cube
+// map's own error, which the matched-error ratio asks for.
+std::vector<BenchSetting> with_matched_tolerance(const BenchScenario& scenario,
+                                                 double cube_512_max_px);
+
 // Runs every scenario. Needs a current GL context. `progress` (may be empty) gets one line per
 // step.
 BenchReport run_bench(const BenchOptions& options, const std::string& renderer,
