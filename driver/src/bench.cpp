@@ -187,20 +187,20 @@ double wall_ms_since(std::chrono::steady_clock::time_point start) {
 }  // namespace
 
 std::vector<BenchSetting> with_matched_tolerance(const BenchScenario& scenario,
-                                                 double cube_512_max_px) {
+                                                 double cube_max_px) {
   std::vector<BenchSetting> settings = scenario.settings;
-  const bool cube_512 = std::any_of(settings.begin(), settings.end(), [](const BenchSetting& s) {
-    return s.method == "cubemap" && s.settings.cube_face_size == 512;
+  const int face = scenario.matched_cube_face;
+  const bool cube = std::any_of(settings.begin(), settings.end(), [face](const BenchSetting& s) {
+    return s.method == "cubemap" && s.settings.cube_face_size == face;
   });
   const bool tolerance = std::any_of(settings.begin(), settings.end(), [](const BenchSetting& s) {
     return s.method == "facets" && std::holds_alternative<FacetTolerance>(s.settings.facets.layout);
   });
-  const double px = std::floor(cube_512_max_px * 1000) / 1000;
-  if (!cube_512 || !tolerance || !(px > 0)) return settings;
-  const auto last_facets =
-      std::find_if(settings.rbegin(), settings.rend(),
-                   [](const BenchSetting& s) { return s.method == "facets"; });
-  BenchSetting matched{"facets", format("tol=%gpx (cube 512)", px), {}, {}};
+  const double px = std::floor(cube_max_px * 1000) / 1000;
+  if (face <= 0 || !cube || !tolerance || !(px > 0)) return settings;
+  const auto last_facets = std::find_if(settings.rbegin(), settings.rend(),
+                                        [](const BenchSetting& s) { return s.method == "facets"; });
+  BenchSetting matched{"facets", format("tol=%gpx (cube %d)", px, face), {}, {}};
   matched.settings.facets.layout = FacetTolerance{px};
   settings.insert(last_facets.base(), matched);
   return settings;
@@ -244,6 +244,8 @@ std::vector<BenchScenario> make_bench_scenarios(const BenchOptions& options) {
   const std::vector<int> faces_sweep =
       faces(quick ? std::vector<int>{256, 1024} : std::vector<int>{256, 512, 1024, 2048});
   std::vector<BenchScenario> scenarios;
+  // The full sweeps match a facets build to the 512² cube map (the scale rows to their one cube).
+  const int matched_face = quick ? 0 : 512;
   for (const std::string& name : names) {
     if (name == "cylinder") {
       BenchScenario s;
@@ -262,6 +264,7 @@ std::vector<BenchScenario> make_bench_scenarios(const BenchOptions& options) {
                   {FacetStrips{160}, FacetStrips{40}, FacetTolerance{1}, FacetTolerance{0.25}},
                   faces_sweep, tess);
       }
+      s.matched_cube_face = matched_face;
       scenarios.push_back(std::move(s));
     } else if (name == "scale") {
       // Frame cost against scene size: every method at one setting each, on the cylinder and the
@@ -285,6 +288,7 @@ std::vector<BenchScenario> make_bench_scenarios(const BenchOptions& options) {
                           std::to_string(triangles) + " triangles)";
           s.settings = sweep({FacetTolerance{0.25}}, FacetTolerance{0.25}, {FacetTolerance{0.25}},
                              faces({512}), {1});
+          s.matched_cube_face = quick ? 0 : faces({512})[0];
           scenarios.push_back(std::move(s));
         }
       }
@@ -307,6 +311,7 @@ std::vector<BenchScenario> make_bench_scenarios(const BenchOptions& options) {
           s.settings = sweep({FacetGrid{cells.x, cells.y}, quarter, FacetTolerance{1}}, quarter,
                              {quarter, FacetTolerance{1}}, faces_sweep, tess);
         }
+        s.matched_cube_face = matched_face;
         scenarios.push_back(std::move(s));
       }
     } else {
@@ -325,6 +330,7 @@ std::vector<BenchScenario> make_bench_scenarios(const BenchOptions& options) {
                      FacetTolerance{0.5}, FacetTolerance{0.1}},
                     FacetGrid{16, 16}, {FacetGrid{16, 16}, FacetTolerance{1}}, faces_sweep, tess);
         }
+        s.matched_cube_face = matched_face;
         scenarios.push_back(std::move(s));
       }
       if (name != "dome-master") {
@@ -342,6 +348,7 @@ std::vector<BenchScenario> make_bench_scenarios(const BenchOptions& options) {
               {FacetTolerance{0.25}, FacetTolerance{1}, FacetTolerance{0.5}, FacetTolerance{0.1}},
               FacetTolerance{1}, {FacetTolerance{1}, FacetTolerance{0.25}}, faces_sweep, tess);
         }
+        s.matched_cube_face = matched_face;
         scenarios.push_back(std::move(s));
       }
     }
@@ -430,12 +437,13 @@ BenchReport run_bench(const BenchOptions& options, const std::string& renderer,
 
     std::vector<Runner> runners;
     std::map<std::string, std::vector<std::vector<std::uint32_t>>> facet_ids;
-    double cube_512_max_px = 0;
-    for (std::size_t i = 0; i < scenario.outputs.size(); ++i) {
-      cube_512_max_px = std::max(
-          cube_512_max_px, cube_texel_error(scenario.outputs[i].warp, inverses[i], 512).first);
+    double cube_max_px = 0;
+    for (std::size_t i = 0; scenario.matched_cube_face > 0 && i < scenario.outputs.size(); ++i) {
+      cube_max_px = std::max(cube_max_px, cube_texel_error(scenario.outputs[i].warp, inverses[i],
+                                                           scenario.matched_cube_face)
+                                              .first);
     }
-    for (const BenchSetting& setting : with_matched_tolerance(scenario, cube_512_max_px)) {
+    for (const BenchSetting& setting : with_matched_tolerance(scenario, cube_max_px)) {
       Runner runner;
       runner.setting = setting;
       BenchRow& row = runner.row;

@@ -220,7 +220,7 @@ TEST(BenchScenarios, EveryScenarioHasValidOutputsAndEveryMethod) {
 }
 
 // At equal error: the cylinder at quarter size runs 512² faces, so it gains a facets tolerance
-// build at the cube map's error, rounded down; the quick sweep, without 512² faces, does not.
+// build at the cube map's error, rounded down; the quick sweep does not.
 TEST(BenchScenarios, MatchedToleranceFollowsTheCubeMapsError) {
   driver::BenchOptions options;
   options.scenarios = {"cylinder"};
@@ -240,6 +240,15 @@ TEST(BenchScenarios, MatchedToleranceFollowsTheCubeMapsError) {
   options.quick = true;
   const auto quick = driver::make_bench_scenarios(options);
   EXPECT_EQ(driver::with_matched_tolerance(quick[0], 0.41378).size(), quick[0].settings.size());
+  // The scale rows match their one cube map: 512 scaled to 128.
+  options.quick = false;
+  options.scenarios = {"scale"};
+  for (const auto& scenario : driver::make_bench_scenarios(options)) {
+    EXPECT_EQ(scenario.matched_cube_face, 128) << scenario.name;
+    const auto scaled = driver::with_matched_tolerance(scenario, 1.6654);
+    ASSERT_EQ(scaled.size(), scenario.settings.size() + 1) << scenario.name;
+    EXPECT_EQ(scaled[1].label, "tol=1.665px (cube 128)") << scenario.name;
+  }
 }
 
 // --scenario scale: every method at one setting on the cylinder and the dome, over growing

@@ -60,6 +60,9 @@ struct BenchScenario {
   std::string scale_group;
   std::vector<OutputSpec> outputs;
   std::vector<BenchSetting> settings;
+  // The cube face edge at whose geometric max error run_bench adds a facets tolerance build
+  // (with_matched_tolerance); 0: none.
+  int matched_cube_face = 0;
 };
 
 struct BenchRow {
@@ -146,12 +149,11 @@ struct BenchReport {
 // scenario name or a bad rig file.
 std::vector<BenchScenario> make_bench_scenarios(const BenchOptions& options);
 
-// The scenario's settings, plus `facets` at a tolerance of cube_512_max_px (the 512² cube map's
-// geometric max error over the outputs) rounded down to 0.001 px, after the last facets setting,
-// when the scenario runs 512² faces and facet tolerance builds: the facets setting at the cube
-// map's own error, which the matched-error ratio asks for.
-std::vector<BenchSetting> with_matched_tolerance(const BenchScenario& scenario,
-                                                 double cube_512_max_px);
+// The scenario's settings, plus `facets` at a tolerance of cube_max_px (the geometric max error
+// over the outputs of the cube map at scenario.matched_cube_face) rounded down to 0.001 px, after
+// the last facets setting, when the scenario runs that cube map and facet tolerance builds: the
+// facets setting at the cube map's own error, which the matched-error ratio asks for.
+std::vector<BenchSetting> with_matched_tolerance(const BenchScenario& scenario, double cube_max_px);
 
 // Runs every scenario. Needs a current GL context. `progress` (may be empty) gets one line per
 // step.
