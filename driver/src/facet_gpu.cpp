@@ -43,7 +43,8 @@ std::optional<std::array<glm::dvec3, 4>> quad_planes(const FacetMesh& mesh, std:
   int k = -1, m = -1;
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j)
-      if (A.vertex[i] == B.vertex[(j + 1) % 3] && A.vertex[(i + 1) % 3] == B.vertex[j]) k = i, m = j;
+      if (A.vertex[i] == B.vertex[(j + 1) % 3] && A.vertex[(i + 1) % 3] == B.vertex[j])
+        k = i, m = j;
   if (k < 0) return std::nullopt;
   // Around the quad: a's corners k + 1, k + 2, k, then b's corner m + 2.
   const std::uint32_t around[4] = {A.vertex[(k + 1) % 3], A.vertex[(k + 2) % 3], A.vertex[k],
@@ -126,13 +127,13 @@ FacetPieces make_facet_pieces(const FacetMesh& mesh, bool merge_coplanar, double
   return pieces;
 }
 
-std::vector<GpuFacet> pack_facets(const FacetMesh& mesh, const FacetPieces& pieces,
-                                  double z_near) {
+std::vector<GpuFacet> pack_facets(const FacetMesh& mesh, const FacetPieces& pieces, double z_near) {
   std::vector<GpuFacet> packed(pieces.size());
   for (std::uint32_t p = 0; p < pieces.size(); ++p) {
     // A facet in a quad takes the quad's projection too (equal up to rounding), so that the walk,
     // which lists facets, writes the same depths as the grid.
-    const std::uint32_t source = pieces.facet(p < pieces.facet_count ? pieces.piece_of_facet[p] : p);
+    const std::uint32_t source =
+        pieces.facet(p < pieces.facet_count ? pieces.piece_of_facet[p] : p);
     const glm::dmat4 clip = mesh.facets[source].clip_from_eye(mesh.output_size, z_near);
     for (int c = 0; c < 4; ++c)
       for (int r = 0; r < 4; ++r) packed[p].clip_from_eye[c * 4 + r] = float(clip[c][r]);
@@ -228,7 +229,8 @@ std::vector<std::uint32_t> pack_coverage_grid(const CoverageGrid& grid, const Fa
   const auto for_each_bucket = [&](const BucketRange& r, auto&& visit) {
     for (std::uint32_t j = r.first_row; j < r.first_row + r.rows; ++j)
       for (std::uint32_t k = 0; k < r.columns; ++k) {
-        const std::uint32_t i = grid.periodic() ? (r.first_column + k) % columns : r.first_column + k;
+        const std::uint32_t i =
+            grid.periodic() ? (r.first_column + k) % columns : r.first_column + k;
         visit(std::size_t(j) * columns + i);
       }
   };
@@ -249,7 +251,8 @@ std::vector<std::uint32_t> pack_coverage_grid(const CoverageGrid& grid, const Fa
   }
   words[21] = std::uint32_t(words.size());
   for (const auto& corners : pieces.corners)
-    for (const glm::dvec3& c : corners) words.insert(words.end(), {bits(c.x), bits(c.y), bits(c.z)});
+    for (const glm::dvec3& c : corners)
+      words.insert(words.end(), {bits(c.x), bits(c.y), bits(c.z)});
   words[22] = std::uint32_t(words.size());
   words.insert(words.end(), pieces.piece_of_facet.begin(), pieces.piece_of_facet.end());
   if (grid.cell_buckets()) {
@@ -292,8 +295,8 @@ FacetSet FacetSet::build(const Warp& warp, const FacetBuildOptions& options, dou
   CoverageIndex index(mesh);
   CoverageGrid grid(mesh, warp.base, warp.R_eye_base);
   FacetPieces pieces = make_facet_pieces(mesh, merge_coplanar);
-  FacetSet set{std::move(mesh), std::move(index), std::move(grid), std::move(pieces),
-               {},              {},               {},              {}};
+  FacetSet set{
+      std::move(mesh), std::move(index), std::move(grid), std::move(pieces), {}, {}, {}, {}};
   const std::vector<GpuFacet> gpu_facets = pack_facets(set.mesh, set.pieces, z_near);
   const auto nodes = pack_coverage_nodes(set.index);
   // Empty buffers cannot be bound; keep one dummy element so that every binding is valid.
@@ -324,6 +327,54 @@ bool sphere_may_meet_cone(const glm::dvec3& centre, double radius, const glm::dv
     if (length > 0 && glm::dot(planes[k], centre) / length < -radius) return false;
   }
   return true;
+}
+
+std::uint32_t sole_piece_of_sphere(const FacetSet& set, const glm::dvec3& centre, double radius) {
+  const CoverageGrid& grid = set.grid;
+  const FacetPieces& pieces = set.pieces;
+  if (!grid.cell_buckets() || !(radius >= 0) || glm::length(centre) <= radius) return kNoPiece;
+  const auto narrowest = [](const std::vector<double>& breaks) {
+    double width = std::numeric_limits<double>::infinity();
+    for (std::size_t k = 1; k < breaks.size(); ++k)
+      width = std::min(width, breaks[k] - breaks[k - 1]);
+    return width;
+  };
+  if (!(grid.pad_p() < narrowest(grid.p_breaks()) && grid.pad_q() < narrowest(grid.q_breaks())))
+    return kNoPiece;
+  const auto near = grid.buckets(grid.chart_point_box(centre));
+  if (!near) return kNoPiece;
+  // The cells within two of those about the centre.
+  const std::uint32_t columns = grid.columns(), rows = grid.rows();
+  const std::uint32_t row_lo = near->first_row >= 2 ? near->first_row - 2 : 0;
+  const std::uint32_t row_hi = std::min(near->first_row + near->rows + 1, rows - 1);
+  std::vector<std::uint32_t> nearby;
+  for (std::uint32_t j = row_lo; j <= row_hi; ++j) {
+    for (std::int64_t k = -2; k < std::int64_t(near->columns) + 2; ++k) {
+      std::int64_t i = std::int64_t(near->first_column) + k;
+      if (grid.periodic()) {
+        if (std::int64_t(near->columns) + 4 > std::int64_t(columns)) return kNoPiece;
+        i = (i % std::int64_t(columns) + columns) % columns;
+      } else if (i < 0 || i >= std::int64_t(columns)) {
+        continue;
+      }
+      const std::size_t b = std::size_t(j) * columns + std::size_t(i);
+      for (std::uint32_t m = grid.bucket_first()[b]; m < grid.bucket_first()[b + 1]; ++m)
+        nearby.push_back(pieces.piece_of_facet[grid.bucket_facets()[m]]);
+    }
+  }
+  std::sort(nearby.begin(), nearby.end());
+  nearby.erase(std::unique(nearby.begin(), nearby.end()), nearby.end());
+  std::uint32_t sole = kNoPiece;
+  for (const std::uint32_t p : nearby) {
+    if (!sphere_may_meet_cone(centre, radius, pieces.planes[p].data(), 4)) continue;
+    if (sole != kNoPiece) return kNoPiece;  // two may meet it
+    bool inside = true;
+    for (const glm::dvec3& plane : pieces.planes[p])
+      inside = inside && glm::dot(glm::normalize(plane), centre) >= radius * (1 + 1e-9) + 1e-12;
+    if (!inside) return kNoPiece;
+    sole = p;
+  }
+  return sole;
 }
 
 bool sphere_may_meet_facets(const FacetSet& set, const glm::dvec3& centre, double radius) {

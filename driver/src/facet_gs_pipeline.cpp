@@ -43,6 +43,7 @@ class FacetGsPipeline final : public FacetMethodBase {
       targets[i].clear();
       stats.facets += out.facets.mesh.facets.size();
       stats.triangles_in += out.triangles;
+      stats.triangles_sole_piece += out.triangles_sole_piece;
       stats.gpu_buffer_bytes += buffer_bytes(out);
       if (out.triangles == 0 || out.facets.mesh.facets.empty()) {
         targets[i].resolve();

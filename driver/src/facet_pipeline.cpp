@@ -76,6 +76,7 @@ class FacetPipeline final : public FacetMethodBase {
       const OutputState& out = outputs_[i];
       stats.facets += out.facets.mesh.facets.size();
       stats.triangles_in += out.triangles;
+      stats.triangles_sole_piece += out.triangles_sole_piece;
       stats.gpu_buffer_bytes += buffer_bytes(out);
       targets[i].resolve();
       if (out.triangles == 0 || out.facets.mesh.facets.empty()) continue;

@@ -94,8 +94,8 @@ void FacetMethodBase::prepare(const Scene& scene, const GpuScene& gpu_scene,
                                               epoxy_has_gl_extension("GL_ARB_indirect_parameters"));
   outputs_.clear();
   for (const OutputSpec& output : outputs) {
-    OutputState state(
-        FacetSet::build(output.warp, settings.facets, settings.z_near, settings.merge_coplanar_facets));
+    OutputState state(FacetSet::build(output.warp, settings.facets, settings.z_near,
+                                      settings.merge_coplanar_facets));
     const std::uint32_t no_stats[4] = {0, 0, 0, 0};
     state.stats = Buffer::create(sizeof no_stats, no_stats);
     outputs_.push_back(std::move(state));
@@ -132,15 +132,27 @@ bool FacetMethodBase::update_view(const glm::dmat4& T_eye_world) {
       out.object_visible[o] =
           radius[o] >= 0 && sphere_may_meet_facets(out.facets, centre[o], radius[o] * 1.0001);
     }
+    // Objects inside one piece and clear of the others: pass 1 gives their triangles that piece
+    // without the grid (the walk, the reference, always walks).
+    std::vector<std::uint32_t> sole_piece(scene.objects.size(), kNoPiece);
+    if (settings_.coverage == FacetCoverage::grid) {
+      for (std::size_t o = 0; o < scene.objects.size(); ++o) {
+        if (out.object_visible[o])
+          sole_piece[o] = sole_piece_of_sphere(out.facets, centre[o], radius[o] * 1.0001);
+      }
+    }
     out.list.clear();
     out.material_ranges.clear();
     std::uint32_t triangles = 0;
+    out.triangles_sole_piece = 0;
     for (const auto& material_records : records_by_material_) {
       out.material_ranges.push_back(triangles);
       for (std::uint32_t r : material_records) {
-        if (!out.object_visible[records_[r].object]) continue;
-        out.list.push_back({r, triangles});
+        const std::uint32_t object = records_[r].object;
+        if (!out.object_visible[object]) continue;
+        out.list.push_back({r, triangles, sole_piece[object], 0});
         triangles += records_[r].triangle_count;
+        if (sole_piece[object] != kNoPiece) out.triangles_sole_piece += records_[r].triangle_count;
       }
       out.material_ranges.push_back(triangles);
     }

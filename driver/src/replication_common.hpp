@@ -64,9 +64,13 @@ inline constexpr std::uint32_t kSoftwareReplicasPerDraw = 128;
 inline constexpr std::uint64_t kMaxDrawsPerMaterial = 65535u * 64u;
 inline constexpr std::size_t kDrawCommandBytes = 16;  // DrawArraysIndirectCommand
 
-struct ListEntry {  // std430 uvec2 of replication_lib.comp's List
+struct ListEntry {  // std430 ListEntry of replication_lib.comp's List
   std::uint32_t record, first_triangle;
+  // sole_piece_of_sphere of the record's object (grid coverage only), else kNoPiece.
+  std::uint32_t sole_piece = kNoPiece;
+  std::uint32_t padding = 0;
 };
+static_assert(sizeof(ListEntry) == 16);
 
 class FacetMethodBase : public RenderMethod {
  public:
@@ -81,6 +85,7 @@ class FacetMethodBase : public RenderMethod {
     std::vector<ListEntry> list;
     std::vector<std::uint32_t> material_ranges;  // (begin, end) list triangles per material
     std::uint32_t triangles = 0;                 // list triangles
+    std::uint32_t triangles_sole_piece = 0;      // of those, in entries with a sole piece
     Buffer list_buffer, ranges_buffer;
     // Replication results, reused while neither view nor scene changes.
     // stats: visible triangles, pairs, overflow (std430 uints, replication/count.comp).

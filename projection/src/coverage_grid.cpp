@@ -63,8 +63,9 @@ std::optional<std::pair<std::uint32_t, std::uint32_t>> cells_between(
   if (hi < breaks.front() || lo > breaks.back()) return std::nullopt;
   const auto first = std::lower_bound(breaks.begin(), breaks.end(), lo) - breaks.begin();
   const auto last = std::upper_bound(breaks.begin(), breaks.end(), hi) - breaks.begin();
-  return std::pair{std::uint32_t(std::clamp<std::ptrdiff_t>(first - 1, 0, std::ptrdiff_t(cells) - 1)),
-                   std::uint32_t(std::clamp<std::ptrdiff_t>(last - 1, 0, std::ptrdiff_t(cells) - 1))};
+  return std::pair{
+      std::uint32_t(std::clamp<std::ptrdiff_t>(first - 1, 0, std::ptrdiff_t(cells) - 1)),
+      std::uint32_t(std::clamp<std::ptrdiff_t>(last - 1, 0, std::ptrdiff_t(cells) - 1))};
 }
 
 }  // namespace
@@ -239,7 +240,9 @@ std::optional<BucketRange> CoverageGrid::buckets(const ChartBox& box) const {
       return range;
     }
     double lo = box.p_lo - pad_p_;
-    if (periodic_) lo = p_breaks_.front() + std::fmod(std::fmod(lo - p_breaks_.front(), 2 * kPi) + 2 * kPi, 2 * kPi);
+    if (periodic_)
+      lo = p_breaks_.front() +
+           std::fmod(std::fmod(lo - p_breaks_.front(), 2 * kPi) + 2 * kPi, 2 * kPi);
     const double hi = lo + width;
     const auto first = cells_between(p_breaks_, lo, lo);
     if (!periodic_) {
@@ -250,8 +253,11 @@ std::optional<BucketRange> CoverageGrid::buckets(const ChartBox& box) const {
       return range;
     }
     // Periodic: the breaks span the whole turn, so lo lies in the first turn and hi may wrap.
-    std::uint32_t last = cells_between(p_breaks_, std::min(hi, p_breaks_.back()), std::min(hi, p_breaks_.back()))->second;
-    if (hi > p_breaks_.back()) last = columns_ + cells_between(p_breaks_, hi - 2 * kPi, hi - 2 * kPi)->second;
+    std::uint32_t last =
+        cells_between(p_breaks_, std::min(hi, p_breaks_.back()), std::min(hi, p_breaks_.back()))
+            ->second;
+    if (hi > p_breaks_.back())
+      last = columns_ + cells_between(p_breaks_, hi - 2 * kPi, hi - 2 * kPi)->second;
     range.first_column = first->first;
     range.columns = std::min(last - first->first + 1, columns_);
     if (range.columns == columns_) range.first_column = 0;
@@ -403,6 +409,17 @@ CoverageGrid::CoverageGrid(const FacetMesh& mesh, const BaseProjection& base,
   }
 }
 
+ChartBox CoverageGrid::chart_point_box(const glm::dvec3& v_eye) const {
+  const glm::dvec2 pq = chart_point(R_base_eye_ * glm::normalize(v_eye), chart_);
+  ChartBox box;
+  box.p_lo = box.p_hi = pq.x;
+  box.q_lo = box.q_hi = pq.y;
+  box.empty = !std::isfinite(pq.x) || !std::isfinite(pq.y) ||
+              (chart_ == CoverageChart::perspective &&
+               !(glm::dot(R_base_eye_ * v_eye, glm::dvec3(0, 0, -1)) > 0));
+  return box;
+}
+
 bool CoverageGrid::fit_cells(const FacetMesh& mesh, std::vector<std::uint32_t>& cell_of_facet) {
   if (mesh.s_breaks.size() < 2 || mesh.t_breaks.size() < 2) return false;
   const std::size_t C = mesh.s_breaks.size() - 1, R = mesh.t_breaks.size() - 1;
@@ -490,7 +507,10 @@ bool CoverageGrid::fit_cells(const FacetMesh& mesh, std::vector<std::uint32_t>& 
       double step_p = 0, step_q = 0, reach_p = 0, reach_q = 0;
       for (int m = 0; m <= kSamples; ++m) {
         const double w = double(m) / kSamples;
-        const glm::dvec3 d = angle > 1e-12 ? (std::sin((1 - w) * angle) * a + std::sin(w * angle) * b) / std::sin(angle) : a;
+        const glm::dvec3 d =
+            angle > 1e-12
+                ? (std::sin((1 - w) * angle) * a + std::sin(w * angle) * b) / std::sin(angle)
+                : a;
         glm::dvec2 pq = chart_point(glm::normalize(d), chart_);
         if (!std::isfinite(pq.x) || !std::isfinite(pq.y)) return false;
         if (periodic_) pq.x = cell_middle + wrap_pi(pq.x - cell_middle);

@@ -24,8 +24,8 @@ layout(location = 42) uniform uint triangle_count;
 layout(location = 45) uniform uint pair_capacity;
 layout(location = 48) uniform uint staged_capacity;  // words of Staged (staged_words in C++)
 
-void triangle_eye(uint t, out vec3 p[3]);
-uint cover(vec3 p[3], uint t, uint pair_base, uint wanted, out uint wanted_facet);
+uint triangle_eye(uint t, out vec3 p[3]);
+uint cover(vec3 p[3], uint t, uint e, uint pair_base, uint wanted, out uint wanted_facet);
 
 const uint kKept = 8u;               // kStagedChunkFacets
 const uint kChained = 0x80000000u;   // kStagedChained
@@ -72,9 +72,9 @@ void main() {
   uint count = 0u;
   if (t < triangle_count) {
     vec3 p[3];
-    triangle_eye(t, p);
+    uint e = triangle_eye(t, p);
     uint unused;
-    count = cover(p, t, 0u, 0xffffffffu, unused);
+    count = cover(p, t, e, 0u, 0xffffffffu, unused);
     scan[t] = count;
   } else if (t == triangle_count) {
     scan[t] = 0u;

@@ -12,7 +12,6 @@ out vec2 v_uv;
 flat out uint v_triangle_id;
 out float gl_ClipDistance[4];
 
-uint entry_of_triangle(uint t);
 uint vertex_of(uint e, uint t, uint c);
 uint triangle_id(uint e, uint t);
 uint object_of(uint e);
@@ -21,19 +20,18 @@ vec3 world_normal(uint object, uint v);
 vec2 vertex_uv(uint v);
 vec4 facet_clip(uint f, vec3 p_eye);
 float facet_clip_distance(uint f, int k, vec3 p_eye);
-void triangle_eye(uint t, out vec3 p[3]);
-uint cover(vec3 p[3], uint t, uint pair_base, uint wanted, out uint wanted_facet);
+uint triangle_eye(uint t, out vec3 p[3]);
+uint cover(vec3 p[3], uint t, uint e, uint pair_base, uint wanted, out uint wanted_facet);
 void write_pair(uint at, uint t, uint facet) {}
 
 void main() {
   uvec2 replica = pairs[v_index[0]];
   uint t = replica.x;
   vec3 p[3];
-  triangle_eye(t, p);
+  uint e = triangle_eye(t, p);
   uint f;
-  cover(p, t, 0xffffffffu, replica.y, f);
+  cover(p, t, e, 0xffffffffu, replica.y, f);
   if (f == 0xffffffffu) return;
-  uint e = entry_of_triangle(t);
   uint object = object_of(e);
   for (uint c = 0u; c < 3u; ++c) {
     uint v = vertex_of(e, t, c);

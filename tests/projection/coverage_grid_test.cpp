@@ -90,11 +90,12 @@ Tally compare(const std::string& name, const Warp& warp, const FacetMesh& mesh, 
     }
   }
   tally.cells = grid.cell_buckets();
-  std::printf("%s: %zu facets, %s %ux%u (pads %.2g, %.2g), %zu queries, %.1f%% by the grid, "
-              "%zu pairs\n",
-              name.c_str(), mesh.facets.size(), tally.cells ? "cells" : "uniform buckets",
-              grid.columns(), grid.rows(), grid.pad_p(), grid.pad_q(), tally.triangles,
-              100.0 * double(tally.by_grid) / double(tally.triangles), tally.pairs);
+  std::printf(
+      "%s: %zu facets, %s %ux%u (pads %.2g, %.2g), %zu queries, %.1f%% by the grid, "
+      "%zu pairs\n",
+      name.c_str(), mesh.facets.size(), tally.cells ? "cells" : "uniform buckets", grid.columns(),
+      grid.rows(), grid.pad_p(), grid.pad_q(), tally.triangles,
+      100.0 * double(tally.by_grid) / double(tally.triangles), tally.pairs);
   return tally;
 }
 

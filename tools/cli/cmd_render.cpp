@@ -210,6 +210,7 @@ void run(const RenderOptions& options) {
                            {"triangles_scene", scene.triangle_count()},
                            {"triangles_in", last.triangles_in},
                            {"triangles_visible", last.triangles_visible},
+                           {"triangles_sole_piece", last.triangles_sole_piece},
                            {"replicas", last.replicas},
                            {"replication_ratio", last.replication_ratio()},
                            {"replication_ratio_mean", ratio_sum / options.frames},

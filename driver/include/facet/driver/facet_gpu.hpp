@@ -45,8 +45,8 @@ inline constexpr GLuint positions = 0, normals = 1, uvs = 2, indices = 3, record
 // (as the CPU reference, CoverageIndex, does) and writes their pieces, a quad once per facet.
 struct FacetPieces {
   std::uint32_t facet_count = 0;
-  std::vector<std::uint32_t> piece_of_facet;          // the piece that draws facet f
-  std::vector<std::array<std::uint32_t, 2>> quads;    // the facets of piece facet_count + k
+  std::vector<std::uint32_t> piece_of_facet;        // the piece that draws facet f
+  std::vector<std::array<std::uint32_t, 2>> quads;  // the facets of piece facet_count + k
   // Per piece: unit normals of its guarded clip planes (X is inside when planes[k]·X >= 0, the
   // facets' FacetMesh::clip_planes) and the unit corner directions of its guarded pyramid, where
   // adjacent planes meet. A triangle repeats its first plane and its first corner.
@@ -106,8 +106,7 @@ struct GpuObjectFrame {
 };
 static_assert(sizeof(GpuObjectFrame) == 128);
 
-std::vector<GpuFacet> pack_facets(const FacetMesh& mesh, const FacetPieces& pieces,
-                                  double z_near);
+std::vector<GpuFacet> pack_facets(const FacetMesh& mesh, const FacetPieces& pieces, double z_near);
 std::vector<GpuCoverageNode> pack_coverage_nodes(const CoverageIndex& index);
 
 // The coverage grid as one uint array, the layout replication_lib.comp reads: a header of
@@ -116,9 +115,9 @@ std::vector<GpuCoverageNode> pack_coverage_nodes(const CoverageIndex& index);
 // then R_base_eye column-major, then the offsets of the pyramid corners, of piece_of_facet and of
 // the cell breaks, 0 for uniform buckets), then those arrays, the pieces' guarded pyramid corners
 // (4 × 3 floats per piece), FacetPieces::piece_of_facet and, for cell buckets, pad_p and pad_q
-// (grown by the float rounding), then p_breaks and q_breaks as floats. Buckets list pieces: a quad in every bucket of the smallest range
-// holding both its facets' ranges (its guarded pyramid lies in the union of theirs), a facet no
-// quad holds where the grid lists it.
+// (grown by the float rounding), then p_breaks and q_breaks as floats. Buckets list pieces: a quad
+// in every bucket of the smallest range holding both its facets' ranges (its guarded pyramid lies
+// in the union of theirs), a facet no quad holds where the grid lists it.
 inline constexpr std::uint32_t kGridHeaderWords = 24;
 std::vector<std::uint32_t> pack_coverage_grid(const CoverageGrid& grid, const FacetPieces& pieces);
 // Pass 1 of `facets` stages every facet it finds (binding::staged; replication/count.comp, kKept
@@ -151,6 +150,13 @@ struct FacetSet {
   void bind() const;
 };
 
+// The one piece whose guarded pyramid holds the sphere (eye frame, metres) while no other
+// piece's may meet it, else kNoPiece: then every triangle inside the sphere covers that piece
+// alone, and pass 1 takes it without the grid. Needs cell buckets (CoverageGrid) whose pads are
+// under a cell: the pieces that may meet such a sphere lie within two cells of its centre's.
+inline constexpr std::uint32_t kNoPiece = 0xffffffffu;
+std::uint32_t sole_piece_of_sphere(const FacetSet& set, const glm::dvec3& centre, double radius);
+
 // True when a sphere (eye frame, metres) may meet the cone {X : plane_k·X >= 0}; conservative.
 bool sphere_may_meet_cone(const glm::dvec3& centre, double radius, const glm::dvec3* planes,
                           int plane_count);
@@ -158,8 +164,8 @@ bool sphere_may_meet_cone(const glm::dvec3& centre, double radius, const glm::dv
 bool sphere_may_meet_facets(const FacetSet& set, const glm::dvec3& centre, double radius);
 
 // Passes 1 and 2 of the "facets" pipeline on eye-frame triangles (metres, T_eye_world = identity),
-// read back: for each triangle, the pieces (sorted; FacetPieces) it is replicated into. For tests against
-// CoverageIndex::query. Needs a current context.
+// read back: for each triangle, the pieces (sorted; FacetPieces) it is replicated into. For tests
+// against CoverageIndex::query. Needs a current context.
 std::vector<std::vector<std::uint32_t>> gpu_triangle_coverage(
     const Warp& warp, const RenderSettings& settings,
     const std::vector<std::array<glm::vec3, 3>>& triangles_eye);

@@ -96,9 +96,13 @@ class OutputTarget {
 struct RenderStats {
   std::uint64_t triangles_in = 0;       // triangles of the objects that survived bounds culling
   std::uint64_t triangles_visible = 0;  // after per-triangle culling (back face, behind, coverage)
-  std::uint64_t replicas = 0;           // triangle draws issued, summed over outputs
-  std::uint64_t facets = 0;             // facets over all outputs (0 for non-facet methods)
-  bool reused_replication = false;      // passes 1+2 skipped: neither view nor scene changed
+  // Facet pipelines: of triangles_in, those whose object lies inside one piece's guarded pyramid
+  // and clear of every other piece's (sole_piece_of_sphere), which pass 1 gives that piece
+  // without the coverage grid.
+  std::uint64_t triangles_sole_piece = 0;
+  std::uint64_t replicas = 0;       // triangle draws issued, summed over outputs
+  std::uint64_t facets = 0;         // facets over all outputs (0 for non-facet methods)
+  bool reused_replication = false;  // passes 1+2 skipped: neither view nor scene changed
   // Per-vertex baseline only: triangles (tessellated pieces) dropped because the warp's P has no
   // value at a corner or they surround or near a singular direction, and draws beyond a
   // triangle's first on a 360° base (seam copies, included in replicas).

@@ -126,6 +126,9 @@ class CoverageGrid {
   // triangle's edge planes.
   const std::vector<std::array<glm::dvec3, 3>>& pyramid_corners() const { return corners_; }
 
+  // The chart box of one eye-frame direction (a point; full_p never set).
+  ChartBox chart_point_box(const glm::dvec3& v_eye) const;
+
   // Candidate facets of a triangle box, each once, in the GPU's visiting order; nullopt when the
   // box is too large for the grid (the walk takes it).
   std::optional<std::vector<std::uint32_t>> candidates(const BucketRange& range) const;
