@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
-#include <limits>
 #include <optional>
 
 #include "facet/projection/errors.hpp"
@@ -333,14 +332,8 @@ bool sphere_may_meet_cone(const glm::dvec3& centre, double radius, const glm::dv
 std::uint32_t sole_piece_of_sphere(const FacetSet& set, const glm::dvec3& centre, double radius) {
   const CoverageGrid& grid = set.grid;
   const FacetPieces& pieces = set.pieces;
-  if (!grid.cell_buckets() || !(radius >= 0) || glm::length(centre) <= radius) return kNoPiece;
-  const auto narrowest = [](const std::vector<double>& breaks) {
-    double width = std::numeric_limits<double>::infinity();
-    for (std::size_t k = 1; k < breaks.size(); ++k)
-      width = std::min(width, breaks[k] - breaks[k - 1]);
-    return width;
-  };
-  if (!(grid.pad_p() < narrowest(grid.p_breaks()) && grid.pad_q() < narrowest(grid.q_breaks())))
+  if (!grid.cell_buckets() || !grid.pads_under_a_cell() || !(radius >= 0) ||
+      glm::length(centre) <= radius)
     return kNoPiece;
   const auto near = grid.buckets(grid.chart_point_box(centre));
   if (!near) return kNoPiece;

@@ -244,7 +244,6 @@ std::optional<BucketRange> CoverageGrid::buckets(const ChartBox& box) const {
       lo = p_breaks_.front() +
            std::fmod(std::fmod(lo - p_breaks_.front(), 2 * kPi) + 2 * kPi, 2 * kPi);
     const double hi = lo + width;
-    const auto first = cells_between(p_breaks_, lo, lo);
     if (!periodic_) {
       const auto columns = cells_between(p_breaks_, lo, hi);
       if (!columns) return std::nullopt;
@@ -253,6 +252,7 @@ std::optional<BucketRange> CoverageGrid::buckets(const ChartBox& box) const {
       return range;
     }
     // Periodic: the breaks span the whole turn, so lo lies in the first turn and hi may wrap.
+    const auto first = cells_between(p_breaks_, lo, lo);
     std::uint32_t last =
         cells_between(p_breaks_, std::min(hi, p_breaks_.back()), std::min(hi, p_breaks_.back()))
             ->second;
@@ -526,6 +526,13 @@ bool CoverageGrid::fit_cells(const FacetMesh& mesh, std::vector<std::uint32_t>& 
       pad_q = std::max(pad_q, reach_q + step_q);
     }
   }
+  const auto narrowest = [](const std::vector<double>& breaks) {
+    double width = std::numeric_limits<double>::infinity();
+    for (std::size_t k = 1; k < breaks.size(); ++k)
+      width = std::min(width, breaks[k] - breaks[k - 1]);
+    return width;
+  };
+  pads_under_a_cell_ = pad_p < narrowest(p) && pad_q < narrowest(q);
   p_breaks_ = std::move(p);
   q_breaks_ = std::move(q);
   pad_p_ = pad_p;

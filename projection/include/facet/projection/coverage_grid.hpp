@@ -115,6 +115,9 @@ class CoverageGrid {
   const std::vector<double>& q_breaks() const { return q_breaks_; }
   double pad_p() const { return pad_p_; }
   double pad_q() const { return pad_q_; }
+  // Cell buckets whose pads are under the narrowest cell in each direction: no guarded pyramid
+  // reaches past the cells next to its own.
+  bool pads_under_a_cell() const { return pads_under_a_cell_; }
   // Bucket b = row·columns + column holds bucket_facets[bucket_first[b], bucket_first[b + 1]).
   const std::vector<std::uint32_t>& bucket_first() const { return bucket_first_; }
   const std::vector<std::uint32_t>& bucket_facets() const { return bucket_facets_; }
@@ -149,6 +152,7 @@ class CoverageGrid {
   bool cells_ = false;
   std::vector<double> p_breaks_, q_breaks_;
   double pad_p_ = 0, pad_q_ = 0;
+  bool pads_under_a_cell_ = false;
   std::vector<std::array<glm::dvec3, 3>> planes_;
   std::vector<std::array<glm::dvec3, 3>> corners_;
 };
