@@ -156,11 +156,7 @@ class CubemapMethod final : public RenderMethod {
     }
     face_program_.use();
     glBindVertexArray(empty_vao_.id());
-    for (GLuint b = 0; b < 4; ++b) {
-      const Buffer* buffers[4] = {&gpu_scene_->positions, &gpu_scene_->normals, &gpu_scene_->uvs,
-                                  &gpu_scene_->indices};
-      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, b, buffers[b]->id());
-    }
+    gpu_scene_->bind_for_pulling();
     const int n = settings_.cube_face_size;
     for (int f = 0; f < 6; ++f) {
       if (!face_needed_[f]) continue;

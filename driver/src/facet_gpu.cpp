@@ -296,7 +296,7 @@ FacetSet FacetSet::build(const Warp& warp, const FacetBuildOptions& options, dou
   CoverageGrid grid(mesh, warp.base, warp.R_eye_base);
   FacetPieces pieces = make_facet_pieces(mesh, merge_coplanar);
   FacetSet set{
-      std::move(mesh), std::move(index), std::move(grid), std::move(pieces), {}, {}, {}, {}};
+      std::move(mesh), std::move(index), std::move(grid), std::move(pieces), {}, {}, {}, {}, {}};
   const std::vector<GpuFacet> gpu_facets = pack_facets(set.mesh, set.pieces, z_near);
   const auto nodes = pack_coverage_nodes(set.index);
   // Empty buffers cannot be bound; keep one dummy element so that every binding is valid.
@@ -305,6 +305,7 @@ FacetSet FacetSet::build(const Warp& warp, const FacetBuildOptions& options, dou
   const std::uint32_t no_order = 0;
   set.facets = gpu_facets.empty() ? Buffer::create(sizeof no_facet, &no_facet)
                                   : Buffer::create_from(gpu_facets);
+  set.facet_texels = Texture::create_buffer_view(set.facets, GL_RGBA32F, 4 * sizeof(float));
   set.nodes = nodes.empty() ? Buffer::create(sizeof no_node, &no_node) : Buffer::create_from(nodes);
   set.grid_words = Buffer::create_from(pack_coverage_grid(set.grid, set.pieces));
   set.order = set.index.order().empty() ? Buffer::create(sizeof no_order, &no_order)
@@ -313,7 +314,7 @@ FacetSet FacetSet::build(const Warp& warp, const FacetBuildOptions& options, dou
 }
 
 void FacetSet::bind() const {
-  facets.bind_base(GL_SHADER_STORAGE_BUFFER, binding::facets);
+  facet_texels.bind_unit(texture_unit::facets);
   nodes.bind_base(GL_SHADER_STORAGE_BUFFER, binding::nodes);
   order.bind_base(GL_SHADER_STORAGE_BUFFER, binding::order);
   grid_words.bind_base(GL_SHADER_STORAGE_BUFFER, binding::grid);

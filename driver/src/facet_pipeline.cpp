@@ -22,6 +22,9 @@ namespace facet::driver::detail {
 namespace {
 
 constexpr GLuint kLocalSize = 64;
+// The walk queue's header: the walk pass's indirect dispatch (x, y, z), then the queue's length
+// (replication/count.comp).
+constexpr std::size_t kWalkQueueHeaderWords = 4;
 
 class FacetPipeline final : public FacetMethodBase {
  public:
@@ -32,7 +35,8 @@ class FacetPipeline final : public FacetMethodBase {
     FacetMethodBase::prepare(scene, gpu_scene, outputs, settings);
     if (!count_) {
       count_ = link_replication_program({"replication/count.comp"});
-      scatter_ = build_program({"replication/scatter.comp"});
+      walk_ = link_replication_program({"replication/count.comp"}, {{"WALK_PASS", "1"}});
+      scatter_ = link_replication_program({"replication/scatter.comp"});
       args_ = build_program({"replication/draw_args.comp"}, {{"VERTICES_PER_REPLICA", "3"}});
       draw_ = link_replication_program({"replication/draw.vert", "scene/material.frag"},
                                        {{"WRITE_TRIANGLE_ID", "1"}});
@@ -100,18 +104,28 @@ class FacetPipeline final : public FacetMethodBase {
     const std::uint32_t n = out.triangles;
     ensure_capacity(out.scan, (std::size_t(n) + 1) * sizeof(std::uint32_t));
     ensure_capacity(out.stage_offsets, std::max<std::size_t>(n, 1) * sizeof(std::uint32_t));
+    ensure_capacity(out.walk_queue,
+                    (kWalkQueueHeaderWords + std::size_t(n)) * sizeof(std::uint32_t));
     if (out.pair_capacity == 0) out.pair_capacity = std::max<std::uint32_t>(n, 4096);
     ensure_capacity(out.staged, staged_words(out.pair_capacity) * sizeof(std::uint32_t));
-    ensure_capacity(out.pairs, std::size_t(out.pair_capacity) * 2 * sizeof(std::uint32_t));
+    ensure_capacity(out.pairs, std::size_t(out.pair_capacity) * sizeof(GpuReplica));
     size_draw_commands(out, out.pair_capacity);
     {
       TimedPass scope(timer, "pass1 coverage");
       const std::uint32_t zero[4] = {0, 0, 0, 0};
       out.stats.sub_data(0, sizeof zero, zero);
+      const std::uint32_t empty_queue[kWalkQueueHeaderWords] = {0, 0, 1, 0};
+      out.walk_queue.sub_data(0, sizeof empty_queue, empty_queue);
       bind_output(i);
       set_list_uniforms(count_, i);
       count_.use();
       glDispatchCompute((n + 1 + kLocalSize - 1) / kLocalSize, 1, 1);
+      glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_COMMAND_BARRIER_BIT);
+      set_list_uniforms(walk_, i);
+      walk_.use();
+      glBindBuffer(GL_DISPATCH_INDIRECT_BUFFER, out.walk_queue.id());
+      glDispatchComputeIndirect(0);
+      glBindBuffer(GL_DISPATCH_INDIRECT_BUFFER, 0);
     }
     TimedPass scope(timer, "pass2 replicate");
     scan_.run(out.scan, n + 1);
@@ -149,7 +163,7 @@ class FacetPipeline final : public FacetMethodBase {
   friend std::vector<std::vector<std::uint32_t>> facet::driver::gpu_triangle_coverage(
       const Warp&, const RenderSettings&, const std::vector<std::array<glm::vec3, 3>>&);
 
-  Program count_, scatter_, args_, draw_;
+  Program count_, walk_, scatter_, args_, draw_;
   PrefixScan scan_;
 };
 
@@ -194,10 +208,12 @@ std::vector<std::vector<std::uint32_t>> gpu_triangle_coverage(
     const bool fits = pipeline.read_replication(0);
     FACET_ASSERT(fits);
   }
-  std::vector<std::uint32_t> pairs(2 * out.replicas);
-  if (!pairs.empty()) out.pairs.get_sub_data(0, pairs.size() * sizeof(std::uint32_t), pairs.data());
-  for (std::size_t k = 0; k < out.replicas; ++k)
-    result.at(pairs[2 * k]).push_back(pairs[2 * k + 1]);
+  std::vector<GpuReplica> replicas(out.replicas);
+  if (!replicas.empty())
+    out.pairs.get_sub_data(0, replicas.size() * sizeof(GpuReplica), replicas.data());
+  // The scene's one primitive lists triangle t at index 3t.
+  for (const GpuReplica& replica : replicas)
+    result.at(replica.first_index / 3).push_back(replica.piece);
   for (auto& facets : result) std::sort(facets.begin(), facets.end());
   return result;
 }

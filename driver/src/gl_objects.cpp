@@ -1,6 +1,7 @@
 #include "facet/driver/gl_objects.hpp"
 
 #include <stdexcept>
+#include <string>
 
 #include "facet/projection/errors.hpp"
 
@@ -77,6 +78,20 @@ Texture Texture::create_view(const Texture& source, GLenum internal_format) {
   glTextureView(checked(id, "Texture::create_view"), source.target(), source.id(), internal_format,
                 0, GLuint(levels), 0, 1);
   return Texture(id, source.target());
+}
+
+Texture Texture::create_buffer_view(const Buffer& buffer, GLenum internal_format,
+                                    std::size_t texel_bytes) {
+  GLint max_texels = 0;
+  glGetIntegerv(GL_MAX_TEXTURE_BUFFER_SIZE, &max_texels);
+  if (buffer.size() / texel_bytes > std::size_t(max_texels)) {
+    throw std::runtime_error(
+        "Texture::create_buffer_view: " + std::to_string(buffer.size() / texel_bytes) +
+        " texels, more than GL_MAX_TEXTURE_BUFFER_SIZE (" + std::to_string(max_texels) + ")");
+  }
+  Texture texture = create(GL_TEXTURE_BUFFER);
+  glTextureBuffer(texture.id(), internal_format, buffer.id());
+  return texture;
 }
 
 Texture Texture::create_2d(GLenum internal_format, int width, int height, int levels) {

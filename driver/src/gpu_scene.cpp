@@ -10,6 +10,13 @@
 
 namespace facet::driver {
 
+void GpuScene::bind_for_pulling() const {
+  indices.bind_base(GL_SHADER_STORAGE_BUFFER, pulling::indices_binding);
+  position_texels.bind_unit(pulling::position_unit);
+  normal_texels.bind_unit(pulling::normal_unit);
+  uv_texels.bind_unit(pulling::uv_unit);
+}
+
 void GpuScene::bind_material_texture(std::uint32_t m, GLuint unit) const {
   FACET_ASSERT(m < material_texture.size());
   const std::int32_t t = material_texture[m];
@@ -47,6 +54,9 @@ GpuScene upload_scene(const Scene& scene, float max_anisotropy) {
   gpu.positions = Buffer::create_from(scene.positions);
   gpu.normals = Buffer::create_from(scene.normals);
   gpu.uvs = Buffer::create_from(scene.uvs);
+  gpu.position_texels = Texture::create_buffer_view(gpu.positions, GL_RGB32F, 3 * sizeof(float));
+  gpu.normal_texels = Texture::create_buffer_view(gpu.normals, GL_RGB32F, 3 * sizeof(float));
+  gpu.uv_texels = Texture::create_buffer_view(gpu.uvs, GL_RG32F, 2 * sizeof(float));
   gpu.indices = Buffer::create_from(scene.indices);
 
   std::vector<GpuMaterial> materials;

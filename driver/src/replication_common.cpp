@@ -89,6 +89,7 @@ void FacetMethodBase::prepare(const Scene& scene, const GpuScene& gpu_scene,
                                      : Buffer::create_from(records_);
   object_frames_ =
       Buffer::create(std::max<std::size_t>(scene.objects.size(), 1) * sizeof(GpuObjectFrame));
+  object_frame_texels_ = Texture::create_buffer_view(object_frames_, GL_RGBA32F, 4 * sizeof(float));
   if (!empty_vao_) empty_vao_ = VertexArray::create();
   chunked_draws_ = is_software_renderer() && (epoxy_gl_version() >= 46 ||
                                               epoxy_has_gl_extension("GL_ARB_indirect_parameters"));
@@ -169,12 +170,9 @@ bool FacetMethodBase::update_view(const glm::dmat4& T_eye_world) {
 
 void FacetMethodBase::bind_output(std::size_t i) const {
   const GpuScene& gpu = *gpu_;
-  gpu.positions.bind_base(GL_SHADER_STORAGE_BUFFER, binding::positions);
-  gpu.normals.bind_base(GL_SHADER_STORAGE_BUFFER, binding::normals);
-  gpu.uvs.bind_base(GL_SHADER_STORAGE_BUFFER, binding::uvs);
-  gpu.indices.bind_base(GL_SHADER_STORAGE_BUFFER, binding::indices);
+  gpu.bind_for_pulling();
   records_buffer_.bind_base(GL_SHADER_STORAGE_BUFFER, binding::records);
-  object_frames_.bind_base(GL_SHADER_STORAGE_BUFFER, binding::object_frames);
+  object_frame_texels_.bind_unit(texture_unit::object_frames);
   const OutputState& out = outputs_[i];
   out.facets.bind();
   out.list_buffer.bind_base(GL_SHADER_STORAGE_BUFFER, binding::list);
@@ -185,6 +183,7 @@ void FacetMethodBase::bind_output(std::size_t i) const {
   if (out.staged) out.staged.bind_base(GL_SHADER_STORAGE_BUFFER, binding::staged);
   if (out.stage_offsets)
     out.stage_offsets.bind_base(GL_SHADER_STORAGE_BUFFER, binding::stage_offsets);
+  if (out.walk_queue) out.walk_queue.bind_base(GL_SHADER_STORAGE_BUFFER, binding::walk_queue);
   if (out.draw_args) out.draw_args.bind_base(GL_SHADER_STORAGE_BUFFER, binding::draw_args);
 }
 
@@ -209,8 +208,9 @@ std::uint64_t FacetMethodBase::buffer_bytes(const OutputState& out) const {
   const FacetSet& set = out.facets;
   std::uint64_t bytes =
       set.facets.size() + set.nodes.size() + set.order.size() + set.grid_words.size();
-  for (const Buffer* b : {&out.list_buffer, &out.ranges_buffer, &out.scan, &out.pairs, &out.stats,
-                          &out.draw_args, &out.draw_counts, &out.staged, &out.stage_offsets})
+  for (const Buffer* b :
+       {&out.list_buffer, &out.ranges_buffer, &out.scan, &out.pairs, &out.stats, &out.draw_args,
+        &out.draw_counts, &out.staged, &out.stage_offsets, &out.walk_queue})
     bytes += b->size();
   return bytes;
 }

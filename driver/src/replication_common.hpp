@@ -94,8 +94,9 @@ class FacetMethodBase : public RenderMethod {
     // replicas, and how many of them each material uses (replication/draw_args.comp).
     Buffer draw_counts;
     std::uint32_t draws_per_material = 1, replicas_per_draw = 1;
-    // Pass 1's facets per triangle (facets only), and where each triangle's run starts.
-    Buffer staged, stage_offsets;
+    // Pass 1's facets per triangle (facets only), and where each triangle's run starts; the
+    // triangles the grid pass leaves to the walk pass (its dispatch and count, then the list).
+    Buffer staged, stage_offsets, walk_queue;
     std::uint32_t pair_capacity = 0;  // pairs that pairs and staged hold
     bool replication_valid = false;
     std::uint64_t replicas = 0, visible = 0;
@@ -132,6 +133,7 @@ class FacetMethodBase : public RenderMethod {
   std::vector<GpuRecord> records_;
   std::vector<std::vector<std::uint32_t>> records_by_material_;
   Buffer records_buffer_, object_frames_;
+  Texture object_frame_texels_;  // object_frames_ as a buffer texture
   // Pass 3 splits each material's replicas into draws of kSoftwareReplicasPerDraw (see there).
   bool chunked_draws_ = false;
   VertexArray empty_vao_;  // core profile draws need a vertex array; attributes are pulled

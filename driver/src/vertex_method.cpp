@@ -236,9 +236,7 @@ class VertexMethod final : public RenderMethod {
     if (timer) timer->begin("draw");
     glClearNamedBufferData(counters_.id(), GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, counters_.id());
-    const Buffer* buffers[4] = {&gpu_scene_->positions, &gpu_scene_->normals, &gpu_scene_->uvs,
-                                &gpu_scene_->indices};
-    for (GLuint b = 0; b < 4; ++b) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, b, buffers[b]->id());
+    gpu_scene_->bind_for_pulling();
     glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE);
     glEnable(GL_DEPTH_TEST);
     // Back faces are culled in 3D by the shaders: a large triangle's projected winding is not

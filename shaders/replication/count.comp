@@ -6,10 +6,22 @@
 // the next chunk's offset), each placed by an atomic of its own. Either way stage_offset[t] says
 // where (chains with kChained set). A frame whose pairs exceed pair_capacity, or whose staged
 // words exceed staged_capacity, sets `overflow` and is run again with more room.
+// Two programs: the grid pass (one invocation per list triangle) takes what the sole pieces and
+// the coverage grid answer and queues the other triangles, with the indirect arguments of the
+// walk pass (WALK_PASS: one invocation per queued triangle), which walks the hierarchy for them.
+// Both write the same counts and staging.
 #ifndef LOCAL_SIZE
 #define LOCAL_SIZE 64
 #endif
+#ifdef WALK_PASS
+// One triangle a work group. llvmpipe runs a work group's invocations as SIMD lanes and counts
+// every loop iteration of the group against one budget of 65535 (LP_MAX_TGSI_LOOP_ITERATIONS);
+// triangles that each cover thousands of the 28,800-facet dome's facets, walked side by side,
+// exceeded it and lost facets.
+layout(local_size_x = 1) in;
+#else
 layout(local_size_x = LOCAL_SIZE) in;
+#endif
 
 layout(std430, binding = 10) writeonly buffer Scan { uint scan[]; };
 layout(std430, binding = 12) buffer Stats {
@@ -23,9 +35,20 @@ layout(std430, binding = 18) writeonly buffer StageOffsets { uint stage_offset[]
 layout(location = 42) uniform uint triangle_count;
 layout(location = 45) uniform uint pair_capacity;
 layout(location = 48) uniform uint staged_capacity;  // words of Staged (staged_words in C++)
+// The walk pass's indirect dispatch, one work group per queued triangle in rows of
+// kWalkRow (work group counts may be capped at 65535 per dimension), then the queue.
+layout(std430, binding = 20) buffer WalkQueue {
+  uint walk_groups_x, walk_groups_y, walk_groups_z;
+  uint walk_count;
+  uint walk_queue[];
+};
+const uint kWalkRow = 1024u;
 
+const uint kNeedsWalk = 0xfffffffeu;
 uint triangle_eye(uint t, out vec3 p[3]);
-uint cover(vec3 p[3], uint t, uint e, uint pair_base, uint wanted, out uint wanted_facet);
+uint cover_without_walk(vec3 p[3], uint t, uint e, uint pair_base, uint wanted,
+                        out uint wanted_facet);
+uint walk_coverage(vec3 p[3], uint t, uint pair_base, uint wanted, out uint wanted_facet);
 
 const uint kKept = 8u;               // kStagedChunkFacets
 const uint kChained = 0x80000000u;   // kStagedChained
@@ -62,7 +85,12 @@ void write_pair(uint at, uint t, uint facet) {
 shared uint group_pairs, group_staged, group_visible, group_base;
 
 void main() {
+#ifdef WALK_PASS
+  uint queued = gl_WorkGroupID.y * kWalkRow + gl_WorkGroupID.x;
+  uint t = queued < walk_count ? walk_queue[queued] : triangle_count + 1u;
+#else
   uint t = gl_GlobalInvocationID.x;
+#endif
   if (gl_LocalInvocationIndex == 0u) {
     group_pairs = 0u;
     group_staged = 0u;
@@ -74,7 +102,18 @@ void main() {
     vec3 p[3];
     uint e = triangle_eye(t, p);
     uint unused;
-    count = cover(p, t, e, 0u, 0xffffffffu, unused);
+#ifdef WALK_PASS
+    count = walk_coverage(p, t, 0u, 0xffffffffu, unused);
+#else
+    count = cover_without_walk(p, t, e, 0u, 0xffffffffu, unused);
+    if (count == kNeedsWalk) {
+      count = 0u;
+      uint at = atomicAdd(walk_count, 1u);
+      walk_queue[at] = t;
+      if (at < kWalkRow) atomicAdd(walk_groups_x, 1u);
+      if (at % kWalkRow == 0u) atomicAdd(walk_groups_y, 1u);
+    }
+#endif
     scan[t] = count;
   } else if (t == triangle_count) {
     scan[t] = 0u;
@@ -94,7 +133,7 @@ void main() {
     atomicAdd(visible_triangles, group_visible);
   }
   barrier();
-  if (t >= triangle_count || count == 0u) return;
+  if (count == 0u) return;
   if (!run) {
     uint head = new_chunk();
     if (head == kNoChunk) return;

@@ -5,10 +5,11 @@
 // geometry). It is validated as a compute shader, so it uses nothing stage-specific.
 // Bindings: driver/include/facet/driver/facet_gpu.hpp.
 
-// Scene (GpuScene): tightly packed floats and uint32 indices.
-layout(std430, binding = 0) readonly buffer Positions { float positions[]; };
-layout(std430, binding = 1) readonly buffer Normals { float normals[]; };
-layout(std430, binding = 2) readonly buffer Uvs { float uvs[]; };
+// Scene (GpuScene): vertices as buffer textures (texelFetch reads a texel for every SIMD lane at
+// once on llvmpipe, where a shader storage load takes one lane at a time), uint32 indices.
+layout(binding = 8) uniform samplerBuffer position_texels;  // RGB32F, metres, object frame
+layout(binding = 9) uniform samplerBuffer normal_texels;    // RGB32F
+layout(binding = 10) uniform samplerBuffer uv_texels;       // RG32F
 layout(std430, binding = 3) readonly buffer Indices { uint indices[]; };
 
 struct Record {  // GpuRecord
@@ -21,17 +22,12 @@ struct Record {  // GpuRecord
 };
 layout(std430, binding = 4) readonly buffer Records { Record records[]; };
 
-struct ObjectFrame {  // GpuObjectFrame
-  mat4 T_eye_object;
-  mat4 T_world_object;
-};
-layout(std430, binding = 5) readonly buffer ObjectFrames { ObjectFrame object_frames[]; };
-
-struct Facet {  // GpuFacet: one per piece (FacetPieces); a triangle repeats its first plane
-  mat4 clip_from_eye;
-  vec4 clip_planes[4];
-};
-layout(std430, binding = 6) readonly buffer Facets { Facet facets[]; };
+// GpuObjectFrame per object, 8 texels: the columns of T_eye_object, then of T_world_object.
+layout(binding = 11) uniform samplerBuffer object_frame_texels;
+// GpuFacet per piece (FacetPieces), 8 texels: the columns of clip_from_eye, then the four guarded
+// clip planes (a triangle repeats its first).
+layout(binding = 12) uniform samplerBuffer facet_texels;
+vec4 clip_plane(uint f, int k) { return texelFetch(facet_texels, 8 * int(f) + 4 + k); }
 
 struct Node {  // GpuCoverageNode
   vec4 pyramid[4];
@@ -77,15 +73,19 @@ uint entry_of_triangle(uint t) {
   return lo;
 }
 
-// Scene vertex index of corner c (0..2) of list triangle t in entry e.
-uint vertex_of(uint e, uint t, uint c) {
-  Record r = records[list[e].record];
-  return indices[r.first_index + 3u * (t - list[e].first_triangle) + c];
+// Index (into indices[]) of the first corner of list triangle t in entry e.
+uint vertex_index_of(uint e, uint t) {
+  return records[list[e].record].first_index + 3u * (t - list[e].first_triangle);
 }
+
+// Scene vertex index of corner c (0..2) of list triangle t in entry e.
+uint vertex_of(uint e, uint t, uint c) { return indices[vertex_index_of(e, t) + c]; }
 
 uint triangle_id(uint e, uint t) {
   return records[list[e].record].first_id + (t - list[e].first_triangle);
 }
+
+uint scene_index(uint i) { return indices[i]; }
 
 // Record r's vertex for its i-th index, its object and the ID of its first triangle.
 uint record_vertex(uint r, uint i) { return indices[records[r].first_index + i]; }
@@ -96,33 +96,43 @@ uint object_of(uint e) { return records[list[e].record].object; }
 uint material_of(uint e) { return records[list[e].record].material; }
 
 vec3 eye_position(uint object, uint v) {
-  precise vec4 p = object_frames[object].T_eye_object *
-                   vec4(positions[3u * v], positions[3u * v + 1u], positions[3u * v + 2u], 1.0);
+  int at = 8 * int(object);
+  mat4 T_eye_object = mat4(texelFetch(object_frame_texels, at),
+                           texelFetch(object_frame_texels, at + 1),
+                           texelFetch(object_frame_texels, at + 2),
+                           texelFetch(object_frame_texels, at + 3));
+  precise vec4 p = T_eye_object * vec4(texelFetch(position_texels, int(v)).xyz, 1.0);
   return p.xyz;
 }
 
 vec3 world_normal(uint object, uint v) {
-  return mat3(object_frames[object].T_world_object) *
-         vec3(normals[3u * v], normals[3u * v + 1u], normals[3u * v + 2u]);
+  int at = 8 * int(object) + 4;
+  mat3 R_world_object = mat3(texelFetch(object_frame_texels, at).xyz,
+                             texelFetch(object_frame_texels, at + 1).xyz,
+                             texelFetch(object_frame_texels, at + 2).xyz);
+  return R_world_object * texelFetch(normal_texels, int(v)).xyz;
 }
 
-vec2 vertex_uv(uint v) { return vec2(uvs[2u * v], uvs[2u * v + 1u]); }
+vec2 vertex_uv(uint v) { return texelFetch(uv_texels, int(v)).xy; }
 
 // GL clip coordinates of an eye-frame point in piece f, and its four clip distances.
 vec4 facet_clip(uint f, vec3 p_eye) {
-  precise vec4 clip = facets[f].clip_from_eye * vec4(p_eye, 1.0);
+  int at = 8 * int(f);
+  mat4 clip_from_eye = mat4(texelFetch(facet_texels, at), texelFetch(facet_texels, at + 1),
+                            texelFetch(facet_texels, at + 2), texelFetch(facet_texels, at + 3));
+  precise vec4 clip = clip_from_eye * vec4(p_eye, 1.0);
   return clip;
 }
 float facet_clip_distance(uint f, int k, vec3 p_eye) {
-  precise float d = dot(facets[f].clip_planes[k].xyz, p_eye);
+  precise float d = dot(clip_plane(f, k).xyz, p_eye);
   return d;
 }
 
 // The three eye-frame corners of list triangle t; returns its list entry.
 uint triangle_eye(uint t, out vec3 p[3]) {
   uint e = entry_of_triangle(t);
-  uint object = object_of(e);
-  for (uint c = 0u; c < 3u; ++c) p[c] = eye_position(object, vertex_of(e, t, c));
+  uint object = object_of(e), first = vertex_index_of(e, t);
+  for (uint c = 0u; c < 3u; ++c) p[c] = eye_position(object, indices[first + c]);
   return e;
 }
 
@@ -262,8 +272,7 @@ uint walk_coverage(vec3 p[3], uint t, uint pair_base, uint wanted, out uint want
       for (uint m = 0u; m < kCoverageLeafSize; ++m) {
         if (m >= node.count) break;
         uint f = facet_order[node.first + m];
-        vec4 planes[4] = vec4[4](facets[f].clip_planes[0], facets[f].clip_planes[1],
-                                 facets[f].clip_planes[2], vec4(0.0));
+        vec4 planes[4] = vec4[4](clip_plane(f, 0), clip_plane(f, 1), clip_plane(f, 2), vec4(0.0));
         if (!meets_cone(u, planes, 3)) continue;
         if (found == wanted) {
           wanted_facet = piece_of_facet(f);
@@ -506,7 +515,7 @@ bool bucket_range(vec4 box, bool full_p, out uvec4 range) {
 const uint kSeparated = 0u, kMayMeet = 1u, kBeyondHemisphere = 2u;
 uint test_candidate(vec3 u[3], vec4 edge[3], vec3 middle, uint f) {
   for (int k = 0; k < 4; ++k) {
-    vec3 n = facets[f].clip_planes[k].xyz;
+    vec3 n = clip_plane(f, k).xyz;
     if (dot(n, u[0]) + kCoverageSlack < 0.0 && dot(n, u[1]) + kCoverageSlack < 0.0 &&
         dot(n, u[2]) + kCoverageSlack < 0.0)
       return kSeparated;
@@ -608,22 +617,35 @@ bool grid_coverage(vec3 p[3], uint t, uint pair_base, uint wanted, out uint want
   return true;
 }
 
-// The facets triangle t (list entry e) with eye-frame corners p may cover: walk_coverage's
-// contract, from the entry's sole piece or the grid where they take the triangle. The walk has one call site: inlined at each of several, it
-// made the whole pass 1 slower on llvmpipe (cylinder 400x300: 99 against 71-76 ms a frame).
-uint cover(vec3 p[3], uint t, uint e, uint pair_base, uint wanted, out uint wanted_facet) {
-  uint found = 0u;
-  if (coverage_by_grid != 0u) {
-    // An object inside one piece and clear of the others: each of its triangles takes that piece.
-    uint sole = list[e].sole_piece;
-    if (sole != kNone) {
-      wanted_facet = kNone;
-      if (!triangle_may_cover(p)) return 0u;
-      if (wanted == 0u) wanted_facet = sole;
-      if (pair_base != kNone) write_pair(pair_base, t, sole);
-      return 1u;
-    }
-    if (grid_coverage(p, t, pair_base, wanted, wanted_facet, found)) return found;
+// cover()'s answer from the entry's sole piece or the grid, or kNeedsWalk when neither takes the
+// triangle (then nothing it wrote counts). Pass 1 of `facets` sends those triangles to a dispatch
+// of the walk of their own: llvmpipe runs both sides of every branch for all lanes of a SIMD
+// group, so the walk's code inside pass 1 cost every triangle its time (cylinder 400x300: a 39 ms
+// frame against 28 ms without it).
+const uint kNeedsWalk = 0xfffffffeu;
+uint cover_without_walk(vec3 p[3], uint t, uint e, uint pair_base, uint wanted,
+                        out uint wanted_facet) {
+  wanted_facet = kNone;
+  if (coverage_by_grid == 0u) return kNeedsWalk;
+  // An object inside one piece and clear of the others: each of its triangles takes that piece.
+  uint sole = list[e].sole_piece;
+  if (sole != kNone) {
+    if (!triangle_may_cover(p)) return 0u;
+    if (wanted == 0u) wanted_facet = sole;
+    if (pair_base != kNone) write_pair(pair_base, t, sole);
+    return 1u;
   }
+  uint found = 0u;
+  if (grid_coverage(p, t, pair_base, wanted, wanted_facet, found)) return found;
+  return kNeedsWalk;
+}
+
+// The facets triangle t (list entry e) with eye-frame corners p may cover: walk_coverage's
+// contract, from the entry's sole piece or the grid where they take the triangle, else the walk.
+// The walk has one call site: inlined at each of several, it made the whole pass 1 slower on
+// llvmpipe (cylinder 400x300: 99 against 71-76 ms a frame).
+uint cover(vec3 p[3], uint t, uint e, uint pair_base, uint wanted, out uint wanted_facet) {
+  uint found = cover_without_walk(p, t, e, pair_base, wanted, wanted_facet);
+  if (found != kNeedsWalk) return found;
   return walk_coverage(p, t, pair_base, wanted, wanted_facet);
 }

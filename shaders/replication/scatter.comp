@@ -1,15 +1,15 @@
-// Modern pipeline, pass 2b: writes each triangle's (triangle, facet) pairs at its offset from the
-// exclusive scan, in the order pass 1 found them, by copying what pass 1 staged: one run, or a
-// chain of chunks (kKept facets, then the next chunk's offset) where stage_offset has kChained
-// set. The list's order, grouped by material, is the draw order. Nothing is written for a frame
-// that overflowed.
+// Modern pipeline, pass 2b: writes each triangle's replicas (GpuReplica: its first corner's index,
+// the piece, its object and ID) at its offset from the exclusive scan, in the order pass 1 found
+// its pieces, by copying what pass 1 staged: one run, or a chain of chunks (kKept facets, then the
+// next chunk's offset) where stage_offset has kChained set. The list's order, grouped by
+// material, is the draw order. Nothing is written for a frame that overflowed.
 #ifndef LOCAL_SIZE
 #define LOCAL_SIZE 64
 #endif
 layout(local_size_x = LOCAL_SIZE) in;
 
 layout(std430, binding = 10) readonly buffer Scan { uint scan[]; };
-layout(std430, binding = 11) writeonly buffer Pairs { uvec2 pairs[]; };
+layout(std430, binding = 11) writeonly buffer Pairs { uvec4 replicas[]; };
 layout(std430, binding = 12) readonly buffer Stats {
   uint visible_triangles;
   uint pair_total;
@@ -23,11 +23,18 @@ layout(location = 42) uniform uint triangle_count;
 const uint kKept = 8u;              // kStagedChunkFacets
 const uint kChained = 0x80000000u;  // kStagedChained
 
+uint entry_of_triangle(uint t);
+uint vertex_index_of(uint e, uint t);
+uint object_of(uint e);
+uint triangle_id(uint e, uint t);
+
 void main() {
   uint t = gl_GlobalInvocationID.x;
   if (t >= triangle_count || overflow != 0u) return;
   uint first = scan[t], count = scan[t + 1u] - first;
   if (count == 0u) return;
+  uint e = entry_of_triangle(t);
+  uvec4 replica = uvec4(vertex_index_of(e, t), 0u, object_of(e), triangle_id(e, t));
   uint source = stage_offset[t];
   bool chained = (source & kChained) != 0u;
   source &= ~kChained;
@@ -35,7 +42,10 @@ void main() {
   // budget per invocation.
   for (uint k = 0u; k < count; k += kKept) {
     for (uint m = 0u; m < kKept; ++m) {
-      if (k + m < count) pairs[first + k + m] = uvec2(t, staged[source + m]);
+      if (k + m < count) {
+        replica.y = staged[source + m];
+        replicas[first + k + m] = replica;
+      }
     }
     source = chained ? staged[source + kKept] : source + kKept;
   }

@@ -5,14 +5,17 @@
 //
 // Shader storage bindings used by shaders/replication/** (one table so that every program sees
 // the same buffers at the same points):
-//   0 positions   1 normals   2 uvs   3 indices            (GpuScene, tightly packed)
-//   4 records     5 object frames (T_eye_object, T_world_object per object, per frame)
-//   6 facets      7 coverage nodes   8 coverage order      (GpuFacetSet, per output)
+//   3 indices (GpuScene)   4 records
+//   7 coverage nodes   8 coverage order      (FacetSet, per output)
 //   9 triangle list of the frame (record, first triangle)  10 counts / exclusive scan
-//   11 pairs (modern: triangle, facet; seed: triangle, replica)  12 stats
+//   11 pairs (modern: GpuReplica; seed: triangle, replica)  12 stats
 //   13 material ranges of the triangle list   14 indirect draw arguments   15 scan block sums
 //   16 coverage grid (GpuFacetSet, per output)   17 staged facets of pass 1   18 their offsets
 //   19 draw commands used per material (pass 3's glMultiDrawArraysIndirectCountARB)
+//   20 pass 1's walk queue: the walk pass's indirect dispatch, then the triangles it takes
+// and buffer textures (samplerBuffer): the scene's vertices (GpuScene::bind_for_pulling), and at
+// texture_unit:: the object frames (RGBA32F, 8 texels per GpuObjectFrame, per frame) and the
+// pieces (RGBA32F, 8 texels per GpuFacet, per output).
 #include <epoxy/gl.h>
 
 #include <array>
@@ -21,6 +24,7 @@
 #include <vector>
 
 #include "facet/driver/gl_objects.hpp"
+#include "facet/driver/gpu_scene.hpp"
 #include "facet/driver/render_method.hpp"
 #include "facet/driver/scene.hpp"
 #include "facet/projection/coverage.hpp"
@@ -29,12 +33,17 @@
 
 namespace facet::driver {
 
+// The object frames and the pieces are read through buffer textures (texelFetch), as the scene's
+// vertices are (gpu_scene.hpp, pulling::).
+namespace texture_unit {
+inline constexpr GLuint object_frames = 11, facets = 12;
+}  // namespace texture_unit
+
 namespace binding {
-inline constexpr GLuint positions = 0, normals = 1, uvs = 2, indices = 3, records = 4,
-                        object_frames = 5, facets = 6, nodes = 7, order = 8, list = 9, scan = 10,
-                        pairs = 11, stats = 12, material_ranges = 13, draw_args = 14,
-                        block_sums = 15, grid = 16, staged = 17, stage_offsets = 18,
-                        draw_counts = 19;
+inline constexpr GLuint indices = pulling::indices_binding, records = 4, nodes = 7, order = 8,
+                        list = 9, scan = 10, pairs = 11, stats = 12, material_ranges = 13,
+                        draw_args = 14, block_sums = 15, grid = 16, staged = 17, stage_offsets = 18,
+                        draw_counts = 19, walk_queue = 20;
 }  // namespace binding
 
 // What pass 3 draws: pieces. Piece f < F is facet f of the mesh (F facets); piece F + k, a quad,
@@ -99,6 +108,17 @@ struct GpuRecord {
 };
 static_assert(sizeof(GpuRecord) == 32);
 
+// std430: one (triangle, piece) pair of the `facets` pipeline (binding::pairs, written by
+// replication/scatter.comp), with what pass 3 needs of the triangle, so that its vertices need no
+// search of the triangle list.
+struct GpuReplica {
+  std::uint32_t first_index;  // of the triangle's first corner, into Scene::indices
+  std::uint32_t piece;        // FacetPieces
+  std::uint32_t object;       // into Scene::objects
+  std::uint32_t id;           // triangle ID (render_method.hpp)
+};
+static_assert(sizeof(GpuReplica) == 16);
+
 // std430, per object, per frame.
 struct GpuObjectFrame {
   float T_eye_object[16];  // column-major, metres
@@ -140,8 +160,8 @@ struct FacetSet {
   CoverageIndex index;
   CoverageGrid grid;
   FacetPieces pieces;
-  Buffer facets, nodes, order, grid_words;  // bind at binding::facets (one GpuFacet per piece),
-                                            // nodes, order, grid
+  Buffer facets, nodes, order, grid_words;  // one GpuFacet per piece; binding::nodes, order, grid
+  Texture facet_texels;                     // facets as a buffer texture (texture_unit::facets)
 
   // Builds the facets of `warp` (InputError when the layout cannot be met) and their pieces, and
   // uploads them. Needs a current context.

@@ -111,6 +111,12 @@ class Texture : public detail::GlName<detail::delete_texture> {
   // `internal_format` of the same size class, e.g. an SRGB8_ALPHA8 texture as RGBA8 so that
   // compute shaders can load and store its raw bytes.
   static Texture create_view(const Texture& source, GLenum internal_format);
+  // A buffer texture over all of `buffer` (texelFetch on a samplerBuffer) read as
+  // `internal_format` (GL_RGBA32F, GL_RGB32F, GL_R32UI, ...) of `texel_bytes` bytes a texel.
+  // Throws std::runtime_error where the buffer holds more texels than
+  // GL_MAX_TEXTURE_BUFFER_SIZE.
+  static Texture create_buffer_view(const Buffer& buffer, GLenum internal_format,
+                                    std::size_t texel_bytes);
 
   GLenum target() const { return target_; }
   void bind_unit(GLuint unit) const { glBindTextureUnit(unit, id()); }

@@ -28,6 +28,16 @@ struct GpuObject {
 };
 static_assert(sizeof(GpuObject) == 112);
 
+// Where GpuScene::bind_for_pulling puts the scene for shaders that pull their vertices
+// (shaders/replication/replication_lib.comp, shaders/baselines/pull_scene.vert): the indices as
+// shader storage, the vertices as buffer textures. llvmpipe (Mesa 22.3) loads a shader storage
+// component one SIMD lane at a time, in a loop with a branch per lane, and fetches a texel for
+// all lanes at once.
+namespace pulling {
+inline constexpr GLuint indices_binding = 3;
+inline constexpr GLuint position_unit = 8, normal_unit = 9, uv_unit = 10;
+}  // namespace pulling
+
 struct GpuScene {
   // Tightly packed floats, 3 per vertex (12-byte stride): in GLSL `float positions[]`, not
   // `vec3[]`, whose std430 stride is 16 bytes.
@@ -37,6 +47,8 @@ struct GpuScene {
   Buffer indices;    // uint32 triangle list (Scene::indices)
   Buffer materials;  // GpuMaterial per Scene::materials entry
   Buffer objects;    // GpuObject per Scene::objects entry
+  // The vertex buffers as buffer textures: RGB32F positions and normals, RG32F uvs.
+  Texture position_texels, normal_texels, uv_texels;
   // Attribute 0: position (vec3), 1: normal (vec3), 2: uv (vec2); element buffer = indices.
   VertexArray vertex_array;
   // One SRGB8_ALPHA8 texture per Scene::images entry, mipmapped, trilinear, with anisotropic
@@ -48,6 +60,8 @@ struct GpuScene {
   std::vector<bool> material_repeat;
   float max_anisotropy = 1.0f;  // as applied to both samplers; 1: anisotropic filtering off
 
+  // Binds the indices and the vertex buffer textures at the pulling:: points.
+  void bind_for_pulling() const;
   // Binds material `m`'s texture (or `white`) and sampler to texture unit `unit`.
   void bind_material_texture(std::uint32_t m, GLuint unit) const;
 };
