@@ -295,8 +295,16 @@ FacetSet FacetSet::build(const Warp& warp, const FacetBuildOptions& options, dou
   CoverageIndex index(mesh);
   CoverageGrid grid(mesh, warp.base, warp.R_eye_base);
   FacetPieces pieces = make_facet_pieces(mesh, merge_coplanar);
-  FacetSet set{
-      std::move(mesh), std::move(index), std::move(grid), std::move(pieces), {}, {}, {}, {}, {}};
+  FacetSet set{std::move(mesh),
+               std::move(index),
+               std::move(grid),
+               std::move(pieces),
+               {},
+               {},
+               {},
+               {},
+               {},
+               {}};
   const std::vector<GpuFacet> gpu_facets = pack_facets(set.mesh, set.pieces, z_near);
   const auto nodes = pack_coverage_nodes(set.index);
   // Empty buffers cannot be bound; keep one dummy element so that every binding is valid.
@@ -308,6 +316,7 @@ FacetSet FacetSet::build(const Warp& warp, const FacetBuildOptions& options, dou
   set.facet_texels = Texture::create_buffer_view(set.facets, GL_RGBA32F, 4 * sizeof(float));
   set.nodes = nodes.empty() ? Buffer::create(sizeof no_node, &no_node) : Buffer::create_from(nodes);
   set.grid_words = Buffer::create_from(pack_coverage_grid(set.grid, set.pieces));
+  set.grid_texels = Texture::create_buffer_view(set.grid_words, GL_R32UI, sizeof(std::uint32_t));
   set.order = set.index.order().empty() ? Buffer::create(sizeof no_order, &no_order)
                                         : Buffer::create_from(set.index.order());
   return set;
@@ -317,7 +326,7 @@ void FacetSet::bind() const {
   facet_texels.bind_unit(texture_unit::facets);
   nodes.bind_base(GL_SHADER_STORAGE_BUFFER, binding::nodes);
   order.bind_base(GL_SHADER_STORAGE_BUFFER, binding::order);
-  grid_words.bind_base(GL_SHADER_STORAGE_BUFFER, binding::grid);
+  grid_texels.bind_unit(texture_unit::grid);
 }
 
 bool sphere_may_meet_cone(const glm::dvec3& centre, double radius, const glm::dvec3* planes,

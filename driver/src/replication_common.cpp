@@ -89,6 +89,8 @@ void FacetMethodBase::prepare(const Scene& scene, const GpuScene& gpu_scene,
                                      : Buffer::create_from(records_);
   object_frames_ =
       Buffer::create(std::max<std::size_t>(scene.objects.size(), 1) * sizeof(GpuObjectFrame));
+  record_texels_ =
+      Texture::create_buffer_view(records_buffer_, GL_RGBA32UI, 4 * sizeof(std::uint32_t));
   object_frame_texels_ = Texture::create_buffer_view(object_frames_, GL_RGBA32F, 4 * sizeof(float));
   if (!empty_vao_) empty_vao_ = VertexArray::create();
   chunked_draws_ = is_software_renderer() && (epoxy_gl_version() >= 46 ||
@@ -159,8 +161,12 @@ bool FacetMethodBase::update_view(const glm::dmat4& T_eye_world) {
     }
     out.triangles = triangles;
     if (out.list.empty()) out.list.push_back({0, 0});  // keeps the binding valid; never read
+    const GLuint list_buffer_before = out.list_buffer.id();
     ensure_capacity(out.list_buffer, out.list.size() * sizeof(ListEntry));
     out.list_buffer.sub_data(0, out.list.size() * sizeof(ListEntry), out.list.data());
+    if (!out.list_texels || out.list_buffer.id() != list_buffer_before)
+      out.list_texels =
+          Texture::create_buffer_view(out.list_buffer, GL_RGBA32UI, sizeof(ListEntry));
     ensure_capacity(out.ranges_buffer, out.material_ranges.size() * sizeof(std::uint32_t));
     out.ranges_buffer.sub_data(0, out.material_ranges.size() * sizeof(std::uint32_t),
                                out.material_ranges.data());
@@ -171,11 +177,11 @@ bool FacetMethodBase::update_view(const glm::dmat4& T_eye_world) {
 void FacetMethodBase::bind_output(std::size_t i) const {
   const GpuScene& gpu = *gpu_;
   gpu.bind_for_pulling();
-  records_buffer_.bind_base(GL_SHADER_STORAGE_BUFFER, binding::records);
+  record_texels_.bind_unit(texture_unit::records);
   object_frame_texels_.bind_unit(texture_unit::object_frames);
   const OutputState& out = outputs_[i];
   out.facets.bind();
-  out.list_buffer.bind_base(GL_SHADER_STORAGE_BUFFER, binding::list);
+  out.list_texels.bind_unit(texture_unit::list);
   out.ranges_buffer.bind_base(GL_SHADER_STORAGE_BUFFER, binding::material_ranges);
   out.stats.bind_base(GL_SHADER_STORAGE_BUFFER, binding::stats);
   if (out.scan) out.scan.bind_base(GL_SHADER_STORAGE_BUFFER, binding::scan);

@@ -87,6 +87,7 @@ class FacetMethodBase : public RenderMethod {
     std::uint32_t triangles = 0;                 // list triangles
     std::uint32_t triangles_sole_piece = 0;      // of those, in entries with a sole piece
     Buffer list_buffer, ranges_buffer;
+    Texture list_texels;  // list_buffer as a buffer texture
     // Replication results, reused while neither view nor scene changes.
     // stats: visible triangles, pairs, overflow (std430 uints, replication/count.comp).
     Buffer scan, pairs, stats, draw_args;
@@ -133,7 +134,8 @@ class FacetMethodBase : public RenderMethod {
   std::vector<GpuRecord> records_;
   std::vector<std::vector<std::uint32_t>> records_by_material_;
   Buffer records_buffer_, object_frames_;
-  Texture object_frame_texels_;  // object_frames_ as a buffer texture
+  Texture record_texels_,
+      object_frame_texels_;  // records_buffer_, object_frames_ as buffer textures
   // Pass 3 splits each material's replicas into draws of kSoftwareReplicasPerDraw (see there).
   bool chunked_draws_ = false;
   VertexArray empty_vao_;  // core profile draws need a vertex array; attributes are pulled

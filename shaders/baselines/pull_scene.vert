@@ -1,12 +1,12 @@
 // Baselines: scene vertex pulling shared by the cube-map faces and the per-vertex projection.
 // Not a program of its own: linked as a second vertex shader object. Bindings are GpuScene's
 // (GpuScene::bind_for_pulling): uint32 indices, vertices as buffer textures.
+layout(std430, binding = 3) readonly buffer Indices { uint indices[]; };
 layout(binding = 8) uniform samplerBuffer position_texels;  // RGB32F, metres, object frame
 layout(binding = 9) uniform samplerBuffer normal_texels;    // RGB32F
 layout(binding = 10) uniform samplerBuffer uv_texels;       // RG32F
-layout(std430, binding = 3) readonly buffer Indices { uint indices[]; };
 
-// The draw's primitive: its first index in Indices.
+// The draw's primitive: its first index in the scene's indices.
 layout(location = 2) uniform uint first_index;
 
 uint pulled_vertex() { return indices[first_index + uint(gl_VertexID)]; }

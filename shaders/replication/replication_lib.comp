@@ -5,22 +5,18 @@
 // geometry). It is validated as a compute shader, so it uses nothing stage-specific.
 // Bindings: driver/include/facet/driver/facet_gpu.hpp.
 
-// Scene (GpuScene): vertices as buffer textures (texelFetch reads a texel for every SIMD lane at
-// once on llvmpipe, where a shader storage load takes one lane at a time), uint32 indices.
+// Read-only tables are buffer textures (texelFetch reads a texel for every SIMD lane at once on
+// llvmpipe, where a shader storage load takes one lane at a time), except the scene's indices
+// (see GpuScene::bind_for_pulling). The scene (GpuScene):
+layout(std430, binding = 3) readonly buffer Indices { uint indices[]; };
 layout(binding = 8) uniform samplerBuffer position_texels;  // RGB32F, metres, object frame
 layout(binding = 9) uniform samplerBuffer normal_texels;    // RGB32F
 layout(binding = 10) uniform samplerBuffer uv_texels;       // RG32F
-layout(std430, binding = 3) readonly buffer Indices { uint indices[]; };
+uint scene_index(uint i) { return indices[i]; }
 
-struct Record {  // GpuRecord
-  uint first_index;
-  uint triangle_count;
-  uint object;
-  uint material;
-  uint first_id;
-  uint padding0, padding1, padding2;
-};
-layout(std430, binding = 4) readonly buffer Records { Record records[]; };
+// GpuRecord, 2 RGBA32UI texels: (first_index, triangle_count, object, material), (first_id, ...).
+layout(binding = 13) uniform usamplerBuffer record_texels;
+uvec4 record(uint r) { return texelFetch(record_texels, 2 * int(r)); }
 
 // GpuObjectFrame per object, 8 texels: the columns of T_eye_object, then of T_world_object.
 layout(binding = 11) uniform samplerBuffer object_frame_texels;
@@ -44,17 +40,13 @@ struct Node {  // GpuCoverageNode
 layout(std430, binding = 7) readonly buffer Nodes { Node nodes[]; };
 layout(std430, binding = 8) readonly buffer Order { uint facet_order[]; };
 
-// The frame's triangle list: runs of records, each with the list position of its first triangle
-// and the one piece all its triangles take, or kNone (ListEntry in replication_common.hpp).
-struct ListEntry {
-  uint record;
-  uint first_triangle;
-  uint sole_piece;
-  uint padding;
-};
-layout(std430, binding = 9) readonly buffer List { ListEntry list[]; };
+// The frame's triangle list (ListEntry in replication_common.hpp), an RGBA32UI texel per run of a
+// record: (record, list position of its first triangle, the one piece all its triangles take or
+// kNone, padding).
+layout(binding = 14) uniform usamplerBuffer list_texels;
+uvec4 list_entry(uint e) { return texelFetch(list_texels, int(e)); }
 
-layout(location = 40) uniform uint list_entries;   // entries in list[]
+layout(location = 40) uniform uint list_entries;   // entries in the list
 layout(location = 41) uniform uint cull_back_faces;  // 1: front is counter-clockwise from the eye
 
 // Rounding slack of the coverage test, radians: every plane is moved outwards by this angle so
@@ -68,32 +60,32 @@ uint entry_of_triangle(uint t) {
   uint lo = 0u, hi = list_entries - 1u;
   while (lo < hi) {
     uint mid = (lo + hi + 1u) / 2u;
-    if (list[mid].first_triangle <= t) lo = mid; else hi = mid - 1u;
+    if (list_entry(mid).y <= t) lo = mid; else hi = mid - 1u;
   }
   return lo;
 }
 
-// Index (into indices[]) of the first corner of list triangle t in entry e.
+// Record r's vertex for its i-th index, its object and the ID of its first triangle.
+uint record_vertex(uint r, uint i) { return scene_index(record(r).x + i); }
+uint record_object(uint r) { return record(r).z; }
+uint record_first_id(uint r) { return texelFetch(record_texels, 2 * int(r) + 1).x; }
+
+// Index (into the scene's indices) of the first corner of list triangle t in entry e.
 uint vertex_index_of(uint e, uint t) {
-  return records[list[e].record].first_index + 3u * (t - list[e].first_triangle);
+  uvec4 entry = list_entry(e);
+  return record(entry.x).x + 3u * (t - entry.y);
 }
 
 // Scene vertex index of corner c (0..2) of list triangle t in entry e.
-uint vertex_of(uint e, uint t, uint c) { return indices[vertex_index_of(e, t) + c]; }
+uint vertex_of(uint e, uint t, uint c) { return scene_index(vertex_index_of(e, t) + c); }
 
 uint triangle_id(uint e, uint t) {
-  return records[list[e].record].first_id + (t - list[e].first_triangle);
+  uvec4 entry = list_entry(e);
+  return record_first_id(entry.x) + (t - entry.y);
 }
 
-uint scene_index(uint i) { return indices[i]; }
-
-// Record r's vertex for its i-th index, its object and the ID of its first triangle.
-uint record_vertex(uint r, uint i) { return indices[records[r].first_index + i]; }
-uint record_object(uint r) { return records[r].object; }
-uint record_first_id(uint r) { return records[r].first_id; }
-
-uint object_of(uint e) { return records[list[e].record].object; }
-uint material_of(uint e) { return records[list[e].record].material; }
+uint object_of(uint e) { return record(list_entry(e).x).z; }
+uint material_of(uint e) { return record(list_entry(e).x).w; }
 
 vec3 eye_position(uint object, uint v) {
   int at = 8 * int(object);
@@ -132,7 +124,7 @@ float facet_clip_distance(uint f, int k, vec3 p_eye) {
 uint triangle_eye(uint t, out vec3 p[3]) {
   uint e = entry_of_triangle(t);
   uint object = object_of(e), first = vertex_index_of(e, t);
-  for (uint c = 0u; c < 3u; ++c) p[c] = eye_position(object, indices[first + c]);
+  for (uint c = 0u; c < 3u; ++c) p[c] = eye_position(object, scene_index(first + c));
   return e;
 }
 
@@ -218,9 +210,11 @@ bool triangle_may_cover(vec3 p[3]) {
   return abs(facing) > 1e-6 * length(normal) * scale;
 }
 
-// The piece that draws facet f (FacetPieces::piece_of_facet, at grid[22]).
-layout(std430, binding = 16) readonly buffer Grid { uint grid[]; };
-uint piece_of_facet(uint f) { return grid[grid[22] + f]; }
+// The piece that draws facet f (FacetPieces::piece_of_facet, at the grid's header word 22).
+// The coverage grid (pack_coverage_grid): one R32UI buffer texture.
+layout(binding = 15) uniform usamplerBuffer grid_texels;
+uint grid_word(uint i) { return texelFetch(grid_texels, int(i)).x; }
+uint piece_of_facet(uint f) { return grid_word(grid_word(22) + f); }
 
 // Walks the facets that triangle p may cover, in the hierarchy's fixed order, and returns how
 // many there are. When pair_base != kNone, writes uvec2(t, piece of the facet) to
@@ -302,7 +296,7 @@ const float kPi = 3.14159265358979;
 const float kPoleMargin = 1e-3;
 const float kShortArc = 1e-2;
 
-float grid_float(uint i) { return uintBitsToFloat(grid[i]); }
+float grid_float(uint i) { return uintBitsToFloat(grid_word(i)); }
 
 float wrap_pi(float angle) { return angle - 2.0 * kPi * round(angle / (2.0 * kPi)); }
 
@@ -420,7 +414,7 @@ bool chart_box(uint chart, vec4 d, bool full_phi, out vec4 box) {
   return true;
 }
 
-// Cells meeting [lo, hi] among `cells` cells between ascending float breaks at grid[at...]:
+// Cells meeting [lo, hi] among `cells` cells between ascending float breaks from grid word `at`:
 // the first and last; false when none (CoverageGrid's cells_between).
 bool cells_between(uint at, uint cells, float lo, float hi, out uint first, out uint last) {
   first = 0u;
@@ -445,17 +439,17 @@ bool cells_between(uint at, uint cells, float lo, float hi, out uint first, out 
 // The buckets a chart box touches: (first column, first row, columns, rows); false when none.
 bool bucket_range(vec4 box, bool full_p, out uvec4 range) {
   range = uvec4(0u);
-  uint columns = grid[2], rows = grid[3];
-  if (grid[23] != 0u) {
+  uint columns = grid_word(2), rows = grid_word(3);
+  if (grid_word(23) != 0u) {
     // Cell buckets (CoverageGrid::buckets): the box grown by the pads, against the breaks.
-    uint pads = grid[23], p_at = grid[23] + 2u, q_at = p_at + columns + 1u;
+    uint pads = grid_word(23), p_at = grid_word(23) + 2u, q_at = p_at + columns + 1u;
     float pad_p = grid_float(pads), pad_q = grid_float(pads + 1u);
     uint first_row, last_row;
     if (!cells_between(q_at, rows, box.z - pad_q, box.w + pad_q, first_row, last_row)) return false;
     range.y = first_row;
     range.w = last_row - first_row + 1u;
     float width = box.y - box.x + 2.0 * pad_p;
-    bool periodic = grid[1] != 0u;
+    bool periodic = grid_word(1) != 0u;
     if (periodic && (full_p || width >= 2.0 * kPi)) {
       range.z = columns;
       return true;
@@ -487,7 +481,7 @@ bool bucket_range(vec4 box, bool full_p, out uvec4 range) {
   if (j_hi < j_lo) return false;
   range.y = uint(j_lo);
   range.w = uint(j_hi - j_lo) + 1u;
-  if (grid[1] != 0u) {
+  if (grid_word(1) != 0u) {
     range.z = columns;
     if (full_p) return true;
     float i_lo = floor((box.x - p0) / dp), i_hi = floor((box.y - p0) / dp);
@@ -520,7 +514,7 @@ uint test_candidate(vec3 u[3], vec4 edge[3], vec3 middle, uint f) {
         dot(n, u[2]) + kCoverageSlack < 0.0)
       return kSeparated;
   }
-  uint at = grid[21] + 12u * f;
+  uint at = grid_word(21) + 12u * f;
   vec3 c[4];
   for (int m = 0; m < 4; ++m)
     c[m] = vec3(grid_float(at + 3u * uint(m)), grid_float(at + 3u * uint(m) + 1u),
@@ -549,7 +543,7 @@ bool grid_coverage(vec3 p[3], uint t, uint pair_base, uint wanted, out uint want
                          grid_float(16u), grid_float(17u), grid_float(18u), grid_float(19u),
                          grid_float(20u));
   vec3 b[3] = vec3[3](R_base_eye * u[0], R_base_eye * u[1], R_base_eye * u[2]);
-  uint chart = grid[0];
+  uint chart = grid_word(0);
   vec4 angles;
   bool full_phi;
   if (!direction_box(b, chart, angles, full_phi)) return false;
@@ -558,16 +552,16 @@ bool grid_coverage(vec3 p[3], uint t, uint pair_base, uint wanted, out uint want
   uvec4 range;
   if (!bucket_range(box, full_phi && chart <= kChartEquirectangular, range)) return true;
   if (range.z * range.w > kGridMaxBuckets) return false;
-  uint columns = grid[2];
-  bool periodic = grid[1] != 0u;
-  uint first_offset = grid[9], facets_offset = grid[10], boxes_offset = grid[11];
+  uint columns = grid_word(2);
+  bool periodic = grid_word(1) != 0u;
+  uint first_offset = grid_word(9), facets_offset = grid_word(10), boxes_offset = grid_word(11);
   // Listed facets, row by row from at most two runs of buckets.
   uint listed = 0u;
   uint end = range.x + range.z;
   for (uint j = range.y; j < range.y + range.w; ++j) {
     uint row = first_offset + j * columns;
-    listed += grid[row + min(end, columns)] - grid[row + range.x];
-    if (end > columns) listed += grid[row + end - columns] - grid[row];
+    listed += grid_word(row + min(end, columns)) - grid_word(row + range.x);
+    if (end > columns) listed += grid_word(row + end - columns) - grid_word(row);
   }
   if (listed > kGridMaxCandidates) return false;
   // Inward unit normals of the triangle's edge planes; the slack covers the rounding of a
@@ -588,16 +582,16 @@ bool grid_coverage(vec3 p[3], uint t, uint pair_base, uint wanted, out uint want
     return false;
   // A facet is listed at most once in a bucket, so a one-bucket box needs no de-duplication, and
   // cell buckets list each facet once, so they need none at all.
-  bool one_bucket = range.z * range.w == 1u || grid[23] != 0u;
+  bool one_bucket = range.z * range.w == 1u || grid_word(23) != 0u;
   for (uint j = range.y; j < range.y + range.w; ++j) {
     for (uint k = 0u; k < range.z; ++k) {
       uint i = periodic ? (range.x + k) % columns : range.x + k;
       uint bucket = first_offset + j * columns + i;
-      for (uint m = grid[bucket]; m < grid[bucket + 1u]; ++m) {
-        uint f = grid[facets_offset + m];
+      for (uint m = grid_word(bucket); m < grid_word(bucket + 1u); ++m) {
+        uint f = grid_word(facets_offset + m);
         if (!one_bucket) {
-          uvec4 fb = uvec4(grid[boxes_offset + 4u * f], grid[boxes_offset + 4u * f + 1u],
-                           grid[boxes_offset + 4u * f + 2u], grid[boxes_offset + 4u * f + 3u]);
+          uvec4 fb = uvec4(grid_word(boxes_offset + 4u * f), grid_word(boxes_offset + 4u * f + 1u),
+                           grid_word(boxes_offset + 4u * f + 2u), grid_word(boxes_offset + 4u * f + 3u));
           // Taken once: in the first bucket, in visiting order, that both ranges share.
           uint first_row = max(range.y, fb.y);
           uint first_column = max(range.x, fb.x);
@@ -628,7 +622,7 @@ uint cover_without_walk(vec3 p[3], uint t, uint e, uint pair_base, uint wanted,
   wanted_facet = kNone;
   if (coverage_by_grid == 0u) return kNeedsWalk;
   // An object inside one piece and clear of the others: each of its triangles takes that piece.
-  uint sole = list[e].sole_piece;
+  uint sole = list_entry(e).z;
   if (sole != kNone) {
     if (!triangle_may_cover(p)) return 0u;
     if (wanted == 0u) wanted_facet = sole;

@@ -5,17 +5,17 @@
 //
 // Shader storage bindings used by shaders/replication/** (one table so that every program sees
 // the same buffers at the same points):
-//   3 indices (GpuScene)   4 records
-//   7 coverage nodes   8 coverage order      (FacetSet, per output)
-//   9 triangle list of the frame (record, first triangle)  10 counts / exclusive scan
-//   11 pairs (modern: GpuReplica; seed: triangle, replica)  12 stats
-//   13 material ranges of the triangle list   14 indirect draw arguments   15 scan block sums
-//   16 coverage grid (GpuFacetSet, per output)   17 staged facets of pass 1   18 their offsets
+//   3 indices (GpuScene)   7 coverage nodes   8 coverage order      (FacetSet, per output)
+//   10 counts / exclusive scan   11 pairs (modern: GpuReplica; seed: triangle, replica)
+//   12 stats   13 material ranges of the triangle list   14 indirect draw arguments
+//   15 scan block sums   17 staged facets of pass 1   18 their offsets
 //   19 draw commands used per material (pass 3's glMultiDrawArraysIndirectCountARB)
 //   20 pass 1's walk queue: the walk pass's indirect dispatch, then the triangles it takes
-// and buffer textures (samplerBuffer): the scene's vertices (GpuScene::bind_for_pulling), and at
-// texture_unit:: the object frames (RGBA32F, 8 texels per GpuObjectFrame, per frame) and the
-// pieces (RGBA32F, 8 texels per GpuFacet, per output).
+// Read-only tables are buffer textures (samplerBuffer, texelFetch): the scene
+// (GpuScene::bind_for_pulling, units 8-10), and at texture_unit:: the object frames (RGBA32F, 8
+// texels per GpuObjectFrame, per frame), the pieces (RGBA32F, 8 texels per GpuFacet, per output),
+// the records (RGBA32UI, 2 texels per GpuRecord), the frame's triangle list (RGBA32UI, a texel per
+// ListEntry, per output) and the coverage grid (R32UI, pack_coverage_grid, per output).
 #include <epoxy/gl.h>
 
 #include <array>
@@ -33,17 +33,16 @@
 
 namespace facet::driver {
 
-// The object frames and the pieces are read through buffer textures (texelFetch), as the scene's
-// vertices are (gpu_scene.hpp, pulling::).
+// Read-only tables are buffer textures (texelFetch), as the scene is (gpu_scene.hpp, pulling::).
 namespace texture_unit {
-inline constexpr GLuint object_frames = 11, facets = 12;
+inline constexpr GLuint object_frames = 11, facets = 12, records = 13, list = 14, grid = 15;
 }  // namespace texture_unit
 
 namespace binding {
-inline constexpr GLuint indices = pulling::indices_binding, records = 4, nodes = 7, order = 8,
-                        list = 9, scan = 10, pairs = 11, stats = 12, material_ranges = 13,
-                        draw_args = 14, block_sums = 15, grid = 16, staged = 17, stage_offsets = 18,
-                        draw_counts = 19, walk_queue = 20;
+inline constexpr GLuint indices = pulling::indices_binding, nodes = 7, order = 8, scan = 10,
+                        pairs = 11, stats = 12, material_ranges = 13, draw_args = 14,
+                        block_sums = 15, staged = 17, stage_offsets = 18, draw_counts = 19,
+                        walk_queue = 20;
 }  // namespace binding
 
 // What pass 3 draws: pieces. Piece f < F is facet f of the mesh (F facets); piece F + k, a quad,
@@ -160,8 +159,8 @@ struct FacetSet {
   CoverageIndex index;
   CoverageGrid grid;
   FacetPieces pieces;
-  Buffer facets, nodes, order, grid_words;  // one GpuFacet per piece; binding::nodes, order, grid
-  Texture facet_texels;                     // facets as a buffer texture (texture_unit::facets)
+  Buffer facets, nodes, order, grid_words;  // one GpuFacet per piece; binding::nodes, order
+  Texture facet_texels, grid_texels;  // buffer textures: texture_unit::facets, texture_unit::grid
 
   // Builds the facets of `warp` (InputError when the layout cannot be met) and their pieces, and
   // uploads them. Needs a current context.

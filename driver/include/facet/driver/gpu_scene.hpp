@@ -29,10 +29,11 @@ struct GpuObject {
 static_assert(sizeof(GpuObject) == 112);
 
 // Where GpuScene::bind_for_pulling puts the scene for shaders that pull their vertices
-// (shaders/replication/replication_lib.comp, shaders/baselines/pull_scene.vert): the indices as
-// shader storage, the vertices as buffer textures. llvmpipe (Mesa 22.3) loads a shader storage
-// component one SIMD lane at a time, in a loop with a branch per lane, and fetches a texel for
-// all lanes at once.
+// (shaders/replication/replication_lib.comp, shaders/baselines/pull_scene.vert): the vertices as
+// buffer textures, not shader storage: llvmpipe (Mesa 22.3) loads a shader storage component one
+// SIMD lane at a time, in a loop with a branch per lane, and fetches a texel for all lanes at
+// once. The indices stay shader storage: as an R32UI buffer texture, the walk pass of `facets`
+// (replication/count.comp) took 530 ms a cylinder frame instead of 6, for reasons not found.
 namespace pulling {
 inline constexpr GLuint indices_binding = 3;
 inline constexpr GLuint position_unit = 8, normal_unit = 9, uv_unit = 10;
