@@ -499,20 +499,22 @@ bool bucket_range(vec4 box, bool full_p, out uvec4 range) {
   return true;
 }
 
-// Candidate piece f against the triangle with unit corners u: kSeparated when one of the piece's
-// four guarded planes or one of the triangle's three edge planes (edge[k], with their rounding
-// slack in w) has all corners of the other outside it; kBeyondHemisphere when they may meet but a
-// pyramid corner lies outside the open hemisphere about `middle`, where that test is not exact
-// (the walk must take the triangle); else kMayMeet. Without the clipping of meets_cone, which
-// made the cylinder's frame 30% slower; what it keeps beyond the exact answer is clipped to
-// nothing in pass 3.
-const uint kSeparated = 0u, kMayMeet = 1u, kBeyondHemisphere = 2u;
-uint test_candidate(vec3 u[3], vec4 edge[3], vec3 middle, uint f) {
+// Whether candidate piece f and the triangle with unit corners u may meet: false when one of the
+// piece's four guarded planes or one of the triangle's three edge planes (edge[k], with their
+// rounding slack in w) has all corners of the other outside it. Either is a separating plane of
+// the two cones (the triangle's cone is where its edge planes meet, the piece's the conic hull of
+// its pyramid corners, both within a hemisphere), so nothing that meets is rejected. The test is
+// exact where the two lie in a common open hemisphere: there both are convex polygons in the
+// gnomonic chart, and edge normals separate disjoint convex polygons. Elsewhere (a triangle
+// spanning more than a right angle seen from the eye, and pieces near its edges) it may keep a
+// piece that the triangle misses, which pass 3 clips to nothing. Without the clipping of
+// meets_cone, which made the cylinder's frame 30% slower.
+bool may_meet(vec3 u[3], vec4 edge[3], uint f) {
   for (int k = 0; k < 4; ++k) {
     vec3 n = clip_plane(f, k).xyz;
     if (dot(n, u[0]) + kCoverageSlack < 0.0 && dot(n, u[1]) + kCoverageSlack < 0.0 &&
         dot(n, u[2]) + kCoverageSlack < 0.0)
-      return kSeparated;
+      return false;
   }
   uint at = grid_word(21) + 12u * f;
   vec3 c[4];
@@ -522,12 +524,9 @@ uint test_candidate(vec3 u[3], vec4 edge[3], vec3 middle, uint f) {
   for (int k = 0; k < 3; ++k) {
     if (dot(edge[k].xyz, c[0]) + edge[k].w < 0.0 && dot(edge[k].xyz, c[1]) + edge[k].w < 0.0 &&
         dot(edge[k].xyz, c[2]) + edge[k].w < 0.0 && dot(edge[k].xyz, c[3]) + edge[k].w < 0.0)
-      return kSeparated;
+      return false;
   }
-  if (!(dot(middle, c[0]) > 0.0 && dot(middle, c[1]) > 0.0 && dot(middle, c[2]) > 0.0 &&
-        dot(middle, c[3]) > 0.0))
-    return kBeyondHemisphere;
-  return kMayMeet;
+  return true;
 }
 
 // walk_coverage's contract, answered from the grid into `found` when the triangle is small
@@ -573,13 +572,8 @@ bool grid_coverage(vec3 p[3], uint t, uint pair_base, uint wanted, out uint want
     float len = length(normal);
     edge[k] = len > 1e-6 ? vec4(normal / len, kCoverageSlack + 4e-7 / len) : vec4(0, 0, 0, 1);
   }
-  // The reject above is exact where the triangle and the facet lie in a common open hemisphere;
-  // a candidate beyond the one about the triangle's mean direction sends the triangle to the
-  // walk. The loop always runs to its end (no early return at the wanted facet), so that a
-  // triangle takes the same path in every pass that covers it.
-  vec3 middle = normalize(u[0] + u[1] + u[2]);
-  if (!(dot(middle, u[0]) > 0.0 && dot(middle, u[1]) > 0.0 && dot(middle, u[2]) > 0.0))
-    return false;
+  // The loop always runs to its end (no early return at the wanted facet), so that a triangle
+  // takes the same path in every pass that covers it.
   // A facet is listed at most once in a bucket, so a one-bucket box needs no de-duplication, and
   // cell buckets list each facet once, so they need none at all.
   bool one_bucket = range.z * range.w == 1u || grid_word(23) != 0u;
@@ -599,9 +593,7 @@ bool grid_coverage(vec3 p[3], uint t, uint pair_base, uint wanted, out uint want
             first_column = (range.x + columns - fb.x) % columns < fb.z ? range.x : fb.x;
           if (i != first_column || j != first_row) continue;
         }
-        uint verdict = test_candidate(u, edge, middle, f);
-        if (verdict == kSeparated) continue;
-        if (verdict == kBeyondHemisphere) return false;
+        if (!may_meet(u, edge, f)) continue;
         if (found == wanted) wanted_facet = f;
         if (pair_base != kNone) write_pair(pair_base + found, t, f);
         ++found;
