@@ -36,6 +36,10 @@ class FacetPipeline final : public FacetMethodBase {
     if (!count_) {
       count_ = link_replication_program({"replication/count.comp"});
       walk_ = link_replication_program({"replication/count.comp"}, {{"WALK_PASS", "1"}});
+      // Eight triangles walked side by side per SIMD row, where every triangle walks: the walk
+      // pass's one per work group took 806 ms a cylinder frame (400x300, 0.25 px), this 160.
+      count_walk_ =
+          link_replication_program({"replication/count.comp"}, {{"WALK_EVERY_TRIANGLE", "1"}});
       scatter_ = link_replication_program({"replication/scatter.comp"});
       args_ = build_program({"replication/draw_args.comp"}, {{"VERTICES_PER_REPLICA", "3"}});
       draw_ = link_replication_program({"replication/draw.vert", "scene/material.frag"},
@@ -117,8 +121,9 @@ class FacetPipeline final : public FacetMethodBase {
       const std::uint32_t empty_queue[kWalkQueueHeaderWords] = {0, 0, 1, 0};
       out.walk_queue.sub_data(0, sizeof empty_queue, empty_queue);
       bind_output(i);
-      set_list_uniforms(count_, i);
-      count_.use();
+      const Program& first = settings_.coverage == FacetCoverage::walk ? count_walk_ : count_;
+      set_list_uniforms(first, i);
+      first.use();
       glDispatchCompute((n + 1 + kLocalSize - 1) / kLocalSize, 1, 1);
       glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_COMMAND_BARRIER_BIT);
       set_list_uniforms(walk_, i);
@@ -163,7 +168,7 @@ class FacetPipeline final : public FacetMethodBase {
   friend std::vector<std::vector<std::uint32_t>> facet::driver::gpu_triangle_coverage(
       const Warp&, const RenderSettings&, const std::vector<std::array<glm::vec3, 3>>&);
 
-  Program count_, walk_, scatter_, args_, draw_;
+  Program count_, walk_, count_walk_, scatter_, args_, draw_;
   PrefixScan scan_;
 };
 

@@ -9,7 +9,8 @@
 // Two programs: the grid pass (one invocation per list triangle) takes what the sole pieces and
 // the coverage grid answer and queues the other triangles, with the indirect arguments of the
 // walk pass (WALK_PASS: one invocation per queued triangle), which walks the hierarchy for them.
-// Both write the same counts and staging.
+// Both write the same counts and staging. With WALK_EVERY_TRIANGLE the first pass walks every
+// triangle itself (RenderSettings::coverage = walk, the reference) and queues none.
 #ifndef LOCAL_SIZE
 #define LOCAL_SIZE 64
 #endif
@@ -102,7 +103,7 @@ void main() {
     vec3 p[3];
     uint e = triangle_eye(t, p);
     uint unused;
-#ifdef WALK_PASS
+#if defined(WALK_PASS) || defined(WALK_EVERY_TRIANGLE)
     count = walk_coverage(p, t, 0u, 0xffffffffu, unused);
 #else
     count = cover_without_walk(p, t, e, 0u, 0xffffffffu, unused);
