@@ -13,6 +13,8 @@
 #include <fstream>
 #include <glm/gtc/matrix_transform.hpp>
 #include <limits>
+#include <string>
+#include <string_view>
 
 #include "facet/driver/city.hpp"
 #include "facet/driver/gl_context.hpp"
@@ -55,10 +57,51 @@ CameraPath default_camera_path(const Scene& scene, bool builtin_city) {
 
 namespace {
 
+// A frame image's name: five or more digits, then ".png".
+bool is_frame_file_name(const std::string& name) {
+  constexpr std::string_view kSuffix = ".png";
+  if (name.size() < 5 + kSuffix.size() || !name.ends_with(kSuffix)) return false;
+  return std::all_of(name.begin(), name.end() - kSuffix.size(),
+                     [](char c) { return c >= '0' && c <= '9'; });
+}
+
+// True when `dir` holds nothing, or exactly what run_headless_session writes: a stats.jsonl and
+// folders of frame images, nothing else (no other file, no symbolic link).
 bool holds_earlier_run_or_nothing(const fs::path& dir) {
-  if (!fs::exists(dir)) return true;
-  if (!fs::is_directory(dir)) return false;
-  return fs::is_empty(dir) || fs::exists(dir / "stats.jsonl");
+  const fs::file_status status = fs::symlink_status(dir);
+  if (!fs::exists(status)) return true;
+  if (!fs::is_directory(status)) return false;
+  bool has_stats = false, empty = true;
+  for (const fs::directory_entry& entry : fs::directory_iterator(dir)) {
+    empty = false;
+    const fs::file_status entry_status = entry.symlink_status();
+    if (entry.path().filename() == "stats.jsonl" && fs::is_regular_file(entry_status)) {
+      has_stats = true;
+      continue;
+    }
+    if (!fs::is_directory(entry_status)) return false;
+    for (const fs::directory_entry& frame : fs::directory_iterator(entry.path())) {
+      if (!fs::is_regular_file(frame.symlink_status()) ||
+          !is_frame_file_name(frame.path().filename().string()))
+        return false;
+    }
+  }
+  return empty || has_stats;
+}
+
+// True when `dir` is the current folder or holds it: replacing it would remove the folder the
+// command runs in.
+bool holds_current_folder(const fs::path& dir) {
+  std::error_code error;
+  const fs::path target = fs::weakly_canonical(dir, error);
+  const fs::path current = fs::current_path(error);
+  if (error) return false;
+  auto t = target.begin(), c = current.begin();
+  for (; t != target.end() && c != current.end(); ++t, ++c) {
+    if (t->empty()) break;  // a trailing separator
+    if (*t != *c) return false;
+  }
+  return t == target.end() || t->empty();
 }
 
 std::string frame_file_name(std::uint64_t frame) {
@@ -71,11 +114,20 @@ std::string frame_file_name(std::uint64_t frame) {
 
 HeadlessRunResult run_headless_session(Session& session, const CameraPath& path,
                                        const HeadlessRunOptions& options) {
-  const fs::path out_dir = options.out_dir;
+  // "run/" names the same folder as "run".
+  fs::path out_dir = options.out_dir.lexically_normal();
+  if (!out_dir.has_filename()) out_dir = out_dir.parent_path();
   if (out_dir.empty()) throw InputError("command line", "--out", "expected an output folder");
+  if (options.frames < 1 || options.frames > kMaxHeadlessFrames)
+    throw InputError("command line", "--frames",
+                     "from 1 to " + std::to_string(kMaxHeadlessFrames) + " frames");
+  if (holds_current_folder(out_dir))
+    throw InputError(out_dir.string(), "--out",
+                     "a folder other than the current folder and its parents");
   if (!holds_earlier_run_or_nothing(out_dir))
     throw InputError(out_dir.string(), "--out",
-                     "an empty folder, a folder from an earlier 'facet run', or a new path");
+                     "a new path, an empty folder, or a folder from an earlier 'facet run' "
+                     "(stats.jsonl and folders of NNNNN.png, nothing else)");
   const fs::path parent = out_dir.has_parent_path() ? out_dir.parent_path() : fs::path(".");
   fs::create_directories(parent);
   const fs::path temporary =
@@ -107,8 +159,18 @@ HeadlessRunResult run_headless_session(Session& session, const CameraPath& path,
     stats_file.close();
     if (!stats_file)
       throw std::runtime_error((out_dir / "stats.jsonl").string() + ": write failed");
-    fs::remove_all(out_dir);
-    fs::rename(temporary, out_dir);
+    // The earlier run moves aside until the new one is in place.
+    const fs::path earlier =
+        parent / ("." + out_dir.filename().string() + ".old" + std::to_string(::getpid()));
+    const bool replacing = fs::exists(fs::symlink_status(out_dir));
+    if (replacing) fs::rename(out_dir, earlier);
+    try {
+      fs::rename(temporary, out_dir);
+    } catch (...) {
+      if (replacing) fs::rename(earlier, out_dir);
+      throw;
+    }
+    if (replacing) fs::remove_all(earlier);
   } catch (...) {
     std::error_code ignored;
     fs::remove_all(temporary, ignored);

@@ -211,6 +211,38 @@ TEST(HeadlessRun, WritesFramesPerOutputAndStatistics) {
   EXPECT_THROW(run_headless_session(session, still, options), InputError);
   EXPECT_TRUE(fs::exists(foreign / "keep.txt"));
   EXPECT_FALSE(fs::exists(foreign / "stats.jsonl"));
+  // A stats.jsonl does not make a folder a run: anything else in it keeps it from being replaced,
+  // beside the frames or among them.
+  std::ofstream(foreign / "stats.jsonl") << "{}\n";
+  EXPECT_THROW(run_headless_session(session, still, options), InputError);
+  EXPECT_TRUE(fs::exists(foreign / "keep.txt"));
+  std::ofstream(out / "front" / "notes.txt") << "mine";
+  options.out_dir = out;
+  EXPECT_THROW(run_headless_session(session, still, options), InputError);
+  EXPECT_TRUE(fs::exists(out / "front" / "notes.txt"));
+  fs::remove(out / "front" / "notes.txt");
+  // "run/" is "run"; the current folder and its parents are refused, as are 0 frames and more
+  // than kMaxHeadlessFrames, before anything is written.
+  options.out_dir = out.string() + "/";
+  EXPECT_NO_THROW(run_headless_session(session, still, options));
+  EXPECT_TRUE(fs::exists(out / "stats.jsonl"));
+  const fs::path before = fs::current_path();
+  fs::current_path(out / "front");
+  for (const char* here : {".", "..", "../"}) {
+    options.out_dir = here;
+    EXPECT_THROW(run_headless_session(session, still, options), InputError) << here;
+  }
+  fs::current_path(before);
+  EXPECT_TRUE(fs::exists(out / "front" / "00000.png"));
+  options.out_dir = folder / "counted";
+  for (const std::uint64_t frames : {std::uint64_t(0), kMaxHeadlessFrames + 1}) {
+    options.frames = frames;
+    EXPECT_THROW(run_headless_session(session, still, options), InputError) << frames;
+    EXPECT_FALSE(fs::exists(options.out_dir)) << frames;
+  }
+  // Nothing of the runs is left beside them.
+  for (const fs::directory_entry& entry : fs::directory_iterator(folder))
+    EXPECT_NE(entry.path().filename().string().front(), '.') << entry.path();
 }
 
 }  // namespace

@@ -25,7 +25,7 @@ struct RunOptions {
   std::optional<double> tolerance;
   std::optional<double> scale;
   bool headless = false, windowed = false;
-  std::uint64_t frames = 0;
+  std::int64_t frames = 0;  // signed, so that a negative count is refused, not wrapped
   std::string out = "out/session";
   bool span = false, overlay = false, no_path = false;
   std::string report;
@@ -41,6 +41,10 @@ void run(const RunOptions& options) {
                 << " Hz\n";
     return;
   }
+  if (options.frames < 0 || std::uint64_t(options.frames) > driver::kMaxHeadlessFrames)
+    throw InputError("command line", "--frames",
+                     "from 1 to " + std::to_string(driver::kMaxHeadlessFrames) +
+                         " frames (0 or none: the default)");
   std::optional<glm::ivec2> size;
   if (!options.size.empty()) size = parse_size(options.size, "--size");
   driver::SessionDisplay display = driver::load_session_display(options.display, size);
@@ -64,7 +68,7 @@ void run(const RunOptions& options) {
   const bool headless = options.headless || (!options.windowed && !have_display_server);
   if (!headless) {
     driver::WindowRunOptions window_options;
-    if (options.frames > 0) window_options.frames = options.frames;
+    if (options.frames > 0) window_options.frames = std::uint64_t(options.frames);
     window_options.span = options.span;
     window_options.overlay = options.overlay;
     window_options.play_path = !options.no_path;
@@ -77,7 +81,7 @@ void run(const RunOptions& options) {
   auto context = driver::create_headless_context();
   driver::Session session(display, scene);
   driver::HeadlessRunOptions headless_options;
-  headless_options.frames = options.frames > 0 ? options.frames : 10;
+  headless_options.frames = options.frames > 0 ? std::uint64_t(options.frames) : 10;
   headless_options.out_dir = options.out;
   const driver::HeadlessRunResult result =
       driver::run_headless_session(session, path, headless_options);

@@ -22,6 +22,9 @@ inline constexpr double kFramePeriod_s = 1.0 / 60.0;
 using CameraPath = std::function<glm::dmat4(double time_s)>;
 CameraPath default_camera_path(const Scene& scene, bool builtin_city);
 
+// The most frames one headless run writes (a PNG per output and frame).
+inline constexpr std::uint64_t kMaxHeadlessFrames = 1'000'000;
+
 struct HeadlessRunOptions {
   std::uint64_t frames = 1;
   std::filesystem::path out_dir;  // receives <output>/<frame>.png and stats.jsonl
@@ -35,9 +38,11 @@ struct HeadlessRunResult {
 
 // Renders frames 0..frames-1 at times k·kFramePeriod_s along `path` and writes
 // out_dir/<output>/<frame, 5 digits>.png and out_dir/stats.jsonl (one frame_stats_to_json line
-// per frame). The folder is written under a temporary name and renamed when complete; an existing
-// out_dir is replaced only when it is empty or holds an earlier run (a stats.jsonl), else
-// InputError.
+// per frame). The folder is written under a temporary name and renamed when complete. An existing
+// out_dir is replaced only when it is empty or holds exactly an earlier run (stats.jsonl and
+// folders of NNNNN.png, nothing else); a folder with anything else in it, the current folder or
+// one of its parents, and a frame count outside [1, kMaxHeadlessFrames] are InputErrors, raised
+// before anything is written.
 HeadlessRunResult run_headless_session(Session& session, const CameraPath& path,
                                        const HeadlessRunOptions& options);
 
