@@ -16,11 +16,12 @@ void write_image(const std::filesystem::path& path, const OIIO::ImageSpec& spec,
                  const void* pixels) {
   write_atomically(path, [&](const std::filesystem::path& temporary) {
     auto out = OIIO::ImageOutput::create(path.string());
-    if (!out || !out->open(temporary.string(), spec) || !out->write_image(spec.format, pixels)) {
+    // close() writes what is left: a full disk fails there.
+    if (!out || !out->open(temporary.string(), spec) || !out->write_image(spec.format, pixels) ||
+        !out->close()) {
       const std::string reason = out ? out->geterror() : OIIO::geterror();
       throw InputError(path.string(), "", "a writable image file (" + reason + ")");
     }
-    out->close();
   });
 }
 

@@ -265,6 +265,32 @@ TEST(InteropCli, LookupOfAWarp) {
                        scratch.path);
   EXPECT_EQ(r.status, 0) << r.output;
   EXPECT_TRUE(fs::exists(scratch.path / "l.exr"));
+  // Never over its input, nor over something that is not a regular file.
+  const auto size_before = fs::file_size(scratch.path / "w.warp.exr");
+  for (const std::string& out :
+       {(scratch.path / "w.warp.exr").string(), (scratch.path / "." / "w.warp.exr").string(),
+        std::string("/dev/null")}) {
+    const CliRun over = run(
+        "lookup --warp " + (scratch.path / "w.warp.exr").string() + " --out " + out, scratch.path);
+    EXPECT_EQ(over.status, 2) << over.output;
+    EXPECT_NE(over.output.find(out), std::string::npos) << over.output;
+  }
+  EXPECT_EQ(fs::file_size(scratch.path / "w.warp.exr"), size_before);
+  EXPECT_TRUE(fs::is_character_file("/dev/null"));
+}
+
+TEST(InteropCli, LookupOfADisplayWritesNothingWhenOneWarpIsBad) {
+  test::ScratchFolder scratch("cli-lookup-display");
+  const fs::path wall = scratch.path / "wall", lookups = scratch.path / "lookups";
+  const CliRun made = run("display builtin:wall2x2 --out " + wall.string(), scratch.path);
+  ASSERT_EQ(made.status, 0) << made.output;
+  std::ofstream(wall / "wall_r1c1.warp.exr") << "not an EXR";
+  const CliRun r =
+      run("lookup --display " + (wall / "display.json").string() + " --out " + lookups.string(),
+          scratch.path);
+  EXPECT_EQ(r.status, 2) << r.output;
+  EXPECT_NE(r.output.find("wall_r1c1.warp.exr"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(lookups));
 }
 
 TEST(InteropCli, DevicesListsOrSaysThereAreNone) {

@@ -1,8 +1,10 @@
 // facet lookup: per-pixel source coordinates for tools that only resample.
 #include <iostream>
+#include <vector>
 
 #include "command.hpp"
 #include "facet/interop/lookup.hpp"
+#include "facet/projection/atomic_file.hpp"
 #include "facet/projection/errors.hpp"
 #include "facet/projection_io/display_config.hpp"
 #include "facet/projection_io/warp_file.hpp"
@@ -30,6 +32,7 @@ const Registration registration{
           ->required();
       command->callback([options] {
         if (!options->warp.empty()) {
+          refuse_output_over_inputs(options->out, "--out", {options->warp});
           interop::write_lookup(read_warp(options->warp), options->out);
           std::cout << "wrote " << options->out << "\n";
           return;
@@ -38,11 +41,15 @@ const Registration registration{
           throw InputError("--warp, --display", "", "expected one of them");
         }
         const auto config = projection_io::read_display_config(options->display);
+        // Every warp is read before anything is written: a bad second warp leaves no first file.
+        std::vector<Warp> warps;
+        for (const auto& projector : config.projectors)
+          warps.push_back(read_warp(config.resolve(projector.warp).string()));
         std::filesystem::create_directories(options->out);
-        for (const auto& projector : config.projectors) {
+        for (std::size_t i = 0; i < warps.size(); ++i) {
           const std::filesystem::path path =
-              std::filesystem::path(options->out) / (projector.name + ".lookup.exr");
-          interop::write_lookup(read_warp(config.resolve(projector.warp).string()), path);
+              std::filesystem::path(options->out) / (config.projectors[i].name + ".lookup.exr");
+          interop::write_lookup(warps[i], path);
           std::cout << "wrote " << path.string() << "\n";
         }
       });

@@ -2,12 +2,21 @@
 // Writing output files so that a failure never leaves a partial file behind.
 #include <filesystem>
 #include <functional>
+#include <initializer_list>
+#include <string_view>
 
 namespace facet {
 
 // Calls write(temporary_path) with a path in the same folder as `path`, then renames it onto
-// `path`. If write throws, the temporary file is removed and the exception propagates.
+// `path`. If write throws, the temporary file is removed and the exception propagates. A `path`
+// that exists and is not a regular file (a folder, a device such as /dev/null, a FIFO, a socket,
+// a symbolic link) is an InputError before anything is written: the rename would replace it.
 void write_atomically(const std::filesystem::path& path,
                       const std::function<void(const std::filesystem::path&)>& write);
+
+// InputError naming `out` and `flag` when `out` is the same file as one of `inputs` (after links
+// and relative paths): writing it would replace an input the command reads.
+void refuse_output_over_inputs(const std::filesystem::path& out, std::string_view flag,
+                               std::initializer_list<std::filesystem::path> inputs);
 
 }  // namespace facet
