@@ -14,6 +14,7 @@ extern "C" {
 
 #include "facet/projection/atomic_file.hpp"
 #include "facet/projection/errors.hpp"
+#include "facet/projection/input_file.hpp"
 
 namespace facet::calibration {
 
@@ -113,6 +114,7 @@ CameraModel::CameraModel(const std::string& lensmodel, std::vector<double> intri
 }
 
 CameraModel CameraModel::read(const std::filesystem::path& path) {
+  require_regular_file(path);
   std::ifstream stream(path);
   if (!stream) throw InputError(path.string(), "", "a readable mrcal .cameramodel file");
   std::stringstream buffer;

@@ -7,6 +7,7 @@
 #include "facet/calibration/image_io.hpp"
 #include "facet/projection/atomic_file.hpp"
 #include "facet/projection/errors.hpp"
+#include "facet/projection/input_file.hpp"
 #include "json_fields.hpp"
 
 namespace facet::calibration {
@@ -218,6 +219,7 @@ Capture read_capture(const std::filesystem::path& path) {
   const std::filesystem::path file =
       std::filesystem::is_directory(path, error) ? path / "capture.json" : path;
   const std::string source = file.string();
+  require_regular_file(file);
   std::ifstream stream(file);
   if (!stream) throw InputError(source, "", "a readable capture.json file");
   nlohmann::json root;

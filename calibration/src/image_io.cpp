@@ -11,6 +11,7 @@
 
 #include "facet/projection/atomic_file.hpp"
 #include "facet/projection/errors.hpp"
+#include "facet/projection/input_file.hpp"
 
 namespace facet::calibration {
 namespace {
@@ -24,10 +25,7 @@ OIIO::ImageSpec unassociated_config() {
 }
 
 std::unique_ptr<OIIO::ImageInput> open_image(const std::filesystem::path& path) {
-  std::error_code error;
-  if (!std::filesystem::is_regular_file(path, error)) {
-    throw InputError(path.string(), "", "an image file, but there is no such file");
-  }
+  require_regular_file(path);
   const OIIO::ImageSpec config = unassociated_config();
   auto input = OIIO::ImageInput::open(path.string(), &config);
   if (!input) {

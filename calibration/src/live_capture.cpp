@@ -9,6 +9,7 @@
 #include "facet/calibration/image_io.hpp"
 #include "facet/projection/atomic_file.hpp"
 #include "facet/projection/errors.hpp"
+#include "facet/projection/input_file.hpp"
 
 namespace facet::calibration {
 namespace {
@@ -89,6 +90,7 @@ struct Journal {
 };
 
 Journal read_journal(const fs::path& path) {
+  require_regular_file(path);
   std::ifstream stream(path, std::ios::binary);
   if (!stream) throw InputError(path.string(), "", "a readable capture journal");
   std::stringstream buffer;

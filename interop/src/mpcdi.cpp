@@ -16,6 +16,7 @@
 #include "facet/projection/atomic_file.hpp"
 #include "facet/projection/errors.hpp"
 #include "facet/projection/footprint.hpp"
+#include "facet/projection/input_file.hpp"
 #include "facet/projection/screen.hpp"
 #include "facet/projection/warp_inverse.hpp"
 #include "facet/projection_io/warp_file.hpp"
@@ -336,6 +337,7 @@ MpcdiFiles read_zip(std::string_view bytes, const std::string& source) {
 }
 
 MpcdiFiles read_zip_file(const std::filesystem::path& path) {
+  require_regular_file(path);
   std::ifstream stream(path, std::ios::binary);
   if (!stream) throw InputError(path.string(), "", "cannot open the file");
   std::ostringstream bytes;

@@ -13,6 +13,7 @@
 #include "facet/interop/inverse_grid.hpp"
 #include "facet/interop/mpcdi.hpp"
 #include "facet/projection/errors.hpp"
+#include "facet/projection/input_file.hpp"
 #include "facet/projection/warp_inverse.hpp"
 #include "facet/projection_io/blend_file.hpp"
 #include "facet/projection_io/warp_file.hpp"
@@ -24,6 +25,7 @@ namespace {
 
 std::string read_file(const std::filesystem::path& path, const std::string& source,
                       const std::string& field) {
+  require_regular_file(path);
   std::ifstream stream(path, std::ios::binary);
   if (!stream) throw InputError(source, field, "cannot open \"" + path.string() + "\"");
   std::ostringstream bytes;

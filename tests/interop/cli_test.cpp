@@ -1,9 +1,13 @@
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "facet/interop/mpcdi.hpp"
 #include "facet/interop/pfm.hpp"
@@ -22,10 +26,12 @@ struct CliRun {
   std::string output;
 };
 
-CliRun run(const std::string& arguments, const fs::path& scratch) {
+// Runs the CLI with `arguments`; with limit_s > 0, under timeout(1), which exits 124 on expiry.
+CliRun run(const std::string& arguments, const fs::path& scratch, int limit_s = 0) {
   const fs::path log = scratch / "cli.log";
+  const std::string limit = limit_s > 0 ? "timeout " + std::to_string(limit_s) + " " : "";
   const std::string command =
-      std::string(FACET_CLI) + " " + arguments + " > " + log.string() + " 2>&1";
+      limit + std::string(FACET_CLI) + " " + arguments + " > " + log.string() + " 2>&1";
   const int raw = std::system(command.c_str());
   std::ifstream stream(log);
   std::ostringstream text;
@@ -291,6 +297,40 @@ TEST(InteropCli, LookupOfADisplayWritesNothingWhenOneWarpIsBad) {
   EXPECT_EQ(r.status, 2) << r.output;
   EXPECT_NE(r.output.find("wall_r1c1.warp.exr"), std::string::npos) << r.output;
   EXPECT_FALSE(fs::exists(lookups));
+}
+
+// A FIFO where a file is expected blocked the reader until killed; every reader now refuses a
+// path that is not a regular file (require_regular_file). Each run is limited to 20 s by
+// timeout(1), whose status 124 would fail the test.
+TEST(InteropCli, InputsThatAreNotRegularFilesAreRefused) {
+  test::ScratchFolder scratch("cli-fifo");
+  const fs::path fifo_dir = scratch.path / "fifos";
+  fs::create_directories(fifo_dir);
+  const auto fifo = [&](const std::string& name) {
+    const fs::path path = fifo_dir / name;
+    EXPECT_EQ(::mkfifo(path.c_str(), 0600), 0) << path;
+    return path.string();
+  };
+  const std::string out = (scratch.path / "out").string();
+  const std::string folder = fifo_dir.string();
+  const std::vector<std::pair<std::string, std::string>> runs = {
+      {"lookup --warp " + fifo("a.warp.exr") + " --out " + out + ".exr", "a.warp.exr"},
+      {"lookup --display " + fifo("display.json") + " --out " + out, "display.json"},
+      {"mpcdi import " + fifo("a.mpcdi") + " --out " + out, "a.mpcdi"},
+      {"sgct import " + fifo("cluster.xml") + " --out " + out, "cluster.xml"},
+      {"sgct import " + fifo("mesh.sgc") + " --out " + out, "mesh.sgc"},
+      {"bourke import " + fifo("mesh.data") + " --out " + out, "mesh.data"},
+      {"error --warp " + fifo("b.warp.exr"), "b.warp.exr"},
+      {"calibrate " + fifo("capture.json") + " --out " + out, "capture.json"},
+      {"lookup --warp " + folder + " --out " + out + ".exr", "fifos"},
+  };
+  for (const auto& [arguments, named] : runs) {
+    const CliRun r = run(arguments, scratch.path, 20);
+    EXPECT_EQ(r.status, 2) << arguments << ": " << r.output;
+    EXPECT_NE(r.output.find(named), std::string::npos) << arguments << ": " << r.output;
+    EXPECT_FALSE(fs::exists(out)) << arguments;
+    EXPECT_FALSE(fs::exists(out + ".exr")) << arguments;
+  }
 }
 
 TEST(InteropCli, DevicesListsOrSaysThereAreNone) {

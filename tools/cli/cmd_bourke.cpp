@@ -7,6 +7,7 @@
 #include "display_flags.hpp"
 #include "facet/interop/bourke.hpp"
 #include "facet/projection/errors.hpp"
+#include "facet/projection/input_file.hpp"
 
 namespace facet::cli {
 namespace {
@@ -39,6 +40,7 @@ const Registration registration{
       import_command->add_option("--intensity-gamma", options->gamma,
                                  "Linear blend = intensity^gamma (default 2.2)");
       import_command->callback([options] {
+        require_regular_file(options->file);
         std::ifstream stream(options->file, std::ios::binary);
         if (!stream) throw InputError(options->file, "", "cannot open the file");
         std::ostringstream text;

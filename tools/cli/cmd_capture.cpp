@@ -25,6 +25,7 @@
 #include "facet/projection_io/rig_file.hpp"
 #if __has_include("facet/interop/usb_devices.hpp")
 #include "facet/interop/usb_devices.hpp"
+#include "facet/projection/input_file.hpp"
 #define FACET_CAPTURE_HAS_USB_IDS 1
 #endif
 
@@ -60,6 +61,7 @@ projection_io::DisplayConfig read_capture_display(const std::string& path_text) 
   fs::path path = path_text;
   std::error_code error;
   if (fs::is_directory(path, error)) path /= "display.json";
+  require_regular_file(path);
   std::ifstream stream(path);
   if (!stream) throw InputError(path.string(), "", "a readable display.json");
   nlohmann::json root;
@@ -80,6 +82,7 @@ projection_io::DisplayConfig read_capture_display(const std::string& path_text) 
 }
 
 void read_pose(const std::string& path, calibration::CaptureCamera& camera) {
+  require_regular_file(path);
   std::ifstream stream(path);
   if (!stream) throw InputError(path, "", "a readable camera pose file");
   nlohmann::json root;

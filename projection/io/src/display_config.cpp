@@ -6,6 +6,7 @@
 
 #include "facet/projection/atomic_file.hpp"
 #include "facet/projection/errors.hpp"
+#include "facet/projection/input_file.hpp"
 
 namespace facet::projection_io {
 namespace {
@@ -342,6 +343,7 @@ DisplayConfig read_display_config(const std::filesystem::path& path, bool check_
   std::error_code error;
   const std::filesystem::path file =
       std::filesystem::is_directory(path, error) ? path / "display.json" : path;
+  require_regular_file(file);
   std::ifstream stream(file);
   if (!stream) throw InputError(file.string(), "", "cannot open the file");
   json document;

@@ -8,6 +8,7 @@
 
 #include "facet/projection/atomic_file.hpp"
 #include "facet/projection/errors.hpp"
+#include "facet/projection/input_file.hpp"
 
 namespace facet {
 namespace {
@@ -317,6 +318,7 @@ Rig parse_rig(const std::string& text_in, const std::string& source) {
 }
 
 Rig read_rig(const std::filesystem::path& path) {
+  require_regular_file(path);
   std::ifstream stream(path);
   if (!stream) throw InputError(path.string(), "", "a readable rig JSON file");
   std::stringstream buffer;

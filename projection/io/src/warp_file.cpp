@@ -7,6 +7,7 @@
 
 #include "facet/projection/atomic_file.hpp"
 #include "facet/projection/errors.hpp"
+#include "facet/projection/input_file.hpp"
 
 namespace facet {
 namespace {
@@ -124,6 +125,7 @@ void base_from_json(const json& meta, const std::string& path, Warp& warp) {
 }  // namespace
 
 Warp read_warp(const std::string& path) {
+  require_regular_file(path);
   auto input = OIIO::ImageInput::open(path);
   if (!input) {
     throw InputError(path, "", "cannot open as an image: " + OIIO::geterror());
