@@ -1,5 +1,6 @@
 #include <algorithm>
 #include <cstring>
+#include <string>
 
 #include "facet/driver/render_method.hpp"
 #include "facet/projection/errors.hpp"
@@ -27,6 +28,18 @@ void set_draw_buffers(const Framebuffer& framebuffer) {
 
 OutputTarget OutputTarget::create(glm::ivec2 size, int msaa_samples) {
   FACET_ASSERT(size.x > 0 && size.y > 0);
+  // What the GL can hold, as an input error rather than an incomplete framebuffer.
+  GLint max_texture = 0, max_width = 0, max_height = 0;
+  glGetIntegerv(GL_MAX_TEXTURE_SIZE, &max_texture);
+  glGetIntegerv(GL_MAX_FRAMEBUFFER_WIDTH, &max_width);
+  glGetIntegerv(GL_MAX_FRAMEBUFFER_HEIGHT, &max_height);
+  const int max_x = std::min(max_texture, max_width), max_y = std::min(max_texture, max_height);
+  if (size.x > max_x || size.y > max_y) {
+    throw InputError("output", "size",
+                     "at most " + std::to_string(max_x) + "x" + std::to_string(max_y) +
+                         " pixels on this GL; got " + std::to_string(size.x) + "x" +
+                         std::to_string(size.y));
+  }
   OutputTarget target;
   target.size_ = size;
   target.msaa_samples_ = msaa_samples > 1 ? msaa_samples : 0;

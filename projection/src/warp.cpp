@@ -16,6 +16,16 @@ double cross(glm::dvec2 a, glm::dvec2 b) { return a.x * b.y - a.y * b.x; }
 
 }  // namespace
 
+void check_image_size(glm::ivec2 size, const std::string& source, const std::string& field) {
+  if (size.x < 1 || size.y < 1 || size.x > kMaxImageSide || size.y > kMaxImageSide ||
+      std::int64_t(size.x) * size.y > kMaxImagePixels) {
+    throw InputError(source, field,
+                     "a width and height from 1 to " + std::to_string(kMaxImageSide) + ", " +
+                         std::to_string(kMaxImagePixels) + " pixels in all; got " +
+                         std::to_string(size.x) + "x" + std::to_string(size.y));
+  }
+}
+
 Warp Warp::analytic(const BaseProjection& base, glm::ivec2 output_size, glm::ivec2 grid_size,
                     const glm::dmat3& R_eye_base) {
   Warp warp;
@@ -31,9 +41,7 @@ Warp Warp::analytic(const BaseProjection& base, glm::ivec2 output_size, glm::ive
 
 void Warp::validate(const std::string& source) const {
   base.validate(source);
-  if (output_size.x < 1 || output_size.y < 1) {
-    throw InputError(source, "output_size", "expected a positive width and height");
-  }
+  check_image_size(output_size, source, "output_size");
   if (grid_size.x < 2 || grid_size.y < 2) {
     throw InputError(source, "grid", "expected at least 2×2 nodes");
   }

@@ -333,6 +333,20 @@ TEST(InteropCli, InputsThatAreNotRegularFilesAreRefused) {
   }
 }
 
+TEST(InteropCli, AbsurdSizesAndGridsAreRefusedUpFront) {
+  test::ScratchFolder scratch("cli-sizes");
+  const std::string out = (scratch.path / "out").string();
+  for (const std::string& arguments :
+       {"display builtin:cylinder360 --size 100000x100000 --out " + out,
+        "display builtin:cylinder360 --size 16385x2 --out " + out,
+        "display builtin:wall2x2 --grid 65536x1 --out " + out,
+        std::string("error --base fisheye --size 9000x9000")}) {
+    const CliRun r = run(arguments, scratch.path, 20);
+    EXPECT_EQ(r.status, 2) << arguments << ": " << r.output;
+    EXPECT_FALSE(fs::exists(out)) << arguments;
+  }
+}
+
 TEST(InteropCli, DevicesListsOrSaysThereAreNone) {
   test::ScratchFolder scratch("cli-devices");
   CliRun r = run("devices", scratch.path);

@@ -160,5 +160,18 @@ TEST_F(WarpFile, FailedWriteLeavesNothingBehind) {
   EXPECT_TRUE(fs::is_empty(folder_));
 }
 
+TEST(Warp, SizesBeyondTheImageLimitsAreInputErrors) {
+  for (const glm::ivec2 size :
+       {glm::ivec2(0, 10), glm::ivec2(10, -1), glm::ivec2(kMaxImageSide + 1, 2),
+        glm::ivec2(2, kMaxImageSide + 1), glm::ivec2(8193, 8192)}) {
+    EXPECT_THROW(check_image_size(size, "test", "size"), InputError) << size.x << "x" << size.y;
+    EXPECT_THROW(Warp::analytic(BaseProjection::fisheye(180), size).validate("test"), InputError)
+        << size.x << "x" << size.y;
+  }
+  for (const glm::ivec2 size : {glm::ivec2(1, 1), glm::ivec2(kMaxImageSide, 4096),
+                                glm::ivec2(8192, 8192), glm::ivec2(7680, 4320)})
+    EXPECT_NO_THROW(check_image_size(size, "test", "size")) << size.x << "x" << size.y;
+}
+
 }  // namespace
 }  // namespace facet

@@ -4,6 +4,7 @@
 #include <vector>
 
 #include "facet/projection/errors.hpp"
+#include "facet/projection/warp.hpp"
 #include "facet/projection_io/warp_file.hpp"
 
 namespace facet::cli {
@@ -43,6 +44,7 @@ glm::ivec2 parse_size(const std::string& text, const std::string& flag) {
     throw InputError("command line", flag,
                      "expected WxH with positive integers; got '" + text + "'");
   }
+  check_image_size({w, h}, "command line", flag);
   return {w, h};
 }
 

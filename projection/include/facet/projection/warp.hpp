@@ -11,6 +11,16 @@
 
 namespace facet {
 
+// The largest image size facet accepts anywhere a WxH is given (outputs, cameras, node grids):
+// 16384 a side and 2^26 pixels (8192×8192) in all, beyond any projector or camera. A GL may
+// allow less for outputs (OutputTarget checks it).
+inline constexpr int kMaxImageSide = 16384;
+inline constexpr std::int64_t kMaxImagePixels = std::int64_t(1) << 26;
+
+// InputError naming `source` and `field` unless both sides are at least 1 and the size is within
+// kMaxImageSide and kMaxImagePixels.
+void check_image_size(glm::ivec2 size, const std::string& source, const std::string& field);
+
 struct Warp {
   BaseProjection base;
   glm::dmat3 R_eye_base{1.0};        // base-frame directions into the eye frame
