@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <numbers>
 #include <optional>
@@ -497,11 +498,20 @@ FacetMesh build_facets(const Warp& warp, const FacetBuildOptions& options) {
   warp.validate();
   if (const auto* strips = std::get_if<FacetStrips>(&options.layout)) {
     if (strips->count < 1) throw InputError({}, "pieces", "expected at least 1 strip");
+    if (strips->count > options.max_cells)
+      throw InputError({}, "pieces",
+                       "at most " + std::to_string(options.max_cells) + " strips; got " +
+                           std::to_string(strips->count));
     return assemble(warp, uniform_breaks(strips->count), uniform_breaks(1), kBuildSubdivisions);
   }
   if (const auto* grid = std::get_if<FacetGrid>(&options.layout)) {
     if (grid->columns < 1 || grid->rows < 1) {
       throw InputError({}, "grid", "expected at least 1×1 cells");
+    }
+    if (std::int64_t(grid->columns) * grid->rows > options.max_cells) {
+      throw InputError({}, "grid",
+                       "at most " + std::to_string(options.max_cells) + " cells; got " +
+                           std::to_string(grid->columns) + "x" + std::to_string(grid->rows));
     }
     return assemble(warp, uniform_breaks(grid->columns), uniform_breaks(grid->rows),
                     kBuildSubdivisions);
@@ -510,6 +520,32 @@ FacetMesh build_facets(const Warp& warp, const FacetBuildOptions& options) {
   const double tolerance = layout.px;
   if (!(tolerance > 0) || !std::isfinite(tolerance)) {
     throw InputError({}, "tolerance", "expected a positive number of pixels");
+  }
+  // Below kProbePx / 10 a tolerance is first checked against an estimate of the cells it needs,
+  // from a tensor build at kProbePx: a cell's error grows as the square of its size where the
+  // warp curves both ways, so its cells grow at most about as 1/tolerance. One that would need
+  // more than twice max_cells is refused before building (1e-9 px on the dome took 13 s and
+  // 2.7 GB to give up).
+  constexpr double kProbePx = 1.0;
+  std::optional<double> probe_cells;
+  if (tolerance < 0.1 * kProbePx) {
+    try {
+      probe_cells =
+          double(build_tolerance_layout(warp, kProbePx, options.max_cells).facets.size()) / 2;
+    } catch (const InputError&) {
+      // No estimate: the build below reports what it cannot meet.
+    }
+  }
+  if (probe_cells) {
+    const double estimate = *probe_cells * kProbePx / tolerance;
+    if (estimate > 2.0 * options.max_cells) {
+      char text[200];
+      std::snprintf(text, sizeof text,
+                    "a tolerance the facets can meet with at most %d cells; %g px needs about "
+                    "%.3g (%g at %g px)",
+                    options.max_cells, tolerance, estimate, *probe_cells, kProbePx);
+      throw InputError({}, "tolerance", text);
+    }
   }
   // The per-cell checks sample each cell alone; the mesh is then measured as a whole, as
   // evaluate_facet_error measures it (every covered direction against the facet that holds it,

@@ -102,6 +102,28 @@ TEST(Facets, ToleranceIsMetOnEveryBase) {
   }
 }
 
+// Layouts that would need more than max_cells are refused before the build, quickly: a tiny
+// tolerance by its estimate from a 1 px build, grids and strips by their count.
+TEST(Facets, LayoutsBeyondTheCellCapAreRefusedBeforeBuilding) {
+  const Warp dome = Warp::analytic(BaseProjection::fisheye(180), {512, 512});
+  FacetBuildOptions options;
+  options.max_cells = 4096;
+  for (const FacetLayout& layout :
+       {FacetLayout(FacetTolerance{1e-9}), FacetLayout(FacetTolerance{1e-4}),
+        FacetLayout(FacetGrid{65536, 1}), FacetLayout(FacetGrid{100, 100}),
+        FacetLayout(FacetStrips{5000})}) {
+    options.layout = layout;
+    EXPECT_THROW(build_facets(dome, options), InputError) << layout.index();
+  }
+  // Within the cap they build: 1 px needs 240 cells here, 0.08 px (estimated from them) about
+  // 3,000.
+  options.layout = FacetTolerance{0.08};
+  const FacetMesh mesh = build_facets(dome, options);
+  EXPECT_LE(mesh.facets.size(), 2u * 4096u);
+  options.layout = FacetGrid{64, 64};
+  EXPECT_NO_THROW(build_facets(dome, options));
+}
+
 TEST(Facets, PerspectiveBaseIsExactWithTwoFacets) {
   const Warp warp = Warp::analytic(BaseProjection::perspective_fov(120, 90), {1920, 1080});
   const FacetMesh mesh = build_facets(warp, {FacetTolerance{0.05}});
