@@ -550,9 +550,10 @@ TEST(Pipeline, HostileTrianglesAreStable) {
       RenderSettings settings;
       settings.cull_back_faces = false;
       const Rendered r = render(method, scene, outputs, settings, glm::dmat4(1.0));
-      for (std::uint32_t id : r.ids[0]) ASSERT_LE(id, 5u) << method;
+      const std::string where = std::string(method) + " on " + outputs[0].name;
+      for (std::uint32_t id : r.ids[0]) ASSERT_LE(id, 5u) << where;
       // The huge ground (ID 3) fills the lower half of the cylinder at least partly.
-      EXPECT_GT(count_value(r.ids[0], 3), 0u) << method;
+      EXPECT_GT(count_value(r.ids[0], 3), 0u) << where;
     }
   }
 }
