@@ -12,7 +12,7 @@ void require_regular_file(const std::filesystem::path& path) {
   std::error_code error;
   const fs::file_status status = fs::status(path, error);
   if (fs::is_regular_file(status)) return;
-  const char* what = !fs::exists(status)       ? "there is no such file"
+  const char* what = !fs::exists(status)        ? "there is no such file"
                      : fs::is_directory(status) ? "it is a folder"
                      : fs::is_fifo(status)      ? "it is a FIFO"
                      : fs::is_socket(status)    ? "it is a socket"

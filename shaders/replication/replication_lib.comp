@@ -210,15 +210,15 @@ bool triangle_may_cover(vec3 p[3]) {
   return abs(facing) > 1e-6 * length(normal) * scale;
 }
 
-// The piece that draws facet f (FacetPieces::piece_of_facet, at the grid's header word 22).
 // The coverage grid (pack_coverage_grid): one R32UI buffer texture.
 layout(binding = 15) uniform usamplerBuffer grid_texels;
 uint grid_word(uint i) { return texelFetch(grid_texels, int(i)).x; }
+// The piece that draws facet f (FacetPieces::piece_of_facet, from the grid's header word 22).
 uint piece_of_facet(uint f) { return grid_word(grid_word(22) + f); }
 
 // Walks the facets that triangle p may cover, in the hierarchy's fixed order, and returns how
-// many there are. When pair_base != kNone, writes uvec2(t, piece of the facet) to
-// pairs[pair_base + k] for the k-th (through write_pair). When wanted != kNone, stops at the
+// many there are. When pair_base != kNone, hands the k-th facet's piece to
+// write_pair(pair_base + k, t, piece), which the calling stage defines. When wanted != kNone, stops at the
 // wanted-th facet and returns its piece in wanted_facet (kNone when there are fewer). A quad's two
 // facets both write it, and pass 3 draws it twice with the same depths.
 void write_pair(uint at, uint t, uint facet);
