@@ -1,11 +1,34 @@
 #include "facet/driver/gpu_timer.hpp"
 
+#include <chrono>
+
+#include "facet/driver/gpu_scene.hpp"
 #include "facet/projection/errors.hpp"
 
 namespace facet::driver {
+namespace {
+
+std::int64_t steady_ns() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(
+             std::chrono::steady_clock::now().time_since_epoch())
+      .count();
+}
+
+}  // namespace
+
+GpuTimer::GpuTimer(Clock clock)
+    : wall_clock_(clock == Clock::wall_clock ||
+                  (clock == Clock::automatic && is_software_renderer())) {}
 
 void GpuTimer::begin(std::string_view pass) {
   FACET_ASSERT(!in_pass_);
+  in_pass_ = true;
+  if (wall_clock_) {
+    glFinish();
+    open_frame_.push_back({std::string(pass), Query{}, 0});
+    wall_begin_ns_ = steady_ns();
+    return;
+  }
   Query query;
   if (!free_.empty()) {
     query = std::move(free_.back());
@@ -14,14 +37,18 @@ void GpuTimer::begin(std::string_view pass) {
     query = Query::create(GL_TIME_ELAPSED);
   }
   glBeginQuery(GL_TIME_ELAPSED, query.id());
-  open_frame_.push_back({std::string(pass), std::move(query)});
-  in_pass_ = true;
+  open_frame_.push_back({std::string(pass), std::move(query), 0});
 }
 
 void GpuTimer::end() {
   FACET_ASSERT(in_pass_);
-  glEndQuery(GL_TIME_ELAPSED);
   in_pass_ = false;
+  if (wall_clock_) {
+    glFinish();
+    open_frame_.back().milliseconds = double(steady_ns() - wall_begin_ns_) * 1e-6;
+    return;
+  }
+  glEndQuery(GL_TIME_ELAPSED);
 }
 
 void GpuTimer::end_frame() {
@@ -33,12 +60,16 @@ void GpuTimer::end_frame() {
 std::optional<std::vector<PassTime>> GpuTimer::poll(bool wait) {
   if (frames_.empty()) return std::nullopt;
   auto& frame = frames_.front();
-  if (!wait)
+  if (!wait && !wall_clock_)
     for (const auto& pending : frame)
       if (!pending.query.available()) return std::nullopt;
   std::vector<PassTime> times;
   times.reserve(frame.size());
   for (auto& pending : frame) {
+    if (wall_clock_) {
+      times.push_back({std::move(pending.pass), pending.milliseconds});
+      continue;
+    }
     times.push_back({std::move(pending.pass), static_cast<double>(pending.query.result()) * 1e-6});
     free_.push_back(std::move(pending.query));
   }

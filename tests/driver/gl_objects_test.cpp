@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include <chrono>
+#include <thread>
 #include <type_traits>
 
 #include "facet/driver/gpu_timer.hpp"
@@ -160,33 +162,52 @@ TEST(GpuTimer, ReportsEveryPassOfAFrame) {
   Framebuffer fbo = Framebuffer::create();
   fbo.attach(GL_COLOR_ATTACHMENT0, colour);
   glBindFramebuffer(GL_FRAMEBUFFER, fbo.id());
-  GpuTimer timer;
-  for (int frame = 0; frame < 2; ++frame) {
-    {
-      auto pass = timer.scope("clear");
-      glClearColor(0.1f, 0.2f, 0.3f, 1.0f);
-      glClear(GL_COLOR_BUFFER_BIT);
+  for (const GpuTimer::Clock clock : {GpuTimer::Clock::queries, GpuTimer::Clock::wall_clock}) {
+    SCOPED_TRACE(clock == GpuTimer::Clock::queries ? "queries" : "wall clock");
+    GpuTimer timer(clock);
+    for (int frame = 0; frame < 2; ++frame) {
+      {
+        auto pass = timer.scope("clear");
+        glClearColor(0.1f, 0.2f, 0.3f, 1.0f);
+        glClear(GL_COLOR_BUFFER_BIT);
+      }
+      timer.begin("flush");
+      glFlush();
+      timer.end();
+      timer.end_frame();
     }
-    timer.begin("flush");
-    glFlush();
-    timer.end();
-    timer.end_frame();
+    EXPECT_EQ(timer.pending_frames(), 2u);
+    for (int frame = 0; frame < 2; ++frame) {
+      const auto times = timer.poll(true);
+      ASSERT_TRUE(times.has_value());
+      ASSERT_EQ(times->size(), 2u);
+      EXPECT_EQ((*times)[0].pass, "clear");
+      EXPECT_EQ((*times)[1].pass, "flush");
+      for (const auto& t : *times) EXPECT_GE(t.milliseconds, 0.0);
+    }
+    EXPECT_FALSE(timer.poll(true).has_value());
   }
-  EXPECT_EQ(timer.pending_frames(), 2u);
-  for (int frame = 0; frame < 2; ++frame) {
-    const auto times = timer.poll(true);
-    ASSERT_TRUE(times.has_value());
-    ASSERT_EQ(times->size(), 2u);
-    EXPECT_EQ((*times)[0].pass, "clear");
-    EXPECT_EQ((*times)[1].pass, "flush");
-    for (const auto& t : *times) EXPECT_GE(t.milliseconds, 0.0);
-  }
-  EXPECT_FALSE(timer.poll(true).has_value());
   const auto t0 = GpuTimer::timestamp_ns();
   const auto t1 = GpuTimer::timestamp_ns();
   EXPECT_GE(t1, t0);
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
   check_gl_error("ReportsEveryPassOfAFrame");
+}
+
+// The wall clock spans the whole pass, including what the CPU does inside it: a pass that sleeps
+// 20 ms reports at least 20 ms (a lower bound, which no load on the machine can break).
+TEST(GpuTimer, WallClockSpansThePass) {
+  test::shared_context();
+  GpuTimer timer(GpuTimer::Clock::wall_clock);
+  {
+    auto pass = timer.scope("sleep");
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  timer.end_frame();
+  const auto times = timer.poll(false);  // ready at once: nothing is left to query
+  ASSERT_TRUE(times.has_value());
+  ASSERT_EQ(times->size(), 1u);
+  EXPECT_GE((*times)[0].milliseconds, 20.0);
 }
 
 }  // namespace

@@ -1,6 +1,9 @@
 #pragma once
 // Per-pass GPU timings from GL_TIME_ELAPSED queries, read back frames later so that timing never
-// stalls the pipeline.
+// stalls the pipeline. On a software rasterizer (is_software_renderer) the queries do not time the
+// work (llvmpipe's report seconds for a millisecond's pass), so there each pass is timed by the
+// wall clock between a glFinish at its begin and one at its end: the CPU is the GPU there, and a
+// pass's time is the time its work takes.
 //
 //   GpuTimer timer;
 //   { auto t = timer.scope("pass1 coverage"); ... }   // or begin("...") / end()
@@ -27,7 +30,12 @@ struct PassTime {
 
 class GpuTimer {
  public:
-  GpuTimer() = default;
+  enum class Clock {
+    automatic,   // queries on a GPU, the wall clock on a software rasterizer
+    queries,     // GL_TIME_ELAPSED
+    wall_clock,  // glFinish, then the wall clock, at each begin and end
+  };
+  explicit GpuTimer(Clock clock = Clock::automatic);
   GpuTimer(GpuTimer&&) noexcept = default;
   GpuTimer& operator=(GpuTimer&&) noexcept = default;
 
@@ -65,8 +73,11 @@ class GpuTimer {
  private:
   struct Pending {
     std::string pass;
-    Query query;
+    Query query;              // queries only
+    double milliseconds = 0;  // wall clock only, set by end()
   };
+  bool wall_clock_ = false;
+  std::int64_t wall_begin_ns_ = 0;
   std::vector<Pending> open_frame_;
   std::deque<std::vector<Pending>> frames_;
   std::vector<Query> free_;  // finished queries, reused instead of recreated
