@@ -22,9 +22,9 @@ namespace facet::driver::detail {
 namespace {
 
 constexpr GLuint kLocalSize = 64;
-// The walk queue's header: the walk pass's indirect dispatch (x, y, z), then the queue's length
+// A queue's header: its pass's indirect dispatch (x, y, z), then the queue's length
 // (replication/count.comp).
-constexpr std::size_t kWalkQueueHeaderWords = 4;
+constexpr std::size_t kQueueHeaderWords = 4;
 
 class FacetPipeline final : public FacetMethodBase {
  public:
@@ -35,6 +35,7 @@ class FacetPipeline final : public FacetMethodBase {
     FacetMethodBase::prepare(scene, gpu_scene, outputs, settings);
     if (!count_) {
       count_ = link_replication_program({"replication/count.comp"});
+      grid_ = link_replication_program({"replication/count.comp"}, {{"GRID_PASS", "1"}});
       walk_ = link_replication_program({"replication/count.comp"}, {{"WALK_PASS", "1"}});
       // Eight triangles walked side by side per SIMD row, where every triangle walks: the walk
       // pass's one per work group took 806 ms a cylinder frame (400x300, 0.25 px), this 160.
@@ -108,8 +109,8 @@ class FacetPipeline final : public FacetMethodBase {
     const std::uint32_t n = out.triangles;
     ensure_capacity(out.scan, (std::size_t(n) + 1) * sizeof(std::uint32_t));
     ensure_capacity(out.stage_offsets, std::max<std::size_t>(n, 1) * sizeof(std::uint32_t));
-    ensure_capacity(out.walk_queue,
-                    (kWalkQueueHeaderWords + std::size_t(n)) * sizeof(std::uint32_t));
+    for (Buffer* queue : {&out.grid_queue, &out.walk_queue})
+      ensure_capacity(*queue, (kQueueHeaderWords + std::size_t(n)) * sizeof(std::uint32_t));
     if (out.pair_capacity == 0) out.pair_capacity = std::max<std::uint32_t>(n, 4096);
     ensure_capacity(out.staged, staged_words(out.pair_capacity) * sizeof(std::uint32_t));
     ensure_capacity(out.pairs, std::size_t(out.pair_capacity) * sizeof(GpuReplica));
@@ -118,7 +119,8 @@ class FacetPipeline final : public FacetMethodBase {
       TimedPass scope(timer, "pass1 coverage");
       const std::uint32_t zero[4] = {0, 0, 0, 0};
       out.stats.sub_data(0, sizeof zero, zero);
-      const std::uint32_t empty_queue[kWalkQueueHeaderWords] = {0, 0, 1, 0};
+      const std::uint32_t empty_queue[kQueueHeaderWords] = {0, 0, 1, 0};
+      out.grid_queue.sub_data(0, sizeof empty_queue, empty_queue);
       out.walk_queue.sub_data(0, sizeof empty_queue, empty_queue);
       bind_output(i);
       const Program& first = settings_.coverage == FacetCoverage::walk ? count_walk_ : count_;
@@ -126,10 +128,14 @@ class FacetPipeline final : public FacetMethodBase {
       first.use();
       glDispatchCompute((n + 1 + kLocalSize - 1) / kLocalSize, 1, 1);
       glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_COMMAND_BARRIER_BIT);
-      set_list_uniforms(walk_, i);
-      walk_.use();
-      glBindBuffer(GL_DISPATCH_INDIRECT_BUFFER, out.walk_queue.id());
-      glDispatchComputeIndirect(0);
+      for (const auto& [program, queue] :
+           {std::pair{&grid_, &out.grid_queue}, std::pair{&walk_, &out.walk_queue}}) {
+        set_list_uniforms(*program, i);
+        program->use();
+        glBindBuffer(GL_DISPATCH_INDIRECT_BUFFER, queue->id());
+        glDispatchComputeIndirect(0);
+        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_COMMAND_BARRIER_BIT);
+      }
       glBindBuffer(GL_DISPATCH_INDIRECT_BUFFER, 0);
     }
     TimedPass scope(timer, "pass2 replicate");
@@ -168,7 +174,7 @@ class FacetPipeline final : public FacetMethodBase {
   friend std::vector<std::vector<std::uint32_t>> facet::driver::gpu_triangle_coverage(
       const Warp&, const RenderSettings&, const std::vector<std::array<glm::vec3, 3>>&);
 
-  Program count_, walk_, count_walk_, scatter_, args_, draw_;
+  Program count_, grid_, walk_, count_walk_, scatter_, args_, draw_;
   PrefixScan scan_;
 };
 

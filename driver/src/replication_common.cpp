@@ -190,6 +190,7 @@ void FacetMethodBase::bind_output(std::size_t i) const {
   if (out.stage_offsets)
     out.stage_offsets.bind_base(GL_SHADER_STORAGE_BUFFER, binding::stage_offsets);
   if (out.walk_queue) out.walk_queue.bind_base(GL_SHADER_STORAGE_BUFFER, binding::walk_queue);
+  if (out.grid_queue) out.grid_queue.bind_base(GL_SHADER_STORAGE_BUFFER, binding::grid_queue);
   if (out.draw_args) out.draw_args.bind_base(GL_SHADER_STORAGE_BUFFER, binding::draw_args);
 }
 
@@ -216,7 +217,7 @@ std::uint64_t FacetMethodBase::buffer_bytes(const OutputState& out) const {
       set.facets.size() + set.nodes.size() + set.order.size() + set.grid_words.size();
   for (const Buffer* b :
        {&out.list_buffer, &out.ranges_buffer, &out.scan, &out.pairs, &out.stats, &out.draw_args,
-        &out.draw_counts, &out.staged, &out.stage_offsets, &out.walk_queue})
+        &out.draw_counts, &out.staged, &out.stage_offsets, &out.grid_queue, &out.walk_queue})
     bytes += b->size();
   return bytes;
 }

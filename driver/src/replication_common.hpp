@@ -96,8 +96,9 @@ class FacetMethodBase : public RenderMethod {
     Buffer draw_counts;
     std::uint32_t draws_per_material = 1, replicas_per_draw = 1;
     // Pass 1's facets per triangle (facets only), and where each triangle's run starts; the
-    // triangles the grid pass leaves to the walk pass (its dispatch and count, then the list).
-    Buffer staged, stage_offsets, walk_queue;
+    // triangles the cull pass leaves to the grid pass, and those the grid pass leaves to the walk
+    // pass (each queue: its pass's indirect dispatch and count, then the list triangles).
+    Buffer staged, stage_offsets, grid_queue, walk_queue;
     std::uint32_t pair_capacity = 0;  // pairs that pairs and staged hold
     bool replication_valid = false;
     std::uint64_t replicas = 0, visible = 0;

@@ -42,7 +42,7 @@ namespace binding {
 inline constexpr GLuint indices = pulling::indices_binding, nodes = 7, order = 8, scan = 10,
                         pairs = 11, stats = 12, material_ranges = 13, draw_args = 14,
                         block_sums = 15, staged = 17, stage_offsets = 18, draw_counts = 19,
-                        walk_queue = 20;
+                        walk_queue = 20, grid_queue = 21;
 }  // namespace binding
 
 // What pass 3 draws: pieces. Piece f < F is facet f of the mesh (F facets); piece F + k, a quad,
