@@ -13,7 +13,9 @@
 namespace facet::calibration {
 namespace {
 
-using detail::JsonContext;
+using json_fields::Fields;
+using json_fields::Json;
+using JsonContext = json_fields::FieldPath;
 
 bool valid_name(const std::string& name) {
   if (name.empty() || name.front() == '.' || name.size() > 128) return false;
@@ -42,50 +44,49 @@ void check_rotation(const glm::dmat3& R, const JsonContext& at) {
 
 bool is_unit(const glm::dvec3& v) { return std::abs(glm::length(v) - 1.0) <= 1e-6; }
 
-Screen screen_from_json(const nlohmann::json& object, const JsonContext& at) {
-  using namespace detail;
-  require_object(object, at);
+Screen screen_from_json(const Json& object, const JsonContext& at) {
+  using namespace json_fields;
+  Fields fields(object, at);
   const std::string expected_type = "\"sphere\", \"cylinder\" or \"plane\"";
-  const std::string type =
-      to_string(require_member(object, "type", at, expected_type), at.at("type"));
+  const std::string type = to_string(fields.required("type", expected_type), at["type"]);
   Screen screen;
+  auto read_point = [&](const std::string& key) {
+    return to_dvec3(fields.required(key, "a point in metres"), at[key]);
+  };
   auto read_radius = [&] {
-    const double radius = to_number(
-        require_member(object, "radius", at, "a positive number of metres"), at.at("radius"));
-    if (!(radius > 0)) at.at("radius").fail("a positive number of metres");
+    const double radius =
+        to_number(fields.required("radius", "a positive number of metres"), at["radius"]);
+    if (!(radius > 0)) at["radius"].fail("a positive number of metres", radius);
     return radius;
   };
   auto read_unit = [&](const std::string& key) {
-    const glm::dvec3 v =
-        to_dvec3(require_member(object, key, at, "a list of 3 numbers"), at.at(key));
+    const glm::dvec3 v = to_dvec3(fields.required(key, "a list of 3 numbers"), at[key]);
     const double length = glm::length(v);
-    if (!(length > 1e-12)) at.at(key).fail("a non-zero vector");
+    if (!(length > 1e-12)) at[key].fail("a non-zero vector");
     return v / length;
   };
   if (type == "sphere") {
     screen.type = Screen::Type::sphere;
-    screen.center =
-        to_dvec3(require_member(object, "center", at, "a point in metres"), at.at("center"));
+    screen.center = read_point("center");
     screen.radius = read_radius();
   } else if (type == "cylinder") {
     screen.type = Screen::Type::cylinder;
-    screen.center =
-        to_dvec3(require_member(object, "center", at, "a point in metres"), at.at("center"));
+    screen.center = read_point("center");
     screen.axis = read_unit("axis");
     screen.radius = read_radius();
   } else if (type == "plane") {
     screen.type = Screen::Type::plane;
-    screen.point =
-        to_dvec3(require_member(object, "point", at, "a point in metres"), at.at("point"));
+    screen.point = read_point("point");
     screen.normal = read_unit("normal");
   } else {
-    at.at("type").fail(expected_type);
+    at["type"].fail(expected_type, type);
   }
+  fields.finish();
   return screen;
 }
 
 nlohmann::json screen_to_json(const Screen& screen) {
-  using detail::from_dvec3;
+  using json_fields::from_dvec3;
   switch (screen.type) {
     case Screen::Type::sphere:
       return {{"type", "sphere"}, {"center", from_dvec3(screen.center)}, {"radius", screen.radius}};
@@ -102,180 +103,180 @@ nlohmann::json screen_to_json(const Screen& screen) {
   FACET_ASSERT(false);
 }
 
-CaptureProjector projector_from_json(const nlohmann::json& object, const JsonContext& at) {
-  using namespace detail;
-  require_object(object, at);
+CaptureProjector projector_from_json(const Json& object, const JsonContext& at) {
+  using namespace json_fields;
+  Fields fields(object, at);
   CaptureProjector projector;
-  projector.name = to_string(require_member(object, "name", at, "a name"), at.at("name"));
-  const auto& size = require_member(object, "size", at, "[width, height] in projector pixels");
-  if (!size.is_array() || size.size() != 2) {
-    at.at("size").fail("[width, height] in projector pixels");
-  }
-  projector.size = {to_int(size[0], at.at("size").at(0)), to_int(size[1], at.at("size").at(1))};
-  if (const auto* gamma = find_member(object, "gamma")) {
-    projector.gamma = to_number(*gamma, at.at("gamma"));
-  }
-  const auto& frames = require_member(object, "frames", at, "a list of frames");
-  if (!frames.is_array()) at.at("frames").fail("a list of frames");
+  projector.name = to_string(fields.required("name", "a name"), at["name"]);
+  const std::string expected_size = "[width, height] in projector pixels";
+  projector.size = to_ivec2(fields.required("size", expected_size), at["size"], expected_size);
+  if (const Json* gamma = fields.present("gamma")) projector.gamma = to_number(*gamma, at["gamma"]);
+  const Json& frames = fields.required("frames", "a list of frames");
+  if (!frames.is_array()) at["frames"].fail("a list of frames", frames);
   for (std::size_t k = 0; k < frames.size(); ++k) {
-    const JsonContext frame_at = at.at("frames").at(k);
-    require_object(frames[k], frame_at);
+    const JsonContext frame_at = at["frames"][k];
+    Fields frame_fields(frames[k], frame_at);
     CaptureFrame frame;
-    frame.file = to_string(require_member(frames[k], "file", frame_at, "an image file name"),
-                           frame_at.at("file"));
-    frame.pattern =
-        pattern_from_json(require_member(frames[k], "pattern", frame_at, "a pattern object"),
-                          at.source, frame_at.member("pattern"));
+    frame.file = to_string(frame_fields.required("file", "an image file name"), frame_at["file"]);
+    frame.pattern = pattern_from_json(frame_fields.required("pattern", "a pattern object"),
+                                      at.source(), frame_at["pattern"].field());
+    frame_fields.finish();
     projector.frames.push_back(std::move(frame));
   }
+  fields.finish();
   return projector;
 }
 
 }  // namespace
 
 void validate_capture(const Capture& capture, const std::string& source) {
-  const JsonContext root{source, ""};
-  check_relative_path(capture.camera.model, root.at("camera").at("model"));
-  check_rotation(capture.camera.R_eye_camera, root.at("camera").at("R_eye_camera"));
+  const JsonContext root(source);
+  check_relative_path(capture.camera.model, root["camera"]["model"]);
+  check_rotation(capture.camera.R_eye_camera, root["camera"]["R_eye_camera"]);
   for (int i = 0; i < 3; ++i) {
     if (!std::isfinite(capture.camera.t_eye_camera[i])) {
-      root.at("camera").at("t_eye_camera").fail("a list of 3 finite numbers");
+      root["camera"]["t_eye_camera"].fail("a list of 3 finite numbers");
     }
   }
   if (!(capture.camera.gamma > 0) || !std::isfinite(capture.camera.gamma)) {
-    root.at("camera").at("gamma").fail("a positive number");
+    root["camera"]["gamma"].fail("a positive number");
   }
   if (capture.camera.t_eye_camera != glm::dvec3(0.0) && !capture.screen) {
-    root.at("screen").fail(
+    root["screen"].fail(
         "a screen description: the camera is not at the eye point (t_eye_camera is not 0), so "
         "directions from the eye need the surface");
   }
   if (capture.screen) {
     const Screen& screen = *capture.screen;
-    const JsonContext at = root.at("screen");
+    const JsonContext at = root["screen"];
     if (screen.type != Screen::Type::plane && !(screen.radius > 0)) {
-      at.at("radius").fail("a positive number of metres");
+      at["radius"].fail("a positive number of metres");
     }
     if (screen.type == Screen::Type::cylinder && !is_unit(screen.axis)) {
-      at.at("axis").fail("a unit vector");
+      at["axis"].fail("a unit vector");
     }
     if (screen.type == Screen::Type::plane && !is_unit(screen.normal)) {
-      at.at("normal").fail("a unit vector");
+      at["normal"].fail("a unit vector");
     }
   }
-  if (capture.projectors.empty()) root.at("projectors").fail("a non-empty list of projectors");
+  if (capture.projectors.empty()) root["projectors"].fail("a non-empty list of projectors");
   std::set<std::string> names;
   for (std::size_t p = 0; p < capture.projectors.size(); ++p) {
     const CaptureProjector& projector = capture.projectors[p];
-    const JsonContext at = root.at("projectors").at(p);
+    const JsonContext at = root["projectors"][p];
     if (!valid_name(projector.name)) {
-      at.at("name").fail(
+      at["name"].fail(
           "a name of letters, digits, '_', '-' and '.' that does not start with '.' (it names "
           "files)");
     }
     if (!names.insert(projector.name).second) {
-      at.at("name").fail("a name no other projector has, but '" + projector.name + "' repeats");
+      at["name"].fail("a name no other projector has, but '" + projector.name + "' repeats");
     }
     if (projector.size.x < 1 || projector.size.y < 1 || projector.size.x > 65536 ||
         projector.size.y > 65536) {
-      at.at("size").fail("[width, height], each from 1 to 65536");
+      at["size"].fail("[width, height], each from 1 to 65536");
     }
     if (!(projector.gamma > 0) || !std::isfinite(projector.gamma)) {
-      at.at("gamma").fail("a positive number");
+      at["gamma"].fail("a positive number");
     }
-    if (projector.frames.empty()) at.at("frames").fail("a non-empty list of frames");
+    if (projector.frames.empty()) at["frames"].fail("a non-empty list of frames");
     std::set<std::string> seen;
     for (std::size_t k = 0; k < projector.frames.size(); ++k) {
       const CaptureFrame& frame = projector.frames[k];
-      const JsonContext frame_at = at.at("frames").at(k);
-      check_relative_path(frame.file, frame_at.at("file"));
+      const JsonContext frame_at = at["frames"][k];
+      check_relative_path(frame.file, frame_at["file"]);
       const Pattern& pattern = frame.pattern;
       if (pattern.type == PatternType::gray) {
         const int axis_size = pattern.axis == Axis::x ? projector.size.x : projector.size.y;
         const int bits = gray_bits(axis_size);
         if (pattern.bit < 0 || pattern.bit >= bits) {
-          frame_at.at("pattern").at("bit").fail("a bit from 0 to " + std::to_string(bits - 1) +
-                                                " (ceil(log2(" + std::to_string(axis_size) +
-                                                ")) bits identify every pixel of this axis)");
+          frame_at["pattern"]["bit"].fail("a bit from 0 to " + std::to_string(bits - 1) +
+                                          " (ceil(log2(" + std::to_string(axis_size) +
+                                          ")) bits identify every pixel of this axis)");
         }
       }
       if (pattern.type == PatternType::phase &&
           (!(pattern.period > 0) || pattern.steps < 3 || pattern.step < 0 ||
            pattern.step >= pattern.steps)) {
-        frame_at.at("pattern").fail(
-            "a phase pattern with period > 0, steps >= 3, 0 <= step < steps");
+        frame_at["pattern"].fail("a phase pattern with period > 0, steps >= 3, 0 <= step < steps");
       }
       if (!seen.insert(pattern_to_json(pattern).dump()).second) {
-        frame_at.at("pattern").fail("a pattern that no other frame of this projector shows");
+        frame_at["pattern"].fail("a pattern that no other frame of this projector shows");
       }
     }
   }
-  if (capture.truth) check_relative_path(*capture.truth, root.at("truth"));
+  if (capture.truth) check_relative_path(*capture.truth, root["truth"]);
 }
 
 Capture read_capture(const std::filesystem::path& path) {
-  using namespace detail;
+  using namespace json_fields;
   std::error_code error;
   const std::filesystem::path file =
       std::filesystem::is_directory(path, error) ? path / "capture.json" : path;
   const std::string source = file.string();
-  require_regular_file(file);
-  std::ifstream stream(file);
-  if (!stream) throw InputError(source, "", "a readable capture.json file");
-  nlohmann::json root;
-  try {
-    root = nlohmann::json::parse(stream);
-  } catch (const nlohmann::json::parse_error& parse_error) {
-    throw InputError(source, "", std::string("valid JSON (") + parse_error.what() + ")");
-  }
-  const JsonContext at{source, ""};
-  require_object(root, at);
-  const auto& format =
-      require_member(root, "format", at, std::string("\"") + kCaptureFormat + "\"");
+  const Json root = parse_file(file);
+  const JsonContext at(source);
+  Fields fields(root, at);
+  const std::string expected_format = std::string("\"") + kCaptureFormat + "\"";
+  const Json& format = fields.required("format", expected_format);
   if (!format.is_string() || format.get<std::string>() != kCaptureFormat) {
-    at.at("format").fail(std::string("\"") + kCaptureFormat + "\"");
+    at["format"].fail(expected_format, format);
   }
 
   Capture capture;
   capture.folder = file.parent_path();
-  const JsonContext camera_at = at.at("camera");
-  const auto& camera =
-      require_object(require_member(root, "camera", at, "a camera object"), camera_at);
+  const JsonContext camera_at = at["camera"];
+  Fields camera(fields.required("camera", "a camera object"), camera_at);
   capture.camera.model =
-      to_string(require_member(camera, "model", camera_at, "an mrcal .cameramodel file"),
-                camera_at.at("model"));
-  if (const auto* R = find_member(camera, "R_eye_camera")) {
-    capture.camera.R_eye_camera = to_dmat3(*R, camera_at.at("R_eye_camera"));
+      to_string(camera.required("model", "an mrcal .cameramodel file"), camera_at["model"]);
+  if (const Json* R = camera.present("R_eye_camera")) {
+    capture.camera.R_eye_camera = to_dmat3(*R, camera_at["R_eye_camera"]);
   }
-  if (const auto* t = find_member(camera, "t_eye_camera")) {
-    capture.camera.t_eye_camera = to_dvec3(*t, camera_at.at("t_eye_camera"));
+  if (const Json* t = camera.present("t_eye_camera")) {
+    capture.camera.t_eye_camera = to_dvec3(*t, camera_at["t_eye_camera"]);
   }
-  if (const auto* gamma = find_member(camera, "gamma")) {
-    capture.camera.gamma = to_number(*gamma, camera_at.at("gamma"));
+  if (const Json* gamma = camera.present("gamma")) {
+    capture.camera.gamma = to_number(*gamma, camera_at["gamma"]);
   }
-  if (const auto* screen = find_member(root, "screen"); screen != nullptr && !screen->is_null()) {
-    capture.screen = screen_from_json(*screen, at.at("screen"));
+  camera.finish();
+  if (const Json* screen = fields.optional("screen")) {
+    capture.screen = screen_from_json(*screen, at["screen"]);
   }
-  const auto& projectors = require_member(root, "projectors", at, "a list of projectors");
-  if (!projectors.is_array()) at.at("projectors").fail("a list of projectors");
+  const Json& projectors = fields.required("projectors", "a list of projectors");
+  if (!projectors.is_array()) at["projectors"].fail("a list of projectors", projectors);
   for (std::size_t p = 0; p < projectors.size(); ++p) {
-    capture.projectors.push_back(projector_from_json(projectors[p], at.at("projectors").at(p)));
+    capture.projectors.push_back(projector_from_json(projectors[p], at["projectors"][p]));
   }
-  if (const auto* truth = find_member(root, "truth"); truth != nullptr && !truth->is_null()) {
-    capture.truth = to_string(*truth, at.at("truth"));
+  if (const Json* truth = fields.optional("truth")) {
+    capture.truth = to_string(*truth, at["truth"]);
   }
+  fields.finish();
   validate_capture(capture, source);
   if (!std::filesystem::is_regular_file(capture.resolve(capture.camera.model), error)) {
-    camera_at.at("model").fail("an mrcal .cameramodel file, but '" +
-                               capture.resolve(capture.camera.model).string() + "' does not exist");
+    camera_at["model"].fail("an mrcal .cameramodel file, but '" +
+                            capture.resolve(capture.camera.model).string() + "' does not exist");
   }
   return capture;
 }
 
+void read_camera_pose(const std::filesystem::path& path, CaptureCamera& camera) {
+  using namespace json_fields;
+  const Json root = parse_file(path);
+  const JsonContext at(path.string());
+  Fields fields(root, at);
+  if (const Json* R = fields.present("R_eye_camera")) {
+    camera.R_eye_camera = to_dmat3(*R, at["R_eye_camera"]);
+  }
+  if (const Json* t = fields.present("t_eye_camera")) {
+    camera.t_eye_camera = to_dvec3(*t, at["t_eye_camera"]);
+  }
+  fields.finish();
+}
+
 nlohmann::json capture_to_json(const Capture& capture) {
   nlohmann::json camera{{"model", capture.camera.model.generic_string()},
-                        {"R_eye_camera", detail::from_dmat3(capture.camera.R_eye_camera)},
-                        {"t_eye_camera", detail::from_dvec3(capture.camera.t_eye_camera)}};
+                        {"R_eye_camera", json_fields::from_dmat3(capture.camera.R_eye_camera)},
+                        {"t_eye_camera", json_fields::from_dvec3(capture.camera.t_eye_camera)}};
   if (capture.camera.gamma != 1.0) camera["gamma"] = capture.camera.gamma;
   nlohmann::json projectors = nlohmann::json::array();
   for (const CaptureProjector& projector : capture.projectors) {

@@ -117,18 +117,17 @@ nlohmann::json pattern_to_json(const Pattern& pattern) {
 
 Pattern pattern_from_json(const nlohmann::json& object, const std::string& source,
                           const std::string& field) {
-  using namespace detail;
-  const JsonContext at{source, field};
-  require_object(object, at);
-  const std::string type =
-      to_string(require_member(object, "type", at, "\"white\", \"black\", \"gray\" or \"phase\""),
-                at.at("type"));
+  using namespace json_fields;
+  const FieldPath at(source, field);
+  Fields fields(object, at);
+  const std::string expected_type = "\"white\", \"black\", \"gray\" or \"phase\"";
+  const std::string type = to_string(fields.required("type", expected_type), at["type"]);
   auto read_axis = [&] {
-    const std::string axis =
-        to_string(require_member(object, "axis", at, "\"x\" or \"y\""), at.at("axis"));
+    const Json& value = fields.required("axis", "\"x\" or \"y\"");
+    const std::string axis = to_string(value, at["axis"]);
     if (axis == "x") return Axis::x;
     if (axis == "y") return Axis::y;
-    at.at("axis").fail("\"x\" or \"y\"");
+    at["axis"].fail("\"x\" or \"y\"", value);
   };
   Pattern pattern;
   if (type == "white") {
@@ -138,27 +137,28 @@ Pattern pattern_from_json(const nlohmann::json& object, const std::string& sourc
   } else if (type == "gray") {
     pattern.type = PatternType::gray;
     pattern.axis = read_axis();
-    pattern.bit = to_int(require_member(object, "bit", at, "an integer from 0"), at.at("bit"));
-    if (pattern.bit < 0 || pattern.bit > 30) at.at("bit").fail("an integer from 0 to 30");
-    if (const auto* inverted = find_member(object, "inverted")) {
-      pattern.inverted = to_bool(*inverted, at.at("inverted"));
+    pattern.bit = to_int(fields.required("bit", "an integer from 0"), at["bit"]);
+    if (pattern.bit < 0 || pattern.bit > 30) at["bit"].fail("an integer from 0 to 30", pattern.bit);
+    if (const Json* inverted = fields.present("inverted")) {
+      pattern.inverted = to_bool(*inverted, at["inverted"]);
     }
   } else if (type == "phase") {
     pattern.type = PatternType::phase;
     pattern.axis = read_axis();
-    pattern.period = to_number(require_member(object, "period", at, "a positive number of pixels"),
-                               at.at("period"));
-    if (!(pattern.period > 0)) at.at("period").fail("a positive number of pixels");
-    pattern.steps = to_int(require_member(object, "steps", at, "an integer >= 3"), at.at("steps"));
-    if (pattern.steps < 3) at.at("steps").fail("an integer >= 3");
-    pattern.step =
-        to_int(require_member(object, "step", at, "an integer from 0 to steps-1"), at.at("step"));
+    pattern.period =
+        to_number(fields.required("period", "a positive number of pixels"), at["period"]);
+    if (!(pattern.period > 0)) at["period"].fail("a positive number of pixels", pattern.period);
+    pattern.steps = to_int(fields.required("steps", "an integer >= 3"), at["steps"]);
+    if (pattern.steps < 3) at["steps"].fail("an integer >= 3", pattern.steps);
+    pattern.step = to_int(fields.required("step", "an integer from 0 to steps-1"), at["step"]);
     if (pattern.step < 0 || pattern.step >= pattern.steps) {
-      at.at("step").fail("an integer from 0 to steps-1 = " + std::to_string(pattern.steps - 1));
+      at["step"].fail("an integer from 0 to steps-1 = " + std::to_string(pattern.steps - 1),
+                      pattern.step);
     }
   } else {
-    at.at("type").fail("\"white\", \"black\", \"gray\" or \"phase\"");
+    at["type"].fail(expected_type, type);
   }
+  fields.finish();
   return pattern;
 }
 

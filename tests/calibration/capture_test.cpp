@@ -97,7 +97,7 @@ TEST(Capture, DefaultsApply) {
   const facet::test::TempFolder temp;
   small_capture(temp.path());
   write_text(temp.path() / "capture.json", R"({"format": "facet-capture/1",
-    "camera": {"model": "camera.cameramodel"}, "extra": 1,
+    "camera": {"model": "camera.cameramodel"}, "x-extra": 1,
     "projectors": [{"name": "p", "size": [4, 2], "frames": [{"file": "white.png",
                     "pattern": {"type": "white"}}]}]})");
   const fc::Capture capture = fc::read_capture(temp.path() / "capture.json");
@@ -140,9 +140,58 @@ TEST(Capture, BadFieldsAreNamed) {
   two["projectors"].push_back(two["projectors"][0]);
   expect_rejected(temp.path(), two, "projectors[1].name");
 
+  // Unknown keys, by their path, with the nearest known key; "x-" keys are free.
+  expect_rejected(temp.path(), with(ptr("/extra"), 1), "extra");
+  expect_rejected(temp.path(), with(ptr("/camera/gama"), 1.0), "camera.gama");
+  expect_rejected(temp.path(), with(ptr("/projectors/0/frames/2/pattern/invert"), true),
+                  "projectors[0].frames[2].pattern.invert");
+  write_text(temp.path() / "capture.json",
+             with(ptr("/projectors/0/frames/2/pattern/invert"), true).dump());
+  try {
+    fc::read_capture(temp.path());
+  } catch (const facet::InputError& error) {
+    EXPECT_NE(std::string(error.what()).find("unknown field 'invert'; did you mean 'inverted'?"),
+              std::string::npos)
+        << error.what();
+  }
+  nlohmann::json notes = good;
+  notes["x-operator"] = "kim";
+  notes["camera"]["x-lens"] = "8 mm";
+  notes["projectors"][0]["frames"][1]["pattern"]["x-note"] = "dim";
+  write_text(temp.path() / "capture.json", notes.dump());
+  EXPECT_NO_THROW(fc::read_capture(temp.path()));
+
   write_text(temp.path() / "capture.json", "{\"format\": ");
   EXPECT_THROW(fc::read_capture(temp.path()), facet::InputError);
   EXPECT_THROW(fc::read_capture(temp.path() / "nothing.json"), facet::InputError);
+}
+
+TEST(Capture, CameraPoseFilesReadLikeCaptureJson) {
+  const facet::test::TempFolder temp;
+  const std::filesystem::path pose = temp.path() / "pose.json";
+  write_text(pose, R"({"R_eye_camera": [[1, 0, 0], [0, -1, 0], [0, 0, -1]],
+                       "t_eye_camera": [0.5, 0, 0], "x-measured": "2026-11-30"})");
+  fc::CaptureCamera camera;
+  camera.R_eye_camera = glm::dmat3(1.0);
+  fc::read_camera_pose(pose, camera);
+  EXPECT_EQ(camera.R_eye_camera[1][1], -1.0);
+  EXPECT_EQ(camera.t_eye_camera, glm::dvec3(0.5, 0, 0));
+
+  auto field_of = [&](const std::string& text) -> std::string {
+    write_text(pose, text);
+    try {
+      fc::read_camera_pose(pose, camera);
+    } catch (const facet::InputError& error) {
+      EXPECT_EQ(error.source(), pose.string());
+      return error.field();
+    }
+    return "accepted";
+  };
+  EXPECT_EQ(field_of(R"({"t_eye_camra": [0, 0, 0]})"), "t_eye_camra");
+  EXPECT_EQ(field_of(R"({"R_eye_camera": [[1, 0, 0], [0, 1, "0"], [0, 0, 1]]})"),
+            "R_eye_camera[1][2]");
+  EXPECT_EQ(field_of(R"({"t_eye_camera": [0, 0]})"), "t_eye_camera");
+  EXPECT_EQ(field_of("[]"), "");
 }
 
 TEST(Capture, UnreadableOrMismatchedImagesAreNamed) {

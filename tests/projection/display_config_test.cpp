@@ -116,8 +116,9 @@ TEST(DisplayConfig, BadFieldsNameFileFieldAndExpectation) {
   EXPECT_EQ(failing_field(with("/render/tolerance_px", 0)), "render.tolerance_px");
   EXPECT_EQ(failing_field(with("/render/method", "Facets!")), "render.method");
   EXPECT_EQ(failing_field(with("/screen/type", "torus")), "screen.type");
-  // Unknown fields are ignored.
-  EXPECT_EQ(failing_field(with("/comment", "hello")), "");
+  // Unknown fields are refused; "x-" keys are free for notes.
+  EXPECT_EQ(failing_field(with("/comment", "hello")), "comment");
+  EXPECT_EQ(failing_field(with("/x-comment", "hello")), "");
 
   // NaN cannot be written in JSON, but a value built in code can hold it.
   pio::DisplayConfig config = pio::display_config_from_json(sample_document(), "s", ".", false);
@@ -126,6 +127,114 @@ TEST(DisplayConfig, BadFieldsNameFileFieldAndExpectation) {
   const Folder folder;
   EXPECT_THROW(pio::write_display_config(config, folder.path / "display.json"), facet::InputError);
   EXPECT_TRUE(fs::is_empty(folder.path));
+}
+
+namespace {
+
+// The message an InputError carries, or "" when none is thrown.
+std::string failure(const json& document) {
+  try {
+    pio::display_config_from_json(document, "site/display.json", ".", false);
+  } catch (const facet::InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+}  // namespace
+
+TEST(DisplayConfig, MisspelledKeysAreRefusedWithTheNearestName) {
+  json document = sample_document();
+  document["projectors"][0]["blnd"] = document["projectors"][0]["blend"];
+  document["projectors"][0].erase("blend");
+  EXPECT_EQ(failure(document),
+            "site/display.json: field 'projectors[0].blnd': unknown field 'blnd'; did you mean "
+            "'blend'? (keys starting with \"x-\" are free for notes)");
+
+  // Nested objects name the key by its path; swapped letters count as one edit.
+  document = sample_document();
+  document["projectors"][0]["output"]["positon"] = {0, 0};
+  EXPECT_EQ(failing_field(document), "projectors[0].output.positon");
+  EXPECT_NE(failure(document).find("did you mean 'position'"), std::string::npos);
+  document = sample_document();
+  document["render"]["tolerance"] = 0.5;
+  EXPECT_NE(failure(document).find("did you mean 'tolerance_px'"), std::string::npos);
+  document = sample_document();
+  document["scren"] = document["screen"];
+  document.erase("screen");
+  EXPECT_NE(failure(document).find("field 'scren': unknown field 'scren'; did you mean 'screen'"),
+            std::string::npos);
+  // A window output has no fallback size: only the monitor form does.
+  document = sample_document();
+  document["projectors"][1]["output"]["size"] = {10, 10};
+  EXPECT_EQ(failing_field(document), "projectors[1].output.size");
+
+  // Nothing close: no guess, the known keys instead.
+  document = sample_document();
+  document["projectors"][1]["comment"] = "left of the door";
+  const std::string far = failure(document);
+  EXPECT_EQ(far.find("did you mean"), std::string::npos) << far;
+  EXPECT_NE(far.find("known here: black, blend, gamma, name, output, size, warp"),
+            std::string::npos)
+      << far;
+
+  // "x-" keys anywhere are users' notes.
+  document = sample_document();
+  document["x-site"] = "planetarium";
+  document["projectors"][0]["x-serial"] = 1234;
+  document["projectors"][0]["output"]["x-cable"] = "HDMI 3";
+  document["render"]["x-why"] = "tuned for the 2026 show";
+  document["screen"]["x-measured"] = json::object({{"by", "laser"}});
+  EXPECT_EQ(failure(document), "");
+}
+
+TEST(DisplayConfig, TypeErrorsSayWhatWasExpectedAndWhatCame) {
+  json document = sample_document();
+  document["projectors"][0]["blend"] = 3;
+  EXPECT_EQ(failure(document),
+            "site/display.json: field 'projectors[0].blend': expected a string, got 3");
+  document = sample_document();
+  document["eye"] = "middle";
+  EXPECT_EQ(failure(document),
+            "site/display.json: field 'eye': expected a list of 3 numbers, got \"middle\"");
+}
+
+TEST(DisplayConfig, SchemaRefusesUnknownKeysButAllowsNotes) {
+  std::ifstream stream(fs::path(FACET_SOURCE_DIR) / "configs/display.schema.json");
+  const json schema = json::parse(stream);
+  const json* objects[] = {&schema, &schema["properties"]["render"], &schema["$defs"]["projector"]};
+  for (const json* object : objects) {
+    EXPECT_EQ((*object)["additionalProperties"], false);
+    EXPECT_EQ((*object)["patternProperties"]["^x-"], true);
+  }
+  for (const char* one_of : {"screen", "output"}) {
+    for (const json& branch : schema["$defs"][one_of]["oneOf"]) {
+      EXPECT_EQ(branch["additionalProperties"], false) << one_of;
+      EXPECT_EQ(branch["patternProperties"]["^x-"], true) << one_of;
+    }
+  }
+  // The keys the schema defines for a projector are exactly those the reader knows (listed, in
+  // order, when a key is far from all of them; nlohmann keeps object keys sorted).
+  std::string keys;
+  for (const auto& [key, value] : schema["$defs"]["projector"]["properties"].items()) {
+    keys += (keys.empty() ? "" : ", ") + key;
+  }
+  json document = sample_document();
+  document["projectors"][1]["comment"] = "left of the door";
+  EXPECT_NE(failure(document).find("known here: " + keys + ";"), std::string::npos)
+      << failure(document);
+}
+
+TEST(DisplayConfig, ShippedDisplaysLoad) {
+  int loaded = 0;
+  for (const auto& entry :
+       fs::directory_iterator(fs::path(FACET_SOURCE_DIR) / "configs/displays")) {
+    if (!fs::is_regular_file(entry.path() / "display.json")) continue;
+    SCOPED_TRACE(entry.path().string());
+    EXPECT_NO_THROW(pio::read_display_config(entry.path()));
+    ++loaded;
+  }
+  EXPECT_GE(loaded, 6);
 }
 
 TEST(DisplayConfig, MissingFilesAreNamed) {

@@ -3,8 +3,10 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
 #include <numbers>
 #include <random>
+#include <string>
 
 #include "facet/projection/errors.hpp"
 #include "facet/projection_io/rig_file.hpp"
@@ -256,6 +258,7 @@ TEST(RigFile, BadFieldsNameFileAndField) {
   };
   EXPECT_NO_THROW(parse_rig(rig(sphere, projector, camera), "good.json"));
   expect_error("{", "");
+  expect_error(R"({"format": "facet-rig/1", "x-big": 1e999})", "");  // beyond a double's range
   expect_error(R"({"format": "facet-rig/2"})", "format");
   expect_error(rig(R"({"type": "sphere", "center": [0,0,0], "radius": -1})", projector, camera),
                "screen.radius");
@@ -289,6 +292,53 @@ TEST(RigFile, BadFieldsNameFileAndField) {
                "simulation.noise");
   expect_error(rig(sphere, projector, camera, R"(, "simulation": {"phase_steps": 2})"),
                "simulation.phase_steps");
+
+  // Unknown keys are refused by their path, with the nearest known key; "x-" keys are notes.
+  expect_error(rig(sphere, projector, camera, R"(, "simulaton": {})"), "simulaton");
+  expect_error(rig(sphere, projector, camera, R"(, "simulation": {"nosie": 0.1})"),
+               "simulation.nosie");
+  expect_error(rig(R"({"type": "sphere", "center": [0,0,0], "radius": 5, "axis": [0,1,0]})",
+                   projector, camera),
+               "screen.axis");
+  const std::string typo =
+      R"({"lensmodel": "LENSMODEL_STEREOGRAPHIC", "size": [160, 120], "fov_dge": 180})";
+  expect_error(rig(sphere, projector, typo), "camera.fov_dge");
+  try {
+    parse_rig(rig(sphere, projector, typo), "bad.json");
+  } catch (const InputError& error) {
+    EXPECT_EQ(std::string(error.what()),
+              "bad.json: field 'camera.fov_dge': unknown field 'fov_dge'; did you mean 'fov_deg'? "
+              "(keys starting with \"x-\" are free for notes)");
+  }
+  expect_error(rig(sphere, R"({"name": "p0", "size": [64, 48], "fov_deg": 90, "lookat": [0,0,-1],
+                               "R_eye_projector": [[1,0,0],[0,1,0],[0,0,1]]})",
+                   camera),
+               "projectors[0].lookat");
+  EXPECT_NO_THROW(parse_rig(
+      rig(sphere,
+          R"({"name": "p0", "size": [64, 48], "fov_deg": 90, "look_at": [0, 0, -1], "x-lamp": 900})",
+          camera, R"(, "x-note": {"by": "me"}, "simulation": {"x-why": "dim room"})"),
+      "notes.json"));
+  // Alternatives a reader skips stay known: focal_px wins over fov_deg, a matrix over look_at.
+  EXPECT_NO_THROW(parse_rig(rig(sphere,
+                                R"({"name": "p0", "size": [64, 48], "focal_px": [40, 40],
+                                    "fov_deg": 90, "R_eye_projector": [[1,0,0],[0,1,0],[0,0,1]],
+                                    "look_at": [0, 0, -1], "up": [0, 1, 0]})",
+                                camera),
+                            "both.json"));
+}
+
+TEST(RigFile, ShippedRigsLoad) {
+  int loaded = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(
+           std::filesystem::path(FACET_SOURCE_DIR) / "configs/rigs")) {
+    if (entry.path().extension() != ".json") continue;
+    SCOPED_TRACE(entry.path().string());
+    const Rig rig = read_rig(entry.path());
+    EXPECT_EQ(parse_rig(format_rig(rig), "round trip"), rig);
+    ++loaded;
+  }
+  EXPECT_EQ(loaded, 3);
 }
 
 }  // namespace

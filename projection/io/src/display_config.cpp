@@ -7,74 +7,14 @@
 #include "facet/projection/atomic_file.hpp"
 #include "facet/projection/errors.hpp"
 #include "facet/projection/input_file.hpp"
+#include "json_fields.hpp"
 
 namespace facet::projection_io {
 namespace {
 
-using nlohmann::json;
-
-// Where in the document a value sits, for error messages: "projectors[1].output.window".
-struct At {
-  const std::string& source;
-  std::string field;
-
-  At operator[](const std::string& key) const {
-    return {source, field.empty() ? key : field + "." + key};
-  }
-  At operator[](std::size_t index) const {
-    return {source, field + "[" + std::to_string(index) + "]"};
-  }
-  [[noreturn]] void fail(const std::string& expected) const {
-    throw InputError(source, field, expected);
-  }
-};
-
-const json& object(const json& value, const At& at) {
-  if (!value.is_object()) at.fail("a JSON object");
-  return value;
-}
-
-const json* optional_member(const json& parent, const char* key) {
-  const auto it = parent.find(key);
-  return it == parent.end() || it->is_null() ? nullptr : &*it;
-}
-
-const json& member(const json& parent, const char* key, const At& at, const std::string& expected) {
-  const json* value = optional_member(parent, key);
-  if (value == nullptr) at[key].fail(expected + " (the field is missing)");
-  return *value;
-}
-
-std::string text(const json& value, const At& at) {
-  if (!value.is_string()) at.fail("a string");
-  return value.get<std::string>();
-}
-
-double number(const json& value, const At& at) {
-  // nlohmann parses NaN and Inf only from non-standard JSON; a float that holds them still fails.
-  if (!value.is_number()) at.fail("a finite number");
-  const double x = value.get<double>();
-  if (!std::isfinite(x)) at.fail("a finite number");
-  return x;
-}
-
-int integer(const json& value, const At& at) {
-  const double x = number(value, at);
-  if (x != std::floor(x) || std::abs(x) > 1e9) at.fail("an integer");
-  return int(x);
-}
-
-template <int N, typename T, typename Read>
-glm::vec<N, T> vector(const json& value, const At& at, const std::string& expected, Read read) {
-  if (!value.is_array() || value.size() != N) at.fail(expected);
-  glm::vec<N, T> result;
-  for (int k = 0; k < N; ++k) result[k] = read(value[std::size_t(k)], at[std::size_t(k)]);
-  return result;
-}
-
-glm::dvec3 dvec3(const json& value, const At& at) {
-  return vector<3, double>(value, at, "a list of 3 numbers", number);
-}
+using json_fields::Fields;
+using json_fields::Json;
+using At = json_fields::FieldPath;
 
 bool valid_name(const std::string& name) {
   if (name.empty()) return false;
@@ -99,34 +39,40 @@ bool finite(const glm::dvec3& v) {
   return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
 }
 
-DisplayScreen screen_from_json(const json& value, const At& at) {
-  object(value, at);
+DisplayScreen screen_from_json(const Json& value, const At& at) {
+  Fields fields(value, at);
   const std::string expected_type = "\"sphere\", \"cylinder\" or \"plane\"";
-  const std::string type = text(member(value, "type", at, expected_type), at["type"]);
+  const std::string type =
+      json_fields::to_string(fields.required("type", expected_type), at["type"]);
   DisplayScreen screen;
+  auto point = [&](const char* key) {
+    return json_fields::to_dvec3(fields.required(key, "a point in metres"), at[key]);
+  };
   auto unit = [&](const char* key) {
-    const glm::dvec3 v = dvec3(member(value, key, at, "a list of 3 numbers"), at[key]);
+    const glm::dvec3 v =
+        json_fields::to_dvec3(fields.required(key, "a list of 3 numbers"), at[key]);
     if (!(glm::length(v) > 1e-12)) at[key].fail("a non-zero vector");
     return glm::normalize(v);
   };
   if (type == "sphere" || type == "cylinder") {
     screen.type = type == "sphere" ? DisplayScreen::Type::sphere : DisplayScreen::Type::cylinder;
-    screen.center = dvec3(member(value, "center", at, "a point in metres"), at["center"]);
-    screen.radius =
-        number(member(value, "radius", at, "a positive number of metres"), at["radius"]);
+    screen.center = point("center");
+    screen.radius = json_fields::to_number(fields.required("radius", "a positive number of metres"),
+                                           at["radius"]);
     if (type == "cylinder") screen.axis = unit("axis");
   } else if (type == "plane") {
     screen.type = DisplayScreen::Type::plane;
-    screen.point = dvec3(member(value, "point", at, "a point in metres"), at["point"]);
+    screen.point = point("point");
     screen.normal = unit("normal");
   } else {
-    at["type"].fail(expected_type);
+    at["type"].fail(expected_type, type);
   }
+  fields.finish();
   return screen;
 }
 
-json screen_to_json(const DisplayScreen& screen) {
-  auto list = [](const glm::dvec3& v) { return json::array({v.x, v.y, v.z}); };
+Json screen_to_json(const DisplayScreen& screen) {
+  auto list = [](const glm::dvec3& v) { return Json::array({v.x, v.y, v.z}); };
   switch (screen.type) {
     case DisplayScreen::Type::sphere:
       return {{"type", "sphere"}, {"center", list(screen.center)}, {"radius", screen.radius}};
@@ -141,37 +87,38 @@ json screen_to_json(const DisplayScreen& screen) {
   return {};
 }
 
-DisplayOutput output_from_json(const json& value, const At& at) {
-  object(value, at);
+DisplayOutput output_from_json(const Json& value, const At& at) {
+  Fields fields(value, at);
   const std::string expected = "{\"monitor\": NAME} or {\"window\": [x, y, width, height]}";
-  const json* monitor = optional_member(value, "monitor");
-  const json* window = optional_member(value, "window");
+  const Json* monitor = fields.optional("monitor");
+  const Json* window = fields.optional("window");
   if ((monitor == nullptr) == (window == nullptr)) at.fail(expected + ", exactly one of them");
   DisplayOutput output;
   if (monitor != nullptr) {
     output.kind = DisplayOutput::Kind::monitor;
-    output.monitor = text(*monitor, at["monitor"]);
-    if (const json* position = optional_member(value, "position")) {
+    output.monitor = json_fields::to_string(*monitor, at["monitor"]);
+    if (const Json* position = fields.optional("position")) {
       output.position =
-          vector<2, int>(*position, at["position"], "a list of 2 integers [x, y]", integer);
+          json_fields::to_ivec2(*position, at["position"], "a list of 2 integers [x, y]");
     }
-    if (const json* size = optional_member(value, "size")) {
+    if (const Json* size = fields.optional("size")) {
       output.size =
-          vector<2, int>(*size, at["size"], "a list of 2 integers [width, height]", integer);
+          json_fields::to_ivec2(*size, at["size"], "a list of 2 integers [width, height]");
     }
   } else {
     output.kind = DisplayOutput::Kind::window;
-    output.window = vector<4, int>(*window, at["window"],
-                                   "a list of 4 integers [x, y, width, height]", integer);
+    output.window =
+        json_fields::to_ivec4(*window, at["window"], "a list of 4 integers [x, y, width, height]");
   }
+  fields.finish();
   return output;
 }
 
-json output_to_json(const DisplayOutput& output) {
+Json output_to_json(const DisplayOutput& output) {
   if (output.kind == DisplayOutput::Kind::window) {
     return {{"window", {output.window.x, output.window.y, output.window.z, output.window.w}}};
   }
-  json result = {{"monitor", output.monitor}};
+  Json result = {{"monitor", output.monitor}};
   if (output.position) result["position"] = {output.position->x, output.position->y};
   if (output.size) result["size"] = {output.size->x, output.size->y};
   return result;
@@ -195,7 +142,7 @@ void check_relative(const std::filesystem::path& relative, const At& at) {
 
 void validate_display_config(const DisplayConfig& config, const std::string& source,
                              bool check_files) {
-  const At root{source, ""};
+  const At root(source);
   if (config.name.empty()) root["name"].fail("a non-empty display name");
   if (!finite(config.eye)) root["eye"].fail("3 finite numbers (metres)");
   if (config.screen) {
@@ -265,76 +212,79 @@ void validate_display_config(const DisplayConfig& config, const std::string& sou
   }
 }
 
-DisplayConfig display_config_from_json(const json& document, const std::string& source,
+DisplayConfig display_config_from_json(const Json& document, const std::string& source,
                                        const std::filesystem::path& folder, bool check_files) {
-  const At root{source, ""};
-  object(document, root);
-  const json& format = member(document, "format", root, std::string("\"") + kDisplayFormat + "\"");
+  using namespace json_fields;
+  const At root(source);
+  Fields fields(document, root);
+  const std::string expected_format = std::string("\"") + kDisplayFormat + "\"";
+  const Json& format = fields.required("format", expected_format);
   if (!format.is_string() || format.get<std::string>() != kDisplayFormat) {
-    root["format"].fail(std::string("\"") + kDisplayFormat + "\"");
+    root["format"].fail(expected_format, format);
   }
   DisplayConfig config;
   config.folder = folder;
-  config.name = text(member(document, "name", root, "the display's name"), root["name"]);
-  config.eye = dvec3(member(document, "eye", root, "[x, y, z] in metres"), root["eye"]);
-  if (const json* screen = optional_member(document, "screen")) {
+  config.name = to_string(fields.required("name", "the display's name"), root["name"]);
+  config.eye = to_dvec3(fields.required("eye", "[x, y, z] in metres"), root["eye"]);
+  if (const Json* screen = fields.optional("screen")) {
     config.screen = screen_from_json(*screen, root["screen"]);
   }
-  const json& projectors = member(document, "projectors", root, "a list of at least one projector");
-  if (!projectors.is_array()) root["projectors"].fail("a list of at least one projector");
+  const std::string expected_projectors = "a list of at least one projector";
+  const Json& projectors = fields.required("projectors", expected_projectors);
+  if (!projectors.is_array()) root["projectors"].fail(expected_projectors, projectors);
   for (std::size_t k = 0; k < projectors.size(); ++k) {
     const At at = root["projectors"][k];
-    const json& item = object(projectors[k], at);
+    Fields item(projectors[k], at);
     DisplayProjector projector;
-    projector.name = text(member(item, "name", at, "the projector's name"), at["name"]);
-    projector.size = vector<2, int>(member(item, "size", at, "[width, height] in output pixels"),
-                                    at["size"], "[width, height] in output pixels", integer);
-    projector.warp =
-        text(member(item, "warp", at, "the path of its .warp.exr, relative to display.json"),
-             at["warp"]);
-    if (const json* blend = optional_member(item, "blend")) {
-      projector.blend = text(*blend, at["blend"]);
-    }
-    if (const json* black = optional_member(item, "black")) {
-      projector.black = text(*black, at["black"]);
-    }
-    if (const json* gamma = optional_member(item, "gamma")) {
+    projector.name = to_string(item.required("name", "the projector's name"), at["name"]);
+    const std::string expected_size = "[width, height] in output pixels";
+    projector.size = to_ivec2(item.required("size", expected_size), at["size"], expected_size);
+    projector.warp = to_string(
+        item.required("warp", "the path of its .warp.exr, relative to display.json"), at["warp"]);
+    if (const Json* blend = item.optional("blend"))
+      projector.blend = to_string(*blend, at["blend"]);
+    if (const Json* black = item.optional("black"))
+      projector.black = to_string(*black, at["black"]);
+    if (const Json* gamma = item.optional("gamma")) {
       if (gamma->is_string() && gamma->get<std::string>() == "srgb") {
         projector.gamma.reset();
       } else if (gamma->is_number()) {
-        projector.gamma = number(*gamma, at["gamma"]);
+        projector.gamma = to_number(*gamma, at["gamma"]);
       } else {
-        at["gamma"].fail("\"srgb\" or a positive finite output gamma (e.g. 2.2)");
+        at["gamma"].fail("\"srgb\" or a positive finite output gamma (e.g. 2.2)", *gamma);
       }
     }
     projector.output = output_from_json(
-        member(item, "output", at, "{\"monitor\": NAME} or {\"window\": [x, y, width, height]}"),
+        item.required("output", "{\"monitor\": NAME} or {\"window\": [x, y, width, height]}"),
         at["output"]);
+    item.finish();
     config.projectors.push_back(std::move(projector));
   }
-  if (const json* render = optional_member(document, "render")) {
+  if (const Json* render_value = fields.optional("render")) {
     const At at = root["render"];
-    object(*render, at);
-    if (const json* method = optional_member(*render, "method")) {
-      config.render.method = text(*method, at["method"]);
+    Fields render(*render_value, at);
+    if (const Json* method = render.optional("method")) {
+      config.render.method = to_string(*method, at["method"]);
     }
-    if (const json* tolerance = optional_member(*render, "tolerance_px")) {
-      config.render.tolerance_px = number(*tolerance, at["tolerance_px"]);
+    if (const Json* tolerance = render.optional("tolerance_px")) {
+      config.render.tolerance_px = to_number(*tolerance, at["tolerance_px"]);
     }
-    if (const json* z_near = optional_member(*render, "z_near")) {
-      config.render.z_near = number(*z_near, at["z_near"]);
+    if (const Json* z_near = render.optional("z_near")) {
+      config.render.z_near = to_number(*z_near, at["z_near"]);
     }
+    render.finish();
   }
-  if (const json* missing = optional_member(document, "missing_monitor")) {
-    const std::string value = text(*missing, root["missing_monitor"]);
+  if (const Json* missing = fields.optional("missing_monitor")) {
+    const std::string value = to_string(*missing, root["missing_monitor"]);
     if (value == "error") {
       config.missing_monitor = MissingMonitor::error;
     } else if (value == "window") {
       config.missing_monitor = MissingMonitor::window;
     } else {
-      root["missing_monitor"].fail("\"error\" or \"window\", not \"" + value + "\"");
+      root["missing_monitor"].fail("\"error\" or \"window\"", *missing);
     }
   }
+  fields.finish();
   validate_display_config(config, source, check_files);
   return config;
 }
@@ -343,26 +293,18 @@ DisplayConfig read_display_config(const std::filesystem::path& path, bool check_
   std::error_code error;
   const std::filesystem::path file =
       std::filesystem::is_directory(path, error) ? path / "display.json" : path;
-  require_regular_file(file);
-  std::ifstream stream(file);
-  if (!stream) throw InputError(file.string(), "", "cannot open the file");
-  json document;
-  try {
-    document = json::parse(stream);
-  } catch (const json::exception& e) {
-    throw InputError(file.string(), "", std::string("expected valid JSON: ") + e.what());
-  }
-  return display_config_from_json(document, file.string(), file.parent_path(), check_files);
+  return display_config_from_json(json_fields::parse_file(file), file.string(), file.parent_path(),
+                                  check_files);
 }
 
-json display_config_to_json(const DisplayConfig& config) {
-  json document = {{"format", kDisplayFormat},
+Json display_config_to_json(const DisplayConfig& config) {
+  Json document = {{"format", kDisplayFormat},
                    {"name", config.name},
                    {"eye", {config.eye.x, config.eye.y, config.eye.z}}};
   if (config.screen) document["screen"] = screen_to_json(*config.screen);
-  json projectors = json::array();
+  Json projectors = Json::array();
   for (const DisplayProjector& projector : config.projectors) {
-    json item = {{"name", projector.name},
+    Json item = {{"name", projector.name},
                  {"size", {projector.size.x, projector.size.y}},
                  {"warp", projector.warp.generic_string()}};
     if (projector.blend) item["blend"] = projector.blend->generic_string();

@@ -63,8 +63,14 @@ struct Capture {
 
 // Reads and validates capture.json (`path` may also be its folder). Checks every field of §1 and
 // that the camera model file exists; it does not open images (see check_capture_images).
-// Throws InputError(file, field, expected) on the first problem. Unknown fields are ignored.
+// Throws InputError(file, field, expected) on the first problem, unknown fields included (keys
+// starting with "x-" are free for notes).
 Capture read_capture(const std::filesystem::path& path);
+
+// Reads a camera pose file (`facet capture --camera-pose`): a JSON object with an optional
+// `R_eye_camera` (rows) and an optional `t_eye_camera` (metres), which replace those of `camera`.
+// Unknown fields are refused as in read_capture; validate_capture checks the rotation.
+void read_camera_pose(const std::filesystem::path& path, CaptureCamera& camera);
 
 // Validates a Capture as read_capture would (source names the file in errors).
 void validate_capture(const Capture& capture, const std::string& source);

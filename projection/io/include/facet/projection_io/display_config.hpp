@@ -86,7 +86,8 @@ struct DisplayConfig {
 // stored in the result. When `check_files` is set, every referenced warp, blend and black file
 // must exist under `folder`. Throws InputError(source, field, expected) on the first problem:
 // missing or mistyped fields, NaN or Inf, unknown enumerated values, duplicate projector names,
-// missing files. Unknown fields are ignored (FORMATS.md).
+// missing files, and unknown fields ("unknown field 'blnd'; did you mean 'blend'?"); keys starting
+// with "x-" are free for users' notes.
 DisplayConfig display_config_from_json(const nlohmann::json& root, const std::string& source,
                                        const std::filesystem::path& folder, bool check_files);
 

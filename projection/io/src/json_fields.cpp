@@ -1,0 +1,226 @@
+#include "json_fields.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+#include "facet/projection/errors.hpp"
+#include "facet/projection/input_file.hpp"
+
+namespace facet::json_fields {
+
+FieldPath FieldPath::operator[](std::string_view key) const {
+  return FieldPath(source_, field_.empty() ? std::string(key) : field_ + "." + std::string(key));
+}
+
+FieldPath FieldPath::operator[](std::size_t index) const {
+  return FieldPath(source_, field_ + "[" + std::to_string(index) + "]");
+}
+
+void FieldPath::fail(const std::string& expected) const {
+  throw InputError(source_, field_, "expected " + expected);
+}
+
+void FieldPath::fail(const std::string& expected, const Json& got) const {
+  throw InputError(source_, field_, "expected " + expected + ", got " + quote_value(got));
+}
+
+std::string quote_value(const Json& value) {
+  constexpr std::size_t kLongest = 40;
+  std::string text = value.dump(-1, ' ', false, Json::error_handler_t::replace);
+  if (text.size() > kLongest) text = text.substr(0, kLongest - 3) + "...";
+  return text;
+}
+
+Fields::Fields(const Json& value, FieldPath at) : object_(value), at_(std::move(at)) {
+  if (!object_.is_object()) at_.fail("a JSON object", object_);
+}
+
+void Fields::know(std::string_view key) {
+  if (std::find(known_.begin(), known_.end(), key) == known_.end()) known_.emplace_back(key);
+}
+
+const Json* Fields::present(std::string_view key) {
+  know(key);
+  const auto it = object_.find(key);
+  return it == object_.end() ? nullptr : &*it;
+}
+
+const Json* Fields::optional(std::string_view key) {
+  const Json* value = present(key);
+  return value == nullptr || value->is_null() ? nullptr : value;
+}
+
+const Json& Fields::required(std::string_view key, const std::string& expected) {
+  const Json* value = present(key);
+  if (value == nullptr) at_[key].fail(expected + " (the field is missing)");
+  if (value->is_null()) at_[key].fail(expected, *value);
+  return *value;
+}
+
+void Fields::allow(std::initializer_list<std::string_view> keys) {
+  for (const std::string_view key : keys) know(key);
+}
+
+void Fields::finish() const {
+  for (const auto& [key, value] : object_.items()) {
+    if (key.starts_with("x-")) continue;
+    if (std::find(known_.begin(), known_.end(), key) != known_.end()) continue;
+    const std::string free_note = "keys starting with \"x-\" are free for notes";
+    std::string message = "unknown field '" + key + "'";
+    if (const std::string nearest = nearest_key(key, known_); !nearest.empty()) {
+      message += "; did you mean '" + nearest + "'? (" + free_note + ")";
+    } else {
+      std::vector<std::string> sorted = known_;
+      std::sort(sorted.begin(), sorted.end());
+      std::string list;
+      for (const std::string& name : sorted) list += (list.empty() ? "" : ", ") + name;
+      message += " (known here: " + list + "; " + free_note + ")";
+    }
+    throw InputError(at_.source(), at_[key].field(), message);
+  }
+}
+
+namespace {
+
+// Optimal string alignment distance: insertions, deletions, substitutions and swaps of two
+// neighbouring characters each cost 1.
+std::size_t edit_distance(std::string_view a, std::string_view b) {
+  const std::size_t n = a.size(), m = b.size();
+  std::vector<std::vector<std::size_t>> d(n + 1, std::vector<std::size_t>(m + 1));
+  for (std::size_t i = 0; i <= n; ++i) d[i][0] = i;
+  for (std::size_t j = 0; j <= m; ++j) d[0][j] = j;
+  for (std::size_t i = 1; i <= n; ++i) {
+    for (std::size_t j = 1; j <= m; ++j) {
+      const std::size_t cost = a[i - 1] == b[j - 1] ? 0 : 1;
+      d[i][j] = std::min({d[i - 1][j] + 1, d[i][j - 1] + 1, d[i - 1][j - 1] + cost});
+      if (i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1]) {
+        d[i][j] = std::min(d[i][j], d[i - 2][j - 2] + 1);
+      }
+    }
+  }
+  return d[n][m];
+}
+
+}  // namespace
+
+std::string nearest_key(std::string_view key, const std::vector<std::string>& known) {
+  const std::size_t limit = std::max<std::size_t>(2, key.size() / 3);
+  std::string best;
+  std::size_t best_distance = limit + 1;
+  for (const std::string& candidate : known) {
+    const std::size_t distance = edit_distance(key, candidate);
+    if (distance < best_distance) {
+      best_distance = distance;
+      best = candidate;
+    }
+  }
+  // Two edits turn any short key into another ("on" into "x"): suggest only a real resemblance.
+  if (best_distance >= std::max(key.size(), best.size())) return "";
+  return best;
+}
+
+std::string to_string(const Json& value, const FieldPath& at) {
+  if (!value.is_string()) at.fail("a string", value);
+  return value.get<std::string>();
+}
+
+double to_number(const Json& value, const FieldPath& at) {
+  if (!value.is_number()) at.fail("a number", value);
+  const double number = value.get<double>();
+  if (!std::isfinite(number)) at.fail("a finite number", value);
+  return number;
+}
+
+int to_int(const Json& value, const FieldPath& at) {
+  if (value.is_number_integer()) {
+    const auto number = value.get<long long>();
+    if (value.is_number_unsigned() ? value.get<unsigned long long>() > 1'000'000'000ull
+                                   : (number < -1'000'000'000 || number > 1'000'000'000)) {
+      at.fail("an integer of sensible size (within ±1e9)", value);
+    }
+    return int(number);
+  }
+  if (value.is_number_float()) {
+    const double number = value.get<double>();
+    if (std::isfinite(number) && number == std::floor(number) && std::abs(number) <= 1e9) {
+      return int(number);
+    }
+  }
+  at.fail("an integer", value);
+}
+
+bool to_bool(const Json& value, const FieldPath& at) {
+  if (!value.is_boolean()) at.fail("true or false", value);
+  return value.get<bool>();
+}
+
+std::vector<double> to_numbers(const Json& value, const FieldPath& at, std::size_t min_count,
+                               std::size_t max_count, const std::string& expected) {
+  if (!value.is_array() || value.size() < min_count || value.size() > max_count) {
+    at.fail(expected, value);
+  }
+  std::vector<double> numbers;
+  numbers.reserve(value.size());
+  for (std::size_t k = 0; k < value.size(); ++k) numbers.push_back(to_number(value[k], at[k]));
+  return numbers;
+}
+
+glm::dvec2 to_dvec2(const Json& value, const FieldPath& at, const std::string& expected) {
+  const std::vector<double> v = to_numbers(value, at, 2, 2, expected);
+  return {v[0], v[1]};
+}
+
+glm::dvec3 to_dvec3(const Json& value, const FieldPath& at) {
+  const std::vector<double> v = to_numbers(value, at, 3, 3, "a list of 3 numbers");
+  return {v[0], v[1], v[2]};
+}
+
+glm::ivec2 to_ivec2(const Json& value, const FieldPath& at, const std::string& expected) {
+  if (!value.is_array() || value.size() != 2) at.fail(expected, value);
+  return {to_int(value[0], at[0]), to_int(value[1], at[1])};
+}
+
+glm::ivec4 to_ivec4(const Json& value, const FieldPath& at, const std::string& expected) {
+  if (!value.is_array() || value.size() != 4) at.fail(expected, value);
+  return {to_int(value[0], at[0]), to_int(value[1], at[1]), to_int(value[2], at[2]),
+          to_int(value[3], at[3])};
+}
+
+glm::dmat3 to_dmat3(const Json& value, const FieldPath& at) {
+  if (!value.is_array() || value.size() != 3) at.fail("a 3x3 matrix as a list of 3 rows", value);
+  glm::dmat3 matrix(0.0);
+  for (std::size_t row = 0; row < 3; ++row) {
+    const glm::dvec3 values = to_dvec3(value[row], at[row]);
+    for (int column = 0; column < 3; ++column) matrix[column][int(row)] = values[column];
+  }
+  return matrix;
+}
+
+Json from_dvec3(const glm::dvec3& v) { return Json::array({v.x, v.y, v.z}); }
+
+Json from_dmat3(const glm::dmat3& m) {
+  Json rows = Json::array();
+  for (int row = 0; row < 3; ++row) rows.push_back({m[0][row], m[1][row], m[2][row]});
+  return rows;
+}
+
+Json parse(const std::string& text, const std::string& source) {
+  try {
+    return Json::parse(text);
+  } catch (const Json::exception& error) {  // a syntax error, or a number beyond double's range
+    FieldPath(source).fail(std::string("valid JSON (") + error.what() + ")");
+  }
+}
+
+Json parse_file(const std::filesystem::path& path) {
+  require_regular_file(path);
+  std::ifstream stream(path, std::ios::binary);
+  if (!stream) FieldPath(path.string()).fail("a readable file");
+  std::stringstream buffer;
+  buffer << stream.rdbuf();
+  return parse(buffer.str(), path.string());
+}
+
+}  // namespace facet::json_fields

@@ -1,0 +1,117 @@
+#pragma once
+// Internal to facet's libraries: the one way facet reads its JSON files (display.json, rig files,
+// capture.json, camera poses). Every error names the file, the field path and what was expected:
+//
+//   display.json: field 'projectors[2].blend': expected a string, got 3
+//
+// and Fields refuses members the reader does not know, so that a misspelled key is an error
+// rather than a silently ignored setting:
+//
+//   display.json: field 'projectors[0].blnd': unknown field 'blnd'; did you mean 'blend'? (keys
+//   starting with "x-" are free for notes)
+//
+// Not part of any public header: the JSON library stays an implementation detail.
+#include <filesystem>
+#include <glm/glm.hpp>
+#include <initializer_list>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace facet::json_fields {
+
+using Json = nlohmann::json;
+
+// Where a value sits: the file (`source`) and the path to the value inside it, e.g.
+// "projectors[1].output.window" ("" for the document itself).
+class FieldPath {
+ public:
+  explicit FieldPath(std::string source, std::string field = "")
+      : source_(std::move(source)), field_(std::move(field)) {}
+
+  FieldPath operator[](std::string_view key) const;
+  FieldPath operator[](std::size_t index) const;
+
+  const std::string& source() const { return source_; }
+  const std::string& field() const { return field_; }
+
+  // Throws InputError(source, field, "expected " + expected).
+  [[noreturn]] void fail(const std::string& expected) const;
+  // Throws InputError(source, field, "expected " + expected + ", got " + short text of `got`).
+  [[noreturn]] void fail(const std::string& expected, const Json& got) const;
+
+ private:
+  std::string source_, field_;
+};
+
+// A value as an error message quotes it: its JSON text, cut short after about 40 characters.
+std::string quote_value(const Json& value);
+
+// The members of one JSON object, read by name. Every name the reader asks for (found or not)
+// and every name it allows counts as known; finish() refuses any other member whose key does not
+// start with "x-", which stays free for users' own notes.
+class Fields {
+ public:
+  // Fails with "expected a JSON object" unless `value` is one. `value` must outlive this.
+  Fields(const Json& value, FieldPath at);
+
+  const FieldPath& path() const { return at_; }
+  FieldPath path(std::string_view key) const { return at_[key]; }
+
+  // The member `key`, or nullptr when it is absent or null (null reads as "not given").
+  const Json* optional(std::string_view key);
+  // The member `key`, or nullptr when it is absent; a null value is returned as it is, so that the
+  // reader's type check refuses it.
+  const Json* present(std::string_view key);
+  // The member `key`; fails with "expected EXPECTED (the field is missing)" when it is absent
+  // and with "expected EXPECTED, got null" when it is null.
+  const Json& required(std::string_view key, const std::string& expected);
+
+  // Names this object may hold that the reader does not look at on this path (an alternative
+  // that another member overrides): known, so not refused.
+  void allow(std::initializer_list<std::string_view> keys);
+
+  // Throws InputError naming the first unknown member (in document order) by its full path, with
+  // the nearest known key when one is close ("unknown field 'blnd'; did you mean 'blend'?"), or
+  // else the list of known keys.
+  void finish() const;
+
+ private:
+  void know(std::string_view key);
+
+  const Json& object_;
+  FieldPath at_;
+  std::vector<std::string> known_;
+};
+
+// The known key nearest to `key` by edit distance (insertions, deletions, substitutions and
+// swaps of neighbours), or "" when none is within 2 edits, or within a third of the key's length
+// for longer keys.
+std::string nearest_key(std::string_view key, const std::vector<std::string>& known);
+
+// Typed values; each fails at `at` with what it expected and what it got.
+std::string to_string(const Json& value, const FieldPath& at);
+double to_number(const Json& value, const FieldPath& at);  // finite
+// An integer within ±1e9; 3.0 counts (JSON writers differ in how they print whole numbers).
+int to_int(const Json& value, const FieldPath& at);
+bool to_bool(const Json& value, const FieldPath& at);
+// A list of `min_count` to `max_count` finite numbers; `expected` describes it.
+std::vector<double> to_numbers(const Json& value, const FieldPath& at, std::size_t min_count,
+                               std::size_t max_count, const std::string& expected);
+glm::dvec2 to_dvec2(const Json& value, const FieldPath& at, const std::string& expected);
+glm::dvec3 to_dvec3(const Json& value, const FieldPath& at);
+glm::ivec2 to_ivec2(const Json& value, const FieldPath& at, const std::string& expected);
+glm::ivec4 to_ivec4(const Json& value, const FieldPath& at, const std::string& expected);
+// A matrix in JSON is a list of rows; glm stores columns.
+glm::dmat3 to_dmat3(const Json& value, const FieldPath& at);
+
+Json from_dvec3(const glm::dvec3& v);
+Json from_dmat3(const glm::dmat3& m);
+
+// Parses `text` as JSON; fails with "expected valid JSON (...)" at the document.
+Json parse(const std::string& text, const std::string& source);
+// Reads and parses a regular file (require_regular_file's checks first).
+Json parse_file(const std::filesystem::path& path);
+
+}  // namespace facet::json_fields
