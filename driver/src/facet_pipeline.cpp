@@ -4,6 +4,7 @@
 // pipeline").
 #include <algorithm>
 #include <limits>
+#include <map>
 #include <optional>
 #include <string>
 
@@ -35,7 +36,6 @@ class FacetPipeline final : public FacetMethodBase {
     FacetMethodBase::prepare(scene, gpu_scene, outputs, settings);
     if (!count_) {
       count_ = link_replication_program({"replication/count.comp"});
-      grid_ = link_replication_program({"replication/count.comp"}, {{"GRID_PASS", "1"}});
       walk_ = link_replication_program({"replication/count.comp"}, {{"WALK_PASS", "1"}});
       // Eight triangles walked side by side per SIMD row, where every triangle walks: the walk
       // pass's one per work group took 806 ms a cylinder frame (400x300, 0.25 px), this 160.
@@ -46,6 +46,18 @@ class FacetPipeline final : public FacetMethodBase {
       draw_ = link_replication_program({"replication/draw.vert", "scene/material.frag"},
                                        {{"WRITE_TRIANGLE_ID", "1"}});
       scan_.prepare();
+    }
+    // The grid pass is built for each output's kind of grid (replication_lib.comp, grid_chart).
+    for (const OutputState& out : outputs_) {
+      const CoverageGrid& grid = out.facets.grid;
+      const std::uint32_t kind = grid_kind(grid);
+      if (grid_programs_.contains(kind)) continue;
+      grid_programs_.emplace(kind, link_replication_program(
+                                       {"replication/count.comp"},
+                                       {{"GRID_PASS", "1"},
+                                        {"GRID_CHART", std::to_string(std::uint32_t(grid.chart()))},
+                                        {"GRID_PERIODIC", grid.periodic() ? "1" : "0"},
+                                        {"GRID_CELL_BUCKETS", grid.cell_buckets() ? "1" : "0"}}));
     }
   }
 
@@ -128,8 +140,10 @@ class FacetPipeline final : public FacetMethodBase {
       first.use();
       glDispatchCompute((n + 1 + kLocalSize - 1) / kLocalSize, 1, 1);
       glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_COMMAND_BARRIER_BIT);
+      const Program& grid = grid_programs_.at(grid_kind(out.facets.grid));
       for (const auto& [program, queue] :
-           {std::pair{&grid_, &out.grid_queue}, std::pair{&walk_, &out.walk_queue}}) {
+           {std::pair<const Program*, const Buffer*>{&grid, &out.grid_queue},
+            std::pair<const Program*, const Buffer*>{&walk_, &out.walk_queue}}) {
         set_list_uniforms(*program, i);
         program->use();
         glBindBuffer(GL_DISPATCH_INDIRECT_BUFFER, queue->id());
@@ -174,7 +188,13 @@ class FacetPipeline final : public FacetMethodBase {
   friend std::vector<std::vector<std::uint32_t>> facet::driver::gpu_triangle_coverage(
       const Warp&, const RenderSettings&, const std::vector<std::array<glm::vec3, 3>>&);
 
-  Program count_, grid_, walk_, count_walk_, scatter_, args_, draw_;
+  static std::uint32_t grid_kind(const CoverageGrid& grid) {
+    return std::uint32_t(grid.chart()) | (grid.periodic() ? 16u : 0u) |
+           (grid.cell_buckets() ? 32u : 0u);
+  }
+
+  Program count_, walk_, count_walk_, scatter_, args_, draw_;
+  std::map<std::uint32_t, Program> grid_programs_;  // the grid pass per grid_kind
   PrefixScan scan_;
 };
 

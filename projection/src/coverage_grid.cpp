@@ -168,6 +168,29 @@ DirectionBox CoverageGrid::direction_box(const std::array<glm::dvec3, 3>& u, Cov
   return box;
 }
 
+std::optional<ChartBox> CoverageGrid::gnomonic_box(const std::array<glm::dvec3, 3>& u) const {
+  if (chart_ != CoverageChart::perspective) return std::nullopt;
+  ChartBox box;
+  box.p_lo = box.q_lo = std::numeric_limits<double>::infinity();
+  box.p_hi = box.q_hi = -std::numeric_limits<double>::infinity();
+  double largest_squared = 0;
+  for (const glm::dvec3& b : u) {
+    if (!(-b.z > kGnomonicMinDepth)) return std::nullopt;
+    const glm::dvec2 c = glm::dvec2(b.x, b.y) / -b.z;
+    box.p_lo = std::min(box.p_lo, c.x);
+    box.p_hi = std::max(box.p_hi, c.x);
+    box.q_lo = std::min(box.q_lo, c.y);
+    box.q_hi = std::max(box.q_hi, c.y);
+    largest_squared = std::max(largest_squared, glm::dot(c, c));
+  }
+  const double pad = kGnomonicPad * (1 + largest_squared);
+  box.p_lo -= pad;
+  box.p_hi += pad;
+  box.q_lo -= pad;
+  box.q_hi += pad;
+  return box;
+}
+
 ChartBox CoverageGrid::chart_box(const DirectionBox& d) const {
   ChartBox box;
   switch (chart_) {
@@ -593,9 +616,13 @@ bool CoverageGrid::query(const std::array<glm::dvec3, 3>& triangle, const Covera
     return take_walk();
   std::array<glm::dvec3, 3> u;
   for (int c = 0; c < 3; ++c) u[c] = R_base_eye_ * glm::normalize(triangle[c]);
-  const DirectionBox box = direction_box(u, chart_, 0);
-  if (box.walk) return take_walk();
-  const auto range = buckets(chart_box(box));
+  std::optional<ChartBox> box = gnomonic_box(u);
+  if (!box) {
+    const DirectionBox directions = direction_box(u, chart_, 0);
+    if (directions.walk) return take_walk();
+    box = chart_box(directions);
+  }
+  const auto range = buckets(*box);
   if (!range) return true;
   const auto listed = candidates(*range);
   if (!listed) return take_walk();

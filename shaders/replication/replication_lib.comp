@@ -293,10 +293,38 @@ const uint kChartCylindrical = 0u, kChartEquirectangular = 1u, kChartFisheye = 2
 const uint kGridMaxBuckets = 256u;                      // CoverageGrid::kMaxBuckets
 const uint kGridMaxCandidates = 512u;                   // CoverageGrid::kMaxCandidates
 const float kPi = 3.14159265358979;
+const float kGnomonicMinDepth = 0.05;  // CoverageGrid::kGnomonicMinDepth
+const float kGnomonicPad = 1e-5;       // CoverageGrid::kGnomonicPad
 const float kPoleMargin = 1e-3;
 const float kShortArc = 1e-2;
 
 float grid_float(uint i) { return uintBitsToFloat(grid_word(i)); }
+
+// The grid's chart, whether it is periodic, and whether its buckets are cells. A program built
+// for one kind of grid (GRID_CHART, GRID_PERIODIC and GRID_CELL_BUCKETS defined: `facets`' grid
+// pass) has them as constants, so that the compiler drops the other kinds' code, which llvmpipe
+// would otherwise run for every triangle with its lanes masked.
+uint grid_chart() {
+#ifdef GRID_CHART
+  return uint(GRID_CHART);
+#else
+  return grid_word(0);
+#endif
+}
+bool grid_periodic() {
+#ifdef GRID_PERIODIC
+  return GRID_PERIODIC != 0;
+#else
+  return grid_word(1) != 0u;
+#endif
+}
+bool grid_cell_buckets() {
+#ifdef GRID_CELL_BUCKETS
+  return GRID_CELL_BUCKETS != 0;
+#else
+  return grid_word(23) != 0u;
+#endif
+}
 
 float wrap_pi(float angle) { return angle - 2.0 * kPi * round(angle / (2.0 * kPi)); }
 
@@ -440,7 +468,7 @@ bool cells_between(uint at, uint cells, float lo, float hi, out uint first, out 
 bool bucket_range(vec4 box, bool full_p, out uvec4 range) {
   range = uvec4(0u);
   uint columns = grid_word(2), rows = grid_word(3);
-  if (grid_word(23) != 0u) {
+  if (grid_cell_buckets()) {
     // Cell buckets (CoverageGrid::buckets): the box grown by the pads, against the breaks.
     uint pads = grid_word(23), p_at = grid_word(23) + 2u, q_at = p_at + columns + 1u;
     float pad_p = grid_float(pads), pad_q = grid_float(pads + 1u);
@@ -449,7 +477,7 @@ bool bucket_range(vec4 box, bool full_p, out uvec4 range) {
     range.y = first_row;
     range.w = last_row - first_row + 1u;
     float width = box.y - box.x + 2.0 * pad_p;
-    bool periodic = grid_word(1) != 0u;
+    bool periodic = grid_periodic();
     if (periodic && (full_p || width >= 2.0 * kPi)) {
       range.z = columns;
       return true;
@@ -481,7 +509,7 @@ bool bucket_range(vec4 box, bool full_p, out uvec4 range) {
   if (j_hi < j_lo) return false;
   range.y = uint(j_lo);
   range.w = uint(j_hi - j_lo) + 1u;
-  if (grid_word(1) != 0u) {
+  if (grid_periodic()) {
     range.z = columns;
     if (full_p) return true;
     float i_lo = floor((box.x - p0) / dp), i_hi = floor((box.y - p0) / dp);
@@ -542,17 +570,27 @@ bool grid_coverage(vec3 p[3], uint t, uint pair_base, uint wanted, out uint want
                          grid_float(16u), grid_float(17u), grid_float(18u), grid_float(19u),
                          grid_float(20u));
   vec3 b[3] = vec3[3](R_base_eye * u[0], R_base_eye * u[1], R_base_eye * u[2]);
-  uint chart = grid_word(0);
-  vec4 angles;
-  bool full_phi;
-  if (!direction_box(b, chart, angles, full_phi)) return false;
+  uint chart = grid_chart();
+  // A perspective chart is gnomonic: a triangle in front has its chart box at its corners
+  // (CoverageGrid::gnomonic_box).
   vec4 box;
-  if (!chart_box(chart, angles, full_phi, box)) return true;
+  bool full_phi = false;
+  float depth = min(-b[0].z, min(-b[1].z, -b[2].z));
+  if (chart == kChartPerspective && depth > kGnomonicMinDepth) {
+    vec2 c0 = b[0].xy / -b[0].z, c1 = b[1].xy / -b[1].z, c2 = b[2].xy / -b[2].z;
+    vec2 lo = min(c0, min(c1, c2)), hi = max(c0, max(c1, c2));
+    float pad = kGnomonicPad * (1.0 + max(dot(lo, lo), dot(hi, hi)));
+    box = vec4(lo.x - pad, hi.x + pad, lo.y - pad, hi.y + pad);
+  } else {
+    vec4 angles;
+    if (!direction_box(b, chart, angles, full_phi)) return false;
+    if (!chart_box(chart, angles, full_phi, box)) return true;
+  }
   uvec4 range;
   if (!bucket_range(box, full_phi && chart <= kChartEquirectangular, range)) return true;
   if (range.z * range.w > kGridMaxBuckets) return false;
   uint columns = grid_word(2);
-  bool periodic = grid_word(1) != 0u;
+  bool periodic = grid_periodic();
   uint first_offset = grid_word(9), facets_offset = grid_word(10), boxes_offset = grid_word(11);
   // Listed facets, row by row from at most two runs of buckets.
   uint listed = 0u;
@@ -576,7 +614,7 @@ bool grid_coverage(vec3 p[3], uint t, uint pair_base, uint wanted, out uint want
   // takes the same path in every pass that covers it.
   // A facet is listed at most once in a bucket, so a one-bucket box needs no de-duplication, and
   // cell buckets list each facet once, so they need none at all.
-  bool one_bucket = range.z * range.w == 1u || grid_word(23) != 0u;
+  bool one_bucket = range.z * range.w == 1u || grid_cell_buckets();
   for (uint j = range.y; j < range.y + range.w; ++j) {
     for (uint k = 0u; k < range.z; ++k) {
       uint i = periodic ? (range.x + k) % columns : range.x + k;

@@ -254,9 +254,18 @@ TEST(Pipeline, GpuCoverageMatchesCpuReference) {
   // llvmpipe's loop budget per shader invocation would allow one test each.
   RenderSettings dense;
   dense.facets.layout = FacetGrid{120, 120};
-  for (const auto& [name, outputs, settings] : {std::tuple{"cylinder", cylinder(), strips(40)},
-                                                std::tuple{"dome", dome(), RenderSettings{}},
-                                                std::tuple{"dome, 28,800 facets", dome(), dense}}) {
+  // A tilted perspective base: the grid's gnomonic chart boxes (CoverageGrid::gnomonic_box).
+  RenderSettings perspective_grid;
+  perspective_grid.facets.layout = FacetGrid{16, 12};
+  const std::vector<OutputSpec> perspective = {
+      {"perspective",
+       Warp::analytic(BaseProjection::perspective_fov(100, 70), {320, 240}, {2, 2},
+                      glm::dmat3(glm::rotate(glm::dmat4(1.0), 0.5, glm::dvec3(1, 0.3, 0.2))))}};
+  for (const auto& [name, outputs, settings] :
+       {std::tuple{"cylinder", cylinder(), strips(40)},
+        std::tuple{"dome", dome(), RenderSettings{}},
+        std::tuple{"dome, 28,800 facets", dome(), dense},
+        std::tuple{"perspective 100x70 tilted", perspective, perspective_grid}}) {
     for (const auto& [coverage, cull] :
          {std::pair{FacetCoverage::grid, false}, std::pair{FacetCoverage::grid, true},
           std::pair{FacetCoverage::walk, true}}) {

@@ -39,6 +39,14 @@ TEST(Shaders, CoverageGridConstantsMatchTheCpp) {
   EXPECT_EQ(value("kChartEquirectangular"), long(CoverageChart::equirectangular));
   EXPECT_EQ(value("kChartFisheye"), long(CoverageChart::fisheye));
   EXPECT_EQ(value("kChartPerspective"), long(CoverageChart::perspective));
+  const auto real = [&](const std::string& name) {
+    std::smatch match;
+    const std::regex pattern(name + R"( = ([0-9.e+-]+);)");
+    EXPECT_TRUE(std::regex_search(text, match, pattern)) << name;
+    return match.empty() ? -1.0 : std::stod(match[1]);
+  };
+  EXPECT_EQ(real("kGnomonicMinDepth"), CoverageGrid::kGnomonicMinDepth);
+  EXPECT_EQ(real("kGnomonicPad"), CoverageGrid::kGnomonicPad);
 }
 
 // Pass 1's staging layout exists three times: facet_gpu.hpp, count.comp and scatter.comp.

@@ -177,5 +177,45 @@ TEST(CoverageGrid, BoxesContainEveryDirectionOfTheTriangle) {
   }
 }
 
+// The gnomonic chart box of a triangle in front of a perspective base holds every direction of
+// the triangle, and none is given for a triangle with a corner near or behind the base's plane.
+TEST(CoverageGrid, GnomonicBoxesContainEveryDirectionOfTheTriangle) {
+  const Warp warp = Warp::analytic(BaseProjection::perspective_fov(100, 70), {400, 300});
+  const FacetMesh mesh = build_facets(warp, {FacetGrid{8, 6}});
+  const CoverageGrid grid(mesh, warp.base, warp.R_eye_base);
+  std::mt19937_64 random(5);
+  std::uniform_real_distribution<double> unit(0, 1);
+  int boxed = 0;
+  for (int k = 0; k < 20000; ++k) {
+    Triangle u;
+    const glm::dvec3 centre = random_unit(random);
+    const double size = log_uniform(random, 1e-4, 2);
+    for (auto& p : u) p = glm::normalize(centre + size * random_unit(random));
+    const auto box = grid.gnomonic_box(u);
+    const double least_depth = std::min({-u[0].z, -u[1].z, -u[2].z});
+    ASSERT_EQ(box.has_value(), least_depth > CoverageGrid::kGnomonicMinDepth) << k;
+    if (!box) continue;
+    ++boxed;
+    for (int s = 0; s < 32; ++s) {
+      double a = unit(random), b = unit(random);
+      if (a + b > 1) a = 1 - a, b = 1 - b;
+      const glm::dvec3 v = u[0] + a * (u[1] - u[0]) + b * (u[2] - u[0]);
+      const glm::dvec2 c = glm::dvec2(v.x, v.y) / -v.z;
+      ASSERT_GE(c.x, box->p_lo) << k;
+      ASSERT_LE(c.x, box->p_hi) << k;
+      ASSERT_GE(c.y, box->q_lo) << k;
+      ASSERT_LE(c.y, box->q_hi) << k;
+    }
+  }
+  EXPECT_GT(boxed, 2000);
+  const Warp cylinder = Warp::analytic(BaseProjection::cylindrical(-180, 180, 1, -1), {400, 300});
+  const CoverageGrid polar(build_facets(cylinder, {FacetStrips{8}}), cylinder.base,
+                           cylinder.R_eye_base);
+  const Triangle ahead = {glm::dvec3(0, 0, -1), glm::normalize(glm::dvec3(0.1, 0, -1)),
+                          glm::normalize(glm::dvec3(0, 0.1, -1))};
+  EXPECT_FALSE(polar.gnomonic_box(ahead).has_value());
+  EXPECT_TRUE(grid.gnomonic_box(ahead).has_value());
+}
+
 }  // namespace
 }  // namespace facet

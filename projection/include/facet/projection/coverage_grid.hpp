@@ -75,6 +75,9 @@ class CoverageGrid {
  public:
   static constexpr std::uint32_t kMaxBuckets = 256;     // shared with replication_lib.comp
   static constexpr std::uint32_t kMaxCandidates = 512;  // shared with replication_lib.comp
+  // gnomonic_box: the least −b.z of a corner in front, and the padding per unit of 1 + |c|².
+  static constexpr double kGnomonicMinDepth = 0.05;  // shared with replication_lib.comp
+  static constexpr double kGnomonicPad = 1e-5;       // shared with replication_lib.comp
 
   // Lists the guarded pyramids of `mesh` (the facets of a warp with base `base` and rotation
   // R_eye_base) in cell buckets or uniform ones (above).
@@ -93,6 +96,12 @@ class CoverageGrid {
   static DirectionBox direction_box(const std::array<glm::dvec3, 3>& u, CoverageChart chart,
                                     double pad);
   ChartBox chart_box(const DirectionBox& box) const;
+  // A perspective chart is gnomonic, (p, q) = (b.x, b.y) / −b.z: arcs of great circles are
+  // straight in it, so a triangle whose unit corners u (base frame) all have −b.z above
+  // kGnomonicMinDepth has its chart box at its corners c, exact up to a padding of
+  // kGnomonicPad·(1 + |c|²) for the GPU's float rounding. nullopt for other charts and triangles
+  // (direction_box and chart_box take them).
+  std::optional<ChartBox> gnomonic_box(const std::array<glm::dvec3, 3>& u) const;
   // nullopt when the box misses the grid.
   std::optional<BucketRange> buckets(const ChartBox& box) const;
 
