@@ -8,6 +8,7 @@
 #include "facet/calibration/camera_model.hpp"
 #include "facet/calibration/capture.hpp"
 #include "facet/projection/errors.hpp"
+#include "facet/projection/interrupt.hpp"
 #include "facet/projection/warp_inverse.hpp"
 #include "facet/projection_io/display_config.hpp"
 #include "facet/projection_io/warp_file.hpp"
@@ -124,6 +125,8 @@ CalibrationReport calibrate(const fs::path& capture_path, const fs::path& out,
   const Capture capture = read_capture(capture_path);
   const std::string capture_json = (capture.folder / "capture.json").string();
   const fs::path temporary = prepare_output(out);
+  // Polled between projectors and stages; the catch around the writing removes the temporary.
+  const std::string stopped = "stopped before the end; nothing written to " + out.string();
   const CameraModel model = CameraModel::read(capture.resolve(capture.camera.model));
 
   // Check every projector's frames and image headers before any heavy work.
@@ -139,6 +142,7 @@ CalibrationReport calibrate(const fs::path& capture_path, const fs::path& out,
   }
   std::vector<DecodedMap> decoded;
   for (std::size_t p = 0; p < capture.projectors.size(); ++p) {
+    throw_if_interrupted(stopped);
     decoded.push_back(decode_capture(capture, p, options.decode));
     const DecodedMap& map = decoded.back();
     if (!map.has_x || !map.has_y) {
@@ -155,6 +159,7 @@ CalibrationReport calibrate(const fs::path& capture_path, const fs::path& out,
   CalibrationReport report;
   std::vector<Warp> warps;
   for (std::size_t p = 0; p < capture.projectors.size(); ++p) {
+    throw_if_interrupted(stopped);
     const CaptureProjector& projector = capture.projectors[p];
     const std::vector<FitSample> samples = fit_samples(decoded[p], v_eye);
     WarpFit fit;
@@ -184,6 +189,7 @@ CalibrationReport calibrate(const fs::path& capture_path, const fs::path& out,
   }
   decoded.clear();
 
+  throw_if_interrupted(stopped);
   const BlendResult blend = compute_blend(warps, options.blend);
   for (std::size_t p = 0; p < warps.size(); ++p) {
     std::size_t mapped = 0;
@@ -235,6 +241,7 @@ CalibrationReport calibrate(const fs::path& capture_path, const fs::path& out,
       }
     }
     projection_io::write_display_config(display, temporary / "display.json");
+    throw_if_interrupted(stopped);
     std::error_code error;
     if (fs::exists(out, error)) fs::remove(out);  // checked empty above
     fs::rename(temporary, out);

@@ -17,6 +17,7 @@ extern "C" {
 #include "facet/calibration/capture.hpp"
 #include "facet/calibration/image_io.hpp"
 #include "facet/projection/errors.hpp"
+#include "facet/projection/interrupt.hpp"
 #include "facet/projection_io/rig_file.hpp"
 #include "facet/projection_io/warp_file.hpp"
 
@@ -55,6 +56,15 @@ void parallel_tasks(std::size_t count, Body&& body) {
   for (auto& failure : failures) {
     if (failure) std::rethrow_exception(failure);
   }
+}
+
+// Interrupted (after watch_interrupts) once SIGINT or SIGTERM has arrived.
+void throw_if_interrupted_after(std::size_t rendered, std::size_t frames,
+                                const std::filesystem::path& out) {
+  if (const int signal = interrupt_signal())
+    throw Interrupted(signal, "stopped after " + std::to_string(rendered) + " of " +
+                                  std::to_string(frames) + " frames; nothing written to " +
+                                  out.string());
 }
 
 }  // namespace
@@ -317,13 +327,19 @@ SimulationReport simulate_capture(const Rig& rig, const std::filesystem::path& o
     for (const ProjectorModel& projector : rig.projectors) {
       std::filesystem::create_directories(folder / projector.name);
     }
+    // Polled before every frame: an Interrupted leaves the pool and write_folder_atomically
+    // removes the temporary folder.
+    std::atomic<std::size_t> rendered{0};
     parallel_tasks(tasks.size(), [&](std::size_t k) {
+      throw_if_interrupted_after(rendered.load(), tasks.size(), out);
       const Task& task = tasks[k];
       const cv::Mat image = render_frame(rig, views[task.projector], task.projector,
                                          patterns[task.projector][task.frame], task.frame);
       write_grey_image(folder / capture.projectors[task.projector].frames[task.frame].file, image,
                        rig.simulation.bits);
+      ++rendered;
     });
+    throw_if_interrupted_after(rendered.load(), tasks.size(), out);
     for (std::size_t p = 0; p < rig.projectors.size(); ++p) {
       TrueWarpReport warp_report;
       const Warp warp = true_warp(rig, p, {}, &warp_report);
@@ -334,6 +350,7 @@ SimulationReport simulate_capture(const Rig& rig, const std::filesystem::path& o
     }
     write_rig(folder / "truth" / "rig.json", rig);
     write_capture(capture, folder / "capture.json");
+    throw_if_interrupted_after(rendered.load(), tasks.size(), out);
   });
   report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return report;

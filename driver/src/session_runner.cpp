@@ -22,6 +22,7 @@
 #include "facet/driver/program.hpp"
 #include "facet/projection/atomic_file.hpp"
 #include "facet/projection/errors.hpp"
+#include "facet/projection/interrupt.hpp"
 
 // stb_easy_font turns text into quads; it is a single header with internal linkage.
 #if defined(__GNUC__)
@@ -118,9 +119,9 @@ HeadlessRunResult run_headless_session(Session& session, const CameraPath& path,
   fs::path out_dir = options.out_dir.lexically_normal();
   if (!out_dir.has_filename()) out_dir = out_dir.parent_path();
   if (out_dir.empty()) throw InputError("command line", "--out", "expected an output folder");
-  if (options.frames < 1 || options.frames > kMaxHeadlessFrames)
+  if (options.frames < 1 || options.frames > kMaxFrames)
     throw InputError("command line", "--frames",
-                     "from 1 to " + std::to_string(kMaxHeadlessFrames) + " frames");
+                     "from 1 to " + std::to_string(kMaxFrames) + " frames");
   if (holds_current_folder(out_dir))
     throw InputError(out_dir.string(), "--out",
                      "a folder other than the current folder and its parents");
@@ -140,7 +141,18 @@ HeadlessRunResult run_headless_session(Session& session, const CameraPath& path,
     for (const SessionOutput& output : session.display().outputs)
       fs::create_directories(temporary / output.spec.name);
     std::ofstream stats_file(temporary / "stats.jsonl");
+    const bool replacing = fs::exists(fs::symlink_status(out_dir));
+    // Stops before a frame, and before the rename, once SIGINT or SIGTERM has arrived (after
+    // watch_interrupts); the catch below removes the temporary folder.
+    auto stop_if_interrupted = [&](std::uint64_t done) {
+      if (const int signal = interrupt_signal())
+        throw Interrupted(signal, "stopped after " + std::to_string(done) + " of " +
+                                      std::to_string(options.frames) +
+                                      " frames; nothing written to " + out_dir.string() +
+                                      (replacing ? " (what was there is kept)" : ""));
+    };
     for (std::uint64_t frame = 0; frame < options.frames; ++frame) {
+      stop_if_interrupted(frame);
       FrameState state;
       state.frame = frame;
       state.time_s = double(frame) * kFramePeriod_s;
@@ -159,10 +171,10 @@ HeadlessRunResult run_headless_session(Session& session, const CameraPath& path,
     stats_file.close();
     if (!stats_file)
       throw std::runtime_error((out_dir / "stats.jsonl").string() + ": write failed");
+    stop_if_interrupted(options.frames);
     // The earlier run moves aside until the new one is in place.
     const fs::path earlier =
         parent / ("." + out_dir.filename().string() + ".old" + std::to_string(::getpid()));
-    const bool replacing = fs::exists(fs::symlink_status(out_dir));
     if (replacing) fs::rename(out_dir, earlier);
     try {
       fs::rename(temporary, out_dir);
@@ -392,8 +404,14 @@ void run_windowed_session(const SessionDisplay& display, const Scene& scene, con
   auto last = std::chrono::steady_clock::now();
   double fps = 0;
   FrameStats stats;
+  // SIGINT or SIGTERM (after watch_interrupts) closes the windows like Escape, but writes no
+  // report: the run ends with Interrupted below.
+  std::uint64_t frames_shown = 0;
+  int interrupted_by = 0;
   for (std::uint64_t frame = 0; !options.frames || frame < *options.frames; ++frame) {
     glfwPollEvents();
+    interrupted_by = interrupt_signal();
+    if (interrupted_by) break;
     bool closing = nav.quit;
     for (const Window& window : windows) closing = closing || window.context->should_close();
     if (closing) break;
@@ -492,9 +510,10 @@ void run_windowed_session(const SessionDisplay& display, const Scene& scene, con
     }
     windows.front().context->make_current();
     glDeleteSync(rendered);
+    frames_shown = frame + 1;
   }
 
-  if (options.report) {
+  if (options.report && !interrupted_by) {
     nlohmann::json windows_json = nlohmann::json::array();
     for (std::size_t w = 0; w < windows.size(); ++w) {
       nlohmann::json outputs_json = nlohmann::json::array();
@@ -531,6 +550,11 @@ void run_windowed_session(const SessionDisplay& display, const Scene& scene, con
   }
   windows.front().context->make_current();
   raw_views.clear();
+  if (interrupted_by)
+    throw Interrupted(interrupted_by,
+                      "stopped after " + std::to_string(frames_shown) + " frames" +
+                          (options.report ? "; no report written to " + options.report->string()
+                                          : std::string()));
 }
 
 }  // namespace facet::driver

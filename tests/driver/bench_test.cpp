@@ -164,7 +164,8 @@ TEST(BenchCli, QuickWritesJsonCsvAndPlotWithEveryMethod) {
 TEST(BenchCli, BadFlagsExitTwoAndWriteNothing) {
   const fs::path folder = fresh_folder("bad");
   for (const std::string& flags :
-       {std::string("--scenario moon"), std::string("--frames 0"), std::string("--size-scale -1"),
+       {std::string("--scenario moon"), std::string("--frames 0"), std::string("--frames -1"),
+        std::string("--frames 99999999"), std::string("--size-scale -1"),
         std::string("--scenario dome --rig /nonexistent.json")}) {
     const fs::path out = folder / "bench";
     EXPECT_EQ(run("bench --quick " + flags + " --out " + out.string(), folder / "log.txt"), 2)

@@ -1,13 +1,21 @@
 #pragma once
 // Running the facet CLI (or any shell command) from a test, and reading what it wrote.
+#include <fcntl.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
+#include <chrono>
+#include <csignal>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <iterator>
+#include <sstream>
 #include <string>
+#include <thread>
+#include <vector>
 
 namespace facet::test {
 
@@ -41,6 +49,59 @@ inline int run_facet(const std::string& arguments, std::string* output = nullptr
 inline std::string slurp(const std::filesystem::path& path) {
   std::ifstream stream(path, std::ios::binary);
   return {std::istreambuf_iterator<char>(stream), std::istreambuf_iterator<char>()};
+}
+
+// Starts `facet <arguments>` (FACET_CLI) without a shell, its stdout and stderr going to `log`;
+// returns its process id, or -1.
+inline pid_t start_facet(const std::vector<std::string>& arguments,
+                         const std::filesystem::path& log) {
+  std::vector<std::string> argv_storage{"facet"};
+  argv_storage.insert(argv_storage.end(), arguments.begin(), arguments.end());
+  std::vector<char*> argv;
+  for (std::string& argument : argv_storage) argv.push_back(argument.data());
+  argv.push_back(nullptr);
+  const std::string log_path = log.string();
+  const pid_t child = ::fork();
+  if (child == 0) {
+    const int fd = ::open(log_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    if (fd >= 0) {
+      ::dup2(fd, 1);
+      ::dup2(fd, 2);
+    }
+    ::execv(FACET_CLI, argv.data());
+    ::_exit(127);
+  }
+  return child;
+}
+
+// True once `process` has a handler installed for `signal` (its SigCgt mask in /proc).
+inline bool catches_signal(pid_t process, int signal) {
+  std::ifstream status("/proc/" + std::to_string(process) + "/status");
+  std::string line;
+  while (std::getline(status, line)) {
+    if (!line.starts_with("SigCgt:")) continue;
+    unsigned long long mask = 0;
+    std::istringstream(line.substr(7)) >> std::hex >> mask;
+    return (mask >> (signal - 1)) & 1u;
+  }
+  return false;
+}
+
+// Polls `condition` every 10 ms until it holds (true) or `timeout` passes (false).
+inline bool wait_until(const std::function<bool()>& condition, std::chrono::seconds timeout) {
+  const auto deadline = std::chrono::steady_clock::now() + timeout;
+  while (!condition()) {
+    if (std::chrono::steady_clock::now() > deadline) return false;
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  return true;
+}
+
+// The exit status of `process` once it ends; -1 when a signal ended it.
+inline int wait_for_exit(pid_t process) {
+  int status = 0;
+  if (::waitpid(process, &status, 0) != process) return -1;
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
 
 }  // namespace facet::test

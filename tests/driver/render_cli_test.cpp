@@ -1,6 +1,6 @@
 // `facet render` end to end: bad input exits 2 with a message, --json reports the fields that
 // `facet bench` and the paper comparison read, --out writes the images, the view moves every
-// frame unless --static-view.
+// frame unless --static-view, SIGINT stops it with exit 130 and nothing written.
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -13,6 +13,8 @@
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
+
+#include "cli_process.hpp"
 
 namespace {
 
@@ -109,6 +111,8 @@ TEST(RenderCli, BadInputExitsWithStatus2) {
         std::string("render --display builtin:cylinder360 --method bogus"),
         std::string("render --display builtin:cylinder360 --size 0x10"),
         std::string("render --display builtin:cylinder360 --frames 0"),
+        std::string("render --display builtin:cylinder360 --frames -1"),
+        std::string("render --display builtin:cylinder360 --frames 99999999"),
         std::string("render --display builtin:cylinder360 --scene missing.gltf"),
         std::string("render --display builtin:cylinder360 --scene builtin:town"),
         std::string("render --display builtin:cylinder360 --scene builtin:city:0"),
@@ -176,6 +180,36 @@ TEST(RenderCli, ReferenceReportsTheEdgeDisplacement) {
   EXPECT_EQ(report["texture_anisotropy"].get<double>(), 1.0);  // llvmpipe: automatic is off
   EXPECT_TRUE(std::filesystem::is_regular_file(folder / "dome180.reference.ids.exr"));
   std::filesystem::remove_all(folder);
+}
+
+// A render of a million frames stopped by SIGINT once its handler is in place: exit 130, one line
+// saying how far it got, and neither --out nor a temporary folder beside it.
+TEST(RenderCli, SigintStopsBetweenFramesAndWritesNothing) {
+  namespace fs = std::filesystem;
+  const fs::path folder =
+      fs::temp_directory_path() / ("facet_render_sigint_" + std::to_string(getpid()));
+  fs::remove_all(folder);
+  fs::create_directories(folder);
+  const fs::path out = folder / "out", log = folder / "log";
+  const pid_t child =
+      facet::test::start_facet({"render", "--display", "builtin:cylinder360", "--size", "64x32",
+                                "--pieces", "8", "--frames", "1000000", "--out", out.string()},
+                               log);
+  ASSERT_GT(child, 0);
+  const bool watching = facet::test::wait_until(
+      [&] { return facet::test::catches_signal(child, SIGINT); }, std::chrono::seconds(60));
+  ::kill(child, SIGINT);
+  const int status = facet::test::wait_for_exit(child);
+  const std::string output = facet::test::slurp(log);
+  ASSERT_TRUE(watching) << output;
+  EXPECT_EQ(status, 130) << output;
+  EXPECT_NE(output.find("facet render: interrupted by SIGINT: stopped after "), std::string::npos)
+      << output;
+  EXPECT_NE(output.find("nothing written to " + out.string()), std::string::npos) << output;
+  EXPECT_FALSE(fs::exists(out));
+  for (const fs::directory_entry& entry : fs::directory_iterator(folder))
+    EXPECT_NE(entry.path().filename().string().front(), '.') << entry.path();
+  fs::remove_all(folder);
 }
 
 }  // namespace

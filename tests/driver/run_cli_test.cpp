@@ -1,9 +1,12 @@
 // facet run from the command line: a headless session renders the same pixels as facet render,
-// writes non-empty frames for every sample display, and rejects bad displays with exit status 2.
+// writes non-empty frames for every sample display, and rejects bad displays with exit status 2;
+// --frames outside 1..1,000,000 and windows without a display server are exit 2; SIGINT and
+// SIGTERM stop a headless run with 130 and 143, leaving nothing.
 #include <OpenImageIO/imageio.h>
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 
+#include <csignal>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -212,6 +215,10 @@ TEST(RunCli, BadDisplaysExitWithStatusTwoNamingTheProblem) {
        R"({"format": "facet-display/1", "name": "d", "eye": [0, 0, 0], "projectors": [{"name": "p", "size": [64, 48],
           "warp": "p.warp.exr", "gamma": "linear", "output": {"window": [0, 0, 64, 48]}}]})",
        "gamma"},
+      {"misspelled_key",
+       R"({"format": "facet-display/1", "name": "d", "eye": [0, 0, 0], "projectors": [{"name": "p", "size": [64, 48],
+          "warp": "p.warp.exr", "blnd": "p.blend.exr", "output": {"window": [0, 0, 64, 48]}}]})",
+       "display.json: field 'projectors[0].blnd': unknown field 'blnd'; did you mean 'blend'?"},
   };
   for (const Case& c : cases) {
     SCOPED_TRACE(c.name);
@@ -226,6 +233,97 @@ TEST(RunCli, BadDisplaysExitWithStatusTwoNamingTheProblem) {
     const std::string log = slurp(dir / "log");
     EXPECT_NE(log.find(c.expected), std::string::npos) << log;
     EXPECT_FALSE(fs::exists(out)) << "a failed run left output behind";
+  }
+}
+
+// The same limit as facet render and bench (render_cli_test, bench_test), named in the message.
+TEST(RunCli, FramesOutsideOneToAMillionExitWithStatusTwo) {
+  const fs::path folder = fresh_folder("frames");
+  for (const char* frames : {"-1", "0", "99999999"}) {
+    SCOPED_TRACE(frames);
+    const fs::path out = folder / "out";
+    EXPECT_EQ(run("run builtin:cylinder360 --headless --size 64x32 --frames " +
+                      std::string(frames) + " --out " + out.string(),
+                  folder / "log"),
+              2);
+    const std::string log = slurp(folder / "log");
+    EXPECT_NE(
+        log.find("'--frames': a number of frames from 1 to 1000000, got " + std::string(frames)),
+        std::string::npos)
+        << log;
+    EXPECT_FALSE(fs::exists(out));
+  }
+}
+
+TEST(RunCli, WindowsWithoutADisplayServerExitWithStatusTwo) {
+  const fs::path folder = fresh_folder("no_display");
+  for (const std::string& command :
+       {std::string("run builtin:cylinder360 --windowed --frames 1 --size 64x32"),
+        std::string("run --monitors")}) {
+    SCOPED_TRACE(command);
+    // No display server named, and one named that does not exist.
+    for (const std::string& environment : {std::string("env -u DISPLAY -u WAYLAND_DISPLAY"),
+                                           std::string("env -u WAYLAND_DISPLAY DISPLAY=:4711")}) {
+      std::string output;
+      EXPECT_EQ(test::run_shell(environment + " " + FACET_CLI + " " + command, &output), 2)
+          << environment << "\n"
+          << output;
+      EXPECT_NE(output.find("display server"), std::string::npos) << output;
+      if (command.find("--windowed") != std::string::npos)
+        EXPECT_NE(output.find("use --headless"), std::string::npos) << output;
+      EXPECT_EQ(output.find("internal error"), std::string::npos) << output;
+    }
+  }
+}
+
+// A long headless run stopped by SIGINT, then one by SIGTERM over an earlier run: the documented
+// status (128 + the signal), one line saying how far it got, no output folder (or the earlier run
+// untouched) and no temporary folder beside it.
+TEST(RunCli, SigintAndSigtermStopAHeadlessRunAndLeaveNothing) {
+  const fs::path folder = fresh_folder("signals");
+  const fs::path earlier = folder / "earlier";
+  ASSERT_EQ(
+      run("run builtin:cylinder360 --headless --size 64x32 --frames 1 --out " + earlier.string(),
+          folder / "earlier.log"),
+      0)
+      << slurp(folder / "earlier.log");
+  for (const int signal : {SIGINT, SIGTERM}) {
+    const std::string name = signal == SIGINT ? "SIGINT" : "SIGTERM";
+    SCOPED_TRACE(name);
+    const fs::path out = signal == SIGINT ? folder / "new" : earlier;
+    const fs::path log = folder / (name + ".log");
+    const pid_t child = test::start_facet({"run", "builtin:cylinder360", "--headless", "--size",
+                                           "64x32", "--frames", "1000000", "--out", out.string()},
+                                          log);
+    ASSERT_GT(child, 0);
+    // The second frame in the temporary folder: the handlers are in place and frames are running.
+    const fs::path second = folder /
+                            ("." + out.filename().string() + ".tmp" + std::to_string(child)) /
+                            "cylinder360" / "00001.png";
+    const bool running =
+        test::wait_until([&] { return fs::exists(second); }, std::chrono::seconds(60));
+    ::kill(child, signal);
+    const int status = test::wait_for_exit(child);
+    ASSERT_TRUE(running) << slurp(log);
+    EXPECT_EQ(status, 128 + signal) << slurp(log);
+    const std::string output = slurp(log);
+    EXPECT_NE(output.find("facet run: interrupted by " + name + ": stopped after "),
+              std::string::npos)
+        << output;
+    EXPECT_NE(output.find(" of 1000000 frames; nothing written to " + out.string()),
+              std::string::npos)
+        << output;
+    if (signal == SIGINT) {
+      EXPECT_FALSE(fs::exists(out));
+    } else {
+      // The earlier run is as it was: one frame and its statistics.
+      EXPECT_TRUE(fs::exists(earlier / "cylinder360" / "00000.png"));
+      EXPECT_FALSE(fs::exists(earlier / "cylinder360" / "00001.png"));
+      EXPECT_EQ(slurp(earlier / "stats.jsonl").find('\n') + 1,
+                slurp(earlier / "stats.jsonl").size());
+    }
+    for (const fs::directory_entry& entry : fs::directory_iterator(folder))
+      EXPECT_NE(entry.path().filename().string().front(), '.') << entry.path();
   }
 }
 

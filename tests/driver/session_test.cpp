@@ -222,7 +222,7 @@ TEST(HeadlessRun, WritesFramesPerOutputAndStatistics) {
   EXPECT_TRUE(fs::exists(out / "front" / "notes.txt"));
   fs::remove(out / "front" / "notes.txt");
   // "run/" is "run"; the current folder and its parents are refused, as are 0 frames and more
-  // than kMaxHeadlessFrames, before anything is written.
+  // than kMaxFrames, before anything is written.
   options.out_dir = out.string() + "/";
   EXPECT_NO_THROW(run_headless_session(session, still, options));
   EXPECT_TRUE(fs::exists(out / "stats.jsonl"));
@@ -235,7 +235,7 @@ TEST(HeadlessRun, WritesFramesPerOutputAndStatistics) {
   fs::current_path(before);
   EXPECT_TRUE(fs::exists(out / "front" / "00000.png"));
   options.out_dir = folder / "counted";
-  for (const std::uint64_t frames : {std::uint64_t(0), kMaxHeadlessFrames + 1}) {
+  for (const std::uint64_t frames : {std::uint64_t(0), kMaxFrames + 1}) {
     options.frames = frames;
     EXPECT_THROW(run_headless_session(session, still, options), InputError) << frames;
     EXPECT_FALSE(fs::exists(options.out_dir)) << frames;

@@ -1,7 +1,8 @@
 // The windowed session on a real X server: Xorg with the dummy video driver and three monitors,
 // started by the fixture. Each projector's window must land on its monitor and show exactly its
 // output's pixels; unplugging a monitor mid-session must not crash it; a missing monitor is a
-// clear error. Skipped, saying why, only where Xorg cannot start here.
+// clear error; SIGINT closes the windows with exit 130 and no report. Skipped, saying why, only
+// where Xorg cannot start here.
 #include <gtest/gtest.h>
 #include <signal.h>
 #include <sys/wait.h>
@@ -175,6 +176,41 @@ TEST_F(XorgDummy, AMissingMonitorIsAClearError) {
   const std::string message((std::istreambuf_iterator<char>(in)), {});
   EXPECT_NE(message.find("DP-9"), std::string::npos) << message;
   EXPECT_NE(message.find("projectors[2].output.monitor"), std::string::npos) << message;
+}
+
+TEST_F(XorgDummy, SigintClosesTheWindowsWithoutAReport) {
+  const fs::path display = write_display("sigint");
+  const fs::path report_path = folder_ / "sigint_report.json";
+  // The shell prints its process id, then becomes facet (exec): that id is facet's.
+  FILE* session =
+      ::popen(("echo $$; exec env " +
+               run_command(display, "--frames 1000000 --report " + report_path.string()) + " 2>&1")
+                  .c_str(),
+              "r");
+  ASSERT_NE(session, nullptr);
+  std::string output;
+  char line[512];
+  pid_t facet = 0;
+  bool interrupted = false;
+  while (std::fgets(line, sizeof line, session)) {
+    if (facet == 0) {
+      facet = pid_t(std::atol(line));
+      continue;
+    }
+    output += line;
+    if (!interrupted && output.find("windows open") != std::string::npos) {
+      ::kill(facet, SIGINT);
+      interrupted = true;
+    }
+  }
+  const int status = ::pclose(session);
+  EXPECT_TRUE(interrupted) << output;
+  EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 130) << output;
+  EXPECT_NE(output.find("facet run: interrupted by SIGINT: stopped after "), std::string::npos)
+      << output;
+  EXPECT_NE(output.find("no report written to " + report_path.string()), std::string::npos)
+      << output;
+  EXPECT_FALSE(fs::exists(report_path));
 }
 
 }  // namespace

@@ -1,6 +1,7 @@
 // facet bench: every render method over a sweep of settings, side by side in one run, with median
 // frame times and accuracy against the ray-cast reference; writes bench.json, bench.csv and
 // bench.png (facet/driver/bench.hpp).
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <string>
@@ -10,6 +11,8 @@
 #include "facet/driver/gl_context.hpp"
 #include "facet/driver/scene_names.hpp"
 #include "facet/projection/errors.hpp"
+#include "facet/projection/interrupt.hpp"
+#include "frames_flag.hpp"
 
 namespace facet::cli {
 namespace {
@@ -18,7 +21,7 @@ using namespace facet::driver;
 
 struct BenchCommandOptions {
   std::string scenario = "all";
-  int frames = 5;
+  std::int64_t frames = 5;  // signed, so that a negative count is refused, not wrapped
   double size_scale = 1.0;
   std::string out = "out/bench";
   std::string rig = "configs/rigs/dome4.json";
@@ -29,7 +32,7 @@ struct BenchCommandOptions {
 void run(const BenchCommandOptions& command) {
   BenchOptions options;
   if (command.scenario != "all") options.scenarios = {command.scenario};
-  options.frames = command.frames;
+  options.frames = int(checked_frames(command.frames));
   options.size_scale = command.size_scale;
   options.quick = command.quick;
   options.dome_rig = command.rig;
@@ -40,11 +43,20 @@ void run(const BenchCommandOptions& command) {
   if (command.out.empty()) throw InputError("command line", "--out", "expected a folder");
 
   auto context = create_headless_context();
+  // From here on SIGINT and SIGTERM stop the bench cleanly (Interrupted, exit 128 + signal): at
+  // its next progress line, a setting or a timed frame later, or before the files are written.
+  watch_interrupts();
+  const std::string stopped =
+      "stopped before the end (the lines above are what was measured); "
+      "nothing written to " +
+      command.out;
   const BenchReport report =
-      run_bench(options, context->info().renderer, [](const std::string& line) {
+      run_bench(options, context->info().renderer, [&stopped](const std::string& line) {
         std::printf("%s\n", line.c_str());
         std::fflush(stdout);
+        throw_if_interrupted(stopped);
       });
+  throw_if_interrupted(stopped);
   write_bench_files(report, command.out);
   std::printf("\n");
   for (const std::string& note : report.notes) std::printf("%s\n\n", note.c_str());
@@ -66,7 +78,7 @@ const Registration registration{
           ->capture_default_str();
       command
           ->add_option("--frames", options->frames,
-                       "Timed frames per setting (medians; --quick defaults to 3)")
+                       "Timed frames per setting, 1 to 1000000 (medians; --quick defaults to 3)")
           ->capture_default_str();
       command->add_option("--size-scale", options->size_scale, "Scale every output size by this")
           ->capture_default_str();

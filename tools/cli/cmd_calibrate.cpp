@@ -9,6 +9,7 @@
 #include "command.hpp"
 #include "facet/calibration/calibrate.hpp"
 #include "facet/projection/errors.hpp"
+#include "facet/projection/interrupt.hpp"
 
 namespace {
 
@@ -81,6 +82,8 @@ const facet::cli::Registration registration{
         }
         options.blend.feather_rad = args->feather_deg * M_PI / 180;
         options.display_name = args->name;
+        // From here on SIGINT and SIGTERM stop the calibration cleanly (exit 128 + signal).
+        facet::watch_interrupts();
         const auto report = facet::calibration::calibrate(args->capture, args->out, options);
         if (args->json) {
           std::cout << report.to_json().dump(2) << "\n";

@@ -2,9 +2,7 @@
 // grabs camera frames (a V4L2/UVC camera, or the fake camera that sees the virtual rig) and writes
 // the recorded capture folder frame by frame, resuming an interrupted capture.
 #if __has_include("facet/calibration/live_capture.hpp")
-#include <atomic>
 #include <chrono>
-#include <csignal>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
@@ -21,6 +19,7 @@
 #include "facet/calibration/video_camera.hpp"
 #include "facet/driver/pattern_presenter.hpp"
 #include "facet/projection/errors.hpp"
+#include "facet/projection/interrupt.hpp"
 #include "facet/projection_io/display_config.hpp"
 #include "facet/projection_io/rig_file.hpp"
 #if __has_include("facet/interop/usb_devices.hpp")
@@ -34,8 +33,6 @@ namespace {
 
 namespace fs = std::filesystem;
 using calibration::CaptureProjector;
-
-std::atomic<bool> sigint_received{false};
 
 struct CaptureArgs {
   std::string display, camera, out;
@@ -277,18 +274,17 @@ int run_capture(const CaptureArgs& args) {
   options.allow_clipping = args.allow_clipping;
   options.stop_after = args.stop_after;
   driver::PatternPresenter* watched = presenter.get();
-  options.interrupted = [watched] { return sigint_received.load() || watched->closed(); };
+  // SIGINT and SIGTERM stop the capture after the frame in hand, leaving it resumable (exit 3).
+  options.interrupted = [watched] { return interrupt_signal() != 0 || watched->closed(); };
   if (!args.quiet && !args.json) {
     options.log = [](const std::string& line) {
       std::printf("%s\n", line.c_str());
       std::fflush(stdout);
     };
   }
-  sigint_received = false;
-  std::signal(SIGINT, [](int) { sigint_received = true; });
+  watch_interrupts();
   const calibration::LiveCaptureReport report =
       calibration::run_live_capture(outputs, *camera, setup, options);
-  std::signal(SIGINT, SIG_DFL);
 
   if (args.json) {
     nlohmann::json exposures = nlohmann::json::array();
@@ -312,8 +308,10 @@ int run_capture(const CaptureArgs& args) {
         "%.1f s\n",
         args.out.c_str(), report.frames, report.kept, report.captured, report.seconds);
   } else {
-    std::printf("%s: stopped after %zu of %zu frames; run the same command again to resume\n",
-                args.out.c_str(), report.kept + report.captured, report.frames);
+    const std::string why =
+        interrupt_signal() ? "interrupted by " + signal_name(interrupt_signal()) + ": " : "";
+    std::printf("%s: %sstopped after %zu of %zu frames; run the same command again to resume\n",
+                args.out.c_str(), why.c_str(), report.kept + report.captured, report.frames);
   }
   std::fflush(stdout);
   return report.complete ? 0 : 3;

@@ -1,12 +1,17 @@
 // facet render: renders a scene into every output of a display with one of the render methods,
 // and reports the replication ratio and timings.
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <chrono>
 #include <filesystem>
+#include <functional>
 #include <iostream>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
 
 #include "command.hpp"
 #include "display_flags.hpp"
@@ -19,6 +24,8 @@
 #include "facet/driver/render_method.hpp"
 #include "facet/driver/scene_names.hpp"
 #include "facet/projection/errors.hpp"
+#include "facet/projection/interrupt.hpp"
+#include "frames_flag.hpp"
 
 namespace facet::cli {
 namespace {
@@ -33,7 +40,8 @@ struct RenderOptions {
   std::string display, scene = "builtin:city", method = "facets", size, out;
   LayoutFlags layout;
   std::optional<int> face_size;
-  int frames = 1, msaa = 0;
+  std::int64_t frames = 1;  // signed, so that a negative count is refused, not wrapped
+  int msaa = 0;
   float anisotropy = kAutomaticAnisotropy;
   std::string coverage = "grid";
   bool ids = false, depth = false, reference = false, json = false, static_view = false;
@@ -52,12 +60,14 @@ double median(std::vector<double> values) {
 nlohmann::json compare_with_reference(const Scene& scene, const std::vector<OutputSpec>& outputs,
                                       const std::vector<OutputTarget>& targets,
                                       const glm::dmat4& T_eye_world,
-                                      const std::filesystem::path& ids_folder) {
+                                      const std::filesystem::path& ids_folder,
+                                      const std::string& stopped) {
   const ReferenceRaycaster raycaster(scene);
   IdComparison pooled;
   EdgeDisplacement edges;
   nlohmann::json per_output = nlohmann::json::array();
   for (std::size_t i = 0; i < outputs.size(); ++i) {
+    throw_if_interrupted(stopped);
     const WarpInverse inverse(outputs[i].warp);
     const bool wrap_x = outputs[i].warp.base.wraps_horizontally();
     const std::vector<std::uint32_t> reference = raycaster.ids(inverse, T_eye_world);
@@ -106,8 +116,40 @@ nlohmann::json compare_with_reference(const Scene& scene, const std::vector<Outp
           {"outputs", per_output}};
 }
 
+// Writes the output set through write(temporary folder), then renames its files into `folder`
+// (created when missing; files of other names in it are kept), so that a failure or an
+// interruption leaves no partial set: the temporary folder is removed.
+void write_output_set(const std::filesystem::path& out,
+                      const std::function<void(const std::filesystem::path&)>& write,
+                      const std::string& stopped) {
+  namespace fs = std::filesystem;
+  fs::path folder = out.lexically_normal();
+  if (!folder.has_filename()) folder = folder.parent_path();
+  const fs::path parent = folder.has_parent_path() ? folder.parent_path() : fs::path(".");
+  std::error_code error;
+  fs::create_directories(parent, error);
+  const fs::path temporary =
+      parent / ("." + folder.filename().string() + ".tmp" + std::to_string(::getpid()));
+  fs::remove_all(temporary, error);
+  if (error || !fs::create_directories(temporary, error) || error)
+    throw InputError(out.string(), "--out", "expected a folder that can be created");
+  try {
+    write(temporary);
+    throw_if_interrupted(stopped);
+    fs::create_directories(folder, error);
+    if (error || !fs::is_directory(folder))
+      throw InputError(out.string(), "--out", "expected a folder that can be created");
+    for (const fs::directory_entry& entry : fs::directory_iterator(temporary))
+      fs::rename(entry.path(), folder / entry.path().filename());
+    fs::remove(temporary);
+  } catch (...) {
+    fs::remove_all(temporary, error);
+    throw;
+  }
+}
+
 void run(const RenderOptions& options) {
-  if (options.frames < 1) throw InputError("command line", "--frames", "expected at least 1");
+  const std::uint64_t frame_count = checked_frames(options.frames);
   if (options.msaa < 0) throw InputError("command line", "--msaa", "expected 0 or more samples");
   std::optional<glm::ivec2> size;
   if (!options.size.empty()) size = parse_size(options.size, "--size");
@@ -151,8 +193,14 @@ void run(const RenderOptions& options) {
   std::vector<double> frame_ms;
   std::vector<RenderStats> stats;
   glm::dmat4 T_eye_world(1.0);
-  for (int k = 0; k < options.frames; ++k) {
-    T_eye_world = views.T_eye_world(k);
+  // From here on SIGINT and SIGTERM stop the command cleanly (Interrupted, exit 128 + signal).
+  watch_interrupts();
+  const std::string nothing_written =
+      options.out.empty() ? "nothing printed" : "nothing written to " + options.out;
+  for (std::uint64_t k = 0; k < frame_count; ++k) {
+    throw_if_interrupted("stopped after " + std::to_string(k) + " of " +
+                         std::to_string(frame_count) + " frames; " + nothing_written);
+    T_eye_world = views.T_eye_world(int(k));
     const auto start = std::chrono::steady_clock::now();
     stats.push_back(method->render(T_eye_world, targets, &timer));
     glFinish();
@@ -167,27 +215,41 @@ void run(const RenderOptions& options) {
     for (const auto& [pass, ms] : sums) pass_times[pass].push_back(ms);
   }
 
-  if (!options.out.empty()) {
-    const std::filesystem::path folder(options.out);
-    std::error_code error;
-    std::filesystem::create_directories(folder, error);
-    if (error || !std::filesystem::is_directory(folder)) {
-      throw InputError(options.out, "--out", "expected a folder that can be created");
-    }
-    for (std::size_t i = 0; i < outputs.size(); ++i) {
-      const glm::ivec2 s = targets[i].size();
-      const auto colour = targets[i].read_colour_rgba8();
-      write_png_rgba8(folder / (outputs[i].name + ".png"), s, colour);
-      if (options.ids) {
-        const auto ids = targets[i].read_ids();
-        write_ids_exr(folder / (outputs[i].name + ".ids.exr"), s, ids);
-      }
-      if (options.depth) {
-        const auto depth = targets[i].read_depth();
-        write_depth_exr(folder / (outputs[i].name + ".depth.exr"), s, depth);
-      }
-    }
+  const std::string stopped =
+      "stopped after the " + std::to_string(frame_count) + " frames; " + nothing_written;
+  // The reference (and with --ids its ID images) before the outputs, so that every file of --out
+  // is written as one set.
+  std::optional<nlohmann::json> reference;
+  auto compare = [&](const std::filesystem::path& ids_folder) {
+    if (options.reference)
+      reference = compare_with_reference(scene, outputs, targets, T_eye_world,
+                                         options.ids ? ids_folder : "", stopped);
+  };
+  if (options.out.empty()) {
+    compare("");
+  } else {
+    write_output_set(
+        options.out,
+        [&](const std::filesystem::path& folder) {
+          compare(folder);
+          for (std::size_t i = 0; i < outputs.size(); ++i) {
+            throw_if_interrupted(stopped);
+            const glm::ivec2 s = targets[i].size();
+            const auto colour = targets[i].read_colour_rgba8();
+            write_png_rgba8(folder / (outputs[i].name + ".png"), s, colour);
+            if (options.ids) {
+              const auto ids = targets[i].read_ids();
+              write_ids_exr(folder / (outputs[i].name + ".ids.exr"), s, ids);
+            }
+            if (options.depth) {
+              const auto depth = targets[i].read_depth();
+              write_depth_exr(folder / (outputs[i].name + ".depth.exr"), s, depth);
+            }
+          }
+        },
+        stopped);
   }
+  throw_if_interrupted(stopped);
 
   const RenderStats& last = stats.back();
   double ratio_sum = 0;
@@ -205,7 +267,7 @@ void run(const RenderOptions& options) {
                            {"method", method->name()},
                            {"outputs", names},
                            {"renderer", context->info().renderer},
-                           {"frames", options.frames},
+                           {"frames", frame_count},
                            {"facets", last.facets},
                            {"triangles_scene", scene.triangle_count()},
                            {"triangles_in", last.triangles_in},
@@ -213,7 +275,7 @@ void run(const RenderOptions& options) {
                            {"triangles_sole_piece", last.triangles_sole_piece},
                            {"replicas", last.replicas},
                            {"replication_ratio", last.replication_ratio()},
-                           {"replication_ratio_mean", ratio_sum / options.frames},
+                           {"replication_ratio_mean", ratio_sum / double(frame_count)},
                            {"reused_frames", reused},
                            {"reused_replication", last.reused_replication},
                            {"static_view", options.static_view},
@@ -223,10 +285,7 @@ void run(const RenderOptions& options) {
                            {"frame_ms", median(frame_ms)},
                            {"pass_ms", pass_ms},
                            {"texture_anisotropy", gpu_scene.max_anisotropy}};
-  if (options.reference)
-    report["reference"] = compare_with_reference(
-        scene, outputs, targets, T_eye_world,
-        options.ids && !options.out.empty() ? std::filesystem::path(options.out) : "");
+  if (reference) report["reference"] = *reference;
   if (options.json) {
     std::cout << report.dump(2) << "\n";
   } else {
@@ -237,7 +296,7 @@ void run(const RenderOptions& options) {
         static_cast<unsigned long long>(last.facets),
         static_cast<unsigned long long>(last.triangles_in),
         static_cast<unsigned long long>(last.replicas), last.replication_ratio(), median(frame_ms),
-        options.frames);
+        static_cast<int>(frame_count));
     for (const auto& [pass, times] : pass_times) {
       std::printf("  %-16s %8.3f ms (GPU, median)\n", pass.c_str(), median(times));
     }
@@ -272,7 +331,9 @@ const Registration registration{
       options->layout.add_to(*command);
       command->add_option("--face-size", options->face_size, "Cube-map face size in pixels");
       command->add_option("--size", options->size, "Output size WxH (built-in displays)");
-      command->add_option("--frames", options->frames, "Frames to render (median timings)")
+      command
+          ->add_option("--frames", options->frames,
+                       "Frames to render, 1 to 1000000 (median timings)")
           ->capture_default_str();
       command->add_option("--msaa", options->msaa, "Colour samples per pixel (0: none)");
       command->add_option("--out", options->out, "Folder for <output>.png (and IDs, depth)");

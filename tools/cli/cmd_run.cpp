@@ -4,6 +4,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "command.hpp"
 #include "display_flags.hpp"
@@ -13,6 +14,8 @@
 #include "facet/driver/session.hpp"
 #include "facet/driver/session_runner.hpp"
 #include "facet/projection/errors.hpp"
+#include "facet/projection/interrupt.hpp"
+#include "frames_flag.hpp"
 
 namespace facet::cli {
 namespace {
@@ -25,26 +28,52 @@ struct RunOptions {
   std::optional<double> tolerance;
   std::optional<double> scale;
   bool headless = false, windowed = false;
-  std::int64_t frames = 0;  // signed, so that a negative count is refused, not wrapped
+  std::optional<std::int64_t> frames;  // signed, so that a negative count is refused, not wrapped
   std::string out = "out/session";
   bool span = false, overlay = false, no_path = false;
   std::string report;
   bool monitors = false;
 };
 
+bool have_display_server() {
+  const char* x_display = std::getenv("DISPLAY");
+  const char* wayland_display = std::getenv("WAYLAND_DISPLAY");
+  return (x_display && *x_display) || (wayland_display && *wayland_display);
+}
+
+// The connected monitors, or an InputError naming `flag` when no display server can be reached:
+// windows and monitors need one, and for windows the way out is --headless, not a bug report.
+std::vector<driver::MonitorInfo> monitors_of_display_server(const std::string& flag) {
+  const std::string hint =
+      flag == "--windowed" ? ": use --headless to render frames to files" : std::string();
+  if (!have_display_server())
+    throw InputError("command line", flag,
+                     "a display server (X11) for facet run " + flag +
+                         "; none was found (DISPLAY is not set)" + hint);
+  try {
+    return driver::list_monitors();
+  } catch (const driver::GlContextError& e) {
+    const char* x_display = std::getenv("DISPLAY");
+    throw InputError("command line", flag,
+                     "a display server (X11) for facet run " + flag + "; none could be reached" +
+                         (x_display && *x_display ? std::string(" at DISPLAY=") + x_display : "") +
+                         " (" + e.what() + ")" + hint);
+  }
+}
+
 void run(const RunOptions& options) {
   if (options.monitors) {
     // Names and geometry to put in display.json outputs.
-    for (const driver::MonitorInfo& monitor : driver::list_monitors())
+    for (const driver::MonitorInfo& monitor : monitors_of_display_server("--monitors"))
       std::cout << monitor.name << " " << monitor.size.x << "x" << monitor.size.y << "+"
                 << monitor.position.x << "+" << monitor.position.y << " " << monitor.refresh_hz
                 << " Hz\n";
     return;
   }
-  if (options.frames < 0 || std::uint64_t(options.frames) > driver::kMaxHeadlessFrames)
-    throw InputError("command line", "--frames",
-                     "from 1 to " + std::to_string(driver::kMaxHeadlessFrames) +
-                         " frames (0 or none: the default)");
+  if (options.headless && options.windowed)
+    throw InputError("command line", "--headless", "either --headless or --windowed, not both");
+  std::optional<std::uint64_t> frames;
+  if (options.frames) frames = checked_frames(*options.frames);
   std::optional<glm::ivec2> size;
   if (!options.size.empty()) size = parse_size(options.size, "--size");
   driver::SessionDisplay display = driver::load_session_display(options.display, size);
@@ -57,18 +86,18 @@ void run(const RunOptions& options) {
   }
   // Check the method name before any scene work.
   driver::check_render_method(display.method);
+  const bool headless = options.headless || (!options.windowed && !have_display_server());
+  // Before the scene, so that a missing display server is reported at once.
+  if (!headless) monitors_of_display_server("--windowed");
   const driver::SceneName scene_name = driver::parse_scene_name(options.scene);
   const driver::Scene scene = driver::load_scene(scene_name);
   const driver::CameraPath path = driver::default_camera_path(scene, scene_name.builtin_city());
 
-  const char* x_display = std::getenv("DISPLAY");
-  const char* wayland_display = std::getenv("WAYLAND_DISPLAY");
-  const bool have_display_server =
-      (x_display && *x_display) || (wayland_display && *wayland_display);
-  const bool headless = options.headless || (!options.windowed && !have_display_server);
+  // From here on SIGINT and SIGTERM stop the run cleanly (Interrupted, exit 128 + signal).
+  watch_interrupts();
   if (!headless) {
     driver::WindowRunOptions window_options;
-    if (options.frames > 0) window_options.frames = std::uint64_t(options.frames);
+    window_options.frames = frames;
     window_options.span = options.span;
     window_options.overlay = options.overlay;
     window_options.play_path = !options.no_path;
@@ -81,7 +110,7 @@ void run(const RunOptions& options) {
   auto context = driver::create_headless_context();
   driver::Session session(display, scene);
   driver::HeadlessRunOptions headless_options;
-  headless_options.frames = options.frames > 0 ? std::uint64_t(options.frames) : 10;
+  headless_options.frames = frames.value_or(10);
   headless_options.out_dir = options.out;
   const driver::HeadlessRunResult result =
       driver::run_headless_session(session, path, headless_options);
@@ -115,9 +144,11 @@ const Registration registration{
       command->add_option("--scale", options->scale,
                           "Preview at this fraction of every output's resolution (0, 1]");
       command->add_flag("--headless", options->headless, "Render through EGL to --out");
-      command->add_flag("--windowed", options->windowed, "Open windows even without DISPLAY");
+      command->add_flag("--windowed", options->windowed,
+                        "Open windows (the default when DISPLAY is set; needs a display server)");
       command->add_option("--frames", options->frames,
-                          "Frames to render (headless default 10; windowed: until closed)");
+                          "Frames to render, 1 to 1000000 (headless default 10; windowed: until "
+                          "closed)");
       command->add_option("--out", options->out,
                           "Headless: folder for <output>/<frame>.png and stats.jsonl");
       command->add_flag("--span", options->span, "One borderless window spanning every output");

@@ -10,6 +10,7 @@
 #include "command.hpp"
 #include "facet/calibration/simulate.hpp"
 #include "facet/projection/errors.hpp"
+#include "facet/projection/interrupt.hpp"
 #include "facet/projection_io/rig_file.hpp"
 
 namespace {
@@ -98,6 +99,8 @@ const facet::cli::Registration registration{
         facet::Rig rig = facet::read_rig(args->rig);
         apply_overrides(*args, rig);
         rig.validate(args->rig + " (with the command-line overrides)");
+        // From here on SIGINT and SIGTERM stop the simulation cleanly (exit 128 + signal).
+        facet::watch_interrupts();
         const auto report = facet::calibration::simulate_capture(rig, args->out, args->rig);
         if (args->json) {
           nlohmann::json truth = nlohmann::json::array();

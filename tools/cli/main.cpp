@@ -1,9 +1,11 @@
 #include <algorithm>
 #include <exception>
 #include <iostream>
+#include <string>
 
 #include "command.hpp"
 #include "facet/projection/errors.hpp"
+#include "facet/projection/interrupt.hpp"
 
 namespace facet::cli {
 
@@ -36,6 +38,14 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     app.exit(e);
     return 2;
+  } catch (const facet::Interrupted& e) {
+    // A long command stopped on SIGINT or SIGTERM after removing its temporary outputs; what()
+    // says what was done.
+    const std::string command =
+        app.get_subcommands().empty() ? "" : " " + app.get_subcommands().front()->get_name();
+    std::cerr << "facet" << command << ": interrupted by " << facet::signal_name(e.signal()) << ": "
+              << e.what() << "\n";
+    return e.exit_status();
   } catch (const facet::InputError& e) {
     std::cerr << "facet: error: " << e.what() << "\n";
     return 2;

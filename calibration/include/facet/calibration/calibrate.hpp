@@ -67,7 +67,8 @@ struct CalibrationReport {
 // folder that is renamed onto `out` at the end, so a failure leaves nothing. `out` must not exist,
 // or be an empty folder. Throws InputError naming the file and field on bad input: capture.json
 // errors, missing frames, unreadable images or images of different sizes, a missing camera model,
-// a projector the camera never sees, a truth warp that cannot be read.
+// a projector the camera never sees, a truth warp that cannot be read. After watch_interrupts(),
+// SIGINT or SIGTERM stops it between projectors and stages with Interrupted, leaving nothing.
 CalibrationReport calibrate(const std::filesystem::path& capture_path,
                             const std::filesystem::path& out, const CalibrateOptions& options = {});
 

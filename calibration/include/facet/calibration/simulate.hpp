@@ -101,8 +101,9 @@ struct SimulationReport {
 // Writes the capture folder `out`: capture.json, camera.cameramodel, <projector>/<frame>.png for
 // every projector and frame, and truth/ with <projector>.warp.exr (true_warp) plus rig.json (the
 // rig as simulated). The folder appears whole or not at all: it must not exist or be empty
-// (InputError otherwise). Frames render in parallel on the hardware threads. `source` names the
-// rig in errors.
+// (InputError otherwise). Frames render in parallel on the hardware threads. After
+// watch_interrupts(), SIGINT or SIGTERM stops it before the next frame with Interrupted, leaving
+// nothing. `source` names the rig in errors.
 SimulationReport simulate_capture(const Rig& rig, const std::filesystem::path& out,
                                   const std::string& source = "rig");
 

@@ -22,8 +22,9 @@ inline constexpr double kFramePeriod_s = 1.0 / 60.0;
 using CameraPath = std::function<glm::dmat4(double time_s)>;
 CameraPath default_camera_path(const Scene& scene, bool builtin_city);
 
-// The most frames one headless run writes (a PNG per output and frame).
-inline constexpr std::uint64_t kMaxHeadlessFrames = 1'000'000;
+// The most frames one command renders: facet run (headless or windowed), render and bench refuse
+// a --frames beyond it (a headless run writes a PNG per output and frame).
+inline constexpr std::uint64_t kMaxFrames = 1'000'000;
 
 struct HeadlessRunOptions {
   std::uint64_t frames = 1;
@@ -41,8 +42,10 @@ struct HeadlessRunResult {
 // per frame). The folder is written under a temporary name and renamed when complete. An existing
 // out_dir is replaced only when it is empty or holds exactly an earlier run (stats.jsonl and
 // folders of NNNNN.png, nothing else); a folder with anything else in it, the current folder or
-// one of its parents, and a frame count outside [1, kMaxHeadlessFrames] are InputErrors, raised
-// before anything is written.
+// one of its parents, and a frame count outside [1, kMaxFrames] are InputErrors, raised
+// before anything is written. After watch_interrupts(), SIGINT or SIGTERM stops the run before
+// the next frame (or before the rename): the temporary folder is removed, out_dir is left as it
+// was, and Interrupted says how many frames were rendered.
 HeadlessRunResult run_headless_session(Session& session, const CameraPath& path,
                                        const HeadlessRunOptions& options);
 
@@ -60,9 +63,10 @@ struct WindowRunOptions {
 // windows close or `frames` have been shown. Keys: W/S forward and back, A/D sideways, Q/E down
 // and up, arrows or dragging with the left mouse button turn, P toggles the camera path,
 // O toggles the overlay (fps, replication, ms per pass), Escape quits. Monitors that disappear
-// during the session are reported on stderr and their windows kept. Needs a display server:
-// GlContextError without one. InputError when a monitor the display needs is missing and the
-// display says "missing_monitor": "error".
+// during the session are reported on stderr and their windows kept. After watch_interrupts(),
+// SIGINT or SIGTERM closes the windows and throws Interrupted, writing no report. Needs a display
+// server: GlContextError without one. InputError when a monitor the display needs is missing and
+// the display says "missing_monitor": "error".
 void run_windowed_session(const SessionDisplay& display, const Scene& scene, const CameraPath& path,
                           const WindowRunOptions& options);
 
