@@ -78,46 +78,6 @@ projection_io::DisplayConfig read_capture_display(const std::string& path_text) 
   return projection_io::display_config_from_json(root, path.string(), path.parent_path(), false);
 }
 
-void read_pose(const std::string& path, calibration::CaptureCamera& camera) {
-  require_regular_file(path);
-  std::ifstream stream(path);
-  if (!stream) throw InputError(path, "", "a readable camera pose file");
-  nlohmann::json root;
-  try {
-    root = nlohmann::json::parse(stream);
-  } catch (const nlohmann::json::parse_error& e) {
-    throw InputError(path, "", std::string("valid JSON (") + e.what() + ")");
-  }
-  if (!root.is_object()) throw InputError(path, "", "an object with R_eye_camera, t_eye_camera");
-  auto number = [&](const nlohmann::json& value, const std::string& field) {
-    if (!value.is_number()) throw InputError(path, field, "a number");
-    return value.get<double>();
-  };
-  if (root.contains("R_eye_camera")) {
-    const auto& R = root["R_eye_camera"];
-    if (!R.is_array() || R.size() != 3) {
-      throw InputError(path, "R_eye_camera", "a 3x3 rotation matrix as a list of rows");
-    }
-    for (int row = 0; row < 3; ++row) {
-      if (!R[row].is_array() || R[row].size() != 3) {
-        throw InputError(path, "R_eye_camera[" + std::to_string(row) + "]", "a row of 3 numbers");
-      }
-      for (int column = 0; column < 3; ++column) {
-        camera.R_eye_camera[column][row] =
-            number(R[row][column],
-                   "R_eye_camera[" + std::to_string(row) + "][" + std::to_string(column) + "]");
-      }
-    }
-  }
-  if (root.contains("t_eye_camera")) {
-    const auto& t = root["t_eye_camera"];
-    if (!t.is_array() || t.size() != 3) throw InputError(path, "t_eye_camera", "3 numbers");
-    for (int k = 0; k < 3; ++k) {
-      camera.t_eye_camera[k] = number(t[k], "t_eye_camera[" + std::to_string(k) + "]");
-    }
-  }
-}
-
 // The device node a --camera value names: /dev/videoN and indices as they are, usb: stable ids
 // through sysfs.
 std::string resolve_camera_device(const std::string& camera) {
@@ -252,7 +212,7 @@ int run_capture(const CaptureArgs& args) {
     camera = std::move(owned);
   } else {
     setup.model = calibration::CameraModel::read(args.camera_model);
-    if (!args.camera_pose.empty()) read_pose(args.camera_pose, setup.camera);
+    if (!args.camera_pose.empty()) calibration::read_camera_pose(args.camera_pose, setup.camera);
     setup.screen = display.screen;
     calibration::VideoCameraOptions options;
     if (!args.camera_size.empty()) options.size = parse_size(args.camera_size, "--camera-size");
