@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <nlohmann/json.hpp>
 #include <string>
 
 #include "facet/projection/errors.hpp"
@@ -44,7 +45,7 @@ json sample_document() {
 std::string failing_field(const json& document, const fs::path& folder = ".",
                           bool check_files = false) {
   try {
-    pio::display_config_from_json(document, "display.json", folder, check_files);
+    pio::parse_display_config(document.dump(), "display.json", folder, check_files);
   } catch (const facet::InputError& e) {
     EXPECT_EQ(e.source(), "display.json");
     return e.field();
@@ -56,7 +57,7 @@ std::string failing_field(const json& document, const fs::path& folder = ".",
 
 TEST(DisplayConfig, SampleFileValidatesAndRoundTrips) {
   const pio::DisplayConfig config =
-      pio::display_config_from_json(sample_document(), "sample", ".", false);
+      pio::parse_display_config(sample_document().dump(), "sample", ".", false);
   ASSERT_EQ(config.projectors.size(), 2u);
   EXPECT_EQ(config.projectors[0].output.kind, pio::DisplayOutput::Kind::monitor);
   EXPECT_EQ(config.projectors[0].output.monitor, "DP-1");
@@ -121,7 +122,7 @@ TEST(DisplayConfig, BadFieldsNameFileFieldAndExpectation) {
   EXPECT_EQ(failing_field(with("/x-comment", "hello")), "");
 
   // NaN cannot be written in JSON, but a value built in code can hold it.
-  pio::DisplayConfig config = pio::display_config_from_json(sample_document(), "s", ".", false);
+  pio::DisplayConfig config = pio::parse_display_config(sample_document().dump(), "s", ".", false);
   config.eye.y = std::numeric_limits<double>::quiet_NaN();
   EXPECT_THROW(pio::validate_display_config(config, "s", false), facet::InputError);
   const Folder folder;
@@ -134,7 +135,7 @@ namespace {
 // The message an InputError carries, or "" when none is thrown.
 std::string failure(const json& document) {
   try {
-    pio::display_config_from_json(document, "site/display.json", ".", false);
+    pio::parse_display_config(document.dump(), "site/display.json", ".", false);
   } catch (const facet::InputError& e) {
     return e.what();
   }

@@ -75,7 +75,7 @@ projection_io::DisplayConfig read_capture_display(const std::string& path_text) 
       }
     }
   }
-  return projection_io::display_config_from_json(root, path.string(), path.parent_path(), false);
+  return projection_io::parse_display_config(root.dump(), path.string(), path.parent_path(), false);
 }
 
 // The device node a --camera value names: /dev/videoN and indices as they are, usb: stable ids

@@ -212,8 +212,10 @@ void validate_display_config(const DisplayConfig& config, const std::string& sou
   }
 }
 
-DisplayConfig display_config_from_json(const Json& document, const std::string& source,
-                                       const std::filesystem::path& folder, bool check_files) {
+namespace {
+
+DisplayConfig display_from_json(const Json& document, const std::string& source,
+                                const std::filesystem::path& folder, bool check_files) {
   using namespace json_fields;
   const At root(source);
   Fields fields(document, root);
@@ -289,15 +291,7 @@ DisplayConfig display_config_from_json(const Json& document, const std::string& 
   return config;
 }
 
-DisplayConfig read_display_config(const std::filesystem::path& path, bool check_files) {
-  std::error_code error;
-  const std::filesystem::path file =
-      std::filesystem::is_directory(path, error) ? path / "display.json" : path;
-  return display_config_from_json(json_fields::parse_file(file), file.string(), file.parent_path(),
-                                  check_files);
-}
-
-Json display_config_to_json(const DisplayConfig& config) {
+Json display_to_json(const DisplayConfig& config) {
   Json document = {{"format", kDisplayFormat},
                    {"name", config.name},
                    {"eye", {config.eye.x, config.eye.y, config.eye.z}}};
@@ -326,9 +320,28 @@ Json display_config_to_json(const DisplayConfig& config) {
   return document;
 }
 
+}  // namespace
+
+DisplayConfig parse_display_config(const std::string& text, const std::string& source,
+                                   const std::filesystem::path& folder, bool check_files) {
+  return display_from_json(json_fields::parse(text, source), source, folder, check_files);
+}
+
+DisplayConfig read_display_config(const std::filesystem::path& path, bool check_files) {
+  std::error_code error;
+  const std::filesystem::path file =
+      std::filesystem::is_directory(path, error) ? path / "display.json" : path;
+  return display_from_json(json_fields::parse_file(file), file.string(), file.parent_path(),
+                           check_files);
+}
+
+std::string format_display_config(const DisplayConfig& config) {
+  return display_to_json(config).dump(2) + "\n";
+}
+
 void write_display_config(const DisplayConfig& config, const std::filesystem::path& path) {
   validate_display_config(config, path.string(), false);
-  const std::string text = display_config_to_json(config).dump(2) + "\n";
+  const std::string text = format_display_config(config);
   write_atomically(path, [&](const std::filesystem::path& temporary) {
     std::ofstream stream(temporary, std::ios::binary);
     stream << text;

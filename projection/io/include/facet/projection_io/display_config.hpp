@@ -8,7 +8,6 @@
 // rectangles (desktop pixels, y down).
 #include <filesystem>
 #include <glm/glm.hpp>
-#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 #include <vector>
@@ -82,14 +81,14 @@ struct DisplayConfig {
   }
 };
 
-// Parses and validates a display.json document. `source` names the file in errors; `folder` is
+// Parses and validates the text of a display.json. `source` names the file in errors; `folder` is
 // stored in the result. When `check_files` is set, every referenced warp, blend and black file
 // must exist under `folder`. Throws InputError(source, field, expected) on the first problem:
-// missing or mistyped fields, NaN or Inf, unknown enumerated values, duplicate projector names,
-// missing files, and unknown fields ("unknown field 'blnd'; did you mean 'blend'?"); keys starting
-// with "x-" are free for users' notes.
-DisplayConfig display_config_from_json(const nlohmann::json& root, const std::string& source,
-                                       const std::filesystem::path& folder, bool check_files);
+// invalid JSON, missing or mistyped fields, NaN or Inf, unknown enumerated values, duplicate
+// projector names, missing files, and unknown fields ("unknown field 'blnd'; did you mean
+// 'blend'?"); keys starting with "x-" are free for users' notes.
+DisplayConfig parse_display_config(const std::string& text, const std::string& source,
+                                   const std::filesystem::path& folder, bool check_files);
 
 // Reads display.json (`path` may also be its folder), checking that referenced files exist.
 DisplayConfig read_display_config(const std::filesystem::path& path, bool check_files = true);
@@ -98,7 +97,9 @@ DisplayConfig read_display_config(const std::filesystem::path& path, bool check_
 void validate_display_config(const DisplayConfig& config, const std::string& source,
                              bool check_files);
 
-nlohmann::json display_config_to_json(const DisplayConfig& config);
+// The text of display.json for `config` (2-space indented JSON, a newline at the end), as
+// write_display_config writes it; no validation.
+std::string format_display_config(const DisplayConfig& config);
 
 // Validates (without checking files), then writes atomically. Paths are written as stored.
 void write_display_config(const DisplayConfig& config, const std::filesystem::path& path);
