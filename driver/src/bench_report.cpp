@@ -7,6 +7,8 @@
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
+#include <limits>
+#include <limits>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -448,6 +450,25 @@ std::vector<std::string> bench_notes(const std::vector<BenchRow>& rows,
       "mean anything; absolute times count only on a GPU.",
       frames, renderer.c_str()));
   for (const std::string& scenario : scenarios_of(rows)) {
+    // The fastest row on this machine within each error bound, whatever its method.
+    std::string fastest;
+    for (const double bound_px : {std::numeric_limits<double>::infinity(), 1.0, 0.5, 0.25}) {
+      const BenchRow* best = nullptr;
+      for (const BenchRow& row : rows) {
+        if (row.scenario != scenario || !row.error.empty() || !(row.frame_ms > 0)) continue;
+        if (row.geometric_max_px <= bound_px && (!best || row.frame_ms < best->frame_ms))
+          best = &row;
+      }
+      if (!best) continue;
+      const std::string bound =
+          std::isinf(bound_px) ? std::string("at any error") : format("within %g px", bound_px);
+      fastest +=
+          format(" %s: %s %s, %.1f ms (max error %.3f px);", bound.c_str(), best->method.c_str(),
+                 best->setting.c_str(), best->frame_ms, best->geometric_max_px);
+    }
+    if (!fastest.empty())
+      notes.push_back(scenario + ": fastest on " + renderer +
+                      " (frame ms; geometric max error):" + fastest);
     const auto facets = rows_of(rows, scenario, "facets");
     // facets / naive at the same facets (the same error by construction).
     std::string line;

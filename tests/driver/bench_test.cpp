@@ -358,5 +358,38 @@ TEST(BenchScaleFit, FitsEachGroupAndMethodAndSaysWhatDoesNotVary) {
   EXPECT_TRUE(noted);
 }
 
+// Each scenario's notes name the fastest row on the machine the bench ran on, at any error and
+// within 1, 0.5 and 0.25 px of geometric max error; rows that could not be prepared are left out.
+TEST(BenchNotes, NameTheFastestMethodWithinEachErrorBound) {
+  std::vector<driver::BenchRow> rows;
+  const auto add = [&](const char* method, const char* setting, double ms, double max_px) {
+    driver::BenchRow row;
+    row.scenario = "dome";
+    row.method = method;
+    row.setting = setting;
+    row.frames = 3;
+    row.frame_ms = ms;
+    row.geometric_max_px = max_px;
+    rows.push_back(row);
+  };
+  add("cubemap", "face=64", 10, 6.0);
+  add("cubemap", "face=512", 30, 0.75);
+  add("facets", "tol=1px", 20, 0.97);
+  add("facets", "tol=0.25px", 40, 0.24);
+  add("vertex", "tess=16", 25, 0.6);
+  add("facets", "broken", 1, 0.0);
+  rows.back().error = "could not be prepared";
+  std::string fastest;
+  for (const std::string& note : driver::bench_notes(rows, "llvmpipe"))
+    if (note.starts_with("dome: fastest on llvmpipe")) fastest = note;
+  ASSERT_FALSE(fastest.empty());
+  EXPECT_NE(fastest.find("at any error: cubemap face=64, 10.0 ms"), std::string::npos) << fastest;
+  EXPECT_NE(fastest.find("within 1 px: facets tol=1px, 20.0 ms"), std::string::npos) << fastest;
+  EXPECT_NE(fastest.find("within 0.5 px: facets tol=0.25px, 40.0 ms"), std::string::npos)
+      << fastest;
+  EXPECT_NE(fastest.find("within 0.25 px: facets tol=0.25px"), std::string::npos) << fastest;
+  EXPECT_EQ(fastest.find("broken"), std::string::npos) << fastest;
+}
+
 }  // namespace
 }  // namespace facet
