@@ -269,8 +269,9 @@ TEST(RunCli, WindowsWithoutADisplayServerExitWithStatusTwo) {
           << environment << "\n"
           << output;
       EXPECT_NE(output.find("display server"), std::string::npos) << output;
-      if (command.find("--windowed") != std::string::npos)
+      if (command.find("--windowed") != std::string::npos) {
         EXPECT_NE(output.find("use --headless"), std::string::npos) << output;
+      }
       EXPECT_EQ(output.find("internal error"), std::string::npos) << output;
     }
   }
