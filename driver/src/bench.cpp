@@ -62,7 +62,7 @@ Warp deformation_warp(glm::ivec2 output_size, glm::ivec2 texture_cells) {
 // The rig's projectors scaled by `scale` (sizes, focal lengths, principal points), so that the
 // quick run and --size-scale shrink the dome rig as they shrink the other outputs.
 std::vector<OutputSpec> rig_outputs(const std::filesystem::path& path, double scale) {
-  Rig rig = read_rig(path);
+  Rig rig = load_rig(path.string());
   for (ProjectorModel& projector : rig.projectors) {
     const glm::ivec2 size = scaled(projector.size, scale);
     const glm::dvec2 ratio = glm::dvec2(size) / glm::dvec2(projector.size);

@@ -175,11 +175,14 @@ TEST(Simulate, TruthFilesReadBackAndAgreeWithTheRig) {
   EXPECT_LE(worst, 0.01);  // float32 offsets in the file included
 }
 
-int run_cli(const std::string& arguments) {
-  const std::string command = std::string(FACET_CLI) + " " + arguments + " 2>/dev/null >/dev/null";
+// The CLI's exit status; `prefix` runs before it in the same shell (e.g. "cd DIR && ").
+int run_cli_in(const std::string& prefix, const std::string& arguments) {
+  const std::string command =
+      prefix + std::string(FACET_CLI) + " " + arguments + " 2>/dev/null >/dev/null";
   const int status = std::system(command.c_str());
   return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
+int run_cli(const std::string& arguments) { return run_cli_in("", arguments); }
 
 TEST(Simulate, BadRigsFailCleanlyWithNoOutput) {
   test::TempFolder folder;
@@ -227,6 +230,22 @@ TEST(Simulate, BadRigsFailCleanlyWithNoOutput) {
   EXPECT_TRUE(std::filesystem::exists(out / "truth" / "p0.warp.exr"));
   // An existing, non-empty output folder is refused.
   EXPECT_EQ(run_cli("simulate --rig " + good.string() + " --out " + out.string()), 2);
+}
+
+// A built-in rig (configs/rigs, compiled in) simulates from a folder that holds no configs/; an
+// unknown built-in name exits 2.
+TEST(Simulate, BuiltinRigsWorkFromAnyFolder) {
+  test::TempFolder folder;
+  const auto out = folder.path() / "capture";
+  const std::string in_folder = "cd '" + folder.path().string() + "' && ";
+  EXPECT_EQ(run_cli_in(in_folder, "simulate --rig builtin:wall2x2 --out " + out.string() +
+                                      " --camera-size 64x48 --no-phase"),
+            0);
+  EXPECT_TRUE(std::filesystem::exists(out / "capture.json"));
+  EXPECT_TRUE(std::filesystem::exists(out / "truth" / "p3.warp.exr"));
+  const auto unknown = folder.path() / "unknown";
+  EXPECT_EQ(run_cli_in(in_folder, "simulate --rig builtin:dome5 --out " + unknown.string()), 2);
+  EXPECT_FALSE(std::filesystem::exists(unknown));
 }
 
 }  // namespace

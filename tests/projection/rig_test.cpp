@@ -7,6 +7,7 @@
 #include <numbers>
 #include <random>
 #include <string>
+#include <vector>
 
 #include "facet/projection/errors.hpp"
 #include "facet/projection_io/rig_file.hpp"
@@ -336,9 +337,26 @@ TEST(RigFile, ShippedRigsLoad) {
     SCOPED_TRACE(entry.path().string());
     const Rig rig = read_rig(entry.path());
     EXPECT_EQ(parse_rig(format_rig(rig), "round trip"), rig);
+    // The same rig is compiled in under its file name, so it loads from any folder.
+    EXPECT_EQ(load_rig("builtin:" + entry.path().stem().string()), rig);
     ++loaded;
   }
   EXPECT_EQ(loaded, 3);
+  EXPECT_EQ(builtin_rig_names(), (std::vector<std::string>{"cylinder3", "dome4", "wall2x2"}));
+}
+
+TEST(RigFile, UnknownBuiltinRigNamesTheKnownOnes) {
+  try {
+    load_rig("builtin:dome5");
+    FAIL() << "builtin:dome5 loaded";
+  } catch (const InputError& error) {
+    const std::string message = error.what();
+    EXPECT_NE(message.find("builtin:dome5"), std::string::npos) << message;
+    EXPECT_NE(message.find("builtin:cylinder3, builtin:dome4, builtin:wall2x2"), std::string::npos)
+        << message;
+  }
+  // Without the prefix a name is a path.
+  EXPECT_THROW(load_rig("dome4"), InputError);
 }
 
 }  // namespace

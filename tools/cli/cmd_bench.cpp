@@ -24,7 +24,7 @@ struct BenchCommandOptions {
   std::int64_t frames = 5;  // signed, so that a negative count is refused, not wrapped
   double size_scale = 1.0;
   std::string out = "out/bench";
-  std::string rig = "configs/rigs/dome4.json";
+  std::string rig = "builtin:dome4";
   std::string scene = "builtin:city";
   bool quick = false, static_view = false;
 };
@@ -84,7 +84,10 @@ const Registration registration{
           ->capture_default_str();
       command->add_option("--out", options->out, "Folder for bench.json, bench.csv, bench.png")
           ->capture_default_str();
-      command->add_option("--rig", options->rig, "The multi-projector dome rig (dome scenario)")
+      command
+          ->add_option("--rig", options->rig,
+                       "The dome4 scenario's rig: builtin:NAME (configs/rigs, compiled in) or a "
+                       "rig JSON file")
           ->capture_default_str();
       command
           ->add_option("--scene", options->scene,

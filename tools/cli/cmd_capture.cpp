@@ -147,7 +147,7 @@ int run_capture(const CaptureArgs& args) {
 
   std::optional<Rig> rig;
   if (fake) {
-    rig = read_rig(args.camera.substr(5));
+    rig = load_rig(args.camera.substr(5));
     if (!args.camera_model.empty() || !args.camera_pose.empty()) {
       throw InputError("--camera-model", "",
                        "no --camera-model or --camera-pose with a fake camera: the rig gives both");
@@ -292,7 +292,8 @@ const Registration registration{
       cmd->add_option(
              "--camera", args->camera,
              "/dev/videoN, a device index, a USB stable id usb:VVVV:PPPP[:SERIAL|@BUS-PATH] "
-             "(facet devices), or fake:RIG.json (the virtual rig's camera)")
+             "(facet devices), or fake:RIG (the camera of a virtual rig: a rig file or "
+             "builtin:NAME)")
           ->required();
       cmd->add_option("--out", args->out,
                       "capture folder: new, empty, or an interrupted capture to resume")

@@ -77,7 +77,10 @@ const facet::cli::Registration registration{
           "simulate",
           "Render the capture folder a rig's camera would record (capture.json, images, camera "
           "model) with the ground-truth warps in truth/");
-      cmd->add_option("--rig", args->rig, "rig JSON file (configs/rigs/README.md)")->required();
+      cmd->add_option("--rig", args->rig,
+                      "builtin:NAME (configs/rigs: cylinder3, dome4, wall2x2; compiled in) or a "
+                      "rig JSON file (configs/rigs/README.md)")
+          ->required();
       cmd->add_option("--out", args->out, "capture folder to write (must not exist, or be empty)")
           ->required();
       cmd->add_option("--noise", args->noise, "sensor noise σ, fraction of full scale");
@@ -96,7 +99,7 @@ const facet::cli::Registration registration{
       cmd->add_option("--camera-size", args->camera_size, "camera imager WxH, e.g. 1280x1024");
       cmd->add_flag("--json", args->json, "Print a JSON report");
       cmd->callback([args] {
-        facet::Rig rig = facet::read_rig(args->rig);
+        facet::Rig rig = facet::load_rig(args->rig);
         apply_overrides(*args, rig);
         rig.validate(args->rig + " (with the command-line overrides)");
         // From here on SIGINT and SIGTERM stop the simulation cleanly (exit 128 + signal).

@@ -11,6 +11,16 @@
 #include "json_fields.hpp"
 
 namespace facet {
+namespace detail {
+// configs/rigs/*.json, generated into builtin_rigs.cpp by projection/CMakeLists.txt.
+struct BuiltinRig {
+  const char* name;
+  const char* text;
+};
+extern const BuiltinRig kBuiltinRigs[];
+extern const std::size_t kBuiltinRigCount;
+}  // namespace detail
+
 namespace {
 
 using json_fields::Fields;
@@ -247,6 +257,26 @@ Rig read_rig(const std::filesystem::path& path) {
   std::stringstream buffer;
   buffer << stream.rdbuf();
   return parse_rig(buffer.str(), path.string());
+}
+
+std::vector<std::string> builtin_rig_names() {
+  std::vector<std::string> names;
+  for (std::size_t k = 0; k < detail::kBuiltinRigCount; ++k)
+    names.emplace_back(detail::kBuiltinRigs[k].name);
+  return names;
+}
+
+Rig load_rig(const std::string& name_or_path) {
+  constexpr std::string_view kPrefix = "builtin:";
+  if (!name_or_path.starts_with(kPrefix)) return read_rig(name_or_path);
+  const std::string_view name = std::string_view(name_or_path).substr(kPrefix.size());
+  std::string known;
+  for (std::size_t k = 0; k < detail::kBuiltinRigCount; ++k) {
+    if (name == detail::kBuiltinRigs[k].name)
+      return parse_rig(detail::kBuiltinRigs[k].text, name_or_path);
+    known += std::string(known.empty() ? "" : ", ") + "builtin:" + detail::kBuiltinRigs[k].name;
+  }
+  throw InputError(name_or_path, "rig", "one of " + known + " or a rig file");
 }
 
 std::string format_rig(const Rig& rig) {

@@ -39,7 +39,7 @@ struct BenchOptions {
   // Small sizes (size_scale · 1/8 unless set otherwise), fewer settings; for tests.
   bool quick = false;
   // The multi-projector dome rig of the dome scenario (facet-rig/1 JSON).
-  std::filesystem::path dome_rig = "configs/rigs/dome4.json";
+  std::filesystem::path dome_rig = "builtin:dome4";  // load_rig: builtin:NAME or a rig file
 };
 
 // One method at one setting on one scenario.
