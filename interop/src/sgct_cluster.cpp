@@ -6,6 +6,8 @@
 #include <cctype>
 #include <cmath>
 #include <fstream>
+#include <map>
+#include <optional>
 #include <pugixml.hpp>
 #include <set>
 #include <sstream>
@@ -135,6 +137,187 @@ bool has_extension(const std::string& path, const std::string& extension) {
   return tail == extension;
 }
 
+// One row of a SimCAD `<stem>_frustum.csv` (`;`-separated, a header line then one of values):
+// the frustum its `.simcad` mesh was made for, degrees, each FOV edge positive outwards.
+struct SimcadFrustumTable {
+  double heading = 0, pitch = 0, bank = 0, left = 0, right = 0, bottom = 0, top = 0;
+};
+
+std::vector<std::string> split(const std::string& line, char separator) {
+  std::vector<std::string> items;
+  std::stringstream stream(line);
+  for (std::string item; std::getline(stream, item, separator);) {
+    if (!item.empty() && item.back() == '\r') item.pop_back();
+    items.push_back(item);
+  }
+  return items;
+}
+
+SimcadFrustumTable read_frustum_table(const std::filesystem::path& path) {
+  const std::string source = path.string();
+  std::stringstream text(read_file(path, source, ""));
+  std::string header, values;
+  std::getline(text, header);
+  std::getline(text, values);
+  const std::vector<std::string> names = split(header, ';'), numbers = split(values, ';');
+  const auto column = [&](const char* name) {
+    const auto at = std::find(names.begin(), names.end(), name);
+    if (at == names.end())
+      throw InputError(source, "line 1", "expected a column " + std::string(name));
+    const std::size_t index = std::size_t(at - names.begin());
+    if (index >= numbers.size()) {
+      throw InputError(source, "line 2", "expected a value for column " + std::string(name));
+    }
+    return parse_number(numbers[index], source, "line 2/" + std::string(name));
+  };
+  return {column("heading"), column("pitch"),  column("bank"), column("left"),
+          column("right"),   column("bottom"), column("top")};
+}
+
+// Whether two angles in degrees agree within 0.001° (modulo 360°).
+bool same_angle(double a, double b) {
+  const double difference = std::remainder(a - b, 360.0);
+  return std::abs(difference) < 1e-3;
+}
+
+// "channel2" before "channel10": digit runs compare as numbers.
+bool natural_less(const std::string& a, const std::string& b) {
+  std::size_t i = 0, j = 0;
+  while (i < a.size() && j < b.size()) {
+    if (std::isdigit(static_cast<unsigned char>(a[i])) &&
+        std::isdigit(static_cast<unsigned char>(b[j]))) {
+      std::size_t i_end = i, j_end = j;
+      while (i_end < a.size() && std::isdigit(static_cast<unsigned char>(a[i_end]))) ++i_end;
+      while (j_end < b.size() && std::isdigit(static_cast<unsigned char>(b[j_end]))) ++j_end;
+      const std::string x = a.substr(i, i_end - i), y = b.substr(j, j_end - j);
+      const std::string x_digits = x.substr(std::min(x.find_first_not_of('0'), x.size()));
+      const std::string y_digits = y.substr(std::min(y.find_first_not_of('0'), y.size()));
+      if (x_digits.size() != y_digits.size()) return x_digits.size() < y_digits.size();
+      if (x_digits != y_digits) return x_digits < y_digits;
+      i = i_end, j = j_end;
+    } else {
+      if (a[i] != b[j]) return a[i] < b[j];
+      ++i, ++j;
+    }
+  }
+  return a.size() - i < b.size() - j;
+}
+
+// SimCAD's cluster files name no meshes: each projector's viewport has a <PlanarProjection> but
+// no mesh attribute, and the channel's `.simcad` file lies next to the cluster file, with a
+// `<stem>_frustum.csv` holding the frustum it was made for. Pairs such viewports (keyed by their
+// XML node) with those files: by frustum where every `.simcad` file has its table (a viewport
+// takes the one file whose table matches its FOV and heading, pitch, roll within 0.001°), else in
+// order (the k-th such viewport in the file takes the k-th `.simcad` file by name) when the counts
+// are equal. Notes say which file each took, and why a viewport took none.
+std::map<const void*, std::string> pair_sibling_simcad(const pugi::xml_node& cluster,
+                                                       const std::filesystem::path& folder,
+                                                       const std::string& source,
+                                                       std::vector<std::string>& notes) {
+  std::vector<std::pair<pugi::xml_node, std::string>> viewports;  // and their paths
+  int node_index = 0;
+  for (const pugi::xml_node& node : cluster.children("Node")) {
+    int window_index = 0;
+    for (const pugi::xml_node& window : node.children("Window")) {
+      int viewport_index = 0;
+      for (const pugi::xml_node& viewport : window.children("Viewport")) {
+        const std::string path = "Node[" + std::to_string(node_index) + "]/Window[" +
+                                 std::to_string(window_index) + "]/Viewport[" +
+                                 std::to_string(viewport_index++) + "]";
+        if (attribute_of(viewport, {"mesh", "correctionMesh"}).empty() &&
+            viewport.child("PlanarProjection")) {
+          viewports.emplace_back(viewport, path);
+        }
+      }
+      ++window_index;
+    }
+    ++node_index;
+  }
+  std::map<const void*, std::string> paired;
+  if (viewports.empty()) return paired;
+  std::vector<std::string> meshes;
+  std::error_code error;
+  for (const auto& entry : std::filesystem::directory_iterator(
+           folder.empty() ? std::filesystem::path(".") : folder, error)) {
+    const std::string name = entry.path().filename().string();
+    if (has_extension(name, ".simcad") && entry.is_regular_file(error)) meshes.push_back(name);
+  }
+  std::sort(meshes.begin(), meshes.end(), natural_less);
+  if (meshes.empty()) return paired;
+
+  std::vector<std::optional<SimcadFrustumTable>> tables;
+  bool every_table = true;
+  for (const std::string& mesh : meshes) {
+    const std::filesystem::path table =
+        folder / (std::filesystem::path(mesh).stem().string() + "_frustum.csv");
+    tables.push_back(std::filesystem::is_regular_file(table)
+                         ? std::optional(read_frustum_table(table))
+                         : std::nullopt);
+    every_table = every_table && tables.back().has_value();
+  }
+  if (every_table) {
+    std::vector<bool> taken(meshes.size(), false);
+    for (const auto& [viewport, path] : viewports) {
+      const pugi::xml_node projection = viewport.child("PlanarProjection");
+      const pugi::xml_node fov = projection.child("FOV");
+      const pugi::xml_node orientation = projection.child("Orientation");
+      if (!fov || orientation.attribute("w")) {
+        notes.push_back(path +
+                        " has no mesh attribute, and its <PlanarProjection> gives no FOV "
+                        "and heading to find its .simcad file by");
+        continue;
+      }
+      const std::string fov_path = path + "/PlanarProjection/FOV";
+      const std::string orientation_path = path + "/PlanarProjection/Orientation";
+      const double left = number_attribute(fov, "left", 0, source, fov_path);
+      const double right = number_attribute(fov, "right", 0, source, fov_path);
+      const double up = number_attribute(fov, "up", 0, source, fov_path);
+      const double down = number_attribute(fov, "down", 0, source, fov_path);
+      const double heading = number_attribute(orientation, "heading", 0, source, orientation_path);
+      const double pitch = number_attribute(orientation, "pitch", 0, source, orientation_path);
+      const double roll = number_attribute(orientation, "roll", 0, source, orientation_path);
+      std::vector<std::size_t> matches;
+      for (std::size_t m = 0; m < meshes.size(); ++m) {
+        const SimcadFrustumTable& t = *tables[m];
+        if (same_angle(t.left, left) && same_angle(t.right, right) && same_angle(t.top, up) &&
+            same_angle(t.bottom, down) && same_angle(t.heading, heading) &&
+            same_angle(t.pitch, pitch) && same_angle(t.bank, roll)) {
+          matches.push_back(m);
+        }
+      }
+      if (matches.size() != 1 || taken[matches[0]]) {
+        notes.push_back(path + " has no mesh attribute, and " +
+                        (matches.empty() ? std::string("no")
+                                         : std::to_string(matches.size()) + " (or a taken)") +
+                        " _frustum.csv next to the configuration holds its frustum");
+        continue;
+      }
+      taken[matches[0]] = true;
+      const std::string& mesh = meshes[matches[0]];
+      paired[viewport.internal_object()] = mesh;
+      notes.push_back(path + " has no mesh attribute: took \"" + mesh +
+                      "\" next to the configuration, whose " +
+                      std::filesystem::path(mesh).stem().string() +
+                      "_frustum.csv holds this viewport's frustum");
+    }
+  } else if (meshes.size() == viewports.size()) {
+    for (std::size_t k = 0; k < viewports.size(); ++k) {
+      paired[viewports[k].first.internal_object()] = meshes[k];
+      notes.push_back(viewports[k].second + " has no mesh attribute: took \"" + meshes[k] +
+                      "\", the .simcad file next to the configuration in the same place in "
+                      "name order as this viewport among those with a <PlanarProjection> and "
+                      "no mesh");
+    }
+  } else {
+    notes.push_back(std::to_string(viewports.size()) +
+                    " viewports have a <PlanarProjection> but no mesh attribute, and " +
+                    std::to_string(meshes.size()) +
+                    " .simcad files without a _frustum.csv each lie next to the configuration: "
+                    "not paired");
+  }
+  return paired;
+}
+
 }  // namespace
 
 ImportedDisplay import_sgct_cluster(const std::filesystem::path& config,
@@ -155,6 +338,8 @@ ImportedDisplay import_sgct_cluster(const std::filesystem::path& config,
       display.eye[c] = number_attribute(user_pos, axis[c], 0, source, "User/Pos");
     }
   }
+  const std::map<const void*, std::string> sibling_meshes =
+      pair_sibling_simcad(cluster, folder, source, display.notes);
   std::set<std::string> names;
   int desktop_x = 0;
   int node_index = 0;
@@ -180,7 +365,11 @@ ImportedDisplay import_sgct_cluster(const std::filesystem::path& config,
       for (const pugi::xml_node& viewport : window.children("Viewport")) {
         const std::string path =
             window_path + "/Viewport[" + std::to_string(viewport_index++) + "]";
-        const std::string mesh_written = attribute_of(viewport, {"mesh", "correctionMesh"});
+        std::string mesh_written = attribute_of(viewport, {"mesh", "correctionMesh"});
+        if (const auto sibling = sibling_meshes.find(viewport.internal_object());
+            mesh_written.empty() && sibling != sibling_meshes.end()) {
+          mesh_written = sibling->second;
+        }
         const std::string viewport_name = viewport.attribute("name").value();
         if (mesh_written.empty()) {
           display.notes.push_back(path + (viewport_name.empty() ? "" : " (" + viewport_name + ")") +
@@ -250,7 +439,9 @@ ImportedDisplay import_sgct_cluster(const std::filesystem::path& config,
   }
   if (display.projectors.empty()) {
     throw InputError(source, "Node/Window/Viewport@mesh",
-                     "expected at least one viewport with a .sgc or .simcad correction mesh");
+                     "expected at least one viewport with a .sgc or .simcad correction mesh "
+                     "(a mesh attribute, or for viewports with a <PlanarProjection>, .simcad "
+                     "files next to the configuration)");
   }
   if (node_index > 1) {
     display.notes.push_back(

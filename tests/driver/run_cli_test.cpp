@@ -192,6 +192,25 @@ TEST(RunCli, AnImportedScissDomeRendersEveryChannel) {
   }
 }
 
+TEST(RunCli, TheRealSimcadDomeImportsAsShippedAndRendersEveryChannel) {
+  // SimCAD's six-channel dome as shipped: its cluster file names no meshes, the .simcad files
+  // beside it are found by their frustum tables. A sixteenth of 4096×2160 keeps llvmpipe quick.
+  const fs::path folder = fresh_folder("simcad");
+  ASSERT_NO_FATAL_FAILURE(import_then_run(folder,
+                                          "sgct import " + std::string(FACET_SHARED_DATA_DIR) +
+                                              "/warps/sgct-dome/simcad/dome_bravo.xml",
+                                          " --scale 0.0625"));
+  EXPECT_NE(slurp(folder / "import.log").find("6 projectors"), std::string::npos)
+      << slurp(folder / "import.log");
+  for (int channel = 1; channel <= 6; ++channel) {
+    const Png png =
+        read_png(folder / "frames" / ("channel" + std::to_string(channel) + "_warp") / "00000.png");
+    ASSERT_EQ(png.width, 256) << channel;
+    ASSERT_EQ(png.height, 135) << channel;
+    EXPECT_GT(lit_fraction(png), 0.1) << channel;
+  }
+}
+
 TEST(RunCli, BadDisplaysExitWithStatusTwoNamingTheProblem) {
   const fs::path folder = fresh_folder("bad");
   struct Case {

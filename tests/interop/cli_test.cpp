@@ -195,6 +195,20 @@ TEST(InteropCli, AnSgctDomeConfigurationAndBareSgcMeshesImport) {
   ASSERT_NE(max_at, std::string::npos) << error.output;
   EXPECT_LE(std::strtod(error.output.c_str() + max_at + 9, nullptr), 0.25) << error.output;
 
+  // SimCAD's dome as shipped: the cluster file names no meshes; the .simcad files beside it hold
+  // them.
+  const fs::path simcad = scratch.path / "simcad";
+  r = run("sgct import " + kWarps + "sgct-dome/simcad/dome_bravo.xml --out " + simcad.string(),
+          scratch.path);
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("6 projectors"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("took \"channel6_warp.simcad\""), std::string::npos) << r.output;
+  const auto simcad_display = projection_io::read_display_config(simcad / "display.json");
+  ASSERT_EQ(simcad_display.projectors.size(), 6u);
+  for (const auto& projector : simcad_display.projectors) {
+    EXPECT_EQ(projector.size, glm::ivec2(4096, 2160));
+  }
+
   const fs::path meshes = scratch.path / "meshes";
   r = run("sgct import " + kWarps + "sgct-dome/simcad/channel1_warp_u2.sgc " + kWarps +
               "sgct-dome/simcad/channel2_warp_u3.sgc --size 1024x640 --out " + meshes.string(),

@@ -286,23 +286,11 @@ TEST(Sgc, SimcadMeshesAgreeWithTheirTableAndTheirClusterOrientation) {
 }
 
 // The SimCAD XML files hold the same warps as their `.sgc` exports but no frustum: an SGCT cluster
-// names them from viewports with a <PlanarProjection>. dome_bravo.xml is that configuration without
-// the mesh attributes; with them added, each channel must come out as its `.sgc` does.
+// gives it from viewports with a <PlanarProjection>. dome_bravo.xml, as shipped, names no meshes:
+// the `.simcad` files next to it are paired with its viewports by their `_frustum.csv` tables, and
+// each channel must come out as its `.sgc` does.
 TEST(SgctCluster, SimcadMeshesTakeTheirFrustumFromTheViewport) {
-  test::ScratchFolder scratch("simcad");
-  std::string xml = read_bytes(kDome + "simcad/dome_bravo.xml");
-  int channel = 0;
-  for (std::size_t at = 0; (at = xml.find("<Viewport>", at)) != std::string::npos; at += 10) {
-    const std::size_t end = xml.find("</Viewport>", at);
-    if (xml.substr(at, end - at).find("<PlanarProjection>") == std::string::npos) continue;
-    ++channel;
-    xml.replace(at, 10, "<Viewport mesh=\"channel" + std::to_string(channel) + "_warp.simcad\">");
-    fs::copy_file(kDome + "simcad/channel" + std::to_string(channel) + "_warp.simcad",
-                  scratch.path / ("channel" + std::to_string(channel) + "_warp.simcad"));
-  }
-  ASSERT_EQ(channel, 6);
-  std::ofstream(scratch.path / "dome_bravo.xml") << xml;
-  const ImportedDisplay display = import_sgct_cluster(scratch.path / "dome_bravo.xml", {});
+  const ImportedDisplay display = import_sgct_cluster(kDome + "simcad/dome_bravo.xml", {});
   ASSERT_EQ(display.projectors.size(), 6u);
   for (int c = 1; c <= 6; ++c) {
     SCOPED_TRACE(c);
@@ -335,6 +323,57 @@ TEST(SgctCluster, SimcadMeshesTakeTheirFrustumFromTheViewport) {
     }
     std::printf("channel %d: .simcad against .sgc at the nodes, worst %.5f px\n", c, worst);
     EXPECT_LE(worst, 0.005);  // the .sgc stores floats: 2^-24 of 4096 px is 0.0002 px
+  }
+  for (int c = 1; c <= 6; ++c) {
+    EXPECT_EQ(display.projectors[std::size_t(c - 1)].name, "channel" + std::to_string(c) + "_warp");
+  }
+  EXPECT_EQ(display.projectors[1].output.window, glm::ivec4(4096, 0, 4096, 2160));
+}
+
+// How viewports without a mesh attribute find their `.simcad` files: by the frustum in each
+// file's `_frustum.csv` where every file has one, else in order when the counts agree.
+TEST(SgctCluster, SimcadMeshesArePairedByTheirFrustumTablesElseInOrder) {
+  test::ScratchFolder scratch("simcad-pairing");
+  const std::string shipped = read_bytes(kDome + "simcad/dome_bravo.xml");
+  // The first two projectors' viewports swapped: the frustum tables still pair each file with
+  // the viewport of its own frustum, so the first projector is channel 2.
+  std::string swapped = shipped;
+  const std::string first = "heading=\"-45.0\"", second = "heading=\"45.0\"";
+  const std::size_t a = swapped.find(first), b = swapped.find(second);
+  ASSERT_TRUE(a != std::string::npos && b != std::string::npos && a < b);
+  swapped.replace(b, second.size(), first);
+  swapped.replace(a, first.size(), second);
+  for (int c = 1; c <= 6; ++c) {
+    const std::string stem = "channel" + std::to_string(c) + "_warp";
+    fs::copy_file(kDome + "simcad/" + stem + ".simcad", scratch.path / (stem + ".simcad"));
+    fs::copy_file(kDome + "simcad/" + stem + "_frustum.csv",
+                  scratch.path / (stem + "_frustum.csv"));
+  }
+  std::ofstream(scratch.path / "swapped.xml") << swapped;
+  const ImportedDisplay by_frustum = import_sgct_cluster(scratch.path / "swapped.xml", {});
+  ASSERT_EQ(by_frustum.projectors.size(), 6u);
+  EXPECT_EQ(by_frustum.projectors[0].name, "channel2_warp");
+  EXPECT_EQ(by_frustum.projectors[1].name, "channel1_warp");
+  EXPECT_EQ(by_frustum.projectors[2].name, "channel3_warp");
+  // Without the tables, in order: the swapped viewports take channels 1 and 2 as they come.
+  for (int c = 1; c <= 6; ++c) {
+    fs::remove(scratch.path / ("channel" + std::to_string(c) + "_warp_frustum.csv"));
+  }
+  const ImportedDisplay in_order = import_sgct_cluster(scratch.path / "swapped.xml", {});
+  ASSERT_EQ(in_order.projectors.size(), 6u);
+  EXPECT_EQ(in_order.projectors[0].name, "channel1_warp");
+  EXPECT_EQ(in_order.projectors[1].name, "channel2_warp");
+  // With one file fewer than viewports nothing is paired, and the error says where meshes come
+  // from.
+  fs::remove(scratch.path / "channel6_warp.simcad");
+  try {
+    import_sgct_cluster(scratch.path / "swapped.xml", {});
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.field(), "Node/Window/Viewport@mesh") << e.what();
+    EXPECT_NE(std::string(e.what()).find(".simcad files next to the configuration"),
+              std::string::npos)
+        << e.what();
   }
   // Without a <PlanarProjection> a .simcad mesh cannot be placed.
   std::ofstream(scratch.path / "bare.xml")

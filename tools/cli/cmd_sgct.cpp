@@ -95,8 +95,9 @@ const Registration registration{
         for (const std::string& file : options->files) {
           if (lowercase_extension(file) == ".simcad") {
             throw InputError(file, "",
-                             "a .simcad mesh holds no frustum: import the SGCT cluster file whose "
-                             "viewport names it with a <PlanarProjection>");
+                             "a .simcad mesh holds no frustum: import the SGCT cluster file next "
+                             "to it (such as dome_bravo.xml), whose viewports' "
+                             "<PlanarProjection> give the frusta");
           }
         }
         const bool meshes = lowercase_extension(options->files.front()) == ".sgc";

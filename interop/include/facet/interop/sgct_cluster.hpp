@@ -9,7 +9,11 @@
 // Every viewport with a mesh becomes a projector: its output is the viewport's part of its
 // window (viewport Pos and Size are fractions of the window, default the whole window), and the
 // mesh's own frustum and rotation (sgc.hpp) give the warp; a `.simcad` file holds none, so its
-// viewport's <PlanarProjection> (FOV, Orientation) gives them. The mask is an image over the output
+// viewport's <PlanarProjection> (FOV, Orientation) gives them. SimCAD's cluster files name no
+// meshes: viewports with a <PlanarProjection> and no mesh attribute take the `.simcad` files in
+// the configuration's folder, each the one whose `<stem>_frustum.csv` holds the viewport's FOV and
+// heading, pitch, roll within 0.001° where every file has that table, else in order (the k-th such
+// viewport, the k-th file by name) when the counts agree; notes say which file each took. The mask is an image over the output
 // that SGCT multiplies into the encoded colour, so the linear blend weight is mask^gamma.
 // Viewports without a mesh (an operator's GUI window) are left out with a note. Each node is its
 // own machine; the import places the nodes' windows left to right on one desktop.
