@@ -6,6 +6,7 @@
 #include <cmath>
 #include <exception>
 #include <limits>
+#include <mutex>
 #include <numbers>
 #include <opencv2/imgproc.hpp>
 #include <thread>
@@ -267,7 +268,7 @@ cv::Mat render_frame(const Rig& rig, const ProjectorView& view, std::size_t inde
 }
 
 SimulationReport simulate_capture(const Rig& rig, const std::filesystem::path& out,
-                                  const std::string& source) {
+                                  const std::string& source, const ProgressSink& progress) {
   const auto start = std::chrono::steady_clock::now();
   rig.validate(source);
   const CameraModel camera = rig_camera_model(rig.camera, source);
@@ -330,6 +331,9 @@ SimulationReport simulate_capture(const Rig& rig, const std::filesystem::path& o
     // Polled before every frame: an Interrupted leaves the pool and write_folder_atomically
     // removes the temporary folder.
     std::atomic<std::size_t> rendered{0};
+    std::mutex progress_mutex;
+    std::size_t reported = 0;  // under progress_mutex: counts go out in order
+    if (progress) progress({"frames", 0, tasks.size()});
     parallel_tasks(tasks.size(), [&](std::size_t k) {
       throw_if_interrupted_after(rendered.load(), tasks.size(), out);
       const Task& task = tasks[k];
@@ -338,6 +342,12 @@ SimulationReport simulate_capture(const Rig& rig, const std::filesystem::path& o
       write_grey_image(folder / capture.projectors[task.projector].frames[task.frame].file, image,
                        rig.simulation.bits);
       ++rendered;
+      if (progress) {
+        const std::lock_guard lock(progress_mutex);
+        const std::size_t done = rendered.load();
+        if (done > reported) progress({"frames", done, tasks.size()});
+        reported = std::max(reported, done);
+      }
     });
     throw_if_interrupted_after(rendered.load(), tasks.size(), out);
     for (std::size_t p = 0; p < rig.projectors.size(); ++p) {

@@ -151,6 +151,7 @@ HeadlessRunResult run_headless_session(Session& session, const CameraPath& path,
                                       " frames; nothing written to " + out_dir.string() +
                                       (replacing ? " (what was there is kept)" : ""));
     };
+    if (options.progress) options.progress({"frames", 0, options.frames});
     for (std::uint64_t frame = 0; frame < options.frames; ++frame) {
       stop_if_interrupted(frame);
       FrameState state;
@@ -167,6 +168,7 @@ HeadlessRunResult run_headless_session(Session& session, const CameraPath& path,
         result.images.push_back(out_dir / image);
       }
       result.frames.push_back(std::move(stats));
+      if (options.progress) options.progress({"frames", frame + 1, options.frames});
     }
     stats_file.close();
     if (!stats_file)

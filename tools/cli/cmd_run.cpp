@@ -15,6 +15,7 @@
 #include "facet/driver/session_runner.hpp"
 #include "facet/projection/errors.hpp"
 #include "facet/projection/interrupt.hpp"
+#include "facet/projection/progress.hpp"
 #include "frames_flag.hpp"
 
 namespace facet::cli {
@@ -112,8 +113,11 @@ void run(const RunOptions& options) {
   driver::HeadlessRunOptions headless_options;
   headless_options.frames = frames.value_or(10);
   headless_options.out_dir = options.out;
+  facet::TerminalProgress progress(stderr, "facet run");
+  headless_options.progress = progress.sink();
   const driver::HeadlessRunResult result =
       driver::run_headless_session(session, path, headless_options);
+  progress.finish();
   std::cout << "facet run: " << result.frames.size() << " frames of " << display.outputs.size()
             << " output(s) (" << context->info().renderer << ", method " << display.method
             << ") written to " << options.out << "/<output>/<frame>.png; statistics in "

@@ -11,6 +11,7 @@
 #include "facet/calibration/simulate.hpp"
 #include "facet/projection/errors.hpp"
 #include "facet/projection/interrupt.hpp"
+#include "facet/projection/progress.hpp"
 #include "facet/projection_io/rig_file.hpp"
 
 namespace {
@@ -104,7 +105,10 @@ const facet::cli::Registration registration{
         rig.validate(args->rig + " (with the command-line overrides)");
         // From here on SIGINT and SIGTERM stop the simulation cleanly (exit 128 + signal).
         facet::watch_interrupts();
-        const auto report = facet::calibration::simulate_capture(rig, args->out, args->rig);
+        facet::TerminalProgress progress(stderr, "facet simulate");
+        const auto report =
+            facet::calibration::simulate_capture(rig, args->out, args->rig, progress.sink());
+        progress.finish();
         if (args->json) {
           nlohmann::json truth = nlohmann::json::array();
           for (const auto& t : report.truth) {

@@ -29,6 +29,7 @@
 
 #include "facet/calibration/camera_model.hpp"
 #include "facet/calibration/patterns.hpp"
+#include "facet/projection/progress.hpp"
 #include "facet/projection/rig.hpp"
 
 namespace facet::calibration {
@@ -103,8 +104,10 @@ struct SimulationReport {
 // rig as simulated). The folder appears whole or not at all: it must not exist or be empty
 // (InputError otherwise). Frames render in parallel on the hardware threads. After
 // watch_interrupts(), SIGINT or SIGTERM stops it before the next frame with Interrupted, leaving
-// nothing. `source` names the rig in errors.
+// nothing. `source` names the rig in errors. `progress` gets ("frames", done, all) as frames are
+// written (from one thread at a time).
 SimulationReport simulate_capture(const Rig& rig, const std::filesystem::path& out,
-                                  const std::string& source = "rig");
+                                  const std::string& source = "rig",
+                                  const ProgressSink& progress = {});
 
 }  // namespace facet::calibration

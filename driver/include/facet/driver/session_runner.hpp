@@ -11,6 +11,7 @@
 #include "facet/driver/monitors.hpp"
 #include "facet/driver/scene.hpp"
 #include "facet/driver/session.hpp"
+#include "facet/projection/progress.hpp"
 
 namespace facet::driver {
 
@@ -30,6 +31,7 @@ struct HeadlessRunOptions {
   std::uint64_t frames = 1;
   std::filesystem::path out_dir;  // receives <output>/<frame>.png and stats.jsonl
   bool finish_each_frame = true;  // glFinish per frame, so cpu_ms is the frame's whole time
+  ProgressSink progress;          // ("frames", done, frames) before the first and after each frame
 };
 
 struct HeadlessRunResult {
