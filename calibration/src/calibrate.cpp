@@ -98,6 +98,8 @@ nlohmann::json CalibrationReport::to_json() const {
                            {"outlier_fraction", p.fit.outlier_fraction},
                            {"filled", p.fit.filled},
                            {"holes", p.fit.holes},
+                           {"holes_filled", p.fit.holes_filled},
+                           {"folds_refilled", p.fit.folds_refilled},
                            {"folds", p.fit.folds}};
     if (p.accuracy) {
       item["rms_px"] = p.accuracy->rms_px;

@@ -275,6 +275,72 @@ cv::Mat seen_signed_distance(std::span<const glm::dvec2> q_seen, glm::ivec2 size
   return signed_distance;
 }
 
+// Harmonic (membrane) interpolation over the node grid: every node marked in `free` takes the
+// mean of its 4-neighbours in the grid, the others stay fixed and hold it in place (Laplace's
+// equation with the fixed nodes as boundary values, by successive over-relaxation). An affine
+// map is harmonic, so where the warp is close to one (a projector seen through its own optics
+// is nearly a homography) the filled nodes follow it, and a membrane stretched over a convex
+// boundary does not fold.
+void harmonic_fill(std::vector<glm::dvec2>& values, std::span<const char> free, glm::ivec2 grid) {
+  std::vector<std::size_t> order;
+  for (std::size_t k = 0; k < free.size(); ++k) {
+    if (free[k]) order.push_back(k);
+  }
+  if (order.empty()) return;
+  constexpr double kOverRelaxation = 1.8, kTolerancePx = 1e-6;
+  constexpr int kMaxSweeps = 20000;
+  for (int sweep = 0; sweep < kMaxSweeps; ++sweep) {
+    double largest_change = 0;
+    for (const std::size_t k : order) {
+      const int i = int(k % std::size_t(grid.x)), j = int(k / std::size_t(grid.x));
+      glm::dvec2 sum(0.0);
+      int count = 0;
+      auto add = [&](std::size_t n) {
+        sum += values[n];
+        ++count;
+      };
+      if (i > 0) add(k - 1);
+      if (i + 1 < grid.x) add(k + 1);
+      if (j > 0) add(k - std::size_t(grid.x));
+      if (j + 1 < grid.y) add(k + std::size_t(grid.x));
+      const glm::dvec2 change = kOverRelaxation * (sum / double(count) - values[k]);
+      values[k] += change;
+      largest_change = std::max({largest_change, std::abs(change.x), std::abs(change.y)});
+    }
+    if (largest_change < kTolerancePx) break;
+  }
+}
+
+// The cells of the node grid whose four nodes are covered and that map to the output with
+// reversed orientation or zero area (the test of Warp::find_fold), as the index of their
+// top-left node.
+std::vector<std::size_t> folded_cells(const Warp& warp) {
+  std::vector<std::size_t> folded;
+  const glm::ivec2 grid = warp.grid_size;
+  const glm::dvec2 step{double(warp.output_size.x) / (grid.x - 1),
+                        double(warp.output_size.y) / (grid.y - 1)};
+  auto q_node = [&](int i, int j) {
+    return glm::dvec2(i * step.x, j * step.y) + glm::dvec2(warp.offset_px[warp.node_index(i, j)]);
+  };
+  auto cross = [](glm::dvec2 a, glm::dvec2 b) { return a.x * b.y - a.y * b.x; };
+  for (int j = 0; j + 1 < grid.y; ++j) {
+    for (int i = 0; i + 1 < grid.x; ++i) {
+      if (warp.coverage[warp.node_index(i, j)] < 0.5f ||
+          warp.coverage[warp.node_index(i + 1, j)] < 0.5f ||
+          warp.coverage[warp.node_index(i, j + 1)] < 0.5f ||
+          warp.coverage[warp.node_index(i + 1, j + 1)] < 0.5f) {
+        continue;
+      }
+      const glm::dvec2 q00 = q_node(i, j), q10 = q_node(i + 1, j), q01 = q_node(i, j + 1),
+                       q11 = q_node(i + 1, j + 1);
+      const double least = std::min({cross(q10 - q00, q01 - q00), cross(q11 - q10, q00 - q10),
+                                     cross(q01 - q11, q10 - q11), cross(q00 - q01, q11 - q01)});
+      if (!(least > 1e-9 * step.x * step.y)) folded.push_back(warp.node_index(i, j));
+    }
+  }
+  return folded;
+}
+
 using detail::bilinear;
 
 }  // namespace
@@ -650,6 +716,34 @@ WarpFit fit_warp(std::span<const FitSample> samples, glm::ivec2 output_size,
     }
   }
 
+  // Unsupported nodes enclosed by supported ones (4-connected groups touching no side of the
+  // grid: where decoding failed inside the image, e.g. at a chessboard's corners) are
+  // interpolated from all sides rather than extrapolated ring by ring from one, and the ring limit
+  // does not uncover them: whether they are covered is the camera's view's call alone (see
+  // bridge_px).
+  std::vector<char> enclosed(nodes.size(), 0);
+  {
+    cv::Mat unsupported(grid.y, grid.x, CV_8U, cv::Scalar(0));
+    for (std::size_t k = 0; k < nodes.size(); ++k) {
+      if (!nodes[k].supported) unsupported.at<std::uint8_t>(int(k) / grid.x, int(k) % grid.x) = 1;
+    }
+    cv::Mat labels;
+    const int count = cv::connectedComponents(unsupported, labels, 4, CV_32S);
+    std::vector<char> open(std::size_t(count), 0);
+    for (int j = 0; j < grid.y; ++j) {
+      for (int i = 0; i < grid.x; ++i) {
+        if (i == 0 || j == 0 || i + 1 == grid.x || j + 1 == grid.y) {
+          open[std::size_t(labels.at<std::int32_t>(j, i))] = 1;
+        }
+      }
+    }
+    for (std::size_t k = 0; k < nodes.size(); ++k) {
+      const int label = labels.at<std::int32_t>(int(k) / grid.x, int(k) % grid.x);
+      enclosed[k] = label > 0 && !open[std::size_t(label)] ? 1 : 0;
+    }
+    harmonic_fill(offset, enclosed, grid);
+  }
+
   // Coverage: A at each node from the signed distance of its output position to the edge of what
   // the projector can light there, the nearer of the image edge and the edge of the part of the
   // image the camera saw, as 0.5 + distance / ramp. Within a cell, q is bilinear in st, so a
@@ -685,15 +779,50 @@ WarpFit fit_warp(std::span<const FitSample> samples, glm::ivec2 output_size,
           std::min(std::min(q.x, output_size.x - q.x), std::min(q.y, output_size.y - q.y));
       const double inside = std::min(inside_image, bilinear(seen_px, q));
       double coverage = std::clamp(0.5 + inside / ramp_px, 0.0, 1.0);
-      if (ring[k] > extrapolate_rings) coverage = 0;
+      if (ring[k] > extrapolate_rings && !enclosed[k]) coverage = 0;
       warp.coverage[k] = float(coverage);
       if (ring[k] > 0 && inside_image > 0) {
         ++(coverage < 0.5 ? result.report.holes : result.report.filled);
+        if (enclosed[k] && coverage >= 0.5) ++result.report.holes_filled;
       }
     }
   }
 
-  // Folds: uncover nodes until no covered cell reverses orientation.
+  // Folds: a covered cell that reverses orientation holds a node fit that disagrees with its
+  // neighbours (wrong codes along a shadow's edge, extrapolated rings crossing). Its four nodes
+  // are interpolated again from the nodes around them (harmonic_fill), the region growing by a
+  // ring of nodes per round while a fold remains; what still folds after that is uncovered.
+  {
+    constexpr int kRefillRounds = 1;
+    std::vector<char> refill(nodes.size(), 0);
+    for (int round = 0; round < kRefillRounds; ++round) {
+      const std::vector<std::size_t> folded = folded_cells(warp);
+      if (folded.empty()) break;
+      if (round > 0) {
+        const std::vector<char> inner = refill;
+        for (std::size_t k = 0; k < nodes.size(); ++k) {
+          if (!inner[k]) continue;
+          const int i = int(k) % grid.x, j = int(k) / grid.x;
+          for (int b = std::max(0, j - 1); b <= std::min(grid.y - 1, j + 1); ++b) {
+            for (int a = std::max(0, i - 1); a <= std::min(grid.x - 1, i + 1); ++a) {
+              refill[std::size_t(b) * grid.x + a] = 1;
+            }
+          }
+        }
+      }
+      for (const std::size_t k : folded) {
+        for (const std::size_t n :
+             {k, k + 1, k + std::size_t(grid.x), k + std::size_t(grid.x) + 1}) {
+          refill[n] = 1;
+        }
+      }
+      harmonic_fill(offset, refill, grid);
+      for (std::size_t k = 0; k < nodes.size(); ++k) {
+        if (refill[k]) warp.offset_px[k] = glm::vec2(offset[k]);
+      }
+    }
+    result.report.folds_refilled = std::size_t(std::count(refill.begin(), refill.end(), 1));
+  }
   while (const auto fold = warp.find_fold()) {
     warp.coverage[warp.node_index(fold->x, fold->y)] = 0.0f;
     ++result.report.folds;

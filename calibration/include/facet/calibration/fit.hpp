@@ -84,16 +84,18 @@ struct FitOptions {
 };
 
 struct FitReport {
-  std::size_t samples = 0;      // correspondences given
-  glm::ivec2 grid{0, 0};        // node grid chosen
-  std::size_t supported = 0;    // nodes with a well-posed fit
-  std::size_t filled = 0;       // unsupported nodes inside the image, extrapolated and kept covered
-  std::size_t holes = 0;        // unsupported nodes inside the image left uncovered
-  std::size_t folds = 0;        // nodes uncovered because their cell folded
-  double residual_rms_px = 0;   // RMS |warp(v) − q| over samples the warp covers
-  double residual_p50_px = 0;   // median of the same
-  double residual_p99_px = 0;   // 99th percentile of the same
-  double outlier_fraction = 0;  // share of those samples with residual > outlier_px
+  std::size_t samples = 0;    // correspondences given
+  glm::ivec2 grid{0, 0};      // node grid chosen
+  std::size_t supported = 0;  // nodes with a well-posed fit
+  std::size_t filled = 0;     // unsupported nodes inside the image, extrapolated and kept covered
+  std::size_t holes = 0;      // unsupported nodes inside the image left uncovered
+  std::size_t holes_filled = 0;    // of `filled`, nodes enclosed by supported ones, interpolated
+  std::size_t folds_refilled = 0;  // nodes of folded cells interpolated again from around them
+  std::size_t folds = 0;           // nodes uncovered because their cell still folded after that
+  double residual_rms_px = 0;      // RMS |warp(v) − q| over samples the warp covers
+  double residual_p50_px = 0;      // median of the same
+  double residual_p99_px = 0;      // 99th percentile of the same
+  double outlier_fraction = 0;     // share of those samples with residual > outlier_px
 };
 
 struct WarpFit {
