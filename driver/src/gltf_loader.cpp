@@ -92,6 +92,7 @@ class GltfReader {
           out.repeat = model_.samplers[static_cast<std::size_t>(t.sampler)].wrapS !=
                        TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE;
       }
+      out.unlit = in.extensions.count("KHR_materials_unlit") > 0;
       scene.materials.push_back(out);
     }
   }
@@ -150,7 +151,36 @@ class GltfReader {
       object.primitive_count = count;
       scene.objects.push_back(std::move(object));
     }
+    if (node.camera >= 0) {
+      if (node.camera >= static_cast<int>(model_.cameras.size()))
+        fail(field + ".camera", "a camera index below " + std::to_string(model_.cameras.size()));
+      const auto& camera = model_.cameras[static_cast<std::size_t>(node.camera)];
+      SceneCamera out;
+      out.camera_name = camera.name;
+      out.name = !node.name.empty() ? node.name : !camera.name.empty() ? camera.name : field;
+      out.T_world_camera = rigid_part(T_world_node, field);
+      out.orthographic = camera.type == "orthographic";
+      scene.cameras.push_back(std::move(out));
+    }
     for (const int child : node.children) visit(scene, child, T_world_node, depth + 1);
+  }
+
+  // The rotation and translation of a node transform: its axes made orthonormal (scale and
+  // shear dropped), keeping -z as the viewing direction and +y as up as far as they allow.
+  glm::dmat4 rigid_part(const glm::dmat4& T, const std::string& field) const {
+    const glm::dvec3 z_axis(T[2]), y_axis(T[1]);
+    const glm::dvec3 x_axis = glm::cross(y_axis, z_axis);
+    if (!(glm::length(z_axis) > 0) || !(glm::length(x_axis) > 0))
+      fail(field, "a camera node transform that is not degenerate (zero scale)");
+    const glm::dvec3 z = glm::normalize(z_axis);
+    const glm::dvec3 x = glm::normalize(x_axis);
+    const glm::dvec3 y = glm::cross(z, x);
+    glm::dmat4 out(1.0);
+    out[0] = glm::dvec4(x, 0.0);
+    out[1] = glm::dvec4(y, 0.0);
+    out[2] = glm::dvec4(z, 0.0);
+    out[3] = T[3];
+    return out;
   }
 
   glm::dmat4 local_transform(const tinygltf::Node& node, const std::string& field) const {

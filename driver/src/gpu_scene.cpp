@@ -25,6 +25,8 @@ void GpuScene::bind_material_texture(std::uint32_t m, GLuint unit) const {
   else
     white.bind_unit(unit);
   (material_repeat[m] ? repeat_sampler : clamp_sampler).bind_unit(unit);
+  glBindBufferRange(GL_UNIFORM_BUFFER, material_shading_binding, material_shading.id(),
+                    static_cast<GLintptr>(m * material_shading_stride), sizeof(std::uint32_t) * 4);
 }
 
 bool is_software_renderer() {
@@ -65,11 +67,26 @@ GpuScene upload_scene(const Scene& scene, float max_anisotropy) {
     std::memcpy(g.base_colour, glm::value_ptr(m.base_colour), sizeof g.base_colour);
     g.texture = m.texture;
     g.repeat = m.repeat ? 1u : 0u;
+    g.unlit = m.unlit ? 1u : 0u;
     materials.push_back(g);
     gpu.material_texture.push_back(m.texture);
     gpu.material_repeat.push_back(m.repeat);
   }
   gpu.materials = Buffer::create_from(materials);
+
+  GLint alignment = 16;
+  glGetIntegerv(GL_UNIFORM_BUFFER_OFFSET_ALIGNMENT, &alignment);
+  constexpr std::size_t kBlockBytes = 4 * sizeof(std::uint32_t);  // std140: a uint padded to 16
+  gpu.material_shading_stride = std::max(kBlockBytes, static_cast<std::size_t>(alignment));
+  std::vector<std::uint8_t> shading((scene.materials.size() + 1) * gpu.material_shading_stride, 0);
+  for (std::size_t i = 0; i < scene.materials.size(); ++i) {
+    const std::uint32_t unlit = scene.materials[i].unlit ? 1u : 0u;
+    std::memcpy(&shading[i * gpu.material_shading_stride], &unlit, sizeof unlit);
+  }
+  gpu.material_shading = Buffer::create_from(shading);
+  glBindBufferRange(GL_UNIFORM_BUFFER, material_shading_binding, gpu.material_shading.id(),
+                    static_cast<GLintptr>(scene.materials.size() * gpu.material_shading_stride),
+                    kBlockBytes);
 
   std::vector<GpuObject> objects;
   for (const auto& o : scene.objects) {

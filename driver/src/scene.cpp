@@ -62,6 +62,7 @@ Scene subdivide_triangles(const Scene& scene, int n) {
   out.objects = scene.objects;
   out.materials = scene.materials;
   out.images = scene.images;
+  out.cameras = scene.cameras;
   const std::uint64_t pieces = std::uint64_t(n) * std::uint64_t(n);
   const std::uint64_t corners = std::uint64_t(n + 1) * std::uint64_t(n + 2) / 2;
   std::uint64_t triangles = 0;

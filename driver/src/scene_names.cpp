@@ -98,14 +98,19 @@ Scene load_scene(const SceneName& name) {
 FrameViews::FrameViews(const Scene& scene, bool builtin_city, double city_step_s, bool static_view)
     : city_(builtin_city), static_(static_view), step_s_(city_step_s) {
   const Aabb bounds = scene.bounds_world();
-  if (!bounds.empty()) centre_ = glm::dvec3(bounds.centre());
+  if (!bounds.empty()) {
+    view_.pivot_world = glm::dvec3(bounds.centre());
+    view_.T_world_eye = glm::translate(glm::dmat4(1.0), view_.pivot_world);
+  }
 }
+
+FrameViews::FrameViews(const SceneView& view, double city_step_s, bool static_view)
+    : city_(view.follows_city_path), static_(static_view), step_s_(city_step_s), view_(view) {}
 
 glm::dmat4 FrameViews::T_world_eye(int frame) const {
   const int k = static_ ? 0 : frame;
   if (city_) return path_.T_world_eye(k * step_s_);
-  const double yaw = 2 * std::numbers::pi * double(k % kTurnFrames) / kTurnFrames;
-  return glm::rotate(glm::translate(glm::dmat4(1.0), centre_), yaw, glm::dvec3(0, 1, 0));
+  return view_.T_world_eye_turned(double(k % kTurnFrames) / kTurnFrames);
 }
 
 glm::dmat4 FrameViews::T_eye_world(int frame) const { return glm::inverse(T_world_eye(frame)); }

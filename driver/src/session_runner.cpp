@@ -42,18 +42,16 @@ namespace facet::driver {
 
 namespace fs = std::filesystem;
 
-CameraPath default_camera_path(const Scene& scene, bool builtin_city) {
-  if (builtin_city) {
+CameraPath camera_path(const SceneView& view) {
+  if (view.follows_city_path) {
     auto city_path = std::make_shared<CityCameraPath>();
     return [city_path](double time_s) { return city_path->T_world_eye(time_s); };
   }
-  const Aabb bounds = scene.bounds_world();
-  const glm::dvec3 centre = bounds.empty() ? glm::dvec3(0) : glm::dvec3(bounds.centre());
-  return [centre](double time_s) {
-    // One turn a minute, so a whole dome sees every side of the model.
-    const double yaw = 2 * 3.14159265358979323846 * time_s / 60.0;
-    return glm::rotate(glm::translate(glm::dmat4(1.0), centre), yaw, glm::dvec3(0, 1, 0));
-  };
+  return [view](double time_s) { return view.T_world_eye_turned(time_s / kViewTurnPeriod_s); };
+}
+
+CameraPath default_camera_path(const Scene& scene, bool builtin_city) {
+  return camera_path(choose_scene_view(scene, {}, builtin_city));
 }
 
 namespace {

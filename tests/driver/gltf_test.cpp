@@ -1,16 +1,21 @@
 // glTF loading: a tiny file written here (a .gltf with its buffer embedded as base64) loads with
-// the right counts, transforms, materials and bounds; malformed files give InputError naming the
-// file.
+// the right counts, transforms, materials, cameras and bounds; malformed files give InputError
+// naming the file. The view of a scene (scene_view.hpp): the default eye leaves closed geometry,
+// --eye inside it warns, --look-at and --camera set the pose.
 #include <gtest/gtest.h>
 
 #include <array>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <glm/gtc/matrix_transform.hpp>
+#include <numbers>
 #include <string>
 #include <vector>
 
 #include "facet/driver/gltf_loader.hpp"
+#include "facet/driver/reference.hpp"
+#include "facet/driver/scene_view.hpp"
 #include "facet/projection/errors.hpp"
 
 namespace facet::driver {
@@ -172,6 +177,199 @@ TEST(Gltf, MissingFileOrWrongExtension) {
     ADD_FAILURE() << "expected InputError";
   } catch (const InputError& e) {
     EXPECT_EQ(e.source(), "/nonexistent/facet/scene.gltf");
+  }
+}
+
+// A closed 2 m box around the origin, its faces counter-clockwise seen from outside (or from
+// inside when `inward`: a room), with an unlit material and two cameras: "Front" 5 m along +z,
+// and "Side" (camera name "side view", orthographic) under a parent at (1, 0, 0), itself at
+// (3, 1, 0) turned 90° about y and scaled by 2.
+std::string box_gltf(bool inward = false, bool cameras = true) {
+  std::vector<unsigned char> buffer;
+  const float corners[8][3] = {{-1, -1, -1}, {1, -1, -1}, {1, 1, -1}, {-1, 1, -1},
+                               {-1, -1, 1},  {1, -1, 1},  {1, 1, 1},  {-1, 1, 1}};
+  const int faces[6][4] = {{4, 5, 6, 7}, {1, 0, 3, 2}, {5, 1, 2, 6},
+                           {0, 4, 7, 3}, {3, 7, 6, 2}, {0, 1, 5, 4}};
+  for (const auto& corner : corners)
+    for (const float v : corner) append(buffer, v);
+  for (const auto& f : faces) {
+    const int quad[6] = {f[0], f[1], f[2], f[0], f[2], f[3]};
+    for (int k = 0; k < 6; ++k) append(buffer, std::uint16_t(quad[inward ? 5 - k : k]));
+  }
+  const std::string uri = "data:application/octet-stream;base64," + base64(buffer);
+  const std::string camera_nodes =
+      cameras ? R"(, {"name": "Front", "camera": 0, "translation": [0, 0, 5]},
+    {"translation": [1, 0, 0], "children": [3]},
+    {"name": "Side", "camera": 1, "translation": [3, 1, 0], "scale": [2, 2, 2],
+     "rotation": [0, 0.70710678118654752, 0, 0.70710678118654752]})"
+              : "";
+  const std::string camera_list = cameras ? R"("cameras": [
+    {"name": "front view", "type": "perspective", "perspective": {"yfov": 1.0, "znear": 0.1}},
+    {"name": "side view", "type": "orthographic",
+     "orthographic": {"xmag": 1, "ymag": 1, "znear": 0.1, "zfar": 100}}],)"
+                                          : "";
+  return R"({
+  "asset": {"version": "2.0"},
+  "extensionsUsed": ["KHR_materials_unlit"],
+  "scene": 0,
+  "scenes": [{"nodes": )" +
+         std::string(cameras ? "[0, 1, 2]" : "[0]") + R"(}],
+  "nodes": [{"name": "box", "mesh": 0})" +
+         camera_nodes + R"(],
+  )" + camera_list +
+         R"(
+  "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1, "material": 0}]}],
+  "materials": [{"name": "flat", "pbrMetallicRoughness": {"baseColorFactor": [0.2, 0.5, 0.8, 1]},
+                 "extensions": {"KHR_materials_unlit": {}}},
+                {"name": "lit"}],
+  "accessors": [
+    {"bufferView": 0, "componentType": 5126, "count": 8, "type": "VEC3",
+     "min": [-1, -1, -1], "max": [1, 1, 1]},
+    {"bufferView": 1, "componentType": 5123, "count": 36, "type": "SCALAR"}
+  ],
+  "bufferViews": [
+    {"buffer": 0, "byteOffset": 0, "byteLength": 96},
+    {"buffer": 0, "byteOffset": 96, "byteLength": 72}
+  ],
+  "buffers": [{"byteLength": )" +
+         std::to_string(buffer.size()) + R"(, "uri": ")" + uri + R"("}]
+})";
+}
+
+void expect_near(const glm::dmat4& a, const glm::dmat4& b, double tolerance = 1e-9) {
+  for (int c = 0; c < 4; ++c)
+    for (int r = 0; r < 4; ++r) EXPECT_NEAR(a[c][r], b[c][r], tolerance) << c << "," << r;
+}
+
+TEST(Gltf, LoadsUnlitMaterialsAndCameras) {
+  TempDir dir;
+  const Scene scene = load_gltf(dir.write("box.gltf", box_gltf()));
+  ASSERT_EQ(scene.materials.size(), 2u);
+  EXPECT_TRUE(scene.materials[0].unlit);
+  EXPECT_FALSE(scene.materials[1].unlit);
+  ASSERT_EQ(scene.cameras.size(), 2u);
+  EXPECT_EQ(scene.cameras[0].name, "Front");
+  EXPECT_EQ(scene.cameras[0].camera_name, "front view");
+  EXPECT_FALSE(scene.cameras[0].orthographic);
+  expect_near(scene.cameras[0].T_world_camera,
+              glm::translate(glm::dmat4(1.0), glm::dvec3(0, 0, 5)));
+  // Parent translation, then the node's own; its scale is dropped, its turn kept (the camera
+  // looks down world -x).
+  EXPECT_EQ(scene.cameras[1].name, "Side");
+  EXPECT_TRUE(scene.cameras[1].orthographic);
+  const glm::dmat4 expected = glm::rotate(glm::translate(glm::dmat4(1.0), glm::dvec3(4, 1, 0)),
+                                          std::numbers::pi / 2, glm::dvec3(0, 1, 0));
+  expect_near(scene.cameras[1].T_world_camera, expected);
+}
+
+TEST(SceneView, DefaultEyeLeavesClosedGeometry) {
+  TempDir dir;
+  const Scene scene = load_gltf(dir.write("box.gltf", box_gltf()));
+  EXPECT_EQ(back_face_hits(scene, glm::dvec3(0.0)), kInsideTestRays);
+  EXPECT_TRUE(eye_inside_geometry(scene, glm::dvec3(0.0)));
+  EXPECT_FALSE(eye_inside_geometry(scene, glm::dvec3(0, 0, 5)));
+  const SceneView view = choose_scene_view(scene, {}, false);
+  EXPECT_FALSE(view.follows_city_path);
+  EXPECT_FALSE(view.eye_inside);
+  EXPECT_NE(view.message.find("inside geometry"), std::string::npos) << view.message;
+  const double r = std::sqrt(3.0);  // half the box's diagonal
+  const glm::dvec3 p_eye(view.T_world_eye[3]);
+  EXPECT_NEAR(glm::distance(p_eye, glm::dvec3(0, 0.6 * r, 1.6 * r)), 0.0, 1e-9);
+  EXPECT_EQ(view.pivot_world, glm::dvec3(0.0));
+  // It looks at the centre (down its -z), and from there the box's front faces are seen.
+  const glm::dvec3 forward = -glm::dvec3(view.T_world_eye[2]);
+  EXPECT_NEAR(glm::distance(forward, glm::normalize(-p_eye)), 0.0, 1e-9);
+  const ReferenceRaycaster culling(scene);  // culls back faces
+  EXPECT_NE(culling.id_along(p_eye, -p_eye), 0u);
+  // A quarter turn circles the centre, still looking at it.
+  const glm::dmat4 turned = view.T_world_eye_turned(0.25);
+  const glm::dvec3 p_turned(turned[3]);
+  EXPECT_NEAR(glm::length(p_turned), glm::length(p_eye), 1e-9);
+  EXPECT_NEAR(p_turned.y, p_eye.y, 1e-9);
+  EXPECT_NEAR(glm::distance(-glm::dvec3(turned[2]), glm::normalize(-p_turned)), 0.0, 1e-9);
+}
+
+TEST(SceneView, OpenOrOutsideCentreKeepsTheEyeThere) {
+  TempDir dir;
+  // A room: from its centre every ray meets a face from the front.
+  const Scene room = load_gltf(dir.write("room.gltf", box_gltf(true)));
+  EXPECT_EQ(back_face_hits(room, glm::dvec3(0.0)), 0);
+  const SceneView view = choose_scene_view(room, {}, false);
+  EXPECT_TRUE(view.message.empty()) << view.message;
+  expect_near(view.T_world_eye, glm::dmat4(1.0));
+  // Turning on the spot.
+  EXPECT_NEAR(glm::length(glm::dvec3(view.T_world_eye_turned(0.3)[3])), 0.0, 1e-12);
+  // The built-in city keeps its camera path.
+  EXPECT_TRUE(choose_scene_view(room, {}, true).follows_city_path);
+}
+
+TEST(SceneView, EyeAndLookAt) {
+  TempDir dir;
+  const Scene scene = load_gltf(dir.write("box.gltf", box_gltf()));
+  ViewRequest request;
+  request.eye_world = glm::dvec3(0.2, 0.1, 0);
+  const SceneView inside = choose_scene_view(scene, request, false);
+  EXPECT_TRUE(inside.eye_inside);
+  EXPECT_EQ(inside.message.rfind("warning: --eye", 0), 0u) << inside.message;
+  request.eye_world = glm::dvec3(4, 3, 0);
+  request.look_at_world = glm::dvec3(0, 3, 0);
+  const SceneView outside = choose_scene_view(scene, request, false);
+  EXPECT_FALSE(outside.eye_inside);
+  EXPECT_TRUE(outside.message.empty()) << outside.message;
+  expect_near(outside.T_world_eye, glm::rotate(glm::translate(glm::dmat4(1.0), glm::dvec3(4, 3, 0)),
+                                               std::numbers::pi / 2, glm::dvec3(0, 1, 0)));
+  EXPECT_EQ(outside.pivot_world, glm::dvec3(0, 3, 0));
+
+  request.look_at_world = glm::dvec3(4, 3, 0);
+  EXPECT_THROW(choose_scene_view(scene, request, false), InputError);
+  request.eye_world.reset();
+  EXPECT_THROW(choose_scene_view(scene, request, false), InputError);
+
+  EXPECT_EQ(parse_point(" 1, -2.5,+3e1 ", "--eye"), glm::dvec3(1, -2.5, 30));
+  for (const char* bad : {"1,2", "1,2,3,4", "a,b,c", "1,,3", "nan,0,0", "", "1 2 3"}) {
+    try {
+      parse_point(bad, "--look-at");
+      ADD_FAILURE() << bad;
+    } catch (const InputError& e) {
+      EXPECT_EQ(e.field(), "--look-at");
+      EXPECT_NE(e.expected().find("X,Y,Z"), std::string::npos) << e.what();
+    }
+  }
+}
+
+TEST(SceneView, CameraByName) {
+  TempDir dir;
+  const Scene scene = load_gltf(dir.write("box.gltf", box_gltf()));
+  ViewRequest request;
+  request.camera = "Side";
+  const SceneView side = choose_scene_view(scene, request, false);
+  expect_near(side.T_world_eye, scene.cameras[1].T_world_camera);
+  EXPECT_EQ(side.pivot_world, glm::dvec3(4, 1, 0));
+  EXPECT_TRUE(side.message.empty()) << side.message;
+  request.camera = "front view";  // the camera's own name
+  expect_near(choose_scene_view(scene, request, false).T_world_eye,
+              scene.cameras[0].T_world_camera);
+
+  request.camera = "Top";
+  try {
+    choose_scene_view(scene, request, false);
+    ADD_FAILURE();
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.field(), "--camera");
+    EXPECT_NE(e.expected().find("'Front', 'Side'"), std::string::npos) << e.what();
+  }
+  request.camera = "Side";
+  request.eye_world = glm::dvec3(0, 0, 5);
+  EXPECT_THROW(choose_scene_view(scene, request, false), InputError);
+
+  const Scene bare = load_gltf(dir.write("bare.gltf", box_gltf(false, false)));
+  EXPECT_TRUE(bare.cameras.empty());
+  request.eye_world.reset();
+  try {
+    choose_scene_view(bare, request, false);
+    ADD_FAILURE();
+  } catch (const InputError& e) {
+    EXPECT_NE(e.expected().find("bare has none"), std::string::npos) << e.what();
   }
 }
 

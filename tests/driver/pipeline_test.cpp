@@ -416,6 +416,52 @@ TEST(Pipeline, BackgroundSphereLeavesNoHoles) {
 // The grid must draw what the hierarchy walk draws: the same IDs on every base, with quads and
 // without, and facet for facet at most 1% more replicas (clipped to nothing) from its candidate
 // reject without clipping.
+// An unlit material (glTF KHR_materials_unlit) shows its base colour exactly in every method:
+// each covered pixel of an inward sphere around the eye is the colour's sRGB encoding within one
+// step; the same material lit is shaded.
+TEST(Pipeline, UnlitMaterialShowsItsBaseColour) {
+  test::shared_context();
+  Scene sphere = background_sphere(24, 12, 10.0f);
+  const glm::vec4 base_colour(0.2f, 0.5f, 0.8f, 1.0f);
+  sphere.materials[0].base_colour = base_colour;
+  const auto encode = [](float linear) {
+    const double s =
+        linear <= 0.0031308 ? 12.92 * linear : 1.055 * std::pow(double(linear), 1 / 2.4) - 0.055;
+    return int(std::lround(255 * s));
+  };
+  const int expected[3] = {encode(base_colour.x), encode(base_colour.y), encode(base_colour.z)};
+  const auto outputs = load_display_outputs("builtin:cylinder360", glm::ivec2(64, 48));
+  for (const bool unlit : {true, false}) {
+    sphere.materials[0].unlit = unlit;
+    const GpuScene gpu = upload_scene(sphere);
+    for (std::string_view method : {"facets", "facets-gs", "naive", "cubemap", "vertex"}) {
+      SCOPED_TRACE(std::string(method) + (unlit ? " unlit" : " lit"));
+      auto renderer = make_render_method(method);
+      renderer->prepare(sphere, gpu, outputs, RenderSettings{});
+      std::vector<OutputTarget> targets;
+      targets.push_back(OutputTarget::create(outputs[0].warp.output_size));
+      renderer->render(glm::dmat4(1.0), targets);
+      const std::vector<std::uint8_t> rgba = targets[0].read_colour_rgba8();
+      const std::vector<std::uint32_t> ids = targets[0].read_ids();
+      check_gl_error("render");
+      int covered = 0, off = 0;
+      for (std::size_t p = 0; p < ids.size(); ++p) {
+        if (ids[p] == 0) continue;
+        ++covered;
+        bool exact = true;
+        for (int c = 0; c < 3; ++c) exact = exact && std::abs(rgba[4 * p + c] - expected[c]) <= 1;
+        off += !exact;
+      }
+      EXPECT_GT(covered, int(ids.size()) * 9 / 10);
+      if (unlit)
+        EXPECT_EQ(off, 0);
+      else
+        EXPECT_GT(off, covered / 2);
+      if (!unlit) break;  // shading when lit is the same code in every method
+    }
+  }
+}
+
 TEST(Pipeline, GridCoverageGivesTheWalksIds) {
   test::shared_context();
   const Scene scene = small_city();

@@ -1,6 +1,7 @@
 // `facet render` end to end: bad input exits 2 with a message, --json reports the fields that
 // `facet bench` and the paper comparison read, --out writes the images, the view moves every
 // frame unless --static-view, SIGINT stops it with exit 130 and nothing written.
+#include <OpenImageIO/imageio.h>
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -59,6 +60,94 @@ void write_two_walls_gltf(const std::filesystem::path& gltf) {
                   {"buffer": 0, "byteOffset": 96, "byteLength": 24}],
   "buffers": [{"byteLength": 120, "uri": ")"
        << bin.filename().string() << R"("}]})";
+}
+
+// A closed 2 m box around the origin (faces counter-clockwise from outside) and a camera node
+// "Front" 5 m along +z: FILE.gltf beside FILE.bin.
+void write_box_gltf(const std::filesystem::path& gltf) {
+  const float positions[8][3] = {{-1, -1, -1}, {1, -1, -1}, {1, 1, -1}, {-1, 1, -1},
+                                 {-1, -1, 1},  {1, -1, 1},  {1, 1, 1},  {-1, 1, 1}};
+  const int faces[6][4] = {{4, 5, 6, 7}, {1, 0, 3, 2}, {5, 1, 2, 6},
+                           {0, 4, 7, 3}, {3, 7, 6, 2}, {0, 1, 5, 4}};
+  std::vector<std::uint16_t> indices;
+  for (const auto& f : faces)
+    for (const int k : {0, 1, 2, 0, 2, 3}) indices.push_back(std::uint16_t(f[k]));
+  std::filesystem::path bin = gltf;
+  bin.replace_extension(".bin");
+  std::ofstream out(bin, std::ios::binary);
+  out.write(reinterpret_cast<const char*>(positions), sizeof positions);
+  out.write(reinterpret_cast<const char*>(indices.data()), std::streamsize(indices.size() * 2));
+  out.close();
+  std::ofstream json(gltf);
+  json << R"({"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0, 1]}],
+  "nodes": [{"mesh": 0}, {"name": "Front", "camera": 0, "translation": [0, 0, 5]}],
+  "cameras": [{"type": "perspective", "perspective": {"yfov": 1.0, "znear": 0.1}}],
+  "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1}]}],
+  "accessors": [
+    {"bufferView": 0, "componentType": 5126, "count": 8, "type": "VEC3",
+     "min": [-1, -1, -1], "max": [1, 1, 1]},
+    {"bufferView": 1, "componentType": 5123, "count": 36, "type": "SCALAR"}],
+  "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 96},
+                  {"buffer": 0, "byteOffset": 96, "byteLength": 72}],
+  "buffers": [{"byteLength": 168, "uri": ")"
+       << bin.filename().string() << R"("}]})";
+}
+
+// Pixels of a PNG whose colour is not black (0 when it cannot be read).
+int non_black_pixels(const std::filesystem::path& png) {
+  auto in = OIIO::ImageInput::open(png.string());
+  if (!in) return 0;
+  const OIIO::ImageSpec& spec = in->spec();
+  std::vector<unsigned char> pixels(std::size_t(spec.width) * std::size_t(spec.height) *
+                                    std::size_t(spec.nchannels));
+  in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::UINT8, pixels.data());
+  int count = 0;
+  for (std::size_t i = 0; i + 2 < pixels.size(); i += std::size_t(spec.nchannels))
+    count += pixels[i] + pixels[i + 1] + pixels[i + 2] > 0;
+  return count;
+}
+
+// The centre of a closed model is inside it: the default eye goes outside and above (a note
+// says so) and the box is seen; --eye inside it is rendered with a warning (and shows nothing);
+// an unknown --camera or a malformed --eye exits 2 naming what was expected.
+TEST(RenderCli, GltfViewLeavesClosedGeometryAndTakesEyeAndCamera) {
+  namespace fs = std::filesystem;
+  const fs::path folder =
+      fs::temp_directory_path() / ("facet_render_gltf_view_" + std::to_string(getpid()));
+  fs::remove_all(folder);
+  fs::create_directories(folder);
+  const fs::path gltf = folder / "box.gltf";
+  write_box_gltf(gltf);
+  const std::string common =
+      "render --display builtin:cylinder360 --size 64x48 --pieces 8 --scene " + gltf.string();
+
+  const Result outside = run_cli(common + " --out " + (folder / "default").string());
+  ASSERT_EQ(outside.status, 0) << outside.output;
+  EXPECT_NE(outside.output.find("facet render: the eye is at (0, 1.04, 2.77), outside and above"),
+            std::string::npos)
+      << outside.output;
+  EXPECT_GT(non_black_pixels(folder / "default" / "cylinder360.png"), 64 * 48 / 50);
+
+  const Result inside = run_cli(common + " --eye 0.1,0,0 --out " + (folder / "inside").string());
+  ASSERT_EQ(inside.status, 0) << inside.output;
+  EXPECT_NE(inside.output.find("facet render: warning: --eye (0.1, 0, 0) is inside geometry"),
+            std::string::npos)
+      << inside.output;
+  EXPECT_EQ(non_black_pixels(folder / "inside" / "cylinder360.png"), 0);
+
+  const Result camera = run_cli(common + " --camera Front --out " + (folder / "camera").string());
+  ASSERT_EQ(camera.status, 0) << camera.output;
+  EXPECT_EQ(camera.output.find("warning"), std::string::npos) << camera.output;
+  EXPECT_GT(non_black_pixels(folder / "camera" / "cylinder360.png"), 0);
+
+  const Result unknown = run_cli(common + " --camera Top");
+  EXPECT_EQ(unknown.status, 2) << unknown.output;
+  EXPECT_NE(unknown.output.find("--camera"), std::string::npos) << unknown.output;
+  EXPECT_NE(unknown.output.find("'Front'"), std::string::npos) << unknown.output;
+  const Result malformed = run_cli(common + " --eye 1,2");
+  EXPECT_EQ(malformed.status, 2) << malformed.output;
+  EXPECT_NE(malformed.output.find("--eye"), std::string::npos) << malformed.output;
+  fs::remove_all(folder);
 }
 
 // A glTF scene's view turns every frame, so the facet pipeline replicates every frame; with

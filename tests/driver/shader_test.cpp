@@ -6,6 +6,7 @@
 #include <string>
 
 #include "facet/driver/facet_gpu.hpp"
+#include "facet/driver/gpu_scene.hpp"
 #include "facet/driver/program.hpp"
 #include "facet/driver/shader_library.hpp"
 #include "facet/projection/coverage_grid.hpp"
@@ -60,6 +61,15 @@ TEST(Shaders, StagingConstantsMatchTheCpp) {
     ASSERT_TRUE(std::regex_search(text, match, std::regex(R"(kChained = 0x([0-9a-f]+)u)")));
     EXPECT_EQ(std::stoul(match[1], nullptr, 16), kStagedChained);
   }
+}
+
+// The material shading block's binding exists twice, in gpu_scene.hpp and material.frag.
+TEST(Shaders, MaterialShadingBindingMatchesTheCpp) {
+  const std::string text(embedded_shader("scene/material.frag").text);
+  std::smatch match;
+  ASSERT_TRUE(std::regex_search(
+      text, match, std::regex(R"(layout\(std140, binding = (\d+)\) uniform MaterialShading)")));
+  EXPECT_EQ(std::stoul(match[1]), material_shading_binding);
 }
 
 TEST(Shaders, EveryEmbeddedShaderCompiles) {

@@ -26,6 +26,7 @@
 #include "facet/projection/errors.hpp"
 #include "facet/projection/interrupt.hpp"
 #include "frames_flag.hpp"
+#include "view_flags.hpp"
 
 namespace facet::cli {
 namespace {
@@ -33,17 +34,19 @@ namespace {
 using namespace facet::driver;
 
 // Frame k shows the city camera path at k times this step (seconds): 30 frames per second. Other
-// scenes turn 3 degrees a frame (FrameViews).
+// views turn 3 degrees a frame, on the spot or about the point looked at (FrameViews).
 constexpr double kFrameStepS = 1.0 / 30.0;
 
 struct RenderOptions {
   std::string display, scene = "builtin:city", method = "facets", size, out;
   LayoutFlags layout;
+  ViewFlags view;
   std::optional<int> face_size;
   std::int64_t frames = 1;  // signed, so that a negative count is refused, not wrapped
   int msaa = 0;
   float anisotropy = kAutomaticAnisotropy;
   std::string coverage = "grid";
+  DomeOrientationFlags orientation;
   bool ids = false, depth = false, reference = false, json = false, static_view = false;
 };
 
@@ -153,7 +156,11 @@ void run(const RenderOptions& options) {
   if (options.msaa < 0) throw InputError("command line", "--msaa", "expected 0 or more samples");
   std::optional<glm::ivec2> size;
   if (!options.size.empty()) size = parse_size(options.size, "--size");
-  const std::vector<OutputSpec> outputs = load_display_outputs(options.display, size);
+  const auto orientation = builtin_dome_orientation(options.orientation, options.display);
+  std::vector<OutputSpec> outputs = load_display_outputs(options.display, size);
+  for (OutputSpec& output : outputs) {
+    if (orientation) orient_warp(output.warp, *orientation);
+  }
   // Checked before any GL work; made again once the context exists, which must outlive it.
   check_render_method(options.method);
   RenderSettings settings;
@@ -174,8 +181,10 @@ void run(const RenderOptions& options) {
   if (options.anisotropy != kAutomaticAnisotropy && !(options.anisotropy >= 1.0f)) {
     throw InputError("command line", "--anisotropy", "expected 0 (automatic) or a level >= 1");
   }
+  const ViewRequest view_request = options.view.request();  // malformed flags before the scene
   const SceneName scene_name = parse_scene_name(options.scene);
   const Scene scene = load_scene(scene_name);
+  const SceneView view = choose_view(scene, view_request, scene_name.builtin_city(), "render");
 
   auto context = create_headless_context();
   auto method = make_render_method(options.method);
@@ -186,9 +195,9 @@ void run(const RenderOptions& options) {
     targets.push_back(OutputTarget::create(output.warp.output_size, settings.msaa_samples));
   }
 
-  // The view moves every frame (unless --static-view): along the city's camera path, or for
-  // other scenes turning about the bounds' centre.
-  const FrameViews views(scene, scene_name.builtin_city(), kFrameStepS, options.static_view);
+  // The view moves every frame (unless --static-view): along the city's camera path, or turning
+  // on the spot or about the point looked at (choose_scene_view).
+  const FrameViews views(view, kFrameStepS, options.static_view);
   GpuTimer timer;
   std::vector<double> frame_ms;
   std::vector<RenderStats> stats;
@@ -329,6 +338,7 @@ const Registration registration{
           ->add_option("--method", options->method, "facets | facets-gs | cubemap | naive | vertex")
           ->capture_default_str();
       options->layout.add_to(*command);
+      options->view.add_to(*command);
       command->add_option("--face-size", options->face_size, "Cube-map face size in pixels");
       command->add_option("--size", options->size, "Output size WxH (built-in displays)");
       command
@@ -336,6 +346,7 @@ const Registration registration{
                        "Frames to render, 1 to 1000000 (median timings)")
           ->capture_default_str();
       command->add_option("--msaa", options->msaa, "Colour samples per pixel (0: none)");
+      options->orientation.add_to(*command);
       command->add_option("--out", options->out, "Folder for <output>.png (and IDs, depth)");
       command->add_flag("--ids", options->ids, "Also write <output>.ids.exr (needs --out)");
       command->add_flag("--depth", options->depth, "Also write <output>.depth.exr (needs --out)");

@@ -17,6 +17,7 @@
 #include "facet/projection/interrupt.hpp"
 #include "facet/projection/progress.hpp"
 #include "frames_flag.hpp"
+#include "view_flags.hpp"
 
 namespace facet::cli {
 namespace {
@@ -28,12 +29,14 @@ struct RunOptions {
   std::string method;
   std::optional<double> tolerance;
   std::optional<double> scale;
+  DomeOrientationFlags orientation;  // builtin:dome180 only
   bool headless = false, windowed = false;
   std::optional<std::int64_t> frames;  // signed, so that a negative count is refused, not wrapped
   std::string out = "out/session";
   bool span = false, overlay = false, no_path = false;
   std::string report;
   bool monitors = false;
+  ViewFlags view;
 };
 
 bool have_display_server() {
@@ -77,7 +80,11 @@ void run(const RunOptions& options) {
   if (options.frames) frames = checked_frames(*options.frames);
   std::optional<glm::ivec2> size;
   if (!options.size.empty()) size = parse_size(options.size, "--size");
+  const auto orientation = builtin_dome_orientation(options.orientation, options.display);
   driver::SessionDisplay display = driver::load_session_display(options.display, size);
+  for (auto& output : display.outputs) {
+    if (orientation) orient_warp(output.spec.warp, *orientation);
+  }
   if (options.scale) driver::scale_session_display(display, *options.scale);
   if (!options.method.empty()) display.method = options.method;
   if (options.tolerance) {
@@ -90,9 +97,11 @@ void run(const RunOptions& options) {
   const bool headless = options.headless || (!options.windowed && !have_display_server());
   // Before the scene, so that a missing display server is reported at once.
   if (!headless) monitors_of_display_server("--windowed");
+  const driver::ViewRequest view_request = options.view.request();
   const driver::SceneName scene_name = driver::parse_scene_name(options.scene);
   const driver::Scene scene = driver::load_scene(scene_name);
-  const driver::CameraPath path = driver::default_camera_path(scene, scene_name.builtin_city());
+  const driver::CameraPath path =
+      driver::camera_path(choose_view(scene, view_request, scene_name.builtin_city(), "run"));
 
   // From here on SIGINT and SIGTERM stop the run cleanly (Interrupted, exit 128 + signal).
   watch_interrupts();
@@ -142,11 +151,13 @@ const Registration registration{
       command->add_option("--scene", options->scene, driver::kSceneNameSyntax)
           ->capture_default_str();
       command->add_option("--size", options->size, "Output size WxH of a built-in display");
+      options->view.add_to(*command);
       command->add_option("--method", options->method,
                           "facets, facets-gs, naive, cubemap or vertex (default: the display's)");
       command->add_option("--tolerance", options->tolerance, "Facet tolerance in output pixels");
       command->add_option("--scale", options->scale,
                           "Preview at this fraction of every output's resolution (0, 1]");
+      options->orientation.add_to(*command);
       command->add_flag("--headless", options->headless, "Render through EGL to --out");
       command->add_flag("--windowed", options->windowed,
                         "Open windows (the default when DISPLAY is set; needs a display server)");

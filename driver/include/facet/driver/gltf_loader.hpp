@@ -17,7 +17,11 @@ namespace facet::driver {
 //   lines are skipped. Missing normals are computed (area-weighted); missing texture
 //   coordinates are 0.
 // - Materials: pbrMetallicRoughness base colour factor and base colour texture (converted to
-//   RGBA8). Primitives without a material get a default white one.
+//   RGBA8); KHR_materials_unlit marks a material unlit (Material::unlit). Primitives without a
+//   material get a default white one.
+// - Cameras: every node of the scene with a camera (perspective or orthographic) becomes a
+//   SceneCamera with the node's world transform, scale removed; the camera's own projection is
+//   not used: the display decides what is seen.
 //
 // Throws facet::InputError naming the file (and the glTF field, where known) for unreadable,
 // malformed or unsupported input: bad JSON, out-of-range indices or accessors, missing POSITION,

@@ -15,7 +15,8 @@ struct GpuMaterial {
   float base_colour[4];  // linear RGBA
   std::int32_t texture;  // index into GpuScene::textures, or -1
   std::uint32_t repeat;  // 1: texture coordinates wrap, 0: clamp
-  std::uint32_t padding[2];
+  std::uint32_t unlit;   // 1: shown as authored, no lighting (Material::unlit)
+  std::uint32_t padding;
 };
 static_assert(sizeof(GpuMaterial) == 32);
 
@@ -39,6 +40,12 @@ inline constexpr GLuint indices_binding = 3;
 inline constexpr GLuint position_unit = 8, normal_unit = 9, uv_unit = 10;
 }  // namespace pulling
 
+// The uniform block binding of shaders/scene/material.frag's MaterialShading block (one uint:
+// 1 for an unlit material). bind_material_texture binds the material's entry of
+// GpuScene::material_shading there, so every renderer that binds a material's texture gets its
+// shading too.
+inline constexpr GLuint material_shading_binding = 0;
+
 struct GpuScene {
   // Tightly packed floats, 3 per vertex (12-byte stride): in GLSL `float positions[]`, not
   // `vec3[]`, whose std430 stride is 16 bytes.
@@ -59,11 +66,17 @@ struct GpuScene {
   Sampler repeat_sampler, clamp_sampler;
   std::vector<std::int32_t> material_texture;  // Scene::materials[i].texture, kept for binding
   std::vector<bool> material_repeat;
+  // One std140 MaterialShading block per material, then a lit one (bound by upload_scene, so the
+  // block is never unbound), each material_shading_stride bytes apart
+  // (GL_UNIFORM_BUFFER_OFFSET_ALIGNMENT or more).
+  Buffer material_shading;
+  std::size_t material_shading_stride = 0;
   float max_anisotropy = 1.0f;  // as applied to both samplers; 1: anisotropic filtering off
 
   // Binds the indices and the vertex buffer textures at the pulling:: points.
   void bind_for_pulling() const;
-  // Binds material `m`'s texture (or `white`) and sampler to texture unit `unit`.
+  // Binds material `m`'s texture (or `white`) and sampler to texture unit `unit`, and its
+  // shading block to material_shading_binding.
   void bind_material_texture(std::uint32_t m, GLuint unit) const;
 };
 

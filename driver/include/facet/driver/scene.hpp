@@ -40,6 +40,8 @@ struct Material {
   glm::vec4 base_colour{1.0f};  // linear RGBA factor, multiplied with the texture
   int texture = -1;             // index into Scene::images, or -1 for none
   bool repeat = true;           // texture coordinates wrap (else clamp to edge)
+  // Shown as authored: base colour times texture, no lighting (glTF KHR_materials_unlit).
+  bool unlit = false;
 };
 
 // A run of triangles that share one material: indices [first_index, first_index + index_count).
@@ -57,6 +59,15 @@ struct Object {
   Aabb bounds_world;  // tight box around this object's vertices, in the world frame
 };
 
+// A viewpoint stored in the scene file (a glTF node with a camera). The camera frame is the eye
+// frame: x right, y up, looking down -z.
+struct SceneCamera {
+  std::string name;                // the node's name, else the camera's, else "nodes[i]"
+  std::string camera_name;         // the glTF camera's own name (may be empty)
+  glm::dmat4 T_world_camera{1.0};  // rigid: the node's world transform with scale removed
+  bool orthographic = false;       // drawn with the display's own projection either way
+};
+
 struct Scene {
   std::string name;
   // Vertex attributes, one entry per vertex, in the object frame of the objects using them.
@@ -68,6 +79,7 @@ struct Scene {
   std::vector<Object> objects;
   std::vector<Material> materials;
   std::vector<Image> images;
+  std::vector<SceneCamera> cameras;  // in the order the scene graph is visited
 
   // Triangles drawn, counting each instance: sum over objects of their primitives' triangles.
   std::size_t triangle_count() const;

@@ -19,6 +19,7 @@
 
 #include "facet/driver/city.hpp"
 #include "facet/driver/scene.hpp"
+#include "facet/driver/scene_view.hpp"
 
 namespace facet::driver {
 
@@ -58,13 +59,16 @@ class FrameViews {
  public:
   static constexpr int kTurnFrames = 120;
   FrameViews(const Scene& scene, bool builtin_city, double city_step_s, bool static_view = false);
+  // From a chosen view: the city camera path at k · city_step_s seconds when it follows it, else
+  // view.T_world_eye_turned(k / kTurnFrames) (a turn on the spot or about the point looked at).
+  FrameViews(const SceneView& view, double city_step_s, bool static_view = false);
   glm::dmat4 T_world_eye(int frame) const;
   glm::dmat4 T_eye_world(int frame) const;
 
  private:
   bool city_ = false, static_ = false;
   double step_s_ = 0;
-  glm::dvec3 centre_{0.0};
+  SceneView view_;
   CityCameraPath path_;
 };
 

@@ -10,6 +10,7 @@
 
 #include "facet/driver/monitors.hpp"
 #include "facet/driver/scene.hpp"
+#include "facet/driver/scene_view.hpp"
 #include "facet/driver/session.hpp"
 #include "facet/projection/progress.hpp"
 
@@ -19,8 +20,12 @@ namespace facet::driver {
 inline constexpr double kFramePeriod_s = 1.0 / 60.0;
 
 // The eye pose over time when nobody steers: the city's camera path for the built-in city, and
-// for any other scene a slow turn about the vertical at the centre of its bounds.
+// for any other scene one turn a minute of the view (SceneView::T_world_eye_turned: on the spot,
+// or about the point looked at), so a whole dome sees every side of the model.
 using CameraPath = std::function<glm::dmat4(double time_s)>;
+inline constexpr double kViewTurnPeriod_s = 60.0;
+CameraPath camera_path(const SceneView& view);
+// camera_path of the default view (choose_scene_view with no request).
 CameraPath default_camera_path(const Scene& scene, bool builtin_city);
 
 // The most frames one command renders: facet run (headless or windowed), render and bench refuse

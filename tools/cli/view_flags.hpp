@@ -1,0 +1,42 @@
+#pragma once
+// --eye, --look-at and --camera of `facet render` and `facet run`: the view of the scene
+// (driver/scene_view.hpp holds the logic and its tests).
+#include <CLI/CLI.hpp>
+#include <iostream>
+#include <string>
+
+#include "facet/driver/scene_view.hpp"
+
+namespace facet::cli {
+
+struct ViewFlags {
+  std::string eye, look_at, camera;
+
+  void add_to(CLI::App& command) {
+    command.add_option("--eye", eye,
+                       "Eye position X,Y,Z (metres, scene frame, y up); default for glTF: the "
+                       "bounds' centre, or outside and above the model when that is inside it");
+    command.add_option("--look-at", look_at,
+                       "Point X,Y,Z the eye looks at (needs --eye; default: the bounds' centre)");
+    command.add_option("--camera", camera, "Start at the scene file's camera of this name");
+  }
+
+  driver::ViewRequest request() const {
+    driver::ViewRequest request;
+    if (!eye.empty()) request.eye_world = driver::parse_point(eye, "--eye");
+    if (!look_at.empty()) request.look_at_world = driver::parse_point(look_at, "--look-at");
+    request.camera = camera;
+    return request;
+  }
+};
+
+// choose_scene_view, with its message (where the default eye went, or an eye inside geometry)
+// on stderr as "facet <command>: <message>".
+inline driver::SceneView choose_view(const driver::Scene& scene, const driver::ViewRequest& request,
+                                     bool builtin_city, const std::string& command) {
+  driver::SceneView view = driver::choose_scene_view(scene, request, builtin_city);
+  if (!view.message.empty()) std::cerr << "facet " << command << ": " << view.message << "\n";
+  return view;
+}
+
+}  // namespace facet::cli
