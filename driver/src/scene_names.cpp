@@ -2,7 +2,6 @@
 
 #include <charconv>
 #include <glm/gtc/matrix_transform.hpp>
-#include <numbers>
 
 #include "facet/driver/gltf_loader.hpp"
 #include "facet/projection/errors.hpp"

@@ -8,6 +8,7 @@
 #include <glm/geometric.hpp>
 #include <glm/gtc/matrix_transform.hpp>
 #include <numbers>
+#include <stdexcept>
 
 #include "facet/driver/reference.hpp"
 #include "facet/projection/errors.hpp"

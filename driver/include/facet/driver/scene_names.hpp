@@ -51,16 +51,18 @@ std::uint64_t builtin_scene_triangles(const SceneName& name);
 Scene load_scene(const SceneName& name);
 inline Scene load_scene(std::string_view text) { return load_scene(parse_scene_name(text)); }
 
-// The eye pose of frame k of `facet render` and `facet bench`: on the built-in city the city
-// camera path at k · city_step_s seconds; on other scenes the eye at the scene bounds' centre,
-// turning about world up (y) by 360° every kTurnFrames frames. A static view keeps frame 0's pose
-// on every frame (so the facet pipelines reuse passes 1 and 2).
+// The eye pose of frame k of `facet render` and `facet bench`, turning about world up (y) by 360°
+// every kTurnFrames frames where no camera path drives it. A static view keeps frame 0's pose on
+// every frame (so the facet pipelines reuse passes 1 and 2).
 class FrameViews {
  public:
   static constexpr int kTurnFrames = 120;
+  // `facet bench`: on the built-in city the city camera path at k · city_step_s seconds; on
+  // other scenes the eye at the scene bounds' centre, turning on the spot.
   FrameViews(const Scene& scene, bool builtin_city, double city_step_s, bool static_view = false);
-  // From a chosen view: the city camera path at k · city_step_s seconds when it follows it, else
-  // view.T_world_eye_turned(k / kTurnFrames) (a turn on the spot or about the point looked at).
+  // `facet render`, from a chosen view (choose_scene_view): the city camera path at
+  // k · city_step_s seconds when it follows it, else view.T_world_eye_turned(k / kTurnFrames)
+  // (a turn on the spot or about the point looked at).
   FrameViews(const SceneView& view, double city_step_s, bool static_view = false);
   glm::dmat4 T_world_eye(int frame) const;
   glm::dmat4 T_eye_world(int frame) const;
