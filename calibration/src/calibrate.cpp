@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <random>
 
 #include "facet/calibration/camera_model.hpp"
@@ -43,6 +44,94 @@ fs::path prepare_output(const fs::path& out) {
 }
 
 }  // namespace
+
+const char* to_string(Verdict verdict) {
+  switch (verdict) {
+    case Verdict::good:
+      return "good";
+    case Verdict::check:
+      return "check";
+    case Verdict::bad:
+      return "bad";
+  }
+  return "bad";
+}
+
+std::size_t unlit_inside(const std::vector<float>& weight, glm::ivec2 size, int r) {
+  FACET_ASSERT(weight.size() == std::size_t(size.x) * std::size_t(size.y) && r > 0);
+  auto lit = [&](int x, int y) {
+    return x >= 0 && y >= 0 && x < size.x && y < size.y &&
+           weight[std::size_t(y) * std::size_t(size.x) + std::size_t(x)] > 0;
+  };
+  std::size_t unlit = 0;
+  for (int y = 0; y < size.y; ++y) {
+    for (int x = 0; x < size.x; ++x) {
+      if (lit(x, y)) continue;
+      bool inside = true;
+      for (int dy = -r; dy <= r && inside; dy += r) {
+        for (int dx = -r; dx <= r && inside; dx += r) {
+          if (dx != 0 || dy != 0) inside = lit(x + dx, y + dy);
+        }
+      }
+      unlit += inside ? 1 : 0;
+    }
+  }
+  return unlit;
+}
+
+ProjectorVerdict judge(const ProjectorReport& projector, const VerdictThresholds& thresholds) {
+  ProjectorVerdict result;
+  char text[160];
+  // Raises the verdict to `level` with a reason: what, its value, the threshold crossed.
+  auto raise = [&](Verdict level, const char* what, double value, const char* relation,
+                   double threshold, const char* unit) {
+    std::snprintf(text, sizeof text, "%s %.3g%s %s %.3g%s (%s)", what, value, unit, relation,
+                  threshold, unit, to_string(level));
+    result.reasons.emplace_back(text);
+    result.verdict = std::max(result.verdict, level);
+  };
+  // The bad threshold first: one reason per quantity.
+  auto above = [&](const char* what, double value, double check, double bad, const char* unit) {
+    if (value > bad) {
+      raise(Verdict::bad, what, value, ">", bad, unit);
+    } else if (value > check) {
+      raise(Verdict::check, what, value, ">", check, unit);
+    }
+  };
+  const FitReport& fit = projector.fit;
+  if (projector.coverage < thresholds.bad_coverage_below) {
+    raise(Verdict::bad, "coverage", 100 * projector.coverage, "<",
+          100 * thresholds.bad_coverage_below, " %");
+  } else if (projector.coverage < thresholds.check_coverage_below) {
+    raise(Verdict::check, "coverage", 100 * projector.coverage, "<",
+          100 * thresholds.check_coverage_below, " %");
+  }
+  above("residual p50", fit.residual_p50_px, thresholds.check_residual_p50_px,
+        thresholds.bad_residual_p50_px, " px");
+  above("residual p99", fit.residual_p99_px, thresholds.check_residual_p99_px,
+        thresholds.bad_residual_p99_px, " px");
+  above("worst region rms", fit.worst_region_rms_px, thresholds.check_worst_region_px,
+        thresholds.bad_worst_region_px, " px");
+  const double holes_share =
+      fit.supported == 0 ? 0.0 : double(fit.holes_filled) / double(fit.supported);
+  above("holes filled, share of supported nodes,", 100 * holes_share,
+        100 * thresholds.check_holes_filled_share, 100 * thresholds.bad_holes_filled_share, " %");
+  if (fit.folds >= thresholds.check_folds) {
+    raise(Verdict::check, "folds cut", double(fit.folds), ">=", double(thresholds.check_folds),
+          " nodes");
+  }
+  if (projector.unlit_inside >= thresholds.bad_unlit_inside) {
+    raise(Verdict::bad, "unlit pixels inside the lit region", double(projector.unlit_inside),
+          ">=", double(thresholds.bad_unlit_inside), "");
+  }
+  return result;
+}
+
+Verdict CalibrationReport::verdict() const {
+  Verdict worst = Verdict::good;
+  for (const ProjectorReport& p : projectors) worst = std::max(worst, p.verdict.verdict);
+  return worst;
+}
 
 AccuracyReport compare_warps(const Warp& truth, const Warp& calibrated, double border_px) {
   const std::vector<glm::dvec2> st = WarpInverse(truth).st_at_pixel_centres();
@@ -100,7 +189,12 @@ nlohmann::json CalibrationReport::to_json() const {
                            {"holes", p.fit.holes},
                            {"holes_filled", p.fit.holes_filled},
                            {"folds_refilled", p.fit.folds_refilled},
-                           {"folds", p.fit.folds}};
+                           {"folds", p.fit.folds},
+                           {"unlit_inside", p.unlit_inside},
+                           {"worst_region_px", {p.fit.worst_region_px.x, p.fit.worst_region_px.y}},
+                           {"worst_region_rms_px", p.fit.worst_region_rms_px},
+                           {"verdict", to_string(p.verdict.verdict)},
+                           {"reasons", p.verdict.reasons}};
     if (p.accuracy) {
       item["rms_px"] = p.accuracy->rms_px;
       item["p99_px"] = p.accuracy->p99_px;
@@ -112,6 +206,7 @@ nlohmann::json CalibrationReport::to_json() const {
     items.push_back(std::move(item));
   }
   return {{"projectors", items},
+          {"verdict", to_string(verdict())},
           {"blend_sum_max_err", blend_sum_max_err},
           {"blend_overlap_directions", blend_overlap_directions},
           {"blend_worst", blend_worst},
@@ -196,7 +291,10 @@ CalibrationReport calibrate(const fs::path& capture_path, const fs::path& out,
   for (std::size_t p = 0; p < warps.size(); ++p) {
     std::size_t mapped = 0;
     for (const float a : blend.alpha[p].values) mapped += a > 0 ? 1 : 0;
-    report.projectors[p].coverage = double(mapped) / double(blend.alpha[p].values.size());
+    ProjectorReport& item = report.projectors[p];
+    item.coverage = double(mapped) / double(blend.alpha[p].values.size());
+    item.unlit_inside = unlit_inside(blend.alpha[p].values, blend.alpha[p].size);
+    item.verdict = judge(item);
   }
   const BlendCheck check = check_blend(warps, blend.alpha);
   report.blend_sum_max_err = check.sum_max_err;

@@ -829,11 +829,53 @@ WarpFit fit_warp(std::span<const FitSample> samples, glm::ivec2 output_size,
   }
 
   // Residuals of the decoded samples against the fitted warp.
+  // Per block of output pixels (at the decoded position) their sum of squares and count.
+  constexpr int kBlock = FitReport::kResidualBlockPx;
+  const cv::Size blocks((output_size.x + kBlock - 1) / kBlock,
+                        (output_size.y + kBlock - 1) / kBlock);
+  cv::Mat block_sum_sq(blocks, CV_64F, cv::Scalar(0)), block_count(blocks, CV_64F, cv::Scalar(0));
   std::vector<double> residuals;
   residuals.reserve(samples.size());
   for (std::size_t k = 0; k < samples.size(); ++k) {
     if (std::isnan(st[k].x) || warp.coverage_at(st[k]) < 0.5) continue;
     residuals.push_back(glm::length(warp.q_from_st(st[k]) - samples[k].q));
+    const int bx = std::clamp(int(std::floor(samples[k].q.x)) / kBlock, 0, blocks.width - 1);
+    const int by = std::clamp(int(std::floor(samples[k].q.y)) / kBlock, 0, blocks.height - 1);
+    block_sum_sq.at<double>(by, bx) += residuals.back() * residuals.back();
+    block_count.at<double>(by, bx) += 1;
+  }
+  result.report.residual_map.create(blocks, CV_32F);
+  for (int by = 0; by < blocks.height; ++by) {
+    for (int bx = 0; bx < blocks.width; ++bx) {
+      const double n = block_count.at<double>(by, bx);
+      result.report.residual_map.at<float>(by, bx) =
+          n > 0 ? float(std::sqrt(block_sum_sq.at<double>(by, bx) / n)) : float(kNaN);
+    }
+  }
+  // The worst region: the 32×32 output pixels (4×4 blocks, on their grid) with the largest RMS
+  // residual among those holding at least kMinRegionSamples covered samples, so that a few
+  // stray samples do not make one.
+  {
+    constexpr int kRegionBlocks = FitReport::kWorstRegionPx / kBlock;
+    constexpr double kMinRegionSamples = 32;
+    for (int ry = 0; ry < blocks.height; ry += kRegionBlocks) {
+      for (int rx = 0; rx < blocks.width; rx += kRegionBlocks) {
+        const cv::Rect region(rx, ry, std::min(kRegionBlocks, blocks.width - rx),
+                              std::min(kRegionBlocks, blocks.height - ry));
+        const double n = cv::sum(block_count(region))[0];
+        if (n < kMinRegionSamples) continue;
+        const double rms = std::sqrt(cv::sum(block_sum_sq(region))[0] / n);
+        if (rms > result.report.worst_region_rms_px) {
+          result.report.worst_region_rms_px = rms;
+          result.report.worst_region_px =
+              glm::dvec2(std::min(double(output_size.x), (rx + kRegionBlocks) * double(kBlock)) +
+                             rx * double(kBlock),
+                         std::min(double(output_size.y), (ry + kRegionBlocks) * double(kBlock)) +
+                             ry * double(kBlock)) *
+              0.5;
+        }
+      }
+    }
   }
   if (!residuals.empty()) {
     double sum = 0;

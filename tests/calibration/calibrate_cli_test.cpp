@@ -155,3 +155,106 @@ TEST(CliCalibrate, RealBoardOutputHasNoPinHoles) {
   EXPECT_LT(projector.fit.residual_p99_px, 3.15 + 0.5);
   EXPECT_GT(projector.coverage, 0.47);
 }
+
+namespace {
+
+// A projector report that meets every threshold with room to spare.
+facet::calibration::ProjectorReport good_projector() {
+  facet::calibration::ProjectorReport projector;
+  projector.name = "p";
+  projector.coverage = 0.99;
+  projector.fit.supported = 1000;
+  projector.fit.residual_p50_px = 0.1;
+  projector.fit.residual_p99_px = 0.5;
+  projector.fit.worst_region_rms_px = 0.6;
+  return projector;
+}
+
+}  // namespace
+
+TEST(Verdict, EachThresholdMakesItCheckOrBad) {
+  using facet::calibration::judge;
+  using facet::calibration::Verdict;
+  EXPECT_EQ(judge(good_projector()).verdict, Verdict::good);
+  EXPECT_TRUE(judge(good_projector()).reasons.empty());
+
+  struct Case {
+    const char* what;
+    void (*change)(facet::calibration::ProjectorReport&);
+    Verdict expected;
+  };
+  const Case cases[] = {
+      // At a threshold is not past it.
+      {"residual p99", [](auto& p) { p.fit.residual_p99_px = 2.0; }, Verdict::good},
+      {"residual p99", [](auto& p) { p.fit.residual_p99_px = 2.01; }, Verdict::check},
+      {"residual p99", [](auto& p) { p.fit.residual_p99_px = 5.01; }, Verdict::bad},
+      {"residual p50", [](auto& p) { p.fit.residual_p50_px = 0.51; }, Verdict::check},
+      {"residual p50", [](auto& p) { p.fit.residual_p50_px = 1.01; }, Verdict::bad},
+      {"worst region", [](auto& p) { p.fit.worst_region_rms_px = 2.01; }, Verdict::check},
+      {"worst region", [](auto& p) { p.fit.worst_region_rms_px = 5.01; }, Verdict::bad},
+      {"coverage", [](auto& p) { p.coverage = 0.9; }, Verdict::good},
+      {"coverage", [](auto& p) { p.coverage = 0.89; }, Verdict::check},
+      {"coverage", [](auto& p) { p.coverage = 0.09; }, Verdict::bad},
+      {"holes filled", [](auto& p) { p.fit.holes_filled = 20; }, Verdict::good},
+      {"holes filled", [](auto& p) { p.fit.holes_filled = 21; }, Verdict::check},
+      {"holes filled", [](auto& p) { p.fit.holes_filled = 251; }, Verdict::bad},
+      {"folds cut", [](auto& p) { p.fit.folds = 1; }, Verdict::check},
+      {"unlit pixels", [](auto& p) { p.unlit_inside = 1; }, Verdict::bad},
+  };
+  for (const Case& c : cases) {
+    auto projector = good_projector();
+    c.change(projector);
+    const auto verdict = judge(projector);
+    EXPECT_EQ(verdict.verdict, c.expected)
+        << c.what << ": " << ::testing::PrintToString(verdict.reasons);
+    if (c.expected == Verdict::good) {
+      EXPECT_TRUE(verdict.reasons.empty()) << c.what;
+    } else {
+      ASSERT_EQ(verdict.reasons.size(), 1u) << c.what;
+      EXPECT_NE(verdict.reasons[0].find(c.what), std::string::npos) << verdict.reasons[0];
+      EXPECT_NE(verdict.reasons[0].find(facet::calibration::to_string(c.expected)),
+                std::string::npos)
+          << verdict.reasons[0];
+    }
+  }
+  // The worst reason wins.
+  auto projector = good_projector();
+  projector.fit.folds = 3;
+  projector.unlit_inside = 5;
+  const auto verdict = judge(projector);
+  EXPECT_EQ(verdict.verdict, Verdict::bad);
+  EXPECT_EQ(verdict.reasons.size(), 2u);
+}
+
+// procam-board: half the projector's image falls beside the board (coverage 48 %), the shadow's
+// edge leaves a 3.4 px residual p99 and a 4.1 px worst region: "check", with reasons, in the JSON
+// report and in the text summary.
+TEST(Verdict, RealBoardIsCheckInJsonAndText) {
+  const BoardCalibration& board = board_calibration();
+  const nlohmann::json json = board.report.to_json();
+  EXPECT_EQ(json["verdict"], "check");
+  const nlohmann::json& projector = json["projectors"][0];
+  EXPECT_EQ(projector["verdict"], "check");
+  EXPECT_EQ(projector["unlit_inside"], 0);
+  EXPECT_GE(projector["reasons"].size(), 2u);
+  // The worst region lies along the shadow at the bottom of the lit region (y about 656).
+  EXPECT_GT(projector["worst_region_px"][1].get<double>(), 600);
+  EXPECT_GT(projector["worst_region_rms_px"].get<double>(), 2.0);
+
+  const facet::test::TempFolder temp;
+  const fs::path text = temp.path() / "summary.txt";
+  const std::string command = std::string(FACET_CLI) + " calibrate " + FACET_SHARED_DATA_DIR +
+                              "/captures/procam-board --out " + (temp.path() / "out").string() +
+                              " > " + text.string() + " 2>&1";
+  ASSERT_EQ(std::system(command.c_str()), 0);
+  std::ifstream stream(text);
+  const std::string summary((std::istreambuf_iterator<char>(stream)),
+                            std::istreambuf_iterator<char>());
+  std::printf("%s", summary.c_str());
+  for (const char* expected :
+       {"projector    coverage", "p50 px", "p99 px", "worst region", "verdict",
+        "projector: residual p99 3.", "(check)", "verdict: check"}) {
+    EXPECT_NE(summary.find(expected), std::string::npos) << expected << " in\n" << summary;
+  }
+  EXPECT_EQ(summary.find("(bad)"), std::string::npos) << summary;
+}

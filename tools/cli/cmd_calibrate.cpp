@@ -48,9 +48,14 @@ const facet::cli::Registration registration{
           ->required();
       cmd->add_flag("--json", args->json,
                     "print the report as JSON: per projector coverage, decoded pixels, grid, "
-                    "fit residual, filled and holes (nodes extrapolated and kept, or left "
-                    "uncovered) and folds, and with truth/ rms_px, p99_px, max_px, max_at_px and "
-                    "uncovered_fraction; blend_sum_max_err and where (blend_worst); seconds");
+                    "fit residual (rms, p50, p99), filled and holes (nodes extrapolated and kept, "
+                    "or left uncovered), holes_filled (enclosed, interpolated), folds_refilled "
+                    "and folds (cut), unlit_inside, worst_region_px and its rms, verdict and "
+                    "reasons, and with truth/ rms_px, p99_px, max_px, max_at_px and "
+                    "uncovered_fraction; blend_sum_max_err and where (blend_worst); the overall "
+                    "verdict; seconds. Without --json: a table per projector (coverage, holes "
+                    "filled, folds cut, residual p50/p99, worst 32x32 region, verdict) and the "
+                    "reasons");
       cmd->add_option("--grid", args->grid,
                       "offset-map nodes GWxGH for every projector (default: one node about "
                       "every 16 output pixels, refined once where the map curves)");
@@ -89,16 +94,29 @@ const facet::cli::Registration registration{
           std::cout << report.to_json().dump(2) << "\n";
           return;
         }
+        // One row per projector, then the reasons for any verdict other than good.
+        std::printf("%-12s %8s %7s %7s %7s %7s %19s %9s  %s\n", "projector", "coverage", "holes",
+                    "folds", "p50 px", "p99 px", "worst region", "rms px", "verdict");
         for (const auto& p : report.projectors) {
-          std::printf("%s: %zu decoded camera pixels, coverage %.3f, grid %dx%d, residual %.3f px",
-                      p.name.c_str(), p.decoded_pixels, p.coverage, p.fit.grid.x, p.fit.grid.y,
-                      p.fit.residual_rms_px);
-          if (p.accuracy) {
-            std::printf(", against truth: rms %.3f px, p99 %.3f px, max %.3f px",
-                        p.accuracy->rms_px, p.accuracy->p99_px, p.accuracy->max_px);
-          }
-          std::printf("\n");
+          char worst[32];
+          std::snprintf(worst, sizeof worst, "(%.0f, %.0f)", p.fit.worst_region_px.x,
+                        p.fit.worst_region_px.y);
+          std::printf("%-12s %7.1f%% %7zu %7zu %7.3f %7.3f %19s %9.3f  %s\n", p.name.c_str(),
+                      100 * p.coverage, p.fit.holes_filled, p.fit.folds, p.fit.residual_p50_px,
+                      p.fit.residual_p99_px, worst, p.fit.worst_region_rms_px,
+                      facet::calibration::to_string(p.verdict.verdict));
         }
+        for (const auto& p : report.projectors) {
+          for (const std::string& reason : p.verdict.reasons) {
+            std::printf("  %s: %s\n", p.name.c_str(), reason.c_str());
+          }
+          if (p.accuracy) {
+            std::printf("  %s against truth: rms %.3f px, p99 %.3f px, max %.3f px\n",
+                        p.name.c_str(), p.accuracy->rms_px, p.accuracy->p99_px, p.accuracy->max_px);
+          }
+        }
+        std::printf("verdict: %s (thresholds: calibration/README.md)\n",
+                    facet::calibration::to_string(report.verdict()));
         std::printf("blend sum max error %.5f; %.1f s\n", report.blend_sum_max_err, report.seconds);
       });
     }};

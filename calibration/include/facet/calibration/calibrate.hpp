@@ -37,14 +37,50 @@ struct AccuracyReport {
 
 AccuracyReport compare_warps(const Warp& truth, const Warp& calibrated, double border_px = 8);
 
+enum class Verdict { good, check, bad };
+const char* to_string(Verdict verdict);
+
+// What makes a projector's calibration good, check or bad (calibration/README.md, "Verdict").
+// A value past a check_* threshold makes it at least "check", past a bad_* one "bad".
+struct VerdictThresholds {
+  // Share of the output pixels covered: a camera that sees little of the image.
+  double check_coverage_below = 0.9, bad_coverage_below = 0.1;
+  // Fit residual of the decoded samples, output pixels: noise and wrong codes.
+  double check_residual_p50_px = 0.5, bad_residual_p50_px = 1.0;
+  double check_residual_p99_px = 2.0, bad_residual_p99_px = 5.0;
+  // RMS residual of the worst 32×32 region: a local defect (a shadow, a reflection).
+  double check_worst_region_px = 2.0, bad_worst_region_px = 5.0;
+  // Enclosed hole nodes interpolated, as a share of the supported nodes: much of the image was
+  // not decoded and is guessed.
+  double check_holes_filled_share = 0.02, bad_holes_filled_share = 0.25;
+  // Nodes cut back for folding: any makes it "check".
+  std::size_t check_folds = 1;
+  // Unlit output pixels inside the lit region (see unlit_inside): any is a pin-hole, "bad".
+  std::size_t bad_unlit_inside = 1;
+};
+
+struct ProjectorVerdict {
+  Verdict verdict = Verdict::good;
+  std::vector<std::string> reasons;  // one per threshold crossed, e.g. "residual p99 3.4 px > 2"
+};
+
+// Unlit output pixels (weight 0) inside the lit region of a W×H weight map: a pixel is inside
+// when the 8 pixels at (±r, 0), (0, ±r) and (±r, ±r) from it are all lit, so that any unlit speck
+// narrower than r counts while notches in the region's outer edge do not.
+std::size_t unlit_inside(const std::vector<float>& weight, glm::ivec2 size, int r = 24);
+
 struct ProjectorReport {
   std::string name;
   glm::ivec2 size{0, 0};
   std::size_t decoded_pixels = 0;  // camera pixels that decoded this projector
-  double coverage = 0;  // share of the projector's output pixels the calibrated warp maps
+  double coverage = 0;           // share of the projector's output pixels the calibrated warp maps
+  std::size_t unlit_inside = 0;  // of its blend map, r = 24 px
   FitReport fit;
   std::optional<AccuracyReport> accuracy;
+  ProjectorVerdict verdict;  // judge(*this) once the rest is filled in
 };
+
+ProjectorVerdict judge(const ProjectorReport& projector, const VerdictThresholds& thresholds = {});
 
 struct CalibrationReport {
   std::vector<ProjectorReport> projectors;
@@ -59,6 +95,7 @@ struct CalibrationReport {
   double blend_single_min = 1;
   double seconds = 0;
 
+  Verdict verdict() const;  // the worst of the projectors'
   nlohmann::json to_json() const;
 };
 

@@ -96,6 +96,15 @@ struct FitReport {
   double residual_p50_px = 0;      // median of the same
   double residual_p99_px = 0;      // 99th percentile of the same
   double outlier_fraction = 0;     // share of those samples with residual > outlier_px
+  // RMS residual per block of kResidualBlockPx × kResidualBlockPx output pixels, by the samples'
+  // decoded positions (CV_32F, ⌈W/8⌉ × ⌈H/8⌉); NaN where no covered sample falls.
+  static constexpr int kResidualBlockPx = 8;
+  cv::Mat residual_map;
+  // The kWorstRegionPx-square region of output pixels (on a grid from the origin) with the largest
+  // RMS residual, among those holding at least 32 covered samples: its centre and that RMS.
+  static constexpr int kWorstRegionPx = 32;
+  glm::dvec2 worst_region_px{0.0};
+  double worst_region_rms_px = 0;
 };
 
 struct WarpFit {
