@@ -48,6 +48,9 @@ TEST(Bourke, RealSphericalMirrorMeshParses) {
   // ones (whose cells hold extrapolated values), in output pixels.
   const ImportedProjector projector = import_bourke(mesh, {}, path, "mirror");
   EXPECT_NO_THROW(projector.warp.validate());
+  // By default the fisheye master's centre is overhead (eye +y), its bottom edge the front (−z).
+  EXPECT_LE(glm::length(projector.warp.v_eye_from_st({0.5, 0.5}) - glm::dvec3(0, 1, 0)), 1e-12);
+  EXPECT_LE(glm::length(projector.warp.v_eye_from_st({0.5, 1.0}) - glm::dvec3(0, 0, -1)), 1e-12);
   // The file's two top corner nodes hold (u, v) = (0, 0) where their neighbours show about
   // (0.46, 0.96) and (0.54, 0.96): each turns its corner cell over. They are masked and reported.
   BourkeMesh unfolded = mesh;

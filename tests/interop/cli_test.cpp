@@ -2,6 +2,7 @@
 #include <sys/stat.h>
 #include <sys/wait.h>
 
+#include <cmath>
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
@@ -235,6 +236,90 @@ TEST(InteropCli, AnSgctDomeConfigurationAndBareSgcMeshesImport) {
   EXPECT_EQ(
       projection_io::read_display_config(scratch.path / "back" / "display.json").projectors.size(),
       4u);
+}
+
+// The first projector's warp of FOLDER/display.json.
+Warp first_warp(const fs::path& folder) {
+  const auto display = projection_io::read_display_config(folder / "display.json");
+  return read_warp(display.resolve(display.projectors.at(0).warp).string());
+}
+
+// The angle between two directions, radians.
+double angle_between(glm::dvec3 a, glm::dvec3 b) {
+  return std::atan2(glm::length(glm::cross(a, b)), glm::dot(a, b));
+}
+
+// A fisheye master (Bourke's mirror mesh, builtin:dome180) puts its image centre overhead by
+// default; --zenith front puts it straight ahead; --tilt and --orientation then place the dome
+// around the viewer (eye frame: x right, y up, −z ahead). Rotations are written as doubles, so the
+// directions hold within 1e-9 rad.
+TEST(InteropCli, DomesTakeTheirZenithTiltAndOrientation) {
+  test::ScratchFolder scratch("cli-orientation");
+  const std::string mirror =
+      "bourke import " + kWarps + "sgct-mesh/standard_16x9.data --size 480x270";
+  const glm::dvec2 centre{0.5, 0.5}, bottom_middle{0.5, 1.0};  // of the fisheye master
+  const double half = 0.5, root3_2 = std::sqrt(3.0) / 2;
+  struct Case {
+    std::string flags;
+    glm::dvec3 zenith;  // where the master's centre points
+  };
+  const std::vector<Case> cases = {
+      {"", {0, 1, 0}},
+      {"--zenith centre", {0, 1, 0}},
+      {"--zenith front", {0, 0, -1}},
+      {"--tilt 30", {0, root3_2, -half}},
+      {"--tilt 30 --orientation 90", {half, root3_2, 0}},
+  };
+  int k = 0;
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.flags);
+    const fs::path out = scratch.path / ("mirror" + std::to_string(k++));
+    const CliRun r = run(mirror + " " + c.flags + " --out " + out.string(), scratch.path);
+    ASSERT_EQ(r.status, 0) << r.output;
+    const Warp warp = first_warp(out);
+    EXPECT_LE(angle_between(warp.v_eye_from_st(centre), c.zenith), 1e-9);
+    if (c.flags.empty()) {
+      // A dome master's bottom edge is the front.
+      EXPECT_LE(angle_between(warp.v_eye_from_st(bottom_middle), {0, 0, -1}), 1e-9);
+    }
+  }
+  // The analytic built-in dome, written out by facet display.
+  for (const Case& c : {cases[0], cases[3], cases[4]}) {
+    SCOPED_TRACE(c.flags);
+    const fs::path out = scratch.path / ("builtin" + std::to_string(k++));
+    const CliRun r = run(
+        "display builtin:dome180 --size 64x64 " + c.flags + " --out " + out.string(), scratch.path);
+    ASSERT_EQ(r.status, 0) << r.output;
+    EXPECT_LE(angle_between(first_warp(out).v_eye_from_st(centre), c.zenith), 1e-9);
+  }
+  // An SGCT import turned by 90°: every direction turns from ahead (−z) toward the right (+x).
+  const std::string bravo = "sgct import " + kWarps + "sgct-dome/simcad/dome_bravo.xml";
+  CliRun r = run(bravo + " --out " + (scratch.path / "bravo").string(), scratch.path);
+  ASSERT_EQ(r.status, 0) << r.output;
+  r = run(bravo + " --orientation 90 --out " + (scratch.path / "bravo90").string(), scratch.path);
+  ASSERT_EQ(r.status, 0) << r.output;
+  const glm::dvec3 v = first_warp(scratch.path / "bravo").v_eye_from_st(centre);
+  EXPECT_LE(
+      angle_between(first_warp(scratch.path / "bravo90").v_eye_from_st(centre), {-v.z, v.y, v.x}),
+      1e-9);
+
+  // Bad values exit 2 naming the flag, writing nothing.
+  const std::vector<std::pair<std::string, std::string>> bad = {
+      {mirror + " --tilt 200", "--tilt"},
+      {mirror + " --zenith sideways", "--zenith"},
+      {mirror + " --orientation east", "--orientation"},
+      {bravo + " --tilt -91", "--tilt"},
+      {"mpcdi import " + kWarps + "sgct-mpcdi/correction_mesh.mpcdi --orientation 400",
+       "--orientation"},
+      {"display builtin:cylinder360 --tilt 10", "--tilt"},
+  };
+  for (const auto& [command, flag] : bad) {
+    const fs::path out = scratch.path / "bad";
+    const CliRun failed = run(command + " --out " + out.string(), scratch.path);
+    EXPECT_EQ(failed.status, 2) << command << "\n" << failed.output;
+    EXPECT_NE(failed.output.find("'" + flag + "'"), std::string::npos) << failed.output;
+    EXPECT_FALSE(fs::exists(out)) << command;
+  }
 }
 
 TEST(InteropCli, ProfileA3ThroughTheCommands) {

@@ -17,8 +17,9 @@ const Registration registration{
       auto* command = app.add_subcommand("bourke", "Import Paul Bourke warp meshes (.data)");
       command->require_subcommand(1);
       struct Options {
-        std::string file, out, size = "1920x1080", grid;
+        std::string file, out, size = "1920x1080", grid, zenith = "centre";
         double fov = 180, gamma = 2.2;
+        DomeOrientationFlags orientation;
       };
       auto options = std::make_shared<Options>();
       auto* import_command = command->add_subcommand(
@@ -39,7 +40,15 @@ const Registration registration{
           "per side until its nodes are followed within 1 px)");
       import_command->add_option("--intensity-gamma", options->gamma,
                                  "Linear blend = intensity^gamma (default 2.2)");
+      import_command->add_option(
+          "--zenith", options->zenith,
+          "Where the fisheye master's centre points: centre (default: overhead, the image's bottom "
+          "edge to the front, as a dome master) or front (straight ahead, the image's top up)");
+      options->orientation.add_to(*import_command);
       import_command->callback([options] {
+        const FisheyeZenith zenith =
+            fisheye_zenith_from_string(options->zenith, "command line", "--zenith");
+        const glm::dmat3 R_eye_dome = options->orientation.value().R_eye_dome();
         require_regular_file(options->file);
         std::ifstream stream(options->file, std::ios::binary);
         if (!stream) throw InputError(options->file, "", "cannot open the file");
@@ -55,6 +64,7 @@ const Registration registration{
           throw InputError("--intensity-gamma", "", "expected a gamma in (0, 10]");
         }
         import.base = BaseProjection::fisheye(options->fov);
+        import.R_eye_base = R_eye_dome * R_dome_fisheye(zenith);
         import.intensity_gamma = options->gamma;
         if (!options->grid.empty()) {
           import.warp_grid = parse_size(options->grid, "--grid");

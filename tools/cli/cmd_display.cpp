@@ -17,6 +17,7 @@ struct DisplayOptions {
   std::string size;
   std::string name;
   std::string out;
+  DomeOrientationFlags orientation;
 };
 
 const Registration registration{
@@ -30,10 +31,15 @@ const Registration registration{
       command->add_option("--size", options->size, "Output size WxH of a built-in display");
       command->add_option("--name", options->name, "Name in display.json (default: the folder's)");
       command->add_option("--out", options->out, "Folder to create")->required();
+      options->orientation.add_to(*command);
       command->callback([options] {
         std::optional<glm::ivec2> size;
         if (!options->size.empty()) size = parse_size(options->size, "--size");
-        const driver::SessionDisplay display = driver::load_session_display(options->display, size);
+        const auto orientation = builtin_dome_orientation(options->orientation, options->display);
+        driver::SessionDisplay display = driver::load_session_display(options->display, size);
+        for (auto& output : display.outputs) {
+          if (orientation) orient_warp(output.spec.warp, *orientation);
+        }
         const std::filesystem::path out(options->out);
         const std::string name = options->name.empty() ? out.filename().string() : options->name;
         driver::write_session_display(display, name, out);

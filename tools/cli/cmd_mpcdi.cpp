@@ -52,6 +52,7 @@ const Registration registration{
 
       struct ImportOptions {
         std::string file, out, values = "auto", grid, eye;
+        DomeOrientationFlags orientation;
       };
       auto importing = std::make_shared<ImportOptions>();
       auto* import_command = command->add_subcommand(
@@ -69,7 +70,9 @@ const Registration registration{
       import_command->add_option("--eye", importing->eye,
                                  "Profile a3: the eye point x,y,z in the file's frame and "
                                  "geometricUnit (default: the frame's origin)");
+      importing->orientation.add_to(*import_command);
       import_command->callback([importing] {
+        const DomeOrientation orientation = importing->orientation.value();
         interop::MpcdiImportOptions options;
         if (importing->values == "absolute") {
           options.values = interop::MpcdiWarpValues::absolute;
@@ -96,7 +99,8 @@ const Registration registration{
           options.eye = eye;
         }
         const auto files = interop::read_zip_file(importing->file);
-        const auto display = interop::import_mpcdi(files, importing->file, options);
+        auto display = interop::import_mpcdi(files, importing->file, options);
+        for (auto& projector : display.projectors) orient_warp(projector.warp, orientation);
         for (const std::string& note : display.notes) std::cerr << "facet: note: " << note << "\n";
         interop::write_display_folder(display, importing->out);
         std::cout << "wrote " << importing->out << "/display.json (" << display.projectors.size()

@@ -62,6 +62,7 @@ const Registration registration{
         std::vector<std::string> files;
         std::string out, size = "1920x1200", grid;
         double gamma = 2.2;
+        DomeOrientationFlags orientation;
       };
       auto options = std::make_shared<Options>();
       auto* import_command = command->add_subcommand(
@@ -81,7 +82,9 @@ const Registration registration{
           "until it is followed within 0.25 px)");
       import_command->add_option("--mask-gamma", options->gamma,
                                  "Linear blend = mask^gamma (default 2.2)");
+      options->orientation.add_to(*import_command);
       import_command->callback([options] {
+        const DomeOrientation orientation = options->orientation.value();
         if (!(options->gamma > 0 && options->gamma <= 10)) {
           throw InputError("--mask-gamma", "", "expected a gamma in (0, 10]");
         }
@@ -121,6 +124,7 @@ const Registration registration{
           import.warp_grid = grid;
           display = interop::import_sgct_cluster(options->files.front(), import);
         }
+        for (auto& projector : display.projectors) orient_warp(projector.warp, orientation);
         for (const std::string& note : display.notes) std::cerr << "facet: note: " << note << "\n";
         for (const auto& projector : display.projectors) {
           for (const std::string& note : projector.notes) {

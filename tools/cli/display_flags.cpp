@@ -104,6 +104,42 @@ Warp DisplayFlags::make_warp() const {
   return Warp::analytic(projection, parse_size(size, "--size"));
 }
 
+void DomeOrientationFlags::add_to(CLI::App& command) {
+  command.add_option("--tilt", tilt,
+                     "The dome tilted forward by DEG about the eye's x axis, its zenith toward the "
+                     "front, in [-90, 90] (default 0)");
+  command.add_option("--orientation", orientation,
+                     "The dome turned by DEG about the vertical, its front toward the right as a "
+                     "compass heading, in [-360, 360] (default 0)");
+}
+
+DomeOrientation DomeOrientationFlags::value() const {
+  DomeOrientation result;
+  if (!tilt.empty()) result.tilt_deg = parse_numbers(tilt, "--tilt", 1, 1)[0];
+  if (!orientation.empty()) {
+    result.orientation_deg = parse_numbers(orientation, "--orientation", 1, 1)[0];
+  }
+  result.validate("command line");
+  return result;
+}
+
+void orient_warp(Warp& warp, const DomeOrientation& orientation) {
+  warp.R_eye_base = orientation.R_eye_dome() * warp.R_eye_base;
+}
+
+std::optional<DomeOrientation> builtin_dome_orientation(const DomeOrientationFlags& flags,
+                                                        const std::string& display) {
+  if (!flags.given()) return std::nullopt;
+  const DomeOrientation orientation = flags.value();
+  if (display != "builtin:dome180") {
+    throw InputError("command line", flags.tilt.empty() ? "--orientation" : "--tilt",
+                     "expected a built-in dome display (builtin:dome180), not '" + display +
+                         "': imports take the flag (facet bourke|sgct|mpcdi import), and a file's "
+                         "display is placed by its warps");
+  }
+  return orientation;
+}
+
 void LayoutFlags::add_to(CLI::App& command) {
   auto* group = command.add_option_group("facets", "How to choose the facets (one of)");
   group->add_option("--pieces", pieces, "N vertical strips, one row (the seed's cylinder)");

@@ -6,6 +6,7 @@
 #include <optional>
 #include <string>
 
+#include "facet/projection/dome_orientation.hpp"
 #include "facet/projection/facets.hpp"
 #include "facet/projection/warp.hpp"
 
@@ -35,6 +36,27 @@ struct LayoutFlags {
   // Defaults to a tolerance of 0.25 px when no flag is given.
   FacetLayout layout() const;
 };
+
+// --tilt DEG and --orientation DEG: where a dome sits around the viewer (DomeOrientation), for
+// built-in domes and imports.
+struct DomeOrientationFlags {
+  std::string tilt, orientation;  // degrees; empty: 0
+
+  void add_to(CLI::App& command);
+  bool given() const { return !tilt.empty() || !orientation.empty(); }
+  // InputError("command line", "--tilt" or "--orientation", ...) for a bad or out-of-range value.
+  DomeOrientation value() const;
+};
+
+// Turns `warp`'s directions about the eye: R_eye_base ← R_eye_dome · R_eye_base.
+void orient_warp(Warp& warp, const DomeOrientation& orientation);
+
+// The orientation for the outputs of `display` as render, run and display name it: flags apply to
+// built-in domes (builtin:dome180) only; nullopt when none is given. InputError naming the flag
+// for a bad value or another display (a file's display is placed by its file; imports take the
+// flags).
+std::optional<DomeOrientation> builtin_dome_orientation(const DomeOrientationFlags& flags,
+                                                        const std::string& display);
 
 // "WxH" → (W, H); InputError naming the flag otherwise.
 glm::ivec2 parse_size(const std::string& text, const std::string& flag);

@@ -11,7 +11,9 @@
 //
 // facet reads this as an inverse map (interop/inverse_grid.hpp) over a base projection chosen for
 // the source image: for a dome or a spherical mirror, a fisheye master whose image is the (u, v)
-// square (st = (u, 1 − v)).
+// square (st = (u, 1 − v)). By default the master lies on the dome as a dome master does: its
+// centre overhead (eye +y), its bottom edge to the front (−z), its right edge +x
+// (R_dome_fisheye(FisheyeZenith::centre), dome_orientation.hpp).
 #include <glm/glm.hpp>
 #include <string>
 #include <string_view>
@@ -19,6 +21,7 @@
 
 #include "facet/interop/display_folder.hpp"
 #include "facet/projection/base_projection.hpp"
+#include "facet/projection/dome_orientation.hpp"
 
 namespace facet::interop {
 
@@ -41,7 +44,9 @@ BourkeMesh parse_bourke(std::string_view text, const std::string& source);
 struct BourkeImportOptions {
   glm::ivec2 output_size{1920, 1080};  // must match the mesh's aspect within 1%
   BaseProjection base = BaseProjection::fisheye(180);
-  glm::dmat3 R_eye_base{1.0};
+  // The master's base frame into the eye frame: the default puts its centre overhead; identity
+  // puts it straight ahead (FisheyeZenith::front).
+  glm::dmat3 R_eye_base = R_dome_fisheye(FisheyeZenith::centre);
   // 0: automatic: the mesh's own node counts, doubled (up to 1025 per side) while an interior mesh
   // node is reproduced worse than 1 px.
   glm::ivec2 warp_grid{0, 0};
