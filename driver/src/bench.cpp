@@ -15,6 +15,7 @@
 #include "facet/driver/gpu_timer.hpp"
 #include "facet/driver/reference.hpp"
 #include "facet/driver/scene_names.hpp"
+#include "facet/driver/scene_view.hpp"
 #include "facet/projection/errors.hpp"
 #include "facet/projection/facet_error.hpp"
 #include "facet/projection/rig.hpp"
@@ -390,12 +391,14 @@ BenchReport run_bench(const BenchOptions& options, const std::string& renderer,
       next->scene = load_scene(scene_name);
       next->gpu = upload_scene(next->scene);
       next->raycaster = std::make_unique<ReferenceRaycaster>(next->scene);
-      next->views = std::make_unique<FrameViews>(next->scene, scene_name.builtin_city(),
-                                                 kBenchFrameStepS, options.static_view);
+      // The view facet render takes by default: outside a closed model, else at its centre.
+      const SceneView view = choose_scene_view(next->scene, {}, scene_name.builtin_city());
+      next->views = std::make_unique<FrameViews>(view, kBenchFrameStepS, options.static_view);
       loaded = std::move(next);
       say(format("scene %s: %zu triangles, %zu objects, ready in %.0f ms", scene_text.c_str(),
                  loaded->scene.triangle_count(), loaded->scene.objects.size(),
                  wall_ms_since(start)));
+      if (!view.message.empty()) say("scene " + scene_text + ": " + view.message);
     }
     const Scene& scene = loaded->scene;
     const GpuScene& gpu_scene = loaded->gpu;

@@ -94,15 +94,6 @@ Scene load_scene(const SceneName& name) {
   return load_gltf(name.file);
 }
 
-FrameViews::FrameViews(const Scene& scene, bool builtin_city, double city_step_s, bool static_view)
-    : city_(builtin_city), static_(static_view), step_s_(city_step_s) {
-  const Aabb bounds = scene.bounds_world();
-  if (!bounds.empty()) {
-    view_.pivot_world = glm::dvec3(bounds.centre());
-    view_.T_world_eye = glm::translate(glm::dmat4(1.0), view_.pivot_world);
-  }
-}
-
 FrameViews::FrameViews(const SceneView& view, double city_step_s, bool static_view)
     : city_(view.follows_city_path), static_(static_view), step_s_(city_step_s), view_(view) {}
 

@@ -7,10 +7,12 @@
 
 #include <cmath>
 #include <glm/geometric.hpp>
+#include <glm/gtc/matrix_transform.hpp>
 #include <numbers>
 #include <set>
 
 #include "facet/driver/scene_names.hpp"
+#include "facet/driver/scene_view.hpp"
 #include "facet/projection/errors.hpp"
 
 namespace facet::driver {
@@ -345,8 +347,11 @@ TEST(SceneNames, RefuseUnknownNamesAndAbsurdSizes) {
 
 TEST(FrameViews, TurnAboutTheCentreOrFollowThePathUnlessStatic) {
   const Scene& scene = city();
-  const FrameViews turning(scene, false, 0.25);
   const glm::dvec3 centre(scene.bounds_world().centre());
+  SceneView on_the_spot;  // the eye at the centre, turning there
+  on_the_spot.pivot_world = centre;
+  on_the_spot.T_world_eye = glm::translate(glm::dmat4(1.0), centre);
+  const FrameViews turning(on_the_spot, 0.25);
   for (int k : {0, 1, 30, 119}) {
     const glm::dmat4 T = turning.T_world_eye(k);
     EXPECT_NEAR(glm::length(glm::dvec3(T[3]) - centre), 0.0, 1e-9);
@@ -355,11 +360,13 @@ TEST(FrameViews, TurnAboutTheCentreOrFollowThePathUnlessStatic) {
     EXPECT_NEAR(std::remainder(yaw + expected, 2 * std::numbers::pi), 0.0, 1e-9) << k;
   }
   EXPECT_NE(turning.T_world_eye(1), turning.T_world_eye(2));
-  const FrameViews still(scene, false, 0.25, true);
+  const FrameViews still(on_the_spot, 0.25, true);
   EXPECT_EQ(still.T_world_eye(5), still.T_world_eye(0));
-  const FrameViews path(scene, true, 0.25);
+  SceneView city_path;
+  city_path.follows_city_path = true;
+  const FrameViews path(city_path, 0.25);
   EXPECT_EQ(path.T_world_eye(3), CityCameraPath().T_world_eye(0.75));
-  EXPECT_EQ(FrameViews(scene, true, 0.25, true).T_world_eye(3), CityCameraPath().T_world_eye(0));
+  EXPECT_EQ(FrameViews(city_path, 0.25, true).T_world_eye(3), CityCameraPath().T_world_eye(0));
 }
 
 }  // namespace

@@ -57,10 +57,7 @@ inline Scene load_scene(std::string_view text) { return load_scene(parse_scene_n
 class FrameViews {
  public:
   static constexpr int kTurnFrames = 120;
-  // `facet bench`: on the built-in city the city camera path at k · city_step_s seconds; on
-  // other scenes the eye at the scene bounds' centre, turning on the spot.
-  FrameViews(const Scene& scene, bool builtin_city, double city_step_s, bool static_view = false);
-  // `facet render`, from a chosen view (choose_scene_view): the city camera path at
+  // From a chosen view (choose_scene_view; facet render and bench): the city camera path at
   // k · city_step_s seconds when it follows it, else view.T_world_eye_turned(k / kTurnFrames)
   // (a turn on the spot or about the point looked at).
   FrameViews(const SceneView& view, double city_step_s, bool static_view = false);
