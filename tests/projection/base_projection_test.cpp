@@ -5,6 +5,7 @@
 
 #include <random>
 
+#include "facet/projection/dome_orientation.hpp"
 #include "facet/projection/errors.hpp"
 #include "facet/projection/warp.hpp"
 
@@ -126,6 +127,49 @@ TEST(Warp, DirectionPixelDirectionRoundTrip) {
     EXPECT_NEAR(projected->q.y, st.y * 1200, 1e-6);
     EXPECT_LE(angle_between(warp.v_eye_from_st(projected->q / glm::dvec2(1600, 1200)), v), 1e-9);
   }
+}
+
+// A fisheye master on a dome (DomeOrientation, R_dome_fisheye): the master's centre is the zenith
+// (+y) or straight ahead (−z); a tilt moves the zenith toward the front, an orientation turns the
+// front toward the right. Exact rotations, so within 1e-12 rad.
+TEST(DomeOrientation, PlacesAFisheyeMastersCentreAndFront) {
+  const BaseProjection master = BaseProjection::fisheye(180);
+  const glm::dvec2 centre{0.5, 0.5}, bottom_middle{0.5, 1.0}, right_middle{1.0, 0.5};
+  const glm::dmat3 R_centre = R_dome_fisheye(FisheyeZenith::centre);
+  EXPECT_LE(angle_between(R_centre * master.direction(centre), {0, 1, 0}), 1e-12);
+  EXPECT_LE(angle_between(R_centre * master.direction(bottom_middle), {0, 0, -1}), 1e-12);
+  EXPECT_LE(angle_between(R_centre * master.direction(right_middle), {1, 0, 0}), 1e-12);
+  const glm::dmat3 R_front = R_dome_fisheye(FisheyeZenith::front);
+  EXPECT_LE(angle_between(R_front * master.direction(centre), {0, 0, -1}), 1e-12);
+  for (const double tilt : {-90.0, -20.0, 0.0, 15.0, 30.0, 90.0}) {
+    for (const double orientation : {-360.0, -45.0, 0.0, 90.0, 200.0}) {
+      SCOPED_TRACE(std::to_string(tilt) + "°, " + std::to_string(orientation) + "°");
+      const DomeOrientation dome{tilt, orientation};
+      EXPECT_NO_THROW(dome.validate("test"));
+      const glm::dmat3 R = dome.R_eye_dome();
+      EXPECT_LE(glm::length(glm::dvec3(glm::transpose(R) * R * glm::dvec3(1, 2, 3)) -
+                            glm::dvec3(1, 2, 3)),
+                1e-12);
+      EXPECT_NEAR(glm::determinant(R), 1, 1e-12);
+      const double t = glm::radians(tilt), o = glm::radians(orientation);
+      const glm::dvec3 zenith{std::sin(o) * std::sin(t), std::cos(t), -std::cos(o) * std::sin(t)};
+      EXPECT_LE(angle_between(R * R_centre * master.direction(centre), zenith), 1e-12);
+      // The untilted front, turned: −z toward +x by the orientation.
+      const glm::dvec3 front = DomeOrientation{0, orientation}.R_eye_dome() * glm::dvec3(0, 0, -1);
+      EXPECT_LE(angle_between(front, {std::sin(o), 0, -std::cos(o)}), 1e-12);
+    }
+  }
+  for (const DomeOrientation bad : {DomeOrientation{90.5, 0}, DomeOrientation{-200, 0},
+                                    DomeOrientation{0, 361}, DomeOrientation{std::nan(""), 0}}) {
+    try {
+      bad.validate("command line");
+      ADD_FAILURE() << "no error for " << bad.tilt_deg << ", " << bad.orientation_deg;
+    } catch (const InputError& e) {
+      EXPECT_EQ(e.field(), bad.orientation_deg == 361 ? "--orientation" : "--tilt");
+    }
+  }
+  EXPECT_EQ(fisheye_zenith_from_string("center", "s", "--zenith"), FisheyeZenith::centre);
+  EXPECT_THROW(fisheye_zenith_from_string("sideways", "s", "--zenith"), InputError);
 }
 
 }  // namespace
