@@ -4,10 +4,15 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <iterator>
+#include <opencv2/imgproc.hpp>
 #include <random>
+#include <span>
+#include <tuple>
 
 #include "facet/calibration/camera_model.hpp"
 #include "facet/calibration/capture.hpp"
+#include "facet/calibration/image_io.hpp"
 #include "facet/projection/errors.hpp"
 #include "facet/projection/interrupt.hpp"
 #include "facet/projection/warp_inverse.hpp"
@@ -43,6 +48,124 @@ fs::path prepare_output(const fs::path& out) {
   return parent / (out.filename().string() + ".tmp-" + std::to_string(random()));
 }
 
+// The pixels unlit_inside counts, row-major.
+std::vector<char> unlit_inside_mask(const std::vector<float>& weight, glm::ivec2 size, int r) {
+  FACET_ASSERT(weight.size() == std::size_t(size.x) * std::size_t(size.y) && r > 0);
+  auto lit = [&](int x, int y) {
+    return x >= 0 && y >= 0 && x < size.x && y < size.y &&
+           weight[std::size_t(y) * std::size_t(size.x) + std::size_t(x)] > 0;
+  };
+  std::vector<char> unlit(weight.size(), 0);
+  for (int y = 0; y < size.y; ++y) {
+    for (int x = 0; x < size.x; ++x) {
+      if (lit(x, y)) continue;
+      bool inside = true;
+      for (int dy = -r; dy <= r && inside; dy += r) {
+        for (int dx = -r; dx <= r && inside; dx += r) {
+          if (dx != 0 || dy != 0) inside = lit(x + dx, y + dy);
+        }
+      }
+      unlit[std::size_t(y) * std::size_t(size.x) + std::size_t(x)] = inside ? 1 : 0;
+    }
+  }
+  return unlit;
+}
+
+// The colour scale of report/<p>.residual.png (calibration/README.md): RMS residual in output
+// pixels → RGB, linear between the stops, white from 4 px on.
+struct ResidualStop {
+  double px;
+  cv::Vec3b rgb;
+};
+const ResidualStop kResidualScale[] = {{0.0, {0, 0, 255}},
+                                       {0.5, {0, 255, 0}},
+                                       {1.0, {255, 255, 0}},
+                                       {2.0, {255, 0, 0}},
+                                       {4.0, {255, 255, 255}}};
+
+cv::Vec3b residual_colour(double px) {
+  if (!(px > kResidualScale[0].px)) return kResidualScale[0].rgb;
+  for (std::size_t n = 1; n < std::size(kResidualScale); ++n) {
+    const ResidualStop &low = kResidualScale[n - 1], &high = kResidualScale[n];
+    if (px > high.px) continue;
+    const double f = (px - low.px) / (high.px - low.px);
+    cv::Vec3b rgb;
+    for (int c = 0; c < 3; ++c)
+      rgb[c] = cv::saturate_cast<std::uint8_t>((1 - f) * low.rgb[c] + f * high.rgb[c]);
+    return rgb;
+  }
+  return kResidualScale[std::size(kResidualScale) - 1].rgb;
+}
+
+// Colours of report/<p>.coverage.png (calibration/README.md).
+const cv::Vec3b kUncovered(0, 0, 0), kCovered(160, 160, 160), kHoleFilled(0, 110, 255),
+    kFoldRefilled(255, 200, 0), kFoldCut(255, 0, 0), kPinHole(255, 0, 255);
+const cv::Scalar kWorstRegionOutline(255, 0, 255);
+
+// The fit's RMS residual per 8×8 block of output pixels in the colours of kResidualScale, black
+// where no covered sample falls, the worst region outlined in magenta: CV_8UC3, RGB.
+cv::Mat residual_image(const FitReport& fit, glm::ivec2 size) {
+  cv::Mat image(size.y, size.x, CV_8UC3, cv::Scalar(0, 0, 0));
+  const int block = FitReport::kResidualBlockPx;
+  for (int y = 0; y < size.y; ++y) {
+    auto* row = image.ptr<cv::Vec3b>(y);
+    for (int x = 0; x < size.x; ++x) {
+      const float rms = fit.residual_map.at<float>(y / block, x / block);
+      if (std::isfinite(rms)) row[x] = residual_colour(rms);
+    }
+  }
+  if (fit.worst_region_rms_px > 0) {
+    const glm::dvec2 corner = fit.worst_region_px - 0.5 * FitReport::kWorstRegionPx;
+    cv::rectangle(image,
+                  cv::Rect(int(std::lround(corner.x)), int(std::lround(corner.y)),
+                           FitReport::kWorstRegionPx, FitReport::kWorstRegionPx),
+                  kWorstRegionOutline, 1);
+  }
+  return image;
+}
+
+// Lit pixels grey, unlit black; over them, at each node's output position, a disc half a node
+// spacing wide in the colour of where its offset comes from: filled holes and refilled folds
+// over lit pixels, cut folds anywhere; unlit pixels inside the lit region (pin-holes) on top.
+cv::Mat coverage_image(const Warp& warp, std::span<const NodeOrigin> origin,
+                       const projection_io::BlendMap& alpha) {
+  const glm::ivec2 size = alpha.size;
+  cv::Mat image(size.y, size.x, CV_8UC3, cv::Scalar(0, 0, 0));
+  cv::Mat lit(size.y, size.x, CV_8U, cv::Scalar(0));
+  for (int y = 0; y < size.y; ++y) {
+    for (int x = 0; x < size.x; ++x) {
+      const bool on = alpha.at(x, y) > 0;
+      lit.at<std::uint8_t>(y, x) = on ? 1 : 0;
+      image.at<cv::Vec3b>(y, x) = on ? kCovered : kUncovered;
+    }
+  }
+  const glm::ivec2 grid = warp.grid_size;
+  const glm::dvec2 step{double(warp.output_size.x) / (grid.x - 1),
+                        double(warp.output_size.y) / (grid.y - 1)};
+  const int radius = std::max(1, int(std::lround(0.5 * std::min(step.x, step.y))));
+  for (const auto& [kind, colour, only_lit] :
+       {std::tuple{NodeOrigin::fold_refilled, kFoldRefilled, true},
+        std::tuple{NodeOrigin::hole_filled, kHoleFilled, true},
+        std::tuple{NodeOrigin::fold_cut, kFoldCut, false}}) {
+    cv::Mat marks(size.y, size.x, CV_8U, cv::Scalar(0));
+    for (int j = 0; j < grid.y; ++j) {
+      for (int i = 0; i < grid.x; ++i) {
+        const std::size_t k = warp.node_index(i, j);
+        if (origin[k] != kind) continue;
+        const glm::dvec2 q = glm::dvec2(i * step.x, j * step.y) + glm::dvec2(warp.offset_px[k]);
+        cv::circle(marks, cv::Point(int(std::floor(q.x)), int(std::floor(q.y))), radius,
+                   cv::Scalar(1), cv::FILLED);
+      }
+    }
+    if (only_lit) marks &= lit;
+    image.setTo(cv::Scalar(colour[0], colour[1], colour[2]), marks);
+  }
+  const std::vector<char> pin_holes = unlit_inside_mask(alpha.values, size, 24);
+  for (std::size_t n = 0; n < pin_holes.size(); ++n) {
+    if (pin_holes[n]) image.at<cv::Vec3b>(int(n) / size.x, int(n) % size.x) = kPinHole;
+  }
+  return image;
+}
 }  // namespace
 
 const char* to_string(Verdict verdict) {
@@ -58,25 +181,8 @@ const char* to_string(Verdict verdict) {
 }
 
 std::size_t unlit_inside(const std::vector<float>& weight, glm::ivec2 size, int r) {
-  FACET_ASSERT(weight.size() == std::size_t(size.x) * std::size_t(size.y) && r > 0);
-  auto lit = [&](int x, int y) {
-    return x >= 0 && y >= 0 && x < size.x && y < size.y &&
-           weight[std::size_t(y) * std::size_t(size.x) + std::size_t(x)] > 0;
-  };
-  std::size_t unlit = 0;
-  for (int y = 0; y < size.y; ++y) {
-    for (int x = 0; x < size.x; ++x) {
-      if (lit(x, y)) continue;
-      bool inside = true;
-      for (int dy = -r; dy <= r && inside; dy += r) {
-        for (int dx = -r; dx <= r && inside; dx += r) {
-          if (dx != 0 || dy != 0) inside = lit(x + dx, y + dy);
-        }
-      }
-      unlit += inside ? 1 : 0;
-    }
-  }
-  return unlit;
+  const std::vector<char> unlit = unlit_inside_mask(weight, size, r);
+  return std::size_t(std::count(unlit.begin(), unlit.end(), 1));
 }
 
 ProjectorVerdict judge(const ProjectorReport& projector, const VerdictThresholds& thresholds) {
@@ -255,6 +361,7 @@ CalibrationReport calibrate(const fs::path& capture_path, const fs::path& out,
 
   CalibrationReport report;
   std::vector<Warp> warps;
+  std::vector<std::vector<NodeOrigin>> node_origins;
   for (std::size_t p = 0; p < capture.projectors.size(); ++p) {
     throw_if_interrupted(stopped);
     const CaptureProjector& projector = capture.projectors[p];
@@ -282,6 +389,7 @@ CalibrationReport calibrate(const fs::path& capture_path, const fs::path& out,
     }
     fit.warp.eye = glm::dvec3(0.0);
     warps.push_back(std::move(fit.warp));
+    node_origins.push_back(std::move(fit.node_origin));
     report.projectors.push_back(std::move(item));
   }
   decoded.clear();
@@ -341,6 +449,16 @@ CalibrationReport calibrate(const fs::path& capture_path, const fs::path& out,
       }
     }
     projection_io::write_display_config(display, temporary / "display.json");
+    const fs::path pictures = temporary / "report";
+    fs::create_directories(pictures);
+    for (std::size_t p = 0; p < warps.size(); ++p) {
+      throw_if_interrupted(stopped);
+      const std::string& name = capture.projectors[p].name;
+      write_rgb_image(pictures / (name + ".residual.png"),
+                      residual_image(report.projectors[p].fit, warps[p].output_size));
+      write_rgb_image(pictures / (name + ".coverage.png"),
+                      coverage_image(warps[p], node_origins[p], blend.alpha[p]));
+    }
     throw_if_interrupted(stopped);
     std::error_code error;
     if (fs::exists(out, error)) fs::remove(out);  // checked empty above

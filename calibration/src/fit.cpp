@@ -717,7 +717,7 @@ WarpFit fit_warp(std::span<const FitSample> samples, glm::ivec2 output_size,
   }
 
   // Unsupported nodes enclosed by supported ones (4-connected groups touching no side of the
-  // grid: where decoding failed inside the image, e.g. at a chessboard's corners) are
+  // grid: where decoding failed inside the image, e.g. on a printed chessboard's black squares) are
   // interpolated from all sides rather than extrapolated ring by ring from one, and the ring limit
   // does not uncover them: whether they are covered is the camera's view's call alone (see
   // bridge_px).
@@ -771,6 +771,7 @@ WarpFit fit_warp(std::span<const FitSample> samples, glm::ivec2 output_size,
   q_seen = {};
   const double ramp_px = 3 * std::max(step.x, step.y);
   const int extrapolate_rings = std::max(1, int(std::ceil(options.extrapolate_px / spacing_px)));
+  result.node_origin.assign(nodes.size(), NodeOrigin::fitted);
   for (int j = 0; j < grid.y; ++j) {
     for (int i = 0; i < grid.x; ++i) {
       const std::size_t k = std::size_t(j) * grid.x + i;
@@ -785,6 +786,9 @@ WarpFit fit_warp(std::span<const FitSample> samples, glm::ivec2 output_size,
         ++(coverage < 0.5 ? result.report.holes : result.report.filled);
         if (enclosed[k] && coverage >= 0.5) ++result.report.holes_filled;
       }
+      result.node_origin[k] = ring[k] == 0                     ? NodeOrigin::fitted
+                              : enclosed[k] && coverage >= 0.5 ? NodeOrigin::hole_filled
+                                                               : NodeOrigin::extrapolated;
     }
   }
 
@@ -822,9 +826,14 @@ WarpFit fit_warp(std::span<const FitSample> samples, glm::ivec2 output_size,
       }
     }
     result.report.folds_refilled = std::size_t(std::count(refill.begin(), refill.end(), 1));
+    for (std::size_t k = 0; k < nodes.size(); ++k) {
+      if (refill[k]) result.node_origin[k] = NodeOrigin::fold_refilled;
+    }
   }
   while (const auto fold = warp.find_fold()) {
-    warp.coverage[warp.node_index(fold->x, fold->y)] = 0.0f;
+    const std::size_t k = warp.node_index(fold->x, fold->y);
+    warp.coverage[k] = 0.0f;
+    result.node_origin[k] = NodeOrigin::fold_cut;
     ++result.report.folds;
   }
 

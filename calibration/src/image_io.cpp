@@ -97,6 +97,21 @@ void write_grey_image(const std::filesystem::path& path, const cv::Mat& image, i
   });
 }
 
+void write_rgb_image(const std::filesystem::path& path, const cv::Mat& rgb) {
+  FACET_ASSERT(rgb.type() == CV_8UC3 && !rgb.empty());
+  const cv::Mat contiguous = rgb.isContinuous() ? rgb : rgb.clone();
+  const OIIO::ImageSpec spec(rgb.cols, rgb.rows, 3, OIIO::TypeDesc::UINT8);
+  write_atomically(path, [&](const std::filesystem::path& temporary) {
+    auto output = OIIO::ImageOutput::create(temporary.string());
+    if (!output || !output->open(temporary.string(), spec)) {
+      throw InputError(path.string(), "", "a writable image file (" + OIIO::geterror() + ")");
+    }
+    if (!output->write_image(OIIO::TypeDesc::UINT8, contiguous.data) || !output->close()) {
+      throw InputError(path.string(), "", "a writable image file (" + output->geterror() + ")");
+    }
+  });
+}
+
 void write_folder_atomically(const std::filesystem::path& folder,
                              const std::function<void(const std::filesystem::path&)>& write) {
   std::error_code error;

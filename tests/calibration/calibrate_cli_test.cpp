@@ -1,7 +1,10 @@
 // `facet calibrate` on bad captures: exit status 2 and no output folder; on the real
 // procam-board capture: no pin-holes in the output.
+#include <OpenImageIO/imageio.h>
 #include <gtest/gtest.h>
 
+#include <array>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -11,6 +14,7 @@
 #include <string>
 
 #include "facet/calibration/calibrate.hpp"
+#include "facet/calibration/image_io.hpp"
 #include "facet/projection_io/blend_file.hpp"
 #include "facet/projection_io/warp_file.hpp"
 #include "test_folder.hpp"
@@ -123,12 +127,12 @@ TEST(CliCalibrate, BadCapturesExitWithStatusTwoAndWriteNothing) {
   }
 }
 
-// The real board capture: decoding fails around the chessboard's corners (nodes with too few
-// samples, formerly extrapolated three rings deep and uncovered: 14 black pin-holes) and along the
-// shadow at the bottom (wrong codes, formerly 53 nodes uncovered by folds). Enclosed holes are
-// interpolated from all sides and folded cells interpolated again, so the blend map has no unlit
-// pixel inside its lit region (r = 24 px, bridge_px: the widest hole the coverage bridges; 544
-// such pixels without the hole filling, 40 without the fold refilling), and the fit residual
+// The real board capture: decoding fails on the chessboard's black squares (nodes with too few
+// samples, formerly extrapolated three rings deep and uncovered: about 14 black pin-holes) and
+// along the shadow at the bottom (wrong codes, formerly 53 nodes uncovered by folds). Enclosed
+// holes are interpolated from all sides and folded cells interpolated again, so the blend map has
+// no unlit pixel inside its lit region (r = 24 px, bridge_px: the widest hole the coverage bridges;
+// 544 such pixels without the hole filling, 40 without the fold refilling), and the fit residual
 // over the covered samples stays within a stated margin of the 0.388 px median and 3.15 px p99
 // it had before: the median within 0.02 px; the p99 within 0.5 px, as the refilled nodes now
 // cover samples along the shadow's edge that the folds had uncovered (3.39 px).
@@ -257,4 +261,47 @@ TEST(Verdict, RealBoardIsCheckInJsonAndText) {
     EXPECT_NE(summary.find(expected), std::string::npos) << expected << " in\n" << summary;
   }
   EXPECT_EQ(summary.find("(bad)"), std::string::npos) << summary;
+}
+
+namespace {
+
+// The RGB colour of pixel (x, y) of an 8-bit RGB image file.
+std::array<int, 3> rgb_at(const fs::path& path, int x, int y) {
+  auto input = OIIO::ImageInput::open(path.string());
+  EXPECT_TRUE(input) << path;
+  if (!input) return {-1, -1, -1};
+  std::array<std::uint8_t, 3> pixel{};
+  std::vector<std::uint8_t> row(std::size_t(input->spec().width) * 3);
+  input->read_scanline(y, 0, OIIO::TypeDesc::UINT8, row.data());
+  for (int c = 0; c < 3; ++c) pixel[std::size_t(c)] = row[std::size_t(x) * 3 + std::size_t(c)];
+  return {pixel[0], pixel[1], pixel[2]};
+}
+
+}  // namespace
+
+// report/: per projector a residual heat map and a coverage map at the output's size. On
+// procam-board the black square whose undecoded middle sits near output pixel (280, 328) is a
+// filled hole (blue 0, 110, 255), the wall left of the board is covered and plain (grey 160), the
+// wall above it unlit (black); the residual map is black where no sample falls and, on the plain
+// wall, in the scale's colour of that 8×8 block's RMS residual.
+TEST(CliCalibrate, RealBoardReportHasResidualAndCoverageMaps) {
+  const BoardCalibration& board = board_calibration();
+  const fs::path coverage = board.out / "report/projector.coverage.png";
+  const fs::path residual = board.out / "report/projector.residual.png";
+  for (const fs::path& path : {coverage, residual}) {
+    const auto info = facet::calibration::read_image_info(path);
+    EXPECT_EQ(info.size, glm::ivec2(1024, 768)) << path;
+    EXPECT_EQ(info.channels, 3) << path;
+  }
+  EXPECT_EQ(rgb_at(coverage, 280, 328), (std::array<int, 3>{0, 110, 255}));
+  EXPECT_EQ(rgb_at(coverage, 120, 300), (std::array<int, 3>{160, 160, 160}));
+  EXPECT_EQ(rgb_at(coverage, 500, 100), (std::array<int, 3>{0, 0, 0}));
+  EXPECT_EQ(rgb_at(residual, 500, 100), (std::array<int, 3>{0, 0, 0}));
+  // The colour scale: below 0.5 px, from blue (0 px) to green (0.5 px), linearly.
+  const float rms = board.report.projectors[0].fit.residual_map.at<float>(300 / 8, 120 / 8);
+  ASSERT_LT(rms, 0.5f);
+  const auto wall = rgb_at(residual, 120, 300);
+  EXPECT_EQ(wall[0], 0);
+  EXPECT_NEAR(wall[1], 255 * rms / 0.5, 1.0) << rms << " px";
+  EXPECT_NEAR(wall[2], 255 * (1 - rms / 0.5), 1.0) << rms << " px";
 }

@@ -1,4 +1,5 @@
-// facet calibrate: a recorded capture → display.json, <p>.warp.exr and <p>.blend.exr.
+// facet calibrate: a recorded capture → display.json, <p>.warp.exr, <p>.blend.exr and report/,
+// with a verdict per projector.
 #include <cmath>
 #include <cstdio>
 #include <iostream>
@@ -42,7 +43,8 @@ const facet::cli::Registration registration{
       auto* cmd = app.add_subcommand(
           "calibrate",
           "Fit every projector's warp and blend from a recorded capture (capture.json and its "
-          "images) and write display.json, <p>.warp.exr and <p>.blend.exr");
+          "images) and write display.json, <p>.warp.exr and <p>.blend.exr, and report/ with "
+          "<p>.residual.png and <p>.coverage.png; ends with a verdict per projector");
       cmd->add_option("capture", args->capture, "capture folder, or its capture.json")->required();
       cmd->add_option("--out", args->out, "output folder (must not exist, or be empty)")
           ->required();

@@ -13,6 +13,7 @@
 // of the image edge and the edge of what the camera saw of the image (the decoded positions that
 // agree with the fit), each within about a pixel.
 #include <cstddef>
+#include <cstdint>
 #include <glm/glm.hpp>
 #include <opencv2/core.hpp>
 #include <optional>
@@ -107,9 +108,19 @@ struct FitReport {
   double worst_region_rms_px = 0;
 };
 
+// Where a node's offset comes from.
+enum class NodeOrigin : std::uint8_t {
+  fitted,         // its own fit of the samples around it
+  extrapolated,   // filled outwards ring by ring from fitted nodes (covered or not)
+  hole_filled,    // enclosed by fitted nodes, interpolated from all sides and covered
+  fold_refilled,  // in a folded cell, interpolated again from the nodes around it
+  fold_cut,       // uncovered because its cell still folded
+};
+
 struct WarpFit {
   Warp warp;
   FitReport report;
+  std::vector<NodeOrigin> node_origin;  // per node, the layout of Warp::offset_px
 };
 
 // Fits the warp of a projector of `output_size` pixels. Throws InputError(source, "projectors",

@@ -30,6 +30,10 @@ cv::Mat read_luminance(const std::filesystem::path& path);
 // InputError when the file cannot be written.
 void write_grey_image(const std::filesystem::path& path, const cv::Mat& image, int bit_depth = 8);
 
+// Writes a CV_8UC3 image, channels in R, G, B order, as an 8-bit RGB PNG (or any format the
+// extension names), through a temporary file renamed onto `path`. InputError when it cannot.
+void write_rgb_image(const std::filesystem::path& path, const cv::Mat& rgb);
+
 // Calls write(temporary_folder) with a new folder beside `folder`, then renames it onto `folder`.
 // `folder` must not exist or be an empty folder (InputError otherwise). If write throws, the
 // temporary folder is removed and the exception propagates.
