@@ -67,9 +67,10 @@ void print(const char* label, const CalibrationReport& report) {
   for (const ProjectorReport& p : report.projectors) {
     std::printf(
         "%s %s: rms %.4f px, p99 %.4f px, max %.4f px over %zu px (uncovered %.4f), "
-        "folds %zu, holes %zu\n",
+        "folds %zu, holes %zu, unlit inside %zu, verdict %s\n",
         label, p.name.c_str(), p.accuracy->rms_px, p.accuracy->p99_px, p.accuracy->max_px,
-        p.accuracy->compared, p.accuracy->uncovered_fraction, p.fit.folds, p.fit.holes);
+        p.accuracy->compared, p.accuracy->uncovered_fraction, p.fit.folds, p.fit.holes,
+        p.unlit_inside, to_string(p.verdict.verdict));
   }
   std::printf("%s blend: max |sum - 1| %.5f over %zu overlap directions; %.2f s\n", label,
               report.blend_sum_max_err, report.blend_overlap_directions, report.seconds);
@@ -90,6 +91,9 @@ TEST(Replay, PhaseShiftMeetsTheAccuracyTargets) {
     EXPECT_GT(p.accuracy->compared, 112u * 80u * 99 / 100) << p.name;
     EXPECT_EQ(p.fit.folds, 0u) << p.name;
     EXPECT_EQ(p.fit.holes, 0u) << p.name;
+    // A clean simulated capture the camera sees whole: no pin-hole, nothing to check.
+    EXPECT_EQ(p.unlit_inside, 0u) << p.name;
+    EXPECT_EQ(p.verdict.verdict, Verdict::good) << p.name << ": " << p.verdict.reasons.size();
   }
 }
 
