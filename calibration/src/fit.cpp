@@ -287,8 +287,8 @@ void harmonic_fill(std::vector<glm::dvec2>& values, std::span<const char> free, 
     if (free[k]) order.push_back(k);
   }
   if (order.empty()) return;
-  constexpr double kOverRelaxation = 1.8, kTolerancePx = 1e-6;
-  constexpr int kMaxSweeps = 20000;
+  constexpr double kOverRelaxation = 1.8, kTolerancePx = 1e-5;
+  constexpr int kMaxSweeps = 5000;
   for (int sweep = 0; sweep < kMaxSweeps; ++sweep) {
     double largest_change = 0;
     for (const std::size_t k : order) {
@@ -794,40 +794,22 @@ WarpFit fit_warp(std::span<const FitSample> samples, glm::ivec2 output_size,
 
   // Folds: a covered cell that reverses orientation holds a node fit that disagrees with its
   // neighbours (wrong codes along a shadow's edge, extrapolated rings crossing). Its four nodes
-  // are interpolated again from the nodes around them (harmonic_fill), the region growing by a
-  // ring of nodes per round while a fold remains; what still folds after that is uncovered.
+  // are interpolated again, once, from the nodes around them (harmonic_fill); what still folds
+  // after that is uncovered. (Growing the refilled region while a fold remains moves good nodes:
+  // on procam-board three rounds took the residual p99 from 3.4 to 4.8 px.)
   {
-    constexpr int kRefillRounds = 1;
     std::vector<char> refill(nodes.size(), 0);
-    for (int round = 0; round < kRefillRounds; ++round) {
-      const std::vector<std::size_t> folded = folded_cells(warp);
-      if (folded.empty()) break;
-      if (round > 0) {
-        const std::vector<char> inner = refill;
-        for (std::size_t k = 0; k < nodes.size(); ++k) {
-          if (!inner[k]) continue;
-          const int i = int(k) % grid.x, j = int(k) / grid.x;
-          for (int b = std::max(0, j - 1); b <= std::min(grid.y - 1, j + 1); ++b) {
-            for (int a = std::max(0, i - 1); a <= std::min(grid.x - 1, i + 1); ++a) {
-              refill[std::size_t(b) * grid.x + a] = 1;
-            }
-          }
-        }
-      }
-      for (const std::size_t k : folded) {
-        for (const std::size_t n :
-             {k, k + 1, k + std::size_t(grid.x), k + std::size_t(grid.x) + 1}) {
-          refill[n] = 1;
-        }
-      }
-      harmonic_fill(offset, refill, grid);
-      for (std::size_t k = 0; k < nodes.size(); ++k) {
-        if (refill[k]) warp.offset_px[k] = glm::vec2(offset[k]);
+    for (const std::size_t k : folded_cells(warp)) {
+      for (const std::size_t n : {k, k + 1, k + std::size_t(grid.x), k + std::size_t(grid.x) + 1}) {
+        refill[n] = 1;
       }
     }
-    result.report.folds_refilled = std::size_t(std::count(refill.begin(), refill.end(), 1));
+    harmonic_fill(offset, refill, grid);
     for (std::size_t k = 0; k < nodes.size(); ++k) {
-      if (refill[k]) result.node_origin[k] = NodeOrigin::fold_refilled;
+      if (!refill[k]) continue;
+      warp.offset_px[k] = glm::vec2(offset[k]);
+      result.node_origin[k] = NodeOrigin::fold_refilled;
+      ++result.report.folds_refilled;
     }
   }
   while (const auto fold = warp.find_fold()) {
