@@ -96,6 +96,12 @@ CameraModel::CameraModel(const std::string& lensmodel, std::vector<double> intri
   for (double value : intrinsics) {
     if (!std::isfinite(value)) throw InputError(source, "intrinsics", "finite numbers");
   }
+  // A zero or negative focal length would project nothing or mirror the image.
+  if (mrcal_lensmodel_metadata(&impl->lensmodel).has_core &&
+      !(intrinsics[0] > 0 && intrinsics[1] > 0)) {
+    throw InputError(source, "intrinsics",
+                     "positive focal lengths fx and fy (the first two values)");
+  }
   for (double value : rt_cam_ref) {
     if (!std::isfinite(value)) throw InputError(source, "extrinsics", "finite numbers");
   }
@@ -120,7 +126,11 @@ CameraModel CameraModel::read(const std::filesystem::path& path) {
   std::stringstream buffer;
   buffer << stream.rdbuf();
   const std::string text = buffer.str();
-  mrcal_cameramodel_t* model = mrcal_read_cameramodel_string(text.c_str(), int(text.size()));
+  // mrcal's reader skips a '#' comment up to its newline without checking for the end of the
+  // text, so a file that ends inside a comment would be read past its end: end it with one.
+  const std::string terminated = text + '\n';
+  mrcal_cameramodel_t* model =
+      mrcal_read_cameramodel_string(terminated.c_str(), int(terminated.size()));
   if (model == nullptr) {
     throw InputError(path.string(), "",
                      "an mrcal .cameramodel file that mrcal can parse (see its message above)");

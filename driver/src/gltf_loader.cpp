@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cmath>
 #include <cstring>
 #include <glm/geometric.hpp>
 #include <glm/gtc/quaternion.hpp>
@@ -242,6 +243,7 @@ class GltfReader {
         switch (accessor.componentType) {
           case TINYGLTF_COMPONENT_TYPE_FLOAT:
             std::memcpy(&value, element + 4 * c, 4);
+            if (!std::isfinite(value)) fail(field, "finite float components");
             break;
           case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE:
             if (!accessor.normalized) fail(field, "float or normalized integer components");
@@ -317,13 +319,16 @@ class GltfReader {
     if (stride <= 0) fail(field, "a valid byteStride");
     const std::size_t size = static_cast<std::size_t>(element_size);
     const std::size_t step = static_cast<std::size_t>(stride);
-    const std::size_t begin = view.byteOffset + accessor.byteOffset;
-    const std::size_t end =
-        accessor.count == 0 ? begin : begin + (accessor.count - 1) * step + size;
-    if (view.byteOffset + view.byteLength > buffer.data.size() ||
-        end > view.byteOffset + view.byteLength)
+    // Offsets, lengths and counts come from the file: compared by subtraction, which cannot
+    // overflow the way their sums could.
+    const std::size_t buffer_size = buffer.data.size();
+    if (view.byteOffset > buffer_size || view.byteLength > buffer_size - view.byteOffset ||
+        accessor.byteOffset > view.byteLength)
       fail(field, "elements that lie inside their bufferView and buffer");
-    return {buffer.data.data() + begin, step};
+    const std::size_t room = view.byteLength - accessor.byteOffset;
+    if (accessor.count > 0 && (size > room || accessor.count - 1 > (room - size) / step))
+      fail(field, "elements that lie inside their bufferView and buffer");
+    return {buffer.data.data() + view.byteOffset + accessor.byteOffset, step};
   }
 
   void read_primitive(Scene& scene, const tinygltf::Primitive& primitive,
@@ -446,6 +451,10 @@ Scene load_gltf(const std::filesystem::path& path) {
     throw InputError(source, "",
                      "a valid glTF 2.0 file (" + (error.empty() ? "parse failed" : error) + ")");
   }
+  // glTF 1.0 is a different format; tinygltf reads any version string as 2.0.
+  if (!model.asset.version.starts_with("2."))
+    throw InputError(source, "asset.version",
+                     "\"2.0\" (glTF 2), not \"" + model.asset.version + "\"");
   Scene scene = GltfReader(model, source).read();
   scene.name = path.stem().string();
   return scene;

@@ -40,6 +40,16 @@ OutputTarget OutputTarget::create(glm::ivec2 size, int msaa_samples) {
                          " pixels on this GL; got " + std::to_string(size.x) + "x" +
                          std::to_string(size.y));
   }
+  // Likewise the samples every attachment can have (the IDs are R32UI, an integer format).
+  GLint max_samples = 0, max_integer_samples = 0;
+  glGetIntegerv(GL_MAX_SAMPLES, &max_samples);
+  glGetIntegerv(GL_MAX_INTEGER_SAMPLES, &max_integer_samples);
+  const int max_msaa = std::min(max_samples, max_integer_samples);
+  if (msaa_samples > 1 && msaa_samples > max_msaa) {
+    throw InputError("output", "msaa",
+                     "at most " + std::to_string(max_msaa) + " samples per pixel on this GL; got " +
+                         std::to_string(msaa_samples));
+  }
   OutputTarget target;
   target.size_ = size;
   target.msaa_samples_ = msaa_samples > 1 ? msaa_samples : 0;

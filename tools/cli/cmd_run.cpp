@@ -92,8 +92,13 @@ void run(const RunOptions& options) {
       throw InputError("command line", "--tolerance", "a positive number of output pixels");
     display.settings.facets.layout = FacetTolerance{*options.tolerance};
   }
-  // Check the method name before any scene work.
-  driver::check_render_method(display.method);
+  // Check the method name before any scene work; one from display.json is reported there.
+  try {
+    driver::check_render_method(display.method);
+  } catch (const InputError& error) {
+    if (!options.method.empty()) throw;
+    throw InputError(options.display, "render.method", error.expected());
+  }
   const bool headless = options.headless || (!options.windowed && !have_display_server());
   // Before the scene, so that a missing display server is reported at once.
   if (!headless) monitors_of_display_server("--windowed");

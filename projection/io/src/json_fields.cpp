@@ -206,9 +206,19 @@ Json from_dmat3(const glm::dmat3& m) {
   return rows;
 }
 
+// Deeper nesting is refused while parsing: no facet document comes near it, and walking such a
+// document recursively (dumping a value into an error message) would overflow the stack.
+constexpr int kMaxJsonDepth = 256;
+
 Json parse(const std::string& text, const std::string& source) {
   try {
-    return Json::parse(text);
+    return Json::parse(text, [&](int depth, Json::parse_event_t, Json&) {
+      if (depth > kMaxJsonDepth) {
+        FieldPath(source).fail("JSON nested at most " + std::to_string(kMaxJsonDepth) +
+                               " levels deep");
+      }
+      return true;
+    });
   } catch (const Json::exception& error) {  // a syntax error, or a number beyond double's range
     FieldPath(source).fail(std::string("valid JSON (") + error.what() + ")");
   }

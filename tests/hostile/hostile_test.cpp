@@ -1,0 +1,1521 @@
+// Hostile-input suite (issue 19): bad variants of every input kind facet reads, each run through
+// the CLI in its own scratch folder under a 2 GiB address-space limit and a wall-clock limit.
+// Every variant must end with exit status 2 (a user mistake, not an internal error, a crash or a
+// hang), a message on stderr naming the input or the field, and no output left behind: neither
+// the output path nor a hidden temporary (.NAME.tmp*) in the scratch folder.
+//
+// The variants are derived from real valid files (configs/, the shared data in
+// ../shared/data, and small files written here): truncations, flipped magic bytes, wrong JSON
+// types, NaN/Inf/huge/negative numbers, huge sizes and counts, empty files, directories, FIFOs
+// and /dev/null where a file is expected, invalid UTF-8, deep nesting, zip-slip paths, XML entity
+// bombs, glTF accessors past their buffers, buffer URIs leaving the folder and node cycles.
+#include <OpenImageIO/imageio.h>
+#include <fcntl.h>
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/resource.h>
+#include <sys/stat.h>
+#include <sys/time.h>
+#include <sys/types.h>
+#include <sys/wait.h>
+#include <unistd.h>
+#include <zip.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdint>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <iterator>
+#include <limits>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <thread>
+#include <utility>
+#include <vector>
+
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+const fs::path kSource = FACET_SOURCE_DIR;
+const fs::path kShared = FACET_SHARED_DATA_DIR;
+constexpr rlim_t kAddressSpaceLimit = rlim_t{2} << 30;  // 2 GiB
+constexpr long kMaxResidentKiB = 2L << 20;              // 2 GiB in KiB (ru_maxrss)
+constexpr auto kWallLimit = std::chrono::seconds(20);
+
+std::string slurp(const fs::path& path) {
+  std::ifstream stream(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(stream), std::istreambuf_iterator<char>()};
+}
+
+void spit(const fs::path& path, const std::string& bytes) {
+  std::ofstream(path, std::ios::binary | std::ios::trunc) << bytes;
+}
+
+// One hostile variant: `make` writes the inputs into the scratch folder; `args` are the CLI's
+// arguments, where a leading '@' stands for the scratch folder; `output` is the path (relative to
+// the scratch folder) the command would write; stderr must contain one of `mentions`.
+struct Variant {
+  std::string name;
+  std::function<void(const fs::path&)> make;
+  std::vector<std::string> args;
+  std::string output;
+  std::vector<std::string> mentions;
+};
+
+// gtest prints a parameter with this (instead of its bytes).
+void PrintTo(const Variant& variant, std::ostream* stream) { *stream << variant.name; }
+
+// ---- Byte-level mutations of a valid file -------------------------------------------------------
+
+std::string truncated(const std::string& bytes, std::size_t size) {
+  return bytes.substr(0, std::min(size, bytes.size()));
+}
+
+std::string flipped(std::string bytes, std::size_t offset) {
+  if (offset < bytes.size()) bytes[offset] = static_cast<char>(bytes[offset] ^ 0xff);
+  return bytes;
+}
+
+// The byte-level variants of `base` written as `file`: empty, truncated at several offsets and
+// with the first bytes (the magic or the first token) flipped.
+void add_byte_variants(std::vector<Variant>& out, const std::string& prefix,
+                       const std::function<std::string()>& base, const std::string& file,
+                       const std::function<void(const fs::path&)>& context,
+                       const std::vector<std::string>& args, const std::string& output,
+                       const std::vector<double>& fractions = {0.001, 0.1, 0.5, 0.9, 0.999},
+                       bool flip = true) {
+  auto add = [&](const std::string& what, std::function<std::string(const std::string&)> mutate) {
+    out.push_back({prefix + "_" + what,
+                   [=](const fs::path& dir) {
+                     if (context) context(dir);
+                     spit(dir / file, mutate(base()));
+                   },
+                   args,
+                   output,
+                   {fs::path(file).filename().string()}});
+  };
+  add("empty", [](const std::string&) { return std::string(); });
+  for (const double f : fractions) {
+    add("truncated_" + std::to_string(static_cast<int>(f * 1000)) + "permille",
+        [f](const std::string& b) {
+          return truncated(b, std::max<std::size_t>(
+                                  1, static_cast<std::size_t>(static_cast<double>(b.size()) * f)));
+        });
+  }
+  if (flip) {
+    add("magic_flipped", [](const std::string& b) { return flipped(flipped(b, 0), 1); });
+  }
+  add("binary_garbage", [](const std::string& b) {
+    std::string g(std::min<std::size_t>(b.size(), 4096), '\0');
+    for (std::size_t i = 0; i < g.size(); ++i) g[i] = static_cast<char>((i * 2654435761u) >> 13);
+    return g;
+  });
+}
+
+// Non-regular files where `file` is expected: a directory, a FIFO (opening it for reading would
+// block forever), a symbolic link to /dev/zero (endless), a dangling link and a missing file.
+void add_non_regular_variants(std::vector<Variant>& out, const std::string& prefix,
+                              const std::string& file,
+                              const std::function<void(const fs::path&)>& context,
+                              const std::vector<std::string>& args, const std::string& output) {
+  const std::string name = fs::path(file).filename().string();
+  auto add = [&](const std::string& what, std::function<void(const fs::path&)> make) {
+    out.push_back({prefix + "_" + what,
+                   [=](const fs::path& dir) {
+                     if (context) context(dir);
+                     std::error_code ec;
+                     fs::remove(dir / file, ec);
+                     make(dir / file);
+                   },
+                   args,
+                   output,
+                   {name}});
+  };
+  add("directory", [](const fs::path& p) { fs::create_directories(p); });
+  add("fifo", [](const fs::path& p) { ::mkfifo(p.c_str(), 0644); });
+  add("link_to_dev_zero", [](const fs::path& p) { fs::create_symlink("/dev/zero", p); });
+  add("dangling_link", [](const fs::path& p) { fs::create_symlink(p.string() + ".gone", p); });
+  add("missing", [](const fs::path&) {});
+}
+
+// ---- JSON mutations -----------------------------------------------------------------------------
+
+// `base` with the value at `pointer` replaced by `raw` JSON text (which may be invalid JSON, such
+// as NaN, or hold invalid UTF-8); an empty `raw` removes the member.
+std::string json_with(const json& base, const std::string& pointer, const std::string& raw) {
+  json copy = base;
+  const json::json_pointer ptr(pointer);
+  if (raw.empty()) {
+    copy[ptr.parent_pointer()].erase(ptr.back());
+    return copy.dump(1);
+  }
+  copy[ptr] = "@@HOSTILE@@";
+  std::string text = copy.dump(1);
+  const std::string marker = "\"@@HOSTILE@@\"";
+  text.replace(text.find(marker), marker.size(), raw);
+  return text;
+}
+
+struct FieldMutation {
+  std::string what;     // names the variant
+  std::string pointer;  // JSON pointer of the field
+  std::string raw;      // its new raw JSON text ("" removes it)
+  std::string mention;  // a word stderr must hold besides the file name
+};
+
+std::string sanitize(std::string name) {
+  for (char& c : name) {
+    if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
+  }
+  return name;
+}
+
+void add_json_variants(std::vector<Variant>& out, const std::string& prefix,
+                       const std::function<json()>& base, const std::string& file,
+                       const std::function<void(const fs::path&)>& context,
+                       const std::vector<FieldMutation>& mutations,
+                       const std::vector<std::string>& args, const std::string& output) {
+  const std::string name = fs::path(file).filename().string();
+  for (const FieldMutation& m : mutations) {
+    out.push_back({prefix + "_" + sanitize(m.what),
+                   [=](const fs::path& dir) {
+                     if (context) context(dir);
+                     spit(dir / file, json_with(base(), m.pointer, m.raw));
+                   },
+                   args,
+                   output,
+                   {name, m.mention}});
+  }
+  // Whole-document variants.
+  auto add_text = [&](const std::string& what, std::function<std::string()> text) {
+    out.push_back({prefix + "_" + what,
+                   [=](const fs::path& dir) {
+                     if (context) context(dir);
+                     spit(dir / file, text());
+                   },
+                   args,
+                   output,
+                   {name}});
+  };
+  add_text("deeply_nested", [] { return std::string(100000, '[') + std::string(100000, ']'); });
+  add_text("top_level_array", [] { return std::string("[1, 2, 3]"); });
+  add_text("top_level_string", [] { return std::string("\"facet\""); });
+  add_text("null", [] { return std::string("null"); });
+  add_text("invalid_utf8_key", [base] {
+    std::string text = base().dump(1);
+    return text.insert(text.find('{') + 1, "\"\xff\xfe\xc0\x80\": 1,");
+  });
+  add_text("trailing_garbage", [base] { return base().dump(1) + "\n}{"; });
+}
+
+// ---- EXR writing (OpenImageIO) ------------------------------------------------------------------
+
+struct Exr {
+  int width = 0, height = 0;
+  std::vector<std::string> channels;
+  std::vector<float> pixels;
+  std::vector<std::pair<std::string, std::string>> attributes;
+};
+
+Exr read_exr(const fs::path& path) {
+  Exr exr;
+  auto in = OIIO::ImageInput::open(path.string());
+  if (!in) return exr;
+  const OIIO::ImageSpec& spec = in->spec();
+  exr.width = spec.width;
+  exr.height = spec.height;
+  exr.channels = spec.channelnames;
+  exr.pixels.resize(static_cast<std::size_t>(spec.width) * spec.height * spec.nchannels);
+  in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, exr.pixels.data());
+  for (const auto& attribute : spec.extra_attribs) {
+    if (attribute.name().string().starts_with("facet:")) {
+      exr.attributes.emplace_back(attribute.name().string(), attribute.get_string());
+    }
+  }
+  return exr;
+}
+
+void write_exr(const fs::path& path, const Exr& exr) {
+  OIIO::ImageSpec spec(exr.width, exr.height, static_cast<int>(exr.channels.size()),
+                       OIIO::TypeDesc::FLOAT);
+  spec.channelnames = exr.channels;
+  for (const auto& [key, value] : exr.attributes) spec.attribute(key, value);
+  auto out = OIIO::ImageOutput::create(path.string());
+  if (!out || !out->open(path.string(), spec)) return;
+  out->write_image(OIIO::TypeDesc::FLOAT, exr.pixels.data());
+  out->close();
+}
+
+// The EXR's bytes with its dataWindow (box2i) made `width` × `height` pixels: the header then
+// promises far more pixels than the file holds.
+std::string exr_with_data_window(std::string bytes, std::int32_t x_max, std::int32_t y_max) {
+  const std::string key = std::string("dataWindow\0box2i\0", 17);
+  const std::size_t at = bytes.find(key);
+  if (at == std::string::npos) return bytes;
+  const std::size_t box = at + key.size() + 4;  // after the attribute size
+  std::memcpy(&bytes[box + 8], &x_max, 4);
+  std::memcpy(&bytes[box + 12], &y_max, 4);
+  return bytes;
+}
+
+// ---- zip writing (libzip) -----------------------------------------------------------------------
+
+using Entries = std::vector<std::pair<std::string, std::string>>;
+
+Entries read_zip(const fs::path& path) {
+  Entries entries;
+  int error = 0;
+  zip_t* archive = zip_open(path.c_str(), ZIP_RDONLY, &error);
+  if (!archive) return entries;
+  const zip_int64_t count = zip_get_num_entries(archive, 0);
+  for (zip_int64_t i = 0; i < count; ++i) {
+    zip_stat_t stat;
+    zip_stat_index(archive, static_cast<zip_uint64_t>(i), 0, &stat);
+    std::string data(stat.size, '\0');
+    zip_file_t* file = zip_fopen_index(archive, static_cast<zip_uint64_t>(i), 0);
+    if (file) {
+      zip_fread(file, data.data(), stat.size);
+      zip_fclose(file);
+    }
+    entries.emplace_back(stat.name, std::move(data));
+  }
+  zip_close(archive);
+  return entries;
+}
+
+void write_zip(const fs::path& path, const Entries& entries) {
+  int error = 0;
+  zip_t* archive = zip_open(path.c_str(), ZIP_CREATE | ZIP_TRUNCATE, &error);
+  if (!archive) return;
+  for (const auto& [name, data] : entries) {
+    // zip_source_buffer keeps a pointer: copy into memory that lives until zip_close.
+    void* copy = std::malloc(std::max<std::size_t>(1, data.size()));
+    std::memcpy(copy, data.data(), data.size());
+    zip_source_t* source = zip_source_buffer(archive, copy, data.size(), 1);
+    zip_file_add(archive, name.c_str(), source, ZIP_FL_ENC_RAW | ZIP_FL_OVERWRITE);
+  }
+  zip_close(archive);
+}
+
+// A zip entry of `size` zero bytes, compressed (a zip bomb in miniature): written by streaming
+// a callback source so the test never holds it in memory.
+void write_zip_bomb(const fs::path& path, const Entries& entries, const std::string& name,
+                    zip_uint64_t size) {
+  int error = 0;
+  zip_t* archive = zip_open(path.c_str(), ZIP_CREATE | ZIP_TRUNCATE, &error);
+  if (!archive) return;
+  for (const auto& [entry, data] : entries) {
+    void* copy = std::malloc(std::max<std::size_t>(1, data.size()));
+    std::memcpy(copy, data.data(), data.size());
+    zip_file_add(archive, entry.c_str(), zip_source_buffer(archive, copy, data.size(), 1),
+                 ZIP_FL_OVERWRITE);
+  }
+  struct Zeros {
+    zip_uint64_t left;
+  };
+  auto* state = new Zeros{size};
+  auto callback = [](void* user, void* data, zip_uint64_t length,
+                     zip_source_cmd_t command) -> zip_int64_t {
+    auto* zeros = static_cast<Zeros*>(user);
+    switch (command) {
+      case ZIP_SOURCE_OPEN:
+      case ZIP_SOURCE_CLOSE:
+        return 0;
+      case ZIP_SOURCE_READ: {
+        const zip_uint64_t n = std::min(length, zeros->left);
+        std::memset(data, 0, n);
+        zeros->left -= n;
+        return static_cast<zip_int64_t>(n);
+      }
+      case ZIP_SOURCE_STAT: {
+        auto* stat = static_cast<zip_stat_t*>(data);
+        zip_stat_init(stat);
+        return sizeof(zip_stat_t);
+      }
+      case ZIP_SOURCE_FREE:
+        delete zeros;
+        return 0;
+      case ZIP_SOURCE_SUPPORTS:
+        return zip_source_make_command_bitmap(ZIP_SOURCE_OPEN, ZIP_SOURCE_READ, ZIP_SOURCE_CLOSE,
+                                              ZIP_SOURCE_STAT, ZIP_SOURCE_FREE, -1);
+      default:
+        return -1;
+    }
+  };
+  zip_source_t* source = zip_source_function(archive, callback, state);
+  zip_int64_t index = zip_file_add(archive, name.c_str(), source, ZIP_FL_OVERWRITE);
+  zip_set_file_compression(archive, static_cast<zip_uint64_t>(index), ZIP_CM_DEFLATE, 1);
+  zip_close(archive);
+}
+
+// ---- Helpers for folders of valid inputs --------------------------------------------------------
+
+void link_all(const fs::path& from, const fs::path& to, const std::string& except) {
+  fs::create_directories(to);
+  for (const auto& entry : fs::directory_iterator(from)) {
+    const std::string name = entry.path().filename().string();
+    if (name == except) continue;
+    fs::create_symlink(entry.path(), to / name);
+  }
+}
+
+std::string replace_all(std::string text, const std::string& from, const std::string& to) {
+  for (std::size_t at = text.find(from); at != std::string::npos;
+       at = text.find(from, at + to.size())) {
+    text.replace(at, from.size(), to);
+  }
+  return text;
+}
+
+std::string replace_first(std::string text, const std::string& from, const std::string& to) {
+  const std::size_t at = text.find(from);
+  if (at != std::string::npos) text.replace(at, from.size(), to);
+  return text;
+}
+
+// An XML entity-expansion bomb ("billion laughs") in front of `root`.
+std::string entity_bomb(const std::string& root) {
+  std::string text = "<?xml version=\"1.0\"?>\n<!DOCTYPE lolz [\n <!ENTITY lol \"lol\">\n";
+  for (int i = 1; i <= 9; ++i) {
+    text += " <!ENTITY lol" + std::to_string(i) + " \"";
+    for (int j = 0; j < 10; ++j)
+      text += "&lol" + (i == 1 ? std::string() : std::to_string(i - 1)) + ";";
+    text += "\">\n";
+  }
+  return text + "]>\n<" + root + ">&lol9;</" + root + ">\n";
+}
+
+std::string deep_xml(const std::string& root) {
+  std::string text = "<?xml version=\"1.0\"?>\n<" + root + ">";
+  for (int i = 0; i < 200000; ++i) text += "<a>";
+  for (int i = 0; i < 200000; ++i) text += "</a>";
+  return text + "</" + root + ">\n";
+}
+
+// ---- The variants of every input kind ----------------------------------------------------------
+
+// display.json: configs/displays/cylinder3 with its warps and blends linked in.
+json display_base() {
+  return json::parse(slurp(kSource / "configs/displays/cylinder3/display.json"));
+}
+
+void display_context(const fs::path& dir) {
+  link_all(kSource / "configs/displays/cylinder3", dir, "display.json");
+}
+
+void add_display_json(std::vector<Variant>& out) {
+  const std::vector<std::string> args{"display", "@display.json", "--out", "@out"};
+  add_byte_variants(
+      out, "display_json", [] { return display_base().dump(1); }, "display.json", display_context,
+      args, "out", {0.001, 0.3, 0.6, 0.999}, false);
+  add_non_regular_variants(out, "display_json", "display.json", nullptr, args, "out");
+  std::vector<FieldMutation> m = {
+      {"format_number", "/format", "1", "format"},
+      {"format_unknown", "/format", "\"facet-display/99\"", "format"},
+      {"format_missing", "/format", "", "format"},
+      {"projectors_object", "/projectors", "{}", "projectors"},
+      {"projectors_empty", "/projectors", "[]", "projectors"},
+      {"projector_null", "/projectors/0", "null", "projectors"},
+      {"name_invalid_utf8", "/projectors/0/name", "\"p\xff\xfe\"", "name"},
+      {"name_number", "/projectors/0/name", "7", "name"},
+      {"name_path_escape", "/projectors/0/name", "\"../../escape\"", "name"},
+      {"name_duplicate", "/projectors/1/name", "\"p0\"", "name"},
+      {"size_string", "/projectors/0/size", "\"1024x512\"", "size"},
+      {"size_short", "/projectors/0/size", "[1024]", "size"},
+      {"size_negative", "/projectors/0/size", "[-1, 512]", "size"},
+      {"size_zero", "/projectors/0/size", "[0, 0]", "size"},
+      {"size_1e308", "/projectors/0/size", "[1e308, 512]", "size"},
+      {"size_huge_int", "/projectors/0/size", "[4294967296000, 512]", "size"},
+      {"size_fraction", "/projectors/0/size", "[1024.5, 512]", "size"},
+      {"size_nan", "/projectors/0/size", "[NaN, 512]", "size"},
+      {"window_negative_width", "/projectors/0/output/window", "[0, 0, -5, 512]", "window"},
+      {"window_string", "/projectors/0/output/window", "\"left\"", "window"},
+      {"warp_missing_file", "/projectors/0/warp", "\"nowhere.warp.exr\"", "nowhere"},
+      {"warp_number", "/projectors/0/warp", "3", "warp"},
+      {"warp_dev_null", "/projectors/0/warp", "\"/dev/null\"", "/dev/null"},
+      {"warp_directory", "/projectors/0/warp", "\".\"", "warp"},
+      {"warp_etc_passwd", "/projectors/0/warp", "\"../../../../../../etc/passwd\"", "passwd"},
+      {"blend_missing_file", "/projectors/0/blend", "\"nowhere.blend.exr\"", "nowhere"},
+      {"blend_array", "/projectors/0/blend", "[]", "blend"},
+      {"gamma_bogus", "/projectors/0/gamma", "\"bogus\"", "gamma"},
+      {"gamma_negative", "/projectors/0/gamma", "-2.2", "gamma"},
+      {"radius_negative", "/screen/radius", "-1", "radius"},
+      {"radius_zero", "/screen/radius", "0", "radius"},
+      {"radius_inf", "/screen/radius", "1e999", "radius"},
+      {"screen_type_bogus", "/screen/type", "\"banana\"", "type"},
+      {"axis_zero", "/screen/axis", "[0, 0, 0]", "axis"},
+      {"eye_string_element", "/eye", "[\"a\", 0, 0]", "eye"},
+      {"eye_inf", "/eye", "[1e999, 0, 0]", "eye"},
+      {"tolerance_negative", "/render/tolerance_px", "-1", "tolerance"},
+      {"tolerance_zero", "/render/tolerance_px", "0", "tolerance"},
+      {"z_near_negative", "/render/z_near", "-0.05", "z_near"},
+      {"missing_monitor_bogus", "/missing_monitor", "\"bogus\"", "missing_monitor"},
+      {"unknown_key", "/surprise", "1", "surprise"},
+  };
+  add_json_variants(out, "display_json", display_base, "display.json", display_context, m, args,
+                    "out");
+  out.push_back({"display_json_run_method_bogus",
+                 [](const fs::path& dir) {
+                   display_context(dir);
+                   spit(dir / "display.json",
+                        json_with(display_base(), "/render/method", "\"bogus\""));
+                 },
+                 {"run", "@display.json", "--headless", "--frames", "1", "--out", "@out"},
+                 "out",
+                 {"display.json"}});
+  // The same file through the commands that render it (GL, slower: a few of each).
+  for (const FieldMutation& f : {m[4], m[12], m[20], m[29]}) {
+    out.push_back({"display_json_run_" + sanitize(f.what),
+                   [f](const fs::path& dir) {
+                     display_context(dir);
+                     spit(dir / "display.json", json_with(display_base(), f.pointer, f.raw));
+                   },
+                   {"run", "@display.json", "--headless", "--frames", "1", "--out", "@out"},
+                   "out",
+                   {"display.json", f.mention}});
+    out.push_back({"display_json_render_" + sanitize(f.what),
+                   [f](const fs::path& dir) {
+                     display_context(dir);
+                     spit(dir / "display.json", json_with(display_base(), f.pointer, f.raw));
+                   },
+                   {"render", "--display", "@display.json", "--out", "@out"},
+                   "out",
+                   {"display.json", f.mention}});
+  }
+}
+
+// .warp.exr: configs/displays/dome180/dome180.warp.exr (2×2 nodes, facet:warp metadata).
+void add_warp_exr(std::vector<Variant>& out) {
+  const fs::path source = kSource / "configs/displays/dome180/dome180.warp.exr";
+  const std::vector<std::string> lookup{"lookup", "--warp", "@x.warp.exr", "--out", "@out.exr"};
+  add_byte_variants(
+      out, "warp_exr", [source] { return slurp(source); }, "x.warp.exr", nullptr, lookup,
+      "out.exr");
+  add_non_regular_variants(out, "warp_exr", "x.warp.exr", nullptr, lookup, "out.exr");
+  out.push_back({"warp_exr_data_window_huge",
+                 [source](const fs::path& dir) {
+                   spit(dir / "x.warp.exr", exr_with_data_window(slurp(source), 1 << 30, 1 << 30));
+                 },
+                 lookup,
+                 "out.exr",
+                 {"x.warp.exr"}});
+  out.push_back({"warp_exr_data_window_inverted",
+                 [source](const fs::path& dir) {
+                   spit(dir / "x.warp.exr", exr_with_data_window(slurp(source), -5, -5));
+                 },
+                 lookup,
+                 "out.exr",
+                 {"x.warp.exr"}});
+  out.push_back({"warp_exr_png_renamed",
+                 [](const fs::path& dir) {
+                   fs::copy_file(kShared / "warps/sgct-dome/sciss/channel1.png",
+                                 dir / "x.warp.exr");
+                 },
+                 lookup,
+                 "out.exr",
+                 {"x.warp.exr"}});
+  // Written with OpenImageIO: the metadata or the pixels made wrong.
+  auto add_exr = [&](const std::string& what, std::function<void(Exr&)> mutate,
+                     const std::string& mention) {
+    out.push_back({"warp_exr_" + what,
+                   [source, mutate](const fs::path& dir) {
+                     Exr exr = read_exr(source);
+                     mutate(exr);
+                     write_exr(dir / "x.warp.exr", exr);
+                   },
+                   lookup,
+                   "out.exr",
+                   {"x.warp.exr", mention}});
+  };
+  auto with_meta = [](const std::string& pointer, const std::string& raw) {
+    return [pointer, raw](Exr& exr) {
+      for (auto& [key, value] : exr.attributes) {
+        if (key == "facet:warp") value = json_with(json::parse(value), pointer, raw);
+      }
+    };
+  };
+  add_exr(
+      "meta_missing", [](Exr& exr) { exr.attributes.clear(); }, "facet:warp");
+  add_exr(
+      "meta_not_json",
+      [](Exr& exr) {
+        exr.attributes = {{"facet:warp", "{"}};
+      },
+      "facet:warp");
+  add_exr("meta_format_unknown", with_meta("/format", "\"facet-warp/9\""), "format");
+  add_exr("meta_base_bogus", with_meta("/base", "\"bogus\""), "base");
+  add_exr("meta_fov_negative", with_meta("/fov", "-1"), "fov");
+  add_exr("meta_fov_zero", with_meta("/fov", "0"), "fov");
+  add_exr("meta_fov_1e308", with_meta("/fov", "1e308"), "fov");
+  add_exr("meta_fov_string", with_meta("/fov", "\"wide\""), "fov");
+  add_exr("meta_output_size_negative", with_meta("/output_size", "[-1, 2048]"), "output_size");
+  add_exr("meta_output_size_zero", with_meta("/output_size", "[0, 0]"), "output_size");
+  add_exr("meta_output_size_huge", with_meta("/output_size", "[1000000, 1000000]"), "output_size");
+  add_exr("meta_output_size_short", with_meta("/output_size", "[2048]"), "output_size");
+  add_exr("meta_rotation_zero", with_meta("/rotation", "[[0,0,0],[0,0,0],[0,0,0]]"), "rotation");
+  add_exr("meta_rotation_shape", with_meta("/rotation", "[1, 2, 3]"), "rotation");
+  add_exr("meta_invalid_utf8", with_meta("/base", "\"\xff\xfe\""), "base");
+  add_exr(
+      "pixel_nan", [](Exr& exr) { exr.pixels[0] = std::numeric_limits<float>::quiet_NaN(); },
+      "x.warp.exr");
+  add_exr(
+      "pixel_inf", [](Exr& exr) { exr.pixels[1] = std::numeric_limits<float>::infinity(); },
+      "x.warp.exr");
+  add_exr(
+      "two_channels",
+      [](Exr& exr) {
+        std::vector<float> rg;
+        for (std::size_t i = 0; i < exr.pixels.size(); i += 3) {
+          rg.push_back(exr.pixels[i]);
+          rg.push_back(exr.pixels[i + 1]);
+        }
+        exr.pixels = rg;
+        exr.channels = {"R", "G"};
+      },
+      "x.warp.exr");
+  add_exr(
+      "channels_renamed",
+      [](Exr& exr) {
+        exr.channels = {"X", "Y", "Z"};
+      },
+      "x.warp.exr");
+  add_exr(
+      "one_node",
+      [](Exr& exr) {
+        exr.width = exr.height = 1;
+        exr.pixels.resize(3);
+      },
+      "x.warp.exr");
+  // The same file through the other commands that read a warp.
+  for (const std::string what : {"empty", "truncated_500permille", "fifo", "directory"}) {
+    for (std::size_t i = 0; i < out.size(); ++i) {
+      if (out[i].name != "warp_exr_" + what) continue;
+      Variant v = out[i];
+      v.name = "warp_exr_display_" + what;
+      v.args = {"display", "@x.warp.exr", "--out", "@out"};
+      v.output = "out";
+      out.push_back(v);
+      v.name = "warp_exr_render_" + what;
+      v.args = {"render", "--display", "@x.warp.exr", "--out", "@out"};
+      out.push_back(v);
+      break;
+    }
+  }
+}
+
+// Blend EXR: p0's blend of cylinder3 replaced (1024×512, one channel Y, facet:blend metadata).
+void add_blend_exr(std::vector<Variant>& out) {
+  const fs::path source = kSource / "configs/displays/cylinder3/p0.blend.exr";
+  auto context = [](const fs::path& dir) {
+    link_all(kSource / "configs/displays/cylinder3", dir, "p0.blend.exr");
+  };
+  const std::vector<std::string> args{"display", "@display.json", "--out", "@out"};
+  add_byte_variants(out, "blend_exr", [source] { return slurp(source); }, "p0.blend.exr", context,
+                    args, "out", {0.001, 0.01, 0.5, 0.99});
+  add_non_regular_variants(out, "blend_exr", "p0.blend.exr", context, args, "out");
+  auto add_exr = [&](const std::string& what, std::function<void(Exr&)> mutate) {
+    out.push_back({"blend_exr_" + what,
+                   [source, mutate, context](const fs::path& dir) {
+                     context(dir);
+                     Exr exr = read_exr(source);
+                     mutate(exr);
+                     write_exr(dir / "p0.blend.exr", exr);
+                   },
+                   args,
+                   "out",
+                   {"p0.blend.exr"}});
+  };
+  add_exr("pixel_nan", [](Exr& e) { e.pixels[100] = std::numeric_limits<float>::quiet_NaN(); });
+  add_exr("pixel_inf", [](Exr& e) { e.pixels[100] = std::numeric_limits<float>::infinity(); });
+  add_exr("pixel_negative", [](Exr& e) { e.pixels[100] = -1.0f; });
+  add_exr("wrong_size", [](Exr& e) {
+    e.width = 512;
+    e.height = 256;
+    e.pixels.resize(512 * 256);
+  });
+  add_exr("two_channels", [](Exr& e) {
+    std::vector<float> rg;
+    for (const float v : e.pixels) rg.insert(rg.end(), {v, v});
+    e.pixels = rg;
+    e.channels = {"R", "G"};
+  });
+  add_exr("meta_not_json", [](Exr& e) { e.attributes = {{"facet:blend", "{["}}; });
+  add_exr("meta_format_unknown", [](Exr& e) {
+    e.attributes = {{"facet:blend", "{\"format\":\"facet-blend/7\"}"}};
+  });
+  out.push_back({"blend_exr_data_window_huge",
+                 [source, context](const fs::path& dir) {
+                   context(dir);
+                   spit(dir / "p0.blend.exr",
+                        exr_with_data_window(slurp(source), 1 << 30, 1 << 30));
+                 },
+                 args,
+                 "out",
+                 {"p0.blend.exr"}});
+  out.push_back({"blend_exr_warp_given_as_blend",
+                 [context](const fs::path& dir) {
+                   context(dir);
+                   fs::copy_file(kSource / "configs/displays/cylinder3/p0.warp.exr",
+                                 dir / "p0.blend.exr");
+                 },
+                 args,
+                 "out",
+                 {"p0.blend.exr"}});
+}
+
+// Rig JSON: configs/rigs/wall2x2.json, through facet simulate.
+json rig_base() { return json::parse(slurp(kSource / "configs/rigs/wall2x2.json")); }
+
+void add_rig_json(std::vector<Variant>& out) {
+  const std::vector<std::string> args{"simulate", "--rig",         "@rig.json", "--out",
+                                      "@out",     "--camera-size", "64x48"};
+  add_byte_variants(
+      out, "rig_json", [] { return rig_base().dump(1); }, "rig.json", nullptr, args, "out",
+      {0.001, 0.3, 0.6, 0.999}, false);
+  add_non_regular_variants(out, "rig_json", "rig.json", nullptr, args, "out");
+  std::vector<FieldMutation> m = {
+      {"format_unknown", "/format", "\"facet-rig/9\"", "format"},
+      {"format_missing", "/format", "", "format"},
+      {"screen_type_bogus", "/screen/type", "\"banana\"", "type"},
+      {"normal_zero", "/screen/normal", "[0, 0, 0]", "normal"},
+      {"normal_nan", "/screen/normal", "[NaN, 0, 1]", "normal"},
+      {"point_short", "/screen/point", "[0, 0]", "point"},
+      {"projectors_empty", "/projectors", "[]", "projectors"},
+      {"projectors_string", "/projectors", "\"p0\"", "projectors"},
+      {"size_negative", "/projectors/0/size", "[-1024, 576]", "size"},
+      {"size_zero", "/projectors/0/size", "[0, 576]", "size"},
+      {"size_huge", "/projectors/0/size", "[100000000, 100000000]", "size"},
+      {"size_1e308", "/projectors/0/size", "[1e308, 576]", "size"},
+      {"fov_zero", "/projectors/0/fov_deg", "0", "fov_deg"},
+      {"fov_negative", "/projectors/0/fov_deg", "-70", "fov_deg"},
+      {"fov_180", "/projectors/0/fov_deg", "180", "fov_deg"},
+      {"fov_inf", "/projectors/0/fov_deg", "1e999", "fov_deg"},
+      {"fov_string", "/projectors/0/fov_deg", "\"70\"", "fov_deg"},
+      {"distortion_string", "/projectors/0/distortion", "\"none\"", "distortion"},
+      {"gamma_zero", "/projectors/0/gamma", "0", "gamma"},
+      {"gamma_negative", "/projectors/0/gamma", "-2.2", "gamma"},
+      {"t_eye_projector_short", "/projectors/0/t_eye_projector", "[0.3]", "t_eye_projector"},
+      {"look_at_at_projector", "/projectors/0/look_at", "[-0.3, 0.2, 0.5]", "look_at"},
+      {"up_zero", "/projectors/0/up", "[0, 0, 0]", "up"},
+      {"name_duplicate", "/projectors/1/name", "\"p0\"", "name"},
+      {"name_path_escape", "/projectors/0/name", "\"../../escape\"", "name"},
+      {"name_invalid_utf8", "/projectors/0/name", "\"\xc3\x28\"", "name"},
+      {"unknown_key", "/projectors/0/surprise", "true", "surprise"},
+  };
+  add_json_variants(out, "rig_json", rig_base, "rig.json", nullptr, m, args, "out");
+}
+
+// capture.json and camera.cameramodel: the real procam-board capture, images linked in.
+const fs::path kCapture = kShared / "captures/procam-board";
+
+json capture_base() { return json::parse(slurp(kCapture / "capture.json")); }
+
+void capture_context(const fs::path& dir) {
+  fs::create_directories(dir / "cap");
+  for (const auto& entry : fs::directory_iterator(kCapture)) {
+    const std::string name = entry.path().filename().string();
+    if (name == "capture.json" || name == "camera.cameramodel") continue;
+    fs::create_symlink(entry.path(), dir / "cap" / name);
+  }
+  fs::copy_file(kCapture / "camera.cameramodel", dir / "cap/camera.cameramodel");
+}
+
+void add_capture(std::vector<Variant>& out) {
+  const std::vector<std::string> args{"calibrate", "@cap", "--out", "@out"};
+  auto context = [](const fs::path& dir) { capture_context(dir); };
+  add_byte_variants(
+      out, "capture_json", [] { return capture_base().dump(1); }, "cap/capture.json", context, args,
+      "out", {0.001, 0.3, 0.6, 0.999}, false);
+  add_non_regular_variants(out, "capture_json", "cap/capture.json", context, args, "out");
+  std::vector<FieldMutation> m = {
+      {"format_unknown", "/format", "\"facet-capture/9\"", "format"},
+      {"camera_missing", "/camera", "", "camera"},
+      {"model_missing_file", "/camera/model", "\"nowhere.cameramodel\"", "nowhere"},
+      {"model_directory", "/camera/model", "\".\"", "model"},
+      {"model_dev_null", "/camera/model", "\"/dev/null\"", "null"},
+      {"R_zero", "/camera/R_eye_camera", "[[0,0,0],[0,0,0],[0,0,0]]", "R_eye_camera"},
+      {"R_nan", "/camera/R_eye_camera/0/0", "NaN", "R_eye_camera"},
+      {"R_short", "/camera/R_eye_camera", "[[1,0,0]]", "R_eye_camera"},
+      {"t_string", "/camera/t_eye_camera", "\"origin\"", "t_eye_camera"},
+      {"projectors_empty", "/projectors", "[]", "projectors"},
+      {"size_negative", "/projectors/0/size", "[-1024, 768]", "size"},
+      {"size_zero", "/projectors/0/size", "[0, 0]", "size"},
+      {"size_huge", "/projectors/0/size", "[2000000000, 2000000000]", "size"},
+      {"gamma_zero", "/projectors/0/gamma", "0", "gamma"},
+      {"frames_empty", "/projectors/0/frames", "[]", "frames"},
+      {"frame_file_missing", "/projectors/0/frames/0/file", "\"nowhere.png\"", "nowhere"},
+      {"frame_file_escape", "/projectors/0/frames/0/file", "\"../../../../../../etc/passwd\"",
+       "passwd"},
+      {"frame_file_fifo_dev", "/projectors/0/frames/0/file", "\"/dev/zero\"", "/dev/zero"},
+      {"pattern_type_bogus", "/projectors/0/frames/0/pattern/type", "\"plaid\"", "type"},
+      {"pattern_axis_bogus", "/projectors/0/frames/0/pattern/axis", "\"w\"", "axis"},
+      {"pattern_bit_huge", "/projectors/0/frames/0/pattern/bit", "4294967296", "bit"},
+      {"pattern_bit_negative", "/projectors/0/frames/0/pattern/bit", "-1", "bit"},
+      {"name_invalid_utf8", "/projectors/0/name", "\"\xed\xa0\x80\"", "name"},
+  };
+  add_json_variants(out, "capture_json", capture_base, "cap/capture.json", context, m, args, "out");
+  // A frame image truncated.
+  out.push_back({"capture_png_truncated",
+                 [](const fs::path& dir) {
+                   capture_context(dir);
+                   fs::remove(dir / "cap/graycode_00.png");
+                   spit(dir / "cap/graycode_00.png",
+                        truncated(slurp(kCapture / "graycode_00.png"), 5000));
+                   spit(dir / "cap/capture.json", capture_base().dump(1));
+                 },
+                 args,
+                 "out",
+                 {"graycode_00.png"}});
+  out.push_back({"capture_png_wrong_size",
+                 [](const fs::path& dir) {
+                   capture_context(dir);
+                   fs::remove(dir / "cap/graycode_00.png");
+                   fs::copy_file(kShared / "warps/sgct-dome/sciss/channel1.png",
+                                 dir / "cap/graycode_00.png");
+                   spit(dir / "cap/capture.json", capture_base().dump(1));
+                 },
+                 args,
+                 "out",
+                 {"graycode_00.png"}});
+
+  // The camera model (mrcal's Python-literal format) inside the capture.
+  const std::string model = slurp(kCapture / "camera.cameramodel");
+  auto with_model = [](std::string text) {
+    return [text](const fs::path& dir) {
+      capture_context(dir);
+      spit(dir / "cap/capture.json", capture_base().dump(1));
+      fs::remove(dir / "cap/camera.cameramodel");
+      spit(dir / "cap/camera.cameramodel", text);
+    };
+  };
+  auto add_model = [&](const std::string& what, const std::string& text) {
+    out.push_back({"cameramodel_" + what,
+                   with_model(text),
+                   args,
+                   "out",
+                   {"camera.cameramodel", "camera.model"}});
+  };
+  add_model("empty", "");
+  for (const std::size_t at :
+       {std::size_t{20}, model.size() / 3, model.size() / 2, model.size() - 30}) {
+    add_model("truncated_" + std::to_string(at), truncated(model, at));
+  }
+  add_model("lensmodel_unknown", replace_first(model, "LENSMODEL_OPENCV5", "LENSMODEL_BOGUS"));
+  add_model("lensmodel_number", replace_first(model, "'LENSMODEL_OPENCV5'", "5"));
+  add_model("intrinsics_short",
+            replace_first(model, "3452.392907, 3449.924293, 587.1731473, 521.4460257, ", ""));
+  add_model("intrinsics_nan", replace_first(model, "3452.392907", "nan"));
+  add_model("intrinsics_inf", replace_first(model, "3452.392907", "1e999"));
+  add_model("focal_zero", replace_first(model, "3452.392907", "0"));
+  add_model("focal_negative", replace_first(model, "3452.392907", "-3452.392907"));
+  add_model("intrinsics_string", replace_first(model, "3452.392907", "'fx'"));
+  add_model("imagersize_negative", replace_first(model, "[ 1280, 1024,]", "[ -1280, 1024,]"));
+  add_model("imagersize_zero", replace_first(model, "[ 1280, 1024,]", "[ 0, 0,]"));
+  add_model("imagersize_huge",
+            replace_first(model, "[ 1280, 1024,]", "[ 2000000000, 2000000000,]"));
+  add_model("imagersize_mismatch", replace_first(model, "[ 1280, 1024,]", "[ 640, 512,]"));
+  add_model("extrinsics_short", replace_first(model, "[ 0, 0, 0, 0, 0, 0,]", "[ 0, 0,]"));
+  add_model("unbalanced_brace", replace_first(model, "}", ""));
+  add_model("deeply_nested",
+            "{ 'lensmodel': " + std::string(100000, '[') + std::string(100000, ']') + "}");
+  add_model("invalid_utf8", replace_first(model, "LENSMODEL_OPENCV5", "LENSMODEL_\xff\xfe"));
+  add_model("binary_garbage", std::string(2000, '\x9c'));
+  add_model("unterminated_string",
+            replace_first(model, "'LENSMODEL_OPENCV5'", "'LENSMODEL_OPENCV5"));
+  out.push_back({"cameramodel_directory",
+                 [](const fs::path& dir) {
+                   capture_context(dir);
+                   spit(dir / "cap/capture.json", capture_base().dump(1));
+                   fs::remove(dir / "cap/camera.cameramodel");
+                   fs::create_directories(dir / "cap/camera.cameramodel");
+                 },
+                 args,
+                 "out",
+                 {"camera.cameramodel"}});
+  out.push_back({"cameramodel_fifo",
+                 [](const fs::path& dir) {
+                   capture_context(dir);
+                   spit(dir / "cap/capture.json", capture_base().dump(1));
+                   fs::remove(dir / "cap/camera.cameramodel");
+                   ::mkfifo((dir / "cap/camera.cameramodel").c_str(), 0644);
+                 },
+                 args,
+                 "out",
+                 {"camera.cameramodel"}});
+}
+
+// MPCDI: the real correction_mesh.mpcdi (mpcdi1_.xml and surface1.pfm), rewritten.
+const fs::path kMpcdi = kShared / "warps/sgct-mpcdi/correction_mesh.mpcdi";
+
+Entries mpcdi_entries() { return read_zip(kMpcdi); }
+
+std::string& entry(Entries& entries, const std::string& suffix) {
+  for (auto& [name, data] : entries) {
+    if (name.ends_with(suffix)) return data;
+  }
+  static std::string none;
+  return none;
+}
+
+void add_mpcdi(std::vector<Variant>& out) {
+  const std::vector<std::string> args{"mpcdi", "import", "@x.mpcdi", "--out", "@out"};
+  add_byte_variants(
+      out, "mpcdi", [] { return slurp(kMpcdi); }, "x.mpcdi", nullptr, args, "out",
+      {0.001, 0.1, 0.5, 0.9, 0.999}, false);
+  add_non_regular_variants(out, "mpcdi", "x.mpcdi", nullptr, args, "out");
+  auto add_zip = [&](const std::string& what, std::function<void(Entries&)> mutate,
+                     const std::string& mention = "x.mpcdi") {
+    out.push_back({"mpcdi_" + what,
+                   [mutate](const fs::path& dir) {
+                     Entries entries = mpcdi_entries();
+                     mutate(entries);
+                     write_zip(dir / "x.mpcdi", entries);
+                   },
+                   args,
+                   "out",
+                   {"x.mpcdi", mention}});
+  };
+  auto xml = [](const std::function<std::string(std::string)>& edit) {
+    return [edit](Entries& e) {
+      std::string& text = entry(e, ".xml");
+      text = edit(text);
+    };
+  };
+  auto xml_replace = [&](const std::string& from, const std::string& to) {
+    return xml([from, to](std::string t) { return replace_first(t, from, to); });
+  };
+  add_zip("empty_zip", [](Entries& e) { e.clear(); });
+  add_zip("no_xml", [](Entries& e) { e.erase(e.begin()); });
+  add_zip(
+      "no_pfm", [](Entries& e) { e.pop_back(); }, "surface1.pfm");
+  add_zip("xml_entity_bomb", xml([](std::string) { return entity_bomb("MPCDI"); }));
+  add_zip("xml_deeply_nested", xml([](std::string) { return deep_xml("MPCDI"); }));
+  add_zip("xml_truncated", xml([](std::string t) { return t.substr(0, t.size() / 2); }));
+  add_zip("xml_invalid_utf8", xml_replace("surface1_region\"", "surface1_\xff\xfe\""));
+  add_zip(
+      "xml_external_entity", xml([](std::string t) {
+        return replace_first(
+            replace_first(t, "<MPCDI", "<!DOCTYPE m [<!ENTITY x SYSTEM \"/etc/passwd\">]>\n<MPCDI"),
+            "<path>surface1.pfm</path>", "<path>&x;</path>");
+      }));
+  add_zip("resolution_negative", xml_replace("xResolution=\"512\"", "xResolution=\"-512\""),
+          "xResolution");
+  add_zip("resolution_zero", xml_replace("xResolution=\"512\"", "xResolution=\"0\""),
+          "xResolution");
+  add_zip("resolution_huge", xml_replace("xResolution=\"512\"", "xResolution=\"2000000000\""),
+          "xResolution");
+  add_zip("resolution_text", xml_replace("xResolution=\"512\"", "xResolution=\"wide\""),
+          "xResolution");
+  add_zip("angle_nan", xml_replace("<rightAngle>33.231552", "<rightAngle>nan"), "rightAngle");
+  add_zip("angle_inf", xml_replace("<rightAngle>33.231552", "<rightAngle>inf"), "rightAngle");
+  add_zip("angle_text", xml_replace("<rightAngle>33.231552", "<rightAngle>wide"), "rightAngle");
+  add_zip("angles_inverted", xml_replace("<rightAngle>33.231552", "<rightAngle>-40"), "Angle");
+  add_zip("path_zip_slip", xml_replace("<path>surface1.pfm", "<path>../../../../etc/passwd"),
+          "passwd");
+  add_zip("path_absolute", xml_replace("<path>surface1.pfm", "<path>/etc/passwd"), "passwd");
+  add_zip("path_missing_entry", xml_replace("<path>surface1.pfm", "<path>nowhere.pfm"), "nowhere");
+  add_zip("path_empty", xml_replace("<path>surface1.pfm", "<path>"), "path");
+  add_zip("profile_bogus", xml_replace("profile=\"3d\"", "profile=\"9z\""), "profile");
+  add_zip("region_unmatched", xml_replace("region=\"surface1_region\"", "region=\"elsewhere\""),
+          "elsewhere");
+  // PFM inside the container (interop/src/pfm.cpp).
+  auto pfm = [&](const std::string& what, std::function<std::string(std::string)> edit) {
+    add_zip(
+        "pfm_" + what,
+        [edit](Entries& e) {
+          std::string& data = entry(e, ".pfm");
+          data = edit(data);
+        },
+        "surface1.pfm");
+  };
+  const std::size_t header = std::string("PF\n32 32\n-1.000\n").size();
+  pfm("empty", [](std::string) { return std::string(); });
+  pfm("truncated_header", [](std::string d) { return d.substr(0, 5); });
+  pfm("truncated_data", [](std::string d) { return d.substr(0, d.size() / 2); });
+  pfm("truncated_one_float", [](std::string d) { return d.substr(0, d.size() - 4); });
+  pfm("magic_bogus", [](std::string d) { return "PX" + d.substr(2); });
+  pfm("greyscale_magic", [](std::string d) { return "Pf" + d.substr(2); });
+  pfm("size_huge",
+      [header](std::string d) { return "PF\n2000000000 2000000000\n-1.000\n" + d.substr(header); });
+  pfm("size_overflow",
+      [header](std::string d) { return "PF\n4294967297 4294967297\n-1.000\n" + d.substr(header); });
+  pfm("size_negative",
+      [header](std::string d) { return "PF\n-32 32\n-1.000\n" + d.substr(header); });
+  pfm("size_zero", [header](std::string d) { return "PF\n0 0\n-1.000\n" + d.substr(header); });
+  pfm("size_text", [header](std::string d) { return "PF\nab cd\n-1.000\n" + d.substr(header); });
+  pfm("scale_zero", [header](std::string d) { return "PF\n32 32\n0\n" + d.substr(header); });
+  pfm("scale_nan", [header](std::string d) { return "PF\n32 32\nnan\n" + d.substr(header); });
+  pfm("all_inf", [header](std::string d) {
+    const float inf = std::numeric_limits<float>::infinity();
+    for (std::size_t at = header; at + 4 <= d.size(); at += 4)
+      d.replace(at, 4, reinterpret_cast<const char*>(&inf), 4);
+    return d;
+  });
+  // A 600 MB entry of zeros compressed to well under a megabyte.
+  out.push_back({"mpcdi_zip_bomb_pfm",
+                 [](const fs::path& dir) {
+                   Entries entries = mpcdi_entries();
+                   entries.pop_back();
+                   write_zip_bomb(dir / "x.mpcdi", entries, "surface1.pfm", 600u << 20);
+                 },
+                 args,
+                 "out",
+                 {"x.mpcdi", "surface1.pfm"}});
+}
+
+// Bourke .data: the real standard_16x9.data mesh.
+const fs::path kBourke = kShared / "warps/sgct-mesh/standard_16x9.data";
+
+void add_bourke(std::vector<Variant>& out) {
+  const std::vector<std::string> args{"bourke", "import", "@x.data", "--out", "@out"};
+  add_byte_variants(out, "bourke", [] { return slurp(kBourke); }, "x.data", nullptr, args, "out",
+                    {0.001, 0.005, 0.5, 0.999});
+  add_non_regular_variants(out, "bourke", "x.data", nullptr, args, "out");
+  auto add = [&](const std::string& what, std::function<std::string(std::string)> edit) {
+    out.push_back({"bourke_" + what,
+                   [edit](const fs::path& dir) { spit(dir / "x.data", edit(slurp(kBourke))); },
+                   args,
+                   "out",
+                   {"x.data"}});
+  };
+  auto head = [](std::string d, const std::string& second_line) {
+    const std::size_t one = d.find('\n');
+    const std::size_t two = d.find('\n', one + 1);
+    return d.substr(0, one + 1) + second_line + d.substr(two);
+  };
+  add("type_unknown", [](std::string d) { return d.replace(0, d.find('\n'), "7"); });
+  add("type_text", [](std::string d) { return d.replace(0, d.find('\n'), "mesh"); });
+  add("size_negative", [head](std::string d) { return head(d, "-100 60"); });
+  add("size_zero", [head](std::string d) { return head(d, "0 0"); });
+  add("size_one", [head](std::string d) { return head(d, "1 1"); });
+  add("size_huge", [head](std::string d) { return head(d, "2000000000 2000000000"); });
+  add("size_overflow", [head](std::string d) { return head(d, "4294967296 4294967296"); });
+  add("size_text", [head](std::string d) { return head(d, "a b"); });
+  add("size_more_than_rows", [head](std::string d) { return head(d, "100 61"); });
+  add("x_nan", [](std::string d) { return replace_first(d, "-1.77778\t-1\t", "nan\t-1\t"); });
+  add("x_inf", [](std::string d) { return replace_first(d, "-1.77778\t-1\t", "inf\t-1\t"); });
+  add("intensity_nan", [](std::string d) { return replace_first(d, "\t0.530521", "\tnan"); });
+  add("row_short", [](std::string d) { return replace_first(d, "\t0.86737\t0.530521", ""); });
+  add("row_text", [](std::string d) { return replace_first(d, "-1.74186", "abc"); });
+  add("invalid_utf8", [](std::string d) { return replace_first(d, "-1.74186", "\xff\xfe"); });
+  add("nul_bytes",
+      [](std::string d) { return replace_first(d, "-1.74186", std::string(8, '\0')); });
+  add("duplicate_rows", [](std::string d) {
+    const std::size_t two = d.find('\n', d.find('\n') + 1) + 1;
+    const std::size_t row_end = d.find('\n', two) + 1;
+    return d.substr(0, two) + d.substr(two, row_end - two) +
+           d.substr(two, d.rfind('\n', d.size() - 2) + 1 - two);
+  });
+}
+
+// SGC: the real SCISS channel1_planar.sgc (version 2) through facet sgct import.
+const fs::path kSgc = kShared / "warps/sgct-dome/sciss/channel1_planar.sgc";
+
+void add_sgc(std::vector<Variant>& out) {
+  const std::vector<std::string> args{"sgct", "import", "@x.sgc", "--out", "@out"};
+  add_byte_variants(out, "sgc", [] { return slurp(kSgc); }, "x.sgc", nullptr, args, "out",
+                    {0.0001, 0.001, 0.05, 0.5, 0.999});
+  add_non_regular_variants(out, "sgc", "x.sgc", nullptr, args, "out");
+  // Header: "SGC" (3), version (1), type (4), 11 floats (44), two uint32 (8): 60 bytes; then
+  // vertices of 6 floats, then the index count and the indices.
+  auto add = [&](const std::string& what, std::function<std::string(std::string)> edit) {
+    out.push_back({"sgc_" + what,
+                   [edit](const fs::path& dir) { spit(dir / "x.sgc", edit(slurp(kSgc))); },
+                   args,
+                   "out",
+                   {"x.sgc"}});
+  };
+  auto put_u32 = [](std::string d, std::size_t at, std::uint32_t v) {
+    if (at + 4 <= d.size()) d.replace(at, 4, reinterpret_cast<const char*>(&v), 4);
+    return d;
+  };
+  auto put_f32 = [](std::string d, std::size_t at, float v) {
+    if (at + 4 <= d.size()) d.replace(at, 4, reinterpret_cast<const char*>(&v), 4);
+    return d;
+  };
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  const float inf = std::numeric_limits<float>::infinity();
+  add("version_unknown", [](std::string d) {
+    d[3] = 9;
+    return d;
+  });
+  add("type_unknown", [put_u32](std::string d) { return put_u32(d, 4, 7); });
+  add("quaternion_nan", [=](std::string d) { return put_f32(d, 8, nan); });
+  add("quaternion_zero", [=](std::string d) {
+    for (int i = 0; i < 4; ++i) d = put_f32(d, 8 + 4 * i, 0.0f);
+    return d;
+  });
+  add("fov_inf", [=](std::string d) { return put_f32(d, 36, inf); });
+  add("fov_zero", [=](std::string d) {
+    for (int i = 0; i < 4; ++i) d = put_f32(d, 36 + 4 * i, 0.0f);
+    return d;
+  });
+  add("fov_nan", [=](std::string d) { return put_f32(d, 40, nan); });
+  add("vertex_count_huge", [put_u32](std::string d) { return put_u32(d, 56, 0xfffffff0u); });
+  add("vertex_count_zero", [put_u32](std::string d) { return put_u32(d, 56, 0); });
+  add("count_fields_huge",
+      [put_u32](std::string d) { return put_u32(put_u32(d, 52, 0xffffffffu), 56, 0xffffffffu); });
+  add("vertex_nan", [=](std::string d) { return put_f32(put_f32(d, 60, nan), 64, nan); });
+  add("vertex_inf", [=](std::string d) { return put_f32(d, 60 + 12, inf); });
+  add("index_count_huge", [put_u32](std::string d) {
+    std::uint32_t vertices = 0;
+    if (d.size() >= 60) std::memcpy(&vertices, d.data() + 56, 4);
+    return put_u32(d, 60 + static_cast<std::size_t>(vertices) * 24, 0xfffffff0u);
+  });
+  add("index_out_of_range", [put_u32](std::string d) {
+    std::uint32_t vertices = 0;
+    if (d.size() >= 60) std::memcpy(&vertices, d.data() + 56, 4);
+    return put_u32(d, 64 + static_cast<std::size_t>(vertices) * 24, 0x7fffffffu);
+  });
+  add("trailing_bytes", [](std::string d) { return d + std::string(13, '\x7f'); });
+}
+
+// SGCT cluster XML and .simcad: the real dome_alpha.xml (with .sgc meshes and .png masks) and
+// dome_bravo.xml (with .simcad meshes and frustum CSVs), the files linked in.
+const fs::path kAlpha = kShared / "warps/sgct-dome/sciss";
+const fs::path kBravo = kShared / "warps/sgct-dome/simcad";
+
+void add_cluster(std::vector<Variant>& out) {
+  const std::vector<std::string> alpha{"sgct", "import", "@c/dome_alpha.xml", "--out", "@out"};
+  auto alpha_context = [](const fs::path& dir) { link_all(kAlpha, dir / "c", "dome_alpha.xml"); };
+  add_byte_variants(
+      out, "cluster_xml", [] { return slurp(kAlpha / "dome_alpha.xml"); }, "c/dome_alpha.xml",
+      alpha_context, alpha, "out", {0.001, 0.2, 0.5, 0.95}, false);
+  add_non_regular_variants(out, "cluster_xml", "c/dome_alpha.xml", alpha_context, alpha, "out");
+  auto add = [&](const std::string& what, std::function<std::string(std::string)> edit,
+                 const std::string& mention = "dome_alpha.xml") {
+    out.push_back({"cluster_xml_" + what,
+                   [edit, alpha_context](const fs::path& dir) {
+                     alpha_context(dir);
+                     spit(dir / "c/dome_alpha.xml", edit(slurp(kAlpha / "dome_alpha.xml")));
+                   },
+                   alpha,
+                   "out",
+                   {"dome_alpha.xml", mention}});
+  };
+  add("entity_bomb", [](std::string) { return entity_bomb("Cluster"); });
+  add("deeply_nested", [](std::string) { return deep_xml("Cluster"); });
+  add(
+      "size_negative",
+      [](std::string t) { return replace_first(t, "<Size x=\"1280\"", "<Size x=\"-1280\""); },
+      "Size");
+  add(
+      "size_huge",
+      [](std::string t) { return replace_first(t, "<Size x=\"1280\"", "<Size x=\"2000000000\""); },
+      "Size");
+  add(
+      "size_text",
+      [](std::string t) { return replace_first(t, "<Size x=\"1280\"", "<Size x=\"wide\""); },
+      "Size");
+  add(
+      "mesh_zip_slip",
+      [](std::string t) {
+        return replace_first(t, "channel1_planar.sgc", "../../../../../etc/passwd");
+      },
+      "passwd");
+  add(
+      "mesh_missing",
+      [](std::string t) { return replace_first(t, "channel1_planar.sgc", "nowhere.sgc"); },
+      "nowhere");
+  add(
+      "mesh_dev_zero",
+      [](std::string t) { return replace_first(t, "channel1_planar.sgc", "/dev/zero"); }, "zero");
+  add(
+      "mask_missing", [](std::string t) { return replace_first(t, "channel1.png", "nowhere.png"); },
+      "nowhere");
+  add(
+      "mask_directory", [](std::string t) { return replace_first(t, "channel1.png", "."); },
+      "mask");
+  add("no_nodes", [](std::string) { return std::string("<?xml version=\"1.0\"?>\n<Cluster/>\n"); });
+  add("wrong_root",
+      [](std::string) { return std::string("<?xml version=\"1.0\"?>\n<Display/>\n"); });
+  out.push_back({"cluster_mask_truncated_png",
+                 [alpha_context](const fs::path& dir) {
+                   link_all(kAlpha, dir / "c", "channel1.png");
+                   spit(dir / "c/channel1.png", truncated(slurp(kAlpha / "channel1.png"), 3000));
+                 },
+                 alpha,
+                 "out",
+                 {"channel1.png"}});
+  out.push_back({"cluster_mesh_truncated_sgc",
+                 [](const fs::path& dir) {
+                   link_all(kAlpha, dir / "c", "channel1_planar.sgc");
+                   spit(dir / "c/channel1_planar.sgc",
+                        truncated(slurp(kAlpha / "channel1_planar.sgc"), 1000));
+                 },
+                 alpha,
+                 "out",
+                 {"channel1_planar"}});
+
+  // .simcad meshes (and their frustum CSVs) through dome_bravo.xml.
+  const std::vector<std::string> bravo{"sgct", "import", "@c/dome_bravo.xml", "--out", "@out"};
+  const std::string simcad = "channel1_warp.simcad";
+  auto bravo_context = [simcad](const fs::path& dir) { link_all(kBravo, dir / "c", simcad); };
+  add_byte_variants(
+      out, "simcad", [simcad] { return slurp(kBravo / simcad); }, "c/" + simcad, bravo_context,
+      bravo, "out", {0.001, 0.05, 0.5, 0.99}, false);
+  auto add_simcad = [&](const std::string& what, std::function<std::string(std::string)> edit) {
+    out.push_back({"simcad_" + what,
+                   [edit, bravo_context, simcad](const fs::path& dir) {
+                     bravo_context(dir);
+                     spit(dir / "c" / simcad, edit(slurp(kBravo / simcad)));
+                   },
+                   bravo,
+                   "out",
+                   {simcad}});
+  };
+  add_simcad("entity_bomb", [](std::string) { return entity_bomb("GeometryFile"); });
+  add_simcad("deeply_nested", [](std::string) { return deep_xml("GeometryFile"); });
+  add_simcad("range_zero",
+             [](std::string t) { return replace_first(t, "range=\"2560\"", "range=\"0\""); });
+  add_simcad("range_nan",
+             [](std::string t) { return replace_first(t, "range=\"2560\"", "range=\"nan\""); });
+  add_simcad("value_nan",
+             [](std::string t) { return replace_first(t, "496.60932920343123", "nan"); });
+  add_simcad("value_inf",
+             [](std::string t) { return replace_first(t, "496.60932920343123", "inf"); });
+  add_simcad("value_text",
+             [](std::string t) { return replace_first(t, "496.60932920343123", "abc"); });
+  add_simcad("one_value_fewer",
+             [](std::string t) { return replace_first(t, "496.60932920343123 ", ""); });
+  add_simcad("one_value_more",
+             [](std::string t) { return replace_first(t, "496.60932920343123 ", "1 496.6 "); });
+  add_simcad("no_y_parameters",
+             [](std::string t) { return replace_all(t, "Y-FlatParameters", "Z-FlatParameters"); });
+  add_simcad("invalid_utf8",
+             [](std::string t) { return replace_first(t, "496.60932920343123", "\xff\xfe"); });
+  // The frustum CSV beside it.
+  auto add_frustum = [&](const std::string& what, std::function<std::string(std::string)> edit) {
+    out.push_back({"simcad_frustum_" + what,
+                   [edit](const fs::path& dir) {
+                     link_all(kBravo, dir / "c", "channel1_warp_frustum.csv");
+                     spit(dir / "c/channel1_warp_frustum.csv",
+                          edit(slurp(kBravo / "channel1_warp_frustum.csv")));
+                   },
+                   bravo,
+                   "out",
+                   {"channel1_warp_frustum.csv"}});
+  };
+  add_frustum("empty", [](std::string) { return std::string(); });
+  add_frustum("truncated", [](std::string t) { return t.substr(0, t.size() / 2); });
+  add_frustum("binary_garbage", [](std::string t) { return std::string(t.size(), '\xfe'); });
+}
+
+// glTF: a unit square (positions, indices) with its buffer in square.bin beside it, rendered
+// into a tiny built-in dome.
+json gltf_base() {
+  return json::parse(R"({
+  "asset": {"version": "2.0"},
+  "scene": 0,
+  "scenes": [{"nodes": [0]}],
+  "nodes": [{"name": "square", "mesh": 0, "children": [1]}, {"name": "child", "mesh": 0}],
+  "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1}]}],
+  "accessors": [
+    {"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3",
+     "min": [0, 0, 0], "max": [1, 1, 0]},
+    {"bufferView": 1, "componentType": 5123, "count": 6, "type": "SCALAR"}
+  ],
+  "bufferViews": [
+    {"buffer": 0, "byteOffset": 0, "byteLength": 48},
+    {"buffer": 0, "byteOffset": 48, "byteLength": 12}
+  ],
+  "buffers": [{"byteLength": 60, "uri": "square.bin"}]
+})");
+}
+
+std::string gltf_buffer() {
+  std::string bytes;
+  const float positions[4][3] = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}};
+  bytes.append(reinterpret_cast<const char*>(positions), sizeof positions);
+  const std::uint16_t indices[6] = {0, 1, 2, 0, 2, 3};
+  bytes.append(reinterpret_cast<const char*>(indices), sizeof indices);
+  return bytes;
+}
+
+void gltf_context(const fs::path& dir) { spit(dir / "square.bin", gltf_buffer()); }
+
+void add_gltf(std::vector<Variant>& out) {
+  const std::vector<std::string> args{"render",  "--display", "builtin:dome180", "--size", "32x32",
+                                      "--scene", "@x.gltf",   "--out",           "@out"};
+  add_byte_variants(
+      out, "gltf", [] { return gltf_base().dump(1); }, "x.gltf", gltf_context, args, "out",
+      {0.001, 0.5, 0.99}, false);
+  add_non_regular_variants(out, "gltf", "x.gltf", gltf_context, args, "out");
+  std::vector<FieldMutation> m = {
+      {"count_overflow", "/accessors/0/count", "4294967295", "count"},
+      {"count_huge", "/accessors/0/count", "1000000000", "count"},
+      {"count_past_view", "/accessors/1/count", "7", "count"},
+      {"view_past_buffer", "/bufferViews/0/byteLength", "100000", "byteLength"},
+      {"view_offset_huge", "/bufferViews/1/byteOffset", "18446744073709551615", "byteOffset"},
+      {"stride_huge", "/bufferViews/0/byteStride", "252", "byteStride"},
+      {"buffer_length_huge", "/buffers/0/byteLength", "100000000000", "byteLength"},
+      {"uri_escape", "/buffers/0/uri", "\"../../../../../../etc/passwd\"", "uri"},
+      {"uri_absolute", "/buffers/0/uri", "\"/dev/zero\"", "uri"},
+      {"uri_missing", "/buffers/0/uri", "\"nowhere.bin\"", "uri"},
+      {"uri_bad_base64", "/buffers/0/uri", "\"data:application/octet-stream;base64,@@@@\"", "uri"},
+      {"node_cycle", "/nodes/1/children", "[0]", "children"},
+      {"node_self_child", "/nodes/0/children", "[0]", "children"},
+      {"child_out_of_range", "/nodes/0/children", "[99]", "children"},
+      {"mesh_out_of_range", "/nodes/0/mesh", "7", "mesh"},
+      {"accessor_out_of_range", "/meshes/0/primitives/0/indices", "9", "indices"},
+      {"component_type_bogus", "/accessors/1/componentType", "1234", "componentType"},
+      {"type_bogus", "/accessors/0/type", "\"VEC7\"", "type"},
+      {"position_type_scalar", "/accessors/0/type", "\"SCALAR\"", "POSITION"},
+      {"version_1", "/asset/version", "\"1.0\"", "version"},
+      {"scene_out_of_range", "/scene", "5", "scene"},
+      {"translation_nan", "/nodes/0/translation", "[NaN, 0, 0]", "translation"},
+      {"matrix_short", "/nodes/0/matrix", "[1, 0, 0]", "matrix"},
+  };
+  add_json_variants(out, "gltf", gltf_base, "x.gltf", gltf_context, m, args, "out");
+  out.push_back({"gltf_index_out_of_range",
+                 [](const fs::path& dir) {
+                   std::string bytes = gltf_buffer();
+                   const std::uint16_t big = 60000;
+                   std::memcpy(&bytes[48], &big, 2);
+                   spit(dir / "square.bin", bytes);
+                   spit(dir / "x.gltf", gltf_base().dump(1));
+                 },
+                 args,
+                 "out",
+                 {"x.gltf"}});
+  out.push_back({"gltf_position_nan",
+                 [](const fs::path& dir) {
+                   std::string bytes = gltf_buffer();
+                   const float nan = std::numeric_limits<float>::quiet_NaN();
+                   std::memcpy(&bytes[0], &nan, 4);
+                   spit(dir / "square.bin", bytes);
+                   spit(dir / "x.gltf", gltf_base().dump(1));
+                 },
+                 args,
+                 "out",
+                 {"x.gltf"}});
+  out.push_back({"gltf_buffer_truncated",
+                 [](const fs::path& dir) {
+                   spit(dir / "square.bin", gltf_buffer().substr(0, 30));
+                   spit(dir / "x.gltf", gltf_base().dump(1));
+                 },
+                 args,
+                 "out",
+                 {"x.gltf", "square.bin"}});
+}
+
+// Flags: bad values of the CLI's own options, each command with a valid input.
+void add_flags(std::vector<Variant>& out) {
+  const std::string dome = (kSource / "configs/displays/dome180/display.json").string();
+  const std::string warp = (kSource / "configs/displays/dome180/dome180.warp.exr").string();
+  auto add = [&](const std::string& what, std::vector<std::string> args,
+                 const std::string& mention) {
+    out.push_back({"flag_" + what, nullptr, std::move(args), "out", {mention}});
+  };
+  add("render_size_negative",
+      {"render", "--display", "builtin:dome180", "--size", "-5x5", "--out", "@out"}, "--size");
+  add("render_size_huge",
+      {"render", "--display", "builtin:dome180", "--size", "100000x100000", "--out", "@out"},
+      "--size");
+  add("render_size_text",
+      {"render", "--display", "builtin:dome180", "--size", "big", "--out", "@out"}, "--size");
+  add("render_frames_zero",
+      {"render", "--display", "builtin:dome180", "--frames", "0", "--out", "@out"}, "--frames");
+  add("render_msaa_huge",
+      {"render", "--display", "builtin:dome180", "--size", "32x32", "--msaa", "4096", "--out",
+       "@out"},
+      "--msaa");
+  add("render_grid_zero",
+      {"render", "--display", "builtin:dome180", "--grid", "0x0", "--out", "@out"}, "--grid");
+  add("render_tolerance_nan",
+      {"render", "--display", "builtin:dome180", "--tolerance", "nan", "--out", "@out"},
+      "--tolerance");
+  add("render_eye_nan",
+      {"render", "--display", "builtin:dome180", "--eye", "nan,0,0", "--out", "@out"}, "--eye");
+  add("render_method_bogus",
+      {"render", "--display", "builtin:dome180", "--method", "bogus", "--out", "@out"}, "--method");
+  add("render_scene_builtin_huge",
+      {"render", "--display", "builtin:dome180", "--scene", "builtin:city:100000000", "--out",
+       "@out"},
+      "scene");
+  add("render_display_builtin_bogus", {"render", "--display", "builtin:bogus", "--out", "@out"},
+      "builtin:bogus");
+  add("run_scale_zero", {"run", dome, "--headless", "--scale", "0", "--out", "@out"}, "--scale");
+  add("run_frames_negative", {"run", dome, "--headless", "--frames", "-1", "--out", "@out"},
+      "--frames");
+  add("lookup_out_in_missing_dir", {"lookup", "--warp", warp, "--out", "@out/deeper/x.exr"}, "out");
+  add("display_size_huge",
+      {"display", "builtin:dome180", "--size", "2000000000x2000000000", "--out", "@out"}, "--size");
+  add("simulate_camera_size_huge",
+      {"simulate", "--rig", "builtin:wall2x2", "--camera-size", "2000000000x2000000000", "--out",
+       "@out"},
+      "--camera-size");
+  add("simulate_noise_nan",
+      {"simulate", "--rig", "builtin:wall2x2", "--noise", "nan", "--out", "@out"}, "--noise");
+  add("simulate_bits_9", {"simulate", "--rig", "builtin:wall2x2", "--bits", "9", "--out", "@out"},
+      "--bits");
+  add("simulate_gamma_negative",
+      {"simulate", "--rig", "builtin:wall2x2", "--gamma", "-1", "--out", "@out"}, "--gamma");
+  add("calibrate_grid_huge",
+      {"calibrate", kCapture.string(), "--grid", "100000x100000", "--out", "@out"}, "--grid");
+  add("calibrate_node_spacing_zero",
+      {"calibrate", kCapture.string(), "--node-spacing", "0", "--out", "@out"}, "--node-spacing");
+  add("mpcdi_grid_huge",
+      {"mpcdi", "import", kMpcdi.string(), "--grid", "100000x100000", "--out", "@out"}, "--grid");
+  add("mpcdi_tilt_out_of_range",
+      {"mpcdi", "import", kMpcdi.string(), "--tilt", "91", "--out", "@out"}, "--tilt");
+  add("mpcdi_warp_values_bogus",
+      {"mpcdi", "import", kMpcdi.string(), "--warp-values", "bogus", "--out", "@out"},
+      "--warp-values");
+  add("mpcdi_eye_nan", {"mpcdi", "import", kMpcdi.string(), "--eye", "nan,0,0", "--out", "@out"},
+      "--eye");
+  add("bourke_size_aspect",
+      {"bourke", "import", kBourke.string(), "--size", "1000x1000", "--out", "@out"}, "--size");
+  add("bourke_fov_zero", {"bourke", "import", kBourke.string(), "--fov", "0", "--out", "@out"},
+      "--fov");
+  add("bourke_gamma_nan",
+      {"bourke", "import", kBourke.string(), "--intensity-gamma", "nan", "--out", "@out"},
+      "--intensity-gamma");
+  add("bourke_zenith_bogus",
+      {"bourke", "import", kBourke.string(), "--zenith", "up", "--out", "@out"}, "--zenith");
+  add("sgct_size_zero", {"sgct", "import", kSgc.string(), "--size", "0x0", "--out", "@out"},
+      "--size");
+  add("sgct_grid_one", {"sgct", "import", kSgc.string(), "--grid", "1x1", "--out", "@out"},
+      "--grid");
+  add("sgct_orientation_inf",
+      {"sgct", "import", kSgc.string(), "--orientation", "inf", "--out", "@out"}, "--orientation");
+}
+
+std::vector<Variant> all_variants() {
+  std::vector<Variant> out;
+  add_flags(out);
+  add_display_json(out);
+  add_warp_exr(out);
+  add_blend_exr(out);
+  add_rig_json(out);
+  add_capture(out);
+  add_mpcdi(out);
+  add_bourke(out);
+  add_sgc(out);
+  add_cluster(out);
+  add_gltf(out);
+  return out;
+}
+
+// ---- Running one variant ------------------------------------------------------------------------
+
+struct Outcome {
+  int exit_code = -1;  // -1 when a signal ended it
+  int signal = 0;
+  bool timed_out = false;
+  long max_resident_kib = 0;
+  std::string stderr_text;
+};
+
+Outcome run_cli(const std::vector<std::string>& args, const fs::path& cwd, const fs::path& log) {
+  std::vector<std::string> storage{"facet"};
+  storage.insert(storage.end(), args.begin(), args.end());
+  std::vector<char*> argv;
+  for (std::string& a : storage) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  const pid_t child = ::fork();
+  if (child == 0) {
+    ::setpgid(0, 0);
+    const rlimit limit{kAddressSpaceLimit, kAddressSpaceLimit};
+    ::setrlimit(RLIMIT_AS, &limit);
+    const rlimit no_core{0, 0};
+    ::setrlimit(RLIMIT_CORE, &no_core);
+    if (::chdir(cwd.c_str()) != 0) ::_exit(126);
+    const int null = ::open("/dev/null", O_RDWR);
+    const int err = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    ::dup2(null, 0);
+    ::dup2(null, 1);
+    ::dup2(err, 2);
+    ::unsetenv("DISPLAY");
+    ::unsetenv("WAYLAND_DISPLAY");
+    ::execv(FACET_CLI, argv.data());
+    ::_exit(127);
+  }
+  Outcome outcome;
+  const auto deadline = std::chrono::steady_clock::now() + kWallLimit;
+  int status = 0;
+  rusage usage{};
+  for (;;) {
+    const pid_t done = ::wait4(child, &status, WNOHANG, &usage);
+    if (done == child) break;
+    if (std::chrono::steady_clock::now() > deadline) {
+      outcome.timed_out = true;
+      ::kill(-child, SIGKILL);
+      ::kill(child, SIGKILL);
+      ::wait4(child, &status, 0, &usage);
+      break;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  ::kill(-child, SIGKILL);  // anything it left running in its group
+  if (WIFEXITED(status)) outcome.exit_code = WEXITSTATUS(status);
+  if (WIFSIGNALED(status)) outcome.signal = WTERMSIG(status);
+  outcome.max_resident_kib = usage.ru_maxrss;
+  outcome.stderr_text = slurp(log);
+  return outcome;
+}
+
+// Hidden temporaries (.NAME.tmp*) anywhere under `dir`; symbolic links are not followed.
+std::vector<std::string> leftover_temporaries(const fs::path& dir) {
+  std::vector<std::string> found;
+  std::error_code ec;
+  for (auto it = fs::recursive_directory_iterator(dir, ec); !ec && it != fs::end(it);
+       it.increment(ec)) {
+    const std::string name = it->path().filename().string();
+    if (name.starts_with(".") && name.find(".tmp") != std::string::npos) {
+      found.push_back(it->path().string());
+    }
+  }
+  return found;
+}
+
+class Hostile : public ::testing::TestWithParam<Variant> {};
+
+TEST_P(Hostile, ExitsTwoNamingTheInputAndLeavesNothing) {
+  const Variant& variant = GetParam();
+  const fs::path root = fs::temp_directory_path() / ("facet_hostile_" + std::to_string(::getpid()));
+  const fs::path scratch = root / variant.name;
+  std::error_code ec;
+  fs::remove_all(scratch, ec);
+  fs::create_directories(scratch);
+  if (variant.make) variant.make(scratch);
+  std::vector<std::string> args;
+  for (const std::string& a : variant.args) {
+    args.push_back(a.starts_with("@") ? (scratch / a.substr(1)).string() : a);
+  }
+  const Outcome outcome = run_cli(args, scratch, root / (variant.name + ".stderr"));
+  std::string command = "facet";
+  for (const std::string& a : args) command += " " + a;
+  SCOPED_TRACE(command + "\nstderr: " + outcome.stderr_text);
+
+  EXPECT_FALSE(outcome.timed_out) << "ran past " << kWallLimit.count() << " s";
+  EXPECT_EQ(outcome.signal, 0) << "killed by signal " << outcome.signal;
+  EXPECT_EQ(outcome.exit_code, 2);
+  EXPECT_LT(outcome.max_resident_kib, kMaxResidentKiB);
+  EXPECT_EQ(outcome.stderr_text.find("internal error"), std::string::npos);
+  const bool named =
+      std::any_of(variant.mentions.begin(), variant.mentions.end(), [&](const std::string& m) {
+        const std::string bare = m.starts_with("--") ? m.substr(2) : m;
+        return !bare.empty() && outcome.stderr_text.find(bare) != std::string::npos;
+      });
+  EXPECT_TRUE(named) << "stderr names none of the input or field";
+  EXPECT_FALSE(fs::exists(fs::symlink_status(scratch / variant.output)))
+      << variant.output << " left behind";
+  EXPECT_TRUE(leftover_temporaries(scratch).empty()) << "a hidden temporary left behind";
+  EXPECT_FALSE(fs::exists(fs::symlink_status(root / "escape")));
+  fs::remove_all(scratch, ec);
+  fs::remove(root / (variant.name + ".stderr"), ec);
+  if (fs::is_empty(root, ec)) fs::remove(root, ec);
+}
+
+INSTANTIATE_TEST_SUITE_P(Inputs, Hostile, ::testing::ValuesIn(all_variants()),
+                         [](const ::testing::TestParamInfo<Variant>& param) {
+                           return param.param.name;
+                         });
+
+}  // namespace
