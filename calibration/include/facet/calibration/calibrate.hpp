@@ -54,7 +54,7 @@ struct VerdictThresholds {
   double check_worst_region_px = 2.0, bad_worst_region_px = 5.0;
   // Enclosed hole nodes interpolated, as a share of the supported nodes: much of the image was
   // not decoded and is guessed.
-  double check_holes_filled_share = 0.02, bad_holes_filled_share = 0.25;
+  double check_holes_filled_share = 0.05, bad_holes_filled_share = 0.25;
   // Nodes cut back for folding: any makes it "check".
   std::size_t check_folds = 1;
   // Unlit output pixels inside the lit region (see unlit_inside): any is a pin-hole, "bad".
