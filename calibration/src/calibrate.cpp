@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <iterator>
 #include <opencv2/imgproc.hpp>
@@ -343,10 +344,17 @@ CalibrationReport calibrate(const fs::path& capture_path, const fs::path& out,
                            std::to_string(model.imager_size().y));
     }
   }
+  const std::uint64_t projectors = capture.projectors.size();
+  const auto report_step = [&options](std::string_view what, std::uint64_t done,
+                                      std::uint64_t total) {
+    if (options.progress) options.progress({what, done, total});
+  };
   std::vector<DecodedMap> decoded;
+  report_step("decoding", 0, projectors);
   for (std::size_t p = 0; p < capture.projectors.size(); ++p) {
     throw_if_interrupted(stopped);
     decoded.push_back(decode_capture(capture, p, options.decode));
+    report_step("decoding", p + 1, projectors);
     const DecodedMap& map = decoded.back();
     if (!map.has_x || !map.has_y) {
       throw InputError(capture_json, "projectors[" + std::to_string(p) + "].frames",
@@ -362,6 +370,7 @@ CalibrationReport calibrate(const fs::path& capture_path, const fs::path& out,
   CalibrationReport report;
   std::vector<Warp> warps;
   std::vector<std::vector<NodeOrigin>> node_origins;
+  report_step("fitting warps", 0, projectors);
   for (std::size_t p = 0; p < capture.projectors.size(); ++p) {
     throw_if_interrupted(stopped);
     const CaptureProjector& projector = capture.projectors[p];
@@ -391,11 +400,14 @@ CalibrationReport calibrate(const fs::path& capture_path, const fs::path& out,
     warps.push_back(std::move(fit.warp));
     node_origins.push_back(std::move(fit.node_origin));
     report.projectors.push_back(std::move(item));
+    report_step("fitting warps", p + 1, projectors);
   }
   decoded.clear();
 
   throw_if_interrupted(stopped);
+  report_step("blending", 0, 1);
   const BlendResult blend = compute_blend(warps, options.blend);
+  report_step("blending", 1, 1);
   for (std::size_t p = 0; p < warps.size(); ++p) {
     std::size_t mapped = 0;
     for (const float a : blend.alpha[p].values) mapped += a > 0 ? 1 : 0;

@@ -11,6 +11,7 @@
 #include "facet/calibration/calibrate.hpp"
 #include "facet/projection/errors.hpp"
 #include "facet/projection/interrupt.hpp"
+#include "facet/projection/progress.hpp"
 
 namespace {
 
@@ -91,7 +92,10 @@ const facet::cli::Registration registration{
         options.display_name = args->name;
         // From here on SIGINT and SIGTERM stop the calibration cleanly (exit 128 + signal).
         facet::watch_interrupts();
+        facet::TerminalProgress progress(stderr, "facet calibrate");
+        options.progress = progress.sink();
         const auto report = facet::calibration::calibrate(args->capture, args->out, options);
+        progress.finish();
         if (args->json) {
           std::cout << report.to_json().dump(2) << "\n";
           return;

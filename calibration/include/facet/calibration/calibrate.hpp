@@ -15,6 +15,7 @@
 #include "facet/calibration/blend.hpp"
 #include "facet/calibration/decode.hpp"
 #include "facet/calibration/fit.hpp"
+#include "facet/projection/progress.hpp"
 #include "facet/projection/warp.hpp"
 
 namespace facet::calibration {
@@ -25,6 +26,9 @@ struct CalibrateOptions {
   BlendOptions blend;
   std::string display_name;    // empty: the capture folder's name
   double truth_border_px = 8;  // FORMATS.md §5
+  // Steps as they finish: ("decoding", p, projectors), ("fitting warps", p, projectors), then
+  // ("blending", 0 and 1, 1).
+  ProgressSink progress;
 };
 
 // Calibrated against true warp, FORMATS.md §5: at the truth's projector pixel centres at least
