@@ -10,6 +10,7 @@
 #include "facet/projection/atomic_file.hpp"
 #include "facet/projection/errors.hpp"
 #include "facet/projection/input_file.hpp"
+#include "facet/projection/progress.hpp"
 
 namespace facet::calibration {
 namespace {
@@ -285,6 +286,7 @@ LiveCaptureReport run_live_capture(PatternOutputs& outputs, LiveCamera& camera,
   }
 
   const std::size_t total_pixels = std::size_t(camera_size.x) * std::size_t(camera_size.y);
+  const auto started = std::chrono::steady_clock::now();
   bool stopped = false;
   for (std::size_t p = 0; p < capture.projectors.size() && !stopped; ++p) {
     const CaptureProjector& projector = capture.projectors[p];
@@ -344,7 +346,17 @@ LiveCaptureReport run_live_capture(PatternOutputs& outputs, LiveCamera& camera,
       record(frame);
       done[p][k] = true;
       ++report.captured;
-      log("captured " + frame.file.generic_string());
+      // The frames done of all (an earlier run's included), and the time left at this run's pace:
+      // format() takes the time left as elapsed · (all − done) / done, so it is given the time
+      // the finished frames would have taken at that pace.
+      const double elapsed_s =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+      const std::size_t finished = report.kept + report.captured;
+      const double paced_s = finished < report.frames
+                                 ? elapsed_s * double(finished) / double(report.captured)
+                                 : elapsed_s;
+      log(TerminalProgress::format("captured " + frame.file.generic_string(),
+                                   {"frames", finished, report.frames}, paced_s, false));
     }
   }
   outputs.blank();

@@ -76,11 +76,13 @@ struct FakeRun {
   LiveCaptureReport run(const fs::path& out, std::optional<std::size_t> stop_after = {},
                         int average = 1) {
     LiveCaptureOptions options;
+    options.log = [this](const std::string& line) { log.push_back(line); };
     options.out = out;
     options.average = average;
     options.stop_after = stop_after;
     return run_live_capture(*outputs, *camera, setup, options);
   }
+  std::vector<std::string> log;  // every line the runs logged
 };
 
 std::string file_bytes(const fs::path& path) {
@@ -144,6 +146,21 @@ TEST(LiveCapture, AStoppedCaptureResumesToTheSameFrames) {
   EXPECT_TRUE(third.complete);
   EXPECT_EQ(third.kept, 27u);
   EXPECT_EQ(third.kept + third.captured, third.frames);
+  // Each captured frame's line counts the frames done of all, an earlier run's included.
+  std::vector<std::string> captured;
+  for (const std::string& line : parts.log)
+    if (line.starts_with("captured ")) captured.push_back(line);
+  ASSERT_EQ(captured.size(), third.frames);
+  EXPECT_NE(captured[0].find(": frames 1/" + std::to_string(third.frames) + ", "),
+            std::string::npos)
+      << captured[0];
+  EXPECT_NE(captured[6].find(": frames 7/"), std::string::npos) << captured[6];
+  EXPECT_NE(captured[7].find(": frames 8/"), std::string::npos) << captured[7];
+  EXPECT_NE(captured.back().find(": frames " + std::to_string(third.frames) + "/" +
+                                 std::to_string(third.frames) + ", "),
+            std::string::npos)
+      << captured.back();
+  EXPECT_NE(captured[10].find(" left"), std::string::npos) << captured[10];
   // Only the missing frames were shown again.
   EXPECT_EQ(parts.outputs->shows - shows_before, int(third.captured));
   const Capture a = read_capture(temp.path() / "whole"), b = read_capture(out);
