@@ -209,7 +209,10 @@ bool natural_less(const std::string& a, const std::string& b) {
 // XML node) with those files: by frustum where every `.simcad` file has its table (a viewport
 // takes the one file whose table matches its FOV and heading, pitch, roll within 0.001°), else in
 // order (the k-th such viewport in the file takes the k-th `.simcad` file by name) when the counts
-// are equal. Notes say which file each took, and why a viewport took none.
+// are equal. Notes say which file each took. Once one viewport has taken a file, every such
+// viewport must: one left without (its file missing, unreadable or not matching) is an InputError
+// naming it, since a cluster imported without one of its projectors would leave a dark wedge in the
+// show.
 std::map<const void*, std::string> pair_sibling_simcad(const pugi::xml_node& cluster,
                                                        const std::filesystem::path& folder,
                                                        const std::string& source,
@@ -246,6 +249,7 @@ std::map<const void*, std::string> pair_sibling_simcad(const pugi::xml_node& clu
   if (meshes.empty()) return paired;
 
   std::vector<std::optional<SimcadFrustumTable>> tables;
+  std::vector<std::pair<std::string, std::string>> unpaired;  // viewport path, what it lacks
   bool every_table = true;
   for (const std::string& mesh : meshes) {
     const std::filesystem::path table =
@@ -286,10 +290,13 @@ std::map<const void*, std::string> pair_sibling_simcad(const pugi::xml_node& clu
         }
       }
       if (matches.size() != 1 || taken[matches[0]]) {
-        notes.push_back(path + " has no mesh attribute, and " +
-                        (matches.empty() ? std::string("no")
-                                         : std::to_string(matches.size()) + " (or a taken)") +
-                        " _frustum.csv next to the configuration holds its frustum");
+        unpaired.push_back(
+            {path,
+             "a .simcad mesh next to the configuration whose _frustum.csv holds this "
+             "viewport's frustum (FOV and heading, pitch, roll within 0.001°); " +
+                 (matches.empty() ? std::string("none of the ")
+                                  : std::to_string(matches.size()) + " (or a taken one) of the ") +
+                 std::to_string(meshes.size()) + " found does"});
         continue;
       }
       taken[matches[0]] = true;
@@ -315,6 +322,8 @@ std::map<const void*, std::string> pair_sibling_simcad(const pugi::xml_node& clu
                     " .simcad files without a _frustum.csv each lie next to the configuration: "
                     "not paired");
   }
+  if (!paired.empty() && !unpaired.empty())
+    throw InputError(source, unpaired.front().first, unpaired.front().second);
   return paired;
 }
 

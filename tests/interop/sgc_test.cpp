@@ -363,6 +363,28 @@ TEST(SgctCluster, SimcadMeshesArePairedByTheirFrustumTablesElseInOrder) {
   ASSERT_EQ(in_order.projectors.size(), 6u);
   EXPECT_EQ(in_order.projectors[0].name, "channel1_warp");
   EXPECT_EQ(in_order.projectors[1].name, "channel2_warp");
+  // With the tables, one channel's mesh missing: the others pair, and the viewport left without
+  // its projector is an error naming it, not a display with a projector quietly missing.
+  {
+    test::ScratchFolder partial("simcad-one-missing");
+    for (int c = 1; c <= 6; ++c) {
+      if (c == 3) continue;
+      const std::string stem = "channel" + std::to_string(c) + "_warp";
+      fs::copy_file(kDome + "simcad/" + stem + ".simcad", partial.path / (stem + ".simcad"));
+      fs::copy_file(kDome + "simcad/" + stem + "_frustum.csv",
+                    partial.path / (stem + "_frustum.csv"));
+    }
+    std::ofstream(partial.path / "dome_bravo.xml") << shipped;
+    try {
+      import_sgct_cluster(partial.path / "dome_bravo.xml", {});
+      ADD_FAILURE() << "imported without channel 3";
+    } catch (const InputError& e) {
+      EXPECT_EQ(e.field(), "Node[3]/Window[0]/Viewport[0]") << e.what();  // Node[0] drives none
+      EXPECT_NE(std::string(e.what()).find("_frustum.csv holds this viewport's frustum"),
+                std::string::npos)
+          << e.what();
+    }
+  }
   // With one file fewer than viewports nothing is paired, and the error says where meshes come
   // from.
   fs::remove(scratch.path / "channel6_warp.simcad");
