@@ -102,6 +102,11 @@ TEST(DisplayConfig, BadFieldsNameFileFieldAndExpectation) {
   };
   EXPECT_EQ(failing_field(with("/format", "facet-display/2")), "format");
   EXPECT_EQ(failing_field(with("/eye", json::array({0, "up", 0}))), "eye[1]");
+  // Finite but no venue's: positions and radii beyond 1,000 km.
+  EXPECT_EQ(failing_field(with("/eye", json::array({1e308, 1e308, 1e308}))), "eye");
+  EXPECT_EQ(failing_field(with("/eye", json::array({0, 0, -1.5e6}))), "eye");
+  EXPECT_EQ(failing_field(with("/eye", json::array({0, 0, -9e5}))), "");
+  EXPECT_EQ(failing_field(with("/screen/radius", 1e300)), "screen.radius");
   EXPECT_EQ(failing_field(with("/projectors/0/size", json::array({1024}))), "projectors[0].size");
   EXPECT_EQ(failing_field(with("/projectors/0/size", json::array({1024, 0}))),
             "projectors[0].size");

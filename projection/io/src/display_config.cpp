@@ -39,6 +39,14 @@ bool finite(const glm::dvec3& v) {
   return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
 }
 
+// Positions and radii beyond this (1,000 km) are no venue's: refused before any arithmetic with
+// them loses every digit (an eye at 1e308 m made the warps' directions all alike).
+constexpr double kMaxDistance_m = 1e6;
+bool within_reach(const glm::dvec3& p_m) {
+  return finite(p_m) && std::abs(p_m.x) <= kMaxDistance_m && std::abs(p_m.y) <= kMaxDistance_m &&
+         std::abs(p_m.z) <= kMaxDistance_m;
+}
+
 DisplayScreen screen_from_json(const Json& value, const At& at) {
   Fields fields(value, at);
   const std::string expected_type = "\"sphere\", \"cylinder\" or \"plane\"";
@@ -144,16 +152,18 @@ void validate_display_config(const DisplayConfig& config, const std::string& sou
                              bool check_files) {
   const At root(source);
   if (config.name.empty()) root["name"].fail("a non-empty display name");
-  if (!finite(config.eye)) root["eye"].fail("3 finite numbers (metres)");
+  if (!within_reach(config.eye))
+    root["eye"].fail("3 finite numbers (metres), each within ±1,000 km (1e6 m)");
   if (config.screen) {
     const DisplayScreen& screen = *config.screen;
     const At at = root["screen"];
-    if (!finite(screen.center) || !finite(screen.point) || !finite(screen.axis) ||
+    if (!within_reach(screen.center) || !within_reach(screen.point) || !finite(screen.axis) ||
         !finite(screen.normal)) {
-      at.fail("finite numbers");
+      at.fail("finite numbers, positions each within ±1,000 km (1e6 m)");
     }
-    if (screen.type != DisplayScreen::Type::plane && !(screen.radius > 0)) {
-      at["radius"].fail("a positive number of metres");
+    if (screen.type != DisplayScreen::Type::plane &&
+        !(screen.radius > 0 && screen.radius <= kMaxDistance_m)) {
+      at["radius"].fail("a positive number of metres, at most 1,000 km (1e6 m)");
     }
     if (screen.type == DisplayScreen::Type::cylinder && !is_unit(screen.axis)) {
       at["axis"].fail("a unit vector");
