@@ -228,6 +228,14 @@ MpcdiDocument parse_mpcdi_xml(std::string_view xml, const std::string& source) {
             throw InputError(source, fpath, "expected edge angles inside (-90°, 90°)");
           }
         }
+        // Any turn is within one either way; beyond, the degrees lose the digits a pose needs.
+        for (const auto& [name, angle] :
+             {std::pair{"yaw", f.yaw_deg}, std::pair{"pitch", f.pitch_deg},
+              std::pair{"roll", f.roll_deg}}) {
+          if (!(std::abs(angle) <= 360)) {
+            throw InputError(source, fpath + "/" + name, "expected degrees within [-360, 360]");
+          }
+        }
         if (!(f.left_deg < f.right_deg) || !(f.down_deg < f.up_deg)) {
           throw InputError(source, fpath,
                            "expected leftAngle < rightAngle and downAngle < upAngle");

@@ -328,6 +328,15 @@ TEST(MpcdiCrafted, BadContainersGiveInputErrorsNamingTheField) {
   nan_yaw.replace(nan_yaw.find("<yaw>0"), 6, "<yaw>nan");
   EXPECT_EQ(field_of_error({{"mpcdi.xml", frustum_xml(kRegion, nan_yaw, kFileset)}}),
             "display/buffer[0]/region[0]/frustum/yaw");
+  // Finite but beyond a turn either way: no pose, and the degrees have lost their digits.
+  std::string huge_yaw = kFrustum;
+  huge_yaw.replace(huge_yaw.find("<yaw>0"), 6, "<yaw>1e308");
+  EXPECT_EQ(field_of_error({{"mpcdi.xml", frustum_xml(kRegion, huge_yaw, kFileset)}}),
+            "display/buffer[0]/region[0]/frustum/yaw");
+  std::string turned_roll = kFrustum;
+  turned_roll.replace(turned_roll.find("<roll>0"), 7, "<roll>-360.5");
+  EXPECT_EQ(field_of_error({{"mpcdi.xml", frustum_xml(kRegion, turned_roll, kFileset)}}),
+            "display/buffer[0]/region[0]/frustum/roll");
   EXPECT_EQ(field_of_error({{"mpcdi.xml", frustum_xml(kRegion, kFrustum, "")}}),
             "files/fileset[region=r]/geometryWarpFile/path");
   EXPECT_EQ(field_of_error({{"mpcdi.xml", frustum_xml(kRegion, kFrustum, kFileset)}}),
