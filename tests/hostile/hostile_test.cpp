@@ -448,6 +448,8 @@ void add_display_json(std::vector<Variant>& out) {
       {"axis_zero", "/screen/axis", "[0, 0, 0]", "axis"},
       {"eye_string_element", "/eye", "[\"a\", 0, 0]", "eye"},
       {"eye_inf", "/eye", "[1e999, 0, 0]", "eye"},
+      {"eye_far", "/eye", "[1e308, 1e308, 1e308]", "eye"},
+      {"radius_far", "/screen/radius", "1e300", "radius"},
       {"tolerance_negative", "/render/tolerance_px", "-1", "tolerance"},
       {"tolerance_zero", "/render/tolerance_px", "0", "tolerance"},
       {"z_near_negative", "/render/z_near", "-0.05", "z_near"},
@@ -912,6 +914,7 @@ void add_mpcdi(std::vector<Variant>& out) {
   add_zip("angle_inf", xml_replace("<rightAngle>33.231552", "<rightAngle>inf"), "rightAngle");
   add_zip("angle_text", xml_replace("<rightAngle>33.231552", "<rightAngle>wide"), "rightAngle");
   add_zip("angles_inverted", xml_replace("<rightAngle>33.231552", "<rightAngle>-40"), "Angle");
+  add_zip("yaw_huge", xml_replace("<yaw>326.675157", "<yaw>1e308"), "yaw");
   add_zip("path_zip_slip", xml_replace("<path>surface1.pfm", "<path>../../../../etc/passwd"),
           "passwd");
   add_zip("path_absolute", xml_replace("<path>surface1.pfm", "<path>/etc/passwd"), "passwd");
@@ -1184,6 +1187,12 @@ void add_cluster(std::vector<Variant>& out) {
                    {simcad}});
   };
   add_simcad("entity_bomb", [](std::string) { return entity_bomb("GeometryFile"); });
+  // One channel's mesh missing: its viewport is named, not left out of the display.
+  out.push_back({"simcad_missing",
+                 [](const fs::path& dir) { link_all(kBravo, dir / "c", "channel1_warp.simcad"); },
+                 bravo,
+                 "out",
+                 {"dome_bravo.xml", "Viewport"}});
   add_simcad("deeply_nested", [](std::string) { return deep_xml("GeometryFile"); });
   add_simcad("range_zero",
              [](std::string t) { return replace_first(t, "range=\"2560\"", "range=\"0\""); });
