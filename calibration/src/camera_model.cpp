@@ -119,6 +119,40 @@ CameraModel::CameraModel(const std::string& lensmodel, std::vector<double> intri
   impl_ = std::move(impl);
 }
 
+namespace {
+
+// InputError naming `source` and the line when a ' or " string of the text (outside '#' comments)
+// is not closed before the end of the text.
+void require_closed_quotes(std::string_view text, const std::string& source) {
+  char open = 0;  // the quote of the string being read, or 0
+  bool comment = false;
+  int line = 1, opened_at = 0;
+  for (const char c : text) {
+    if (c == '\n') {
+      ++line;
+      comment = false;
+      continue;
+    }
+    if (comment) continue;
+    if (open) {
+      if (c == open) open = 0;
+    } else if (c == '#') {
+      comment = true;
+    } else if (c == '\'' || c == '"') {
+      open = c;
+      opened_at = line;
+    }
+  }
+  if (open) {
+    throw InputError(
+        source, "",
+        "an mrcal .cameramodel file whose strings are closed; the one opened on line " +
+            std::to_string(opened_at) + " never is (a cut file?)");
+  }
+}
+
+}  // namespace
+
 CameraModel CameraModel::read(const std::filesystem::path& path) {
   require_regular_file(path);
   std::ifstream stream(path);
@@ -126,8 +160,11 @@ CameraModel CameraModel::read(const std::filesystem::path& path) {
   std::stringstream buffer;
   buffer << stream.rdbuf();
   const std::string text = buffer.str();
-  // mrcal's reader skips a '#' comment up to its newline without checking for the end of the
-  // text, so a file that ends inside a comment would be read past its end: end it with one.
+  // mrcal's reader looks for the end of a quoted string without checking for the end of the
+  // text (a file cut inside 'lensmodel' was read past its end): every quote must be closed.
+  require_closed_quotes(text, path.string());
+  // It also skips a '#' comment up to its newline without checking for the end of the text, so a
+  // file that ends inside a comment would be read past its end: end it with one.
   const std::string terminated = text + '\n';
   mrcal_cameramodel_t* model =
       mrcal_read_cameramodel_string(terminated.c_str(), int(terminated.size()));

@@ -285,17 +285,26 @@ Entries read_zip(const fs::path& path) {
   return entries;
 }
 
+// Adds an entry holding `data`. zip_source_buffer keeps a pointer: the bytes are copied into
+// memory that lives until zip_close, which frees it (libzip frees no buffer of length 0, so an
+// empty entry gets none).
+void add_zip_entry(zip_t* archive, const std::string& name, const std::string& data,
+                   zip_flags_t flags) {
+  void* copy = nullptr;
+  if (!data.empty()) {
+    copy = std::malloc(data.size());
+    std::memcpy(copy, data.data(), data.size());
+  }
+  zip_source_t* source = zip_source_buffer(archive, copy, data.size(), copy ? 1 : 0);
+  if (zip_file_add(archive, name.c_str(), source, flags) < 0) zip_source_free(source);
+}
+
 void write_zip(const fs::path& path, const Entries& entries) {
   int error = 0;
   zip_t* archive = zip_open(path.c_str(), ZIP_CREATE | ZIP_TRUNCATE, &error);
   if (!archive) return;
-  for (const auto& [name, data] : entries) {
-    // zip_source_buffer keeps a pointer: copy into memory that lives until zip_close.
-    void* copy = std::malloc(std::max<std::size_t>(1, data.size()));
-    std::memcpy(copy, data.data(), data.size());
-    zip_source_t* source = zip_source_buffer(archive, copy, data.size(), 1);
-    zip_file_add(archive, name.c_str(), source, ZIP_FL_ENC_RAW | ZIP_FL_OVERWRITE);
-  }
+  for (const auto& [name, data] : entries)
+    add_zip_entry(archive, name, data, ZIP_FL_ENC_RAW | ZIP_FL_OVERWRITE);
   zip_close(archive);
 }
 
@@ -306,12 +315,7 @@ void write_zip_bomb(const fs::path& path, const Entries& entries, const std::str
   int error = 0;
   zip_t* archive = zip_open(path.c_str(), ZIP_CREATE | ZIP_TRUNCATE, &error);
   if (!archive) return;
-  for (const auto& [entry, data] : entries) {
-    void* copy = std::malloc(std::max<std::size_t>(1, data.size()));
-    std::memcpy(copy, data.data(), data.size());
-    zip_file_add(archive, entry.c_str(), zip_source_buffer(archive, copy, data.size(), 1),
-                 ZIP_FL_OVERWRITE);
-  }
+  for (const auto& [entry, data] : entries) add_zip_entry(archive, entry, data, ZIP_FL_OVERWRITE);
   struct Zeros {
     zip_uint64_t left;
   };
