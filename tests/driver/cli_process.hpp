@@ -35,13 +35,15 @@ inline int run_shell(const std::string& command, std::string* output = nullptr) 
   return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
 
-// In the sanitizer build, LeakSanitizer's own tracer thread sometimes crashes while it stops the
-// threads llvmpipe keeps at exit ("Tracer caught signal 11", then "LeakSanitizer has encountered
-// a fatal error", exit 1) after the command did all its work: 2 of 10 runs of
-// RunCli.HeadlessSessionRendersTheSamePixelsAsRender here, with or without facet's signal
-// handlers. That is the sanitizer failing, not facet and not a leak (a leak is reported as
-// "LeakSanitizer: detected memory leaks"), so such a run is made again, up to
-// kAttemptsAfterSanitizerFailure times in all, and said so.
+// In the sanitizer build, LeakSanitizer's own tracer thread sometimes crashes at exit, after the
+// command did all its work ("Tracer caught signal 11", then "LeakSanitizer has encountered a fatal
+// error", exit 1): with LSAN_OPTIONS=verbosity=1 it reports the main thread's dynamic TLS block
+// 42 at 0x3b13-0x1800'0000'4c15, a record the sanitizer's tracking of dynamically loaded TLS got
+// wrong, and faults reading it. 2 of 10 runs of RunCli.HeadlessSessionRendersTheSamePixelsAsRender
+// here, with or without facet's signal handlers. That is the sanitizer failing, not facet and not
+// a leak (a leak is reported as "LeakSanitizer: detected memory leaks"; use_tls=0 would avoid the
+// crash but reports what only thread-local storage holds as leaks), so such a run is made again,
+// up to kAttemptsAfterSanitizerFailure times in all, and said so.
 inline constexpr int kAttemptsAfterSanitizerFailure = 4;
 inline bool leak_sanitizer_tool_failed(int status, const std::string& output) {
   return status != 0 &&
