@@ -50,24 +50,33 @@ inline bool leak_sanitizer_tool_failed(int status, const std::string& output) {
          output.find("LeakSanitizer has encountered a fatal error") != std::string::npos;
 }
 
+// A file's bytes.
+inline std::string slurp(const std::filesystem::path& path) {
+  std::ifstream stream(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(stream), std::istreambuf_iterator<char>()};
+}
+
+// run() (an exit status) until it ends otherwise than in that failure, whose output() tells,
+// kAttemptsAfterSanitizerFailure times at most; each attempt again is said.
+template <typename Run, typename Output>
+int run_past_sanitizer_tool_failures(const std::string& arguments, Run run, Output output) {
+  int status = run();
+  for (int attempt = 2;
+       attempt <= kAttemptsAfterSanitizerFailure && leak_sanitizer_tool_failed(status, output());
+       ++attempt) {
+    std::printf("note: LeakSanitizer's tracer failed after `facet %s`; attempt %d\n",
+                arguments.c_str(), attempt);
+    status = run();
+  }
+  return status;
+}
+
 // `facet <arguments>` (FACET_CLI), its stdout and stderr written to `log`.
 inline int run_facet(const std::string& arguments, const std::filesystem::path& log) {
   const std::string command =
       std::string(FACET_CLI) + " " + arguments + " > " + log.string() + " 2>&1";
-  const int status = run_shell(command);
-  std::ifstream stream(log);
-  const std::string output{std::istreambuf_iterator<char>(stream),
-                           std::istreambuf_iterator<char>()};
-  int status_now = status;
-  for (int attempt = 2; attempt <= kAttemptsAfterSanitizerFailure; ++attempt) {
-    std::ifstream again(log);
-    const std::string text{std::istreambuf_iterator<char>(again), std::istreambuf_iterator<char>()};
-    if (!leak_sanitizer_tool_failed(status_now, attempt == 2 ? output : text)) break;
-    std::printf("note: LeakSanitizer's tracer failed after `facet %s`; attempt %d\n",
-                arguments.c_str(), attempt);
-    status_now = run_shell(command);
-  }
-  return status_now;
+  return run_past_sanitizer_tool_failures(
+      arguments, [&] { return run_shell(command); }, [&] { return slurp(log); });
 }
 
 // `facet <arguments>`, with its stdout and stderr in `output` when given.
@@ -75,21 +84,8 @@ inline int run_facet(const std::string& arguments, std::string* output = nullptr
   std::string own;
   std::string& text = output ? *output : own;
   const std::string command = std::string(FACET_CLI) + " " + arguments;
-  const int status = run_shell(command, &text);
-  int status_now = status;
-  for (int attempt = 2; attempt <= kAttemptsAfterSanitizerFailure; ++attempt) {
-    if (!leak_sanitizer_tool_failed(status_now, text)) break;
-    std::printf("note: LeakSanitizer's tracer failed after `facet %s`; attempt %d\n",
-                arguments.c_str(), attempt);
-    status_now = run_shell(command, &text);
-  }
-  return status_now;
-}
-
-// A file's bytes.
-inline std::string slurp(const std::filesystem::path& path) {
-  std::ifstream stream(path, std::ios::binary);
-  return {std::istreambuf_iterator<char>(stream), std::istreambuf_iterator<char>()};
+  return run_past_sanitizer_tool_failures(
+      arguments, [&] { return run_shell(command, &text); }, [&] { return text; });
 }
 
 // Starts `facet <arguments>` (FACET_CLI) without a shell, its stdout and stderr going to `log`;

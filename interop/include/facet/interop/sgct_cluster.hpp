@@ -13,10 +13,11 @@
 // meshes: viewports with a <PlanarProjection> and no mesh attribute take the `.simcad` files in
 // the configuration's folder, each the one whose `<stem>_frustum.csv` holds the viewport's FOV and
 // heading, pitch, roll within 0.001° where every file has that table, else in order (the k-th such
-// viewport, the k-th file by name) when the counts agree; notes say which file each took. The mask is an image over the output
-// that SGCT multiplies into the encoded colour, so the linear blend weight is mask^gamma.
-// Viewports without a mesh (an operator's GUI window) are left out with a note. Each node is its
-// own machine; the import places the nodes' windows left to right on one desktop.
+// viewport, the k-th file by name) when the counts agree; notes say which file each took. Once one
+// such viewport has found its file, one that finds none is an InputError naming it. The mask is an
+// image over the output that SGCT multiplies into the encoded colour, so the linear blend weight is
+// mask^gamma. Viewports without a mesh (an operator's GUI window) are left out with a note. Each
+// node is its own machine; the import places the nodes' windows left to right on one desktop.
 //
 // Mesh and mask paths are often absolute paths of the machine that wrote the file; a path that
 // does not exist is looked up by its file name in the configuration's folder, with a note.
