@@ -4,6 +4,8 @@
 #include <chrono>
 #include <cmath>
 #include <filesystem>
+#include <glm/gtc/matrix_access.hpp>
+#include <limits>
 #include <map>
 #include <numbers>
 
@@ -194,14 +196,52 @@ void write_session_display(const SessionDisplay& display, const std::string& nam
   }
 }
 
-nlohmann::json frame_state_to_json(const FrameState& state) {
+namespace {
+
+nlohmann::json matrix_rows(const glm::dmat4& m) {
   nlohmann::json rows = nlohmann::json::array();
   for (int r = 0; r < 4; ++r) {
     nlohmann::json row = nlohmann::json::array();
-    for (int c = 0; c < 4; ++c) row.push_back(state.T_world_eye[c][r]);
+    for (int c = 0; c < 4; ++c) row.push_back(m[c][r]);
     rows.push_back(row);
   }
-  return {{"frame", state.frame}, {"time_s", state.time_s}, {"T_world_eye", rows}};
+  return rows;
+}
+
+// A 4x4 matrix written as 4 rows of 4 finite numbers; `field` names it in errors.
+glm::dmat4 matrix_from_rows(const nlohmann::json* rows, const std::string& source,
+                            const std::string& field) {
+  if (!rows || !rows->is_array() || rows->size() != 4)
+    throw InputError(source, field, "expected a 4x4 matrix as a list of 4 rows");
+  glm::dmat4 m(1.0);
+  for (int r = 0; r < 4; ++r) {
+    const nlohmann::json& row = (*rows)[r];
+    if (!row.is_array() || row.size() != 4)
+      throw InputError(source, field + "[" + std::to_string(r) + "]", "expected 4 numbers");
+    for (int c = 0; c < 4; ++c) {
+      if (!row[c].is_number() || !std::isfinite(row[c].get<double>()))
+        throw InputError(source, field + "[" + std::to_string(r) + "][" + std::to_string(c) + "]",
+                         "expected a finite number");
+      m[c][r] = row[c].get<double>();
+    }
+  }
+  return m;
+}
+
+}  // namespace
+
+nlohmann::json frame_state_to_json(const FrameState& state) {
+  nlohmann::json json = {{"frame", state.frame},
+                         {"time_s", state.time_s},
+                         {"T_world_eye", matrix_rows(state.T_world_eye)}};
+  if (!state.object_poses.empty()) {
+    nlohmann::json poses = nlohmann::json::array();
+    for (const ObjectPose& pose : state.object_poses)
+      poses.push_back(
+          {{"object", pose.object}, {"T_world_object", matrix_rows(pose.T_world_object)}});
+    json["object_poses"] = std::move(poses);
+  }
+  return json;
 }
 
 FrameState frame_state_from_json(const nlohmann::json& value, const std::string& source) {
@@ -214,21 +254,39 @@ FrameState frame_state_from_json(const nlohmann::json& value, const std::string&
       !std::isfinite(value["time_s"].get<double>()))
     throw InputError(source, "time_s", "expected a finite number of seconds");
   state.time_s = value["time_s"].get<double>();
-  const nlohmann::json* rows = value.contains("T_world_eye") ? &value["T_world_eye"] : nullptr;
-  if (!rows || !rows->is_array() || rows->size() != 4)
-    throw InputError(source, "T_world_eye", "expected a 4x4 matrix as a list of 4 rows");
-  for (int r = 0; r < 4; ++r) {
-    const nlohmann::json& row = (*rows)[r];
-    if (!row.is_array() || row.size() != 4)
-      throw InputError(source, "T_world_eye[" + std::to_string(r) + "]", "expected 4 numbers");
-    for (int c = 0; c < 4; ++c) {
-      if (!row[c].is_number() || !std::isfinite(row[c].get<double>()))
-        throw InputError(source,
-                         "T_world_eye[" + std::to_string(r) + "][" + std::to_string(c) + "]",
-                         "expected a finite number");
-      state.T_world_eye[c][r] = row[c].get<double>();
-    }
+  state.T_world_eye = matrix_from_rows(
+      value.contains("T_world_eye") ? &value["T_world_eye"] : nullptr, source, "T_world_eye");
+  if (!value.contains("object_poses")) return state;
+  const nlohmann::json& poses = value["object_poses"];
+  if (!poses.is_array() || poses.size() > kMaxObjectPoses)
+    throw InputError(source, "object_poses",
+                     "expected a list of at most " + std::to_string(kMaxObjectPoses) +
+                         " {object, T_world_object}");
+  std::vector<std::uint32_t> seen;
+  for (std::size_t i = 0; i < poses.size(); ++i) {
+    const std::string field = "object_poses[" + std::to_string(i) + "]";
+    const nlohmann::json& pose = poses[i];
+    if (!pose.is_object()) throw InputError(source, field, "expected {object, T_world_object}");
+    if (!pose.contains("object") || !pose["object"].is_number_unsigned() ||
+        pose["object"].get<std::uint64_t>() > std::numeric_limits<std::uint32_t>::max())
+      throw InputError(source, field + ".object", "expected an object index (0 to 2^32 - 1)");
+    ObjectPose result;
+    result.object = pose["object"].get<std::uint32_t>();
+    result.T_world_object =
+        matrix_from_rows(pose.contains("T_world_object") ? &pose["T_world_object"] : nullptr,
+                         source, field + ".T_world_object");
+    const glm::dvec4 last_row(glm::row(result.T_world_object, 3));
+    if (last_row != glm::dvec4(0, 0, 0, 1))
+      throw InputError(source, field + ".T_world_object[3]",
+                       "an affine transform: the last row 0, 0, 0, 1");
+    seen.push_back(result.object);
+    state.object_poses.push_back(result);
   }
+  std::sort(seen.begin(), seen.end());
+  if (const auto twice = std::adjacent_find(seen.begin(), seen.end()); twice != seen.end())
+    throw InputError(
+        source, "object_poses",
+        "each object at most once; object " + std::to_string(*twice) + " is listed twice");
   return state;
 }
 

@@ -425,7 +425,7 @@ void run_windowed_session(const SessionDisplay& display, const Scene& scene, con
     if (nav.play_path) time_s += options.frames ? kFramePeriod_s : dt;
 
     windows.front().context->make_current();
-    FrameState state{frame, time_s, nav.play_path ? T_path : nav.T_world_eye()};
+    FrameState state{frame, time_s, nav.play_path ? T_path : nav.T_world_eye(), {}};
     stats = session.render(state);
     // The other contexts read the outputs: make the rendering visible to them first.
     GLsync rendered = glFenceSync(GL_SYNC_GPU_COMMANDS_COMPLETE, 0);

@@ -62,8 +62,45 @@ TEST(FrameState, RoundTripsThroughJson) {
   state.T_world_eye = glm::dmat4(1.0);
   state.T_world_eye[3] = glm::dvec4(1.5, 1.7, -3.25, 1.0);
   state.T_world_eye[0][1] = 0.125;
+  EXPECT_EQ(
+      frame_state_from_json(nlohmann::json::parse(frame_state_to_json(state).dump()), "state"),
+      state);
+  ObjectPose moved;
+  moved.object = 3;
+  moved.T_world_object[3] = glm::dvec4(-2.0, 0.5, 7.0, 1.0);
+  moved.T_world_object[1][0] = 0.25;
+  state.object_poses = {moved, ObjectPose{}};
   const nlohmann::json json = frame_state_to_json(state);
+  ASSERT_EQ(json["object_poses"].size(), 2u);
   EXPECT_EQ(frame_state_from_json(nlohmann::json::parse(json.dump()), "state"), state);
+}
+
+TEST(FrameState, RejectsBadObjectPoses) {
+  FrameState state;
+  state.object_poses = {ObjectPose{}, ObjectPose{}};
+  const auto message = [](const nlohmann::json& json) {
+    try {
+      frame_state_from_json(json, "broadcast");
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_NE(message(frame_state_to_json(state)).find("listed twice"), std::string::npos);
+  state.object_poses[1].object = 1;
+  nlohmann::json json = frame_state_to_json(state);
+  EXPECT_EQ(message(json), "no error");
+  json["object_poses"][1]["object"] = -1;
+  EXPECT_NE(message(json).find("object_poses[1].object"), std::string::npos) << message(json);
+  json = frame_state_to_json(state);
+  json["object_poses"][0]["T_world_object"][3][0] = 0.5;  // projective, not affine
+  EXPECT_NE(message(json).find("object_poses[0].T_world_object[3]"), std::string::npos);
+  json = frame_state_to_json(state);
+  json["object_poses"][0].erase("T_world_object");
+  EXPECT_NE(message(json).find("object_poses[0].T_world_object"), std::string::npos);
+  json = frame_state_to_json(state);
+  json["object_poses"] = 7;
+  EXPECT_NE(message(json).find("object_poses"), std::string::npos);
 }
 
 TEST(FrameState, RejectsMalformedValues) {
@@ -190,7 +227,8 @@ TEST(HeadlessRun, WritesFramesPerOutputAndStatistics) {
   options.out_dir = out;
   const CameraPath still = [](double) { return glm::dmat4(1.0); };
   const HeadlessRunResult result = run_headless_session(session, still, options);
-  EXPECT_EQ(result.images.size(), 6u);
+  EXPECT_EQ(result.frames, 3u);
+  EXPECT_EQ(result.images_written, 6u);
   for (const char* file : {"front/00000.png", "front/00002.png", "back/00001.png", "stats.jsonl"})
     EXPECT_TRUE(fs::exists(out / file)) << file;
   std::ifstream stats(out / "stats.jsonl");

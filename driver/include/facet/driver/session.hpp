@@ -59,11 +59,29 @@ void scale_session_display(SessionDisplay& display, double factor);
 void write_session_display(const SessionDisplay& display, const std::string& name,
                            const std::filesystem::path& folder);
 
+// Where one scene object is this frame. Objects are identified by their index in
+// Scene::objects (the order of the triangle-ID numbering, render_method.hpp), which the glTF
+// loader and the API keep stable for a scene's life.
+struct ObjectPose {
+  std::uint32_t object = 0;        // index into Scene::objects
+  glm::dmat4 T_world_object{1.0};  // object-frame points into the world frame (metres); affine
+
+  bool operator==(const ObjectPose&) const = default;
+};
+
+// The most object poses one FrameState may carry (the JSON reader refuses more).
+inline constexpr std::size_t kMaxObjectPoses = std::size_t(1) << 20;
+
 // The whole state one frame depends on.
 struct FrameState {
   std::uint64_t frame = 0;
   double time_s = 0;            // scene time, seconds
   glm::dmat4 T_world_eye{1.0};  // eye pose: eye-frame points into the world frame (metres)
+  // The objects that stand elsewhere than the scene places them, each at most once, in any
+  // order. An object not listed stands where the scene itself puts it (Object::T_world_object
+  // as loaded or built), so every FrameState is complete on its own: a node that missed earlier
+  // frames renders this one right.
+  std::vector<ObjectPose> object_poses;
 
   bool operator==(const FrameState&) const = default;
 };
