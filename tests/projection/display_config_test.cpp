@@ -256,6 +256,127 @@ TEST(DisplayConfig, MissingFilesAreNamed) {
   EXPECT_EQ(failing_field(sample_document(), folder.path, true), "projectors[0].warp");
 }
 
+namespace {
+
+// The sample display (projectors p0 and p1) with a two-node cluster section.
+json cluster_document() {
+  json document = sample_document();
+  document["cluster"] = {
+      {"nodes",
+       {{{"name", "left"},
+         {"address", "tcp://10.0.0.1:7000"},
+         {"projectors", {"p0"}},
+         {"critical", true}},
+        {{"name", "right"}, {"address", "ipc:///tmp/right"}, {"projectors", {"p1"}}}}},
+      {"master", "left"},
+      {"deadline_ms", 40}};
+  return document;
+}
+
+}  // namespace
+
+TEST(DisplayCluster, ReadsValidatesAndRoundTrips) {
+  const pio::DisplayConfig config =
+      pio::parse_display_config(cluster_document().dump(), "sample", ".", false);
+  ASSERT_TRUE(config.cluster.has_value());
+  const pio::DisplayCluster& cluster = *config.cluster;
+  ASSERT_EQ(cluster.nodes.size(), 2u);
+  EXPECT_EQ(cluster.master, "left");
+  EXPECT_EQ(cluster.deadline_ms, 40.0);
+  EXPECT_TRUE(cluster.nodes[0].critical);
+  EXPECT_FALSE(cluster.nodes[1].critical);  // the default
+  EXPECT_EQ(cluster.nodes[1].projectors, std::vector<std::string>{"p1"});
+  EXPECT_EQ(pio::cluster_barrier_address("tcp://10.0.0.1:7000"), "tcp://10.0.0.1:7001");
+  EXPECT_EQ(pio::cluster_barrier_address("ipc:///tmp/right"), "ipc:///tmp/right.barrier");
+
+  const Folder folder;
+  pio::write_display_config(config, folder.path / "display.json");
+  pio::DisplayConfig expected = config;
+  expected.folder = folder.path;
+  EXPECT_EQ(pio::read_display_config(folder.path, false), expected);
+  // Without a deadline, none is written and the reader leaves it to the default.
+  expected.cluster->deadline_ms.reset();
+  pio::write_display_config(expected, folder.path / "display.json");
+  EXPECT_EQ(pio::read_display_config(folder.path, false), expected);
+}
+
+TEST(DisplayCluster, BadSectionsSayWhatIsWrong) {
+  auto with = [](const std::string& pointer, const json& value) {
+    json document = cluster_document();
+    document[json::json_pointer(pointer)] = value;
+    return document;
+  };
+  auto message = [](const json& document) {
+    const std::string text = failure(document);
+    return text.empty() ? std::string("no error") : text;
+  };
+  // An unknown projector, with the nearest name.
+  std::string text = message(with("/cluster/nodes/1/projectors/0", "p2"));
+  EXPECT_NE(text.find("field 'cluster.nodes[1].projectors[0]'"), std::string::npos) << text;
+  EXPECT_NE(text.find("there is no 'p2'"), std::string::npos) << text;
+  // A projector on two nodes, and one on none.
+  text = message(with("/cluster/nodes/1/projectors", {"p1", "p0"}));
+  EXPECT_NE(text.find("'p0' is also on node 'left'"), std::string::npos) << text;
+  text = message(with("/cluster/nodes/1/projectors", json::array()));
+  EXPECT_NE(text.find("cluster.nodes[1].projectors"), std::string::npos) << text;
+  json document = cluster_document();
+  document["cluster"]["nodes"].erase(1);
+  text = message(document);
+  EXPECT_NE(text.find("'p1' is on none"), std::string::npos) << text;
+  // The master: missing, unknown (with the nearest name).
+  document = cluster_document();
+  document["cluster"].erase("master");
+  EXPECT_EQ(failing_field(document), "cluster.master");
+  text = message(with("/cluster/master", "lft"));
+  EXPECT_NE(text.find("no node 'lft'; did you mean 'left'?"), std::string::npos) << text;
+  // Node names and addresses.
+  text = message(with("/cluster/nodes/1/name", "left"));
+  EXPECT_NE(text.find("'left' repeats"), std::string::npos) << text;
+  for (const char* address :
+       {"10.0.0.1:7000", "tcp://10.0.0.1", "tcp://10.0.0.1:0", "tcp://10.0.0.1:65535",
+        "tcp://host:70x", "udp://h:1", "ipc://", "tcp://bad host:7000"}) {
+    text = message(with("/cluster/nodes/1/address", address));
+    EXPECT_NE(text.find("field 'cluster.nodes[1].address': expected tcp://HOST:PORT"),
+              std::string::npos)
+        << address << ": " << text;
+  }
+  // The barrier listens on the next port: 7001 belongs to the first node already.
+  text = message(with("/cluster/nodes/1/address", "tcp://10.0.0.1:7001"));
+  EXPECT_NE(text.find("tcp://10.0.0.1:7001 is another node's"), std::string::npos) << text;
+  EXPECT_EQ(failing_field(with("/cluster/nodes/1/address", "tcp://10.0.0.2:7001")), "");
+  EXPECT_EQ(failing_field(with("/cluster/deadline_ms", 0)), "cluster.deadline_ms");
+  EXPECT_EQ(failing_field(with("/cluster/deadline_ms", 1e9)), "cluster.deadline_ms");
+  EXPECT_EQ(failing_field(with("/cluster/nodes/0/critical", "yes")), "cluster.nodes[0].critical");
+  EXPECT_EQ(failing_field(with("/cluster/nodes", json::array())), "cluster.nodes");
+  // Misspelled keys, as everywhere in display.json.
+  document = cluster_document();
+  document["cluster"]["nodes"][0]["adress"] = "tcp://h:1";
+  text = message(document);
+  EXPECT_NE(text.find("did you mean 'address'?"), std::string::npos) << text;
+  document = cluster_document();
+  document["cluster"]["dedline_ms"] = 10;
+  text = message(document);
+  EXPECT_NE(text.find("did you mean 'deadline_ms'?"), std::string::npos) << text;
+}
+
+TEST(DisplayCluster, SchemaKnowsTheKeysTheReaderKnows) {
+  std::ifstream stream(fs::path(FACET_SOURCE_DIR) / "configs/display.schema.json");
+  const json schema = json::parse(stream);
+  ASSERT_TRUE(schema["properties"].contains("cluster"));
+  for (const char* def : {"cluster", "cluster_node"}) {
+    const json& object = schema["$defs"][def];
+    EXPECT_EQ(object["additionalProperties"], false) << def;
+    EXPECT_EQ(object["patternProperties"]["^x-"], true) << def;
+  }
+  std::string keys;
+  for (const auto& [key, value] : schema["$defs"]["cluster_node"]["properties"].items())
+    keys += (keys.empty() ? "" : ", ") + key;
+  json document = cluster_document();
+  document["cluster"]["nodes"][0]["comment"] = "rack 2";
+  EXPECT_NE(failure(document).find("known here: " + keys + ";"), std::string::npos)
+      << failure(document);
+}
+
 TEST(BlendFile, RoundTripsAndSamples) {
   const Folder folder;
   pio::BlendMap map = pio::BlendMap::constant({5, 3}, 0.0f);

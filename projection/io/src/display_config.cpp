@@ -1,7 +1,10 @@
 #include "facet/projection_io/display_config.hpp"
 
+#include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <fstream>
+#include <map>
 #include <set>
 
 #include "facet/projection/atomic_file.hpp"
@@ -146,7 +149,102 @@ void check_relative(const std::filesystem::path& relative, const At& at) {
   if (relative.is_absolute()) at.fail("a path relative to display.json, not an absolute path");
 }
 
+// "tcp://HOST:PORT" split into host and port; false when it is not of that form.
+bool split_tcp(const std::string& address, std::string& host, int& port) {
+  constexpr std::string_view kTcp = "tcp://";
+  if (!address.starts_with(kTcp)) return false;
+  const std::string rest = address.substr(kTcp.size());
+  const std::size_t colon = rest.rfind(':');
+  if (colon == std::string::npos || colon == 0 || colon + 1 == rest.size()) return false;
+  host = rest.substr(0, colon);
+  const std::string digits = rest.substr(colon + 1);
+  const auto [end, error] = std::from_chars(digits.data(), digits.data() + digits.size(), port);
+  return error == std::errc() && end == digits.data() + digits.size() &&
+         digits.find_first_not_of("0123456789") == std::string::npos;
+}
+
+void validate_cluster(const DisplayConfig& config, const At& root) {
+  const DisplayCluster& cluster = *config.cluster;
+  const At at = root["cluster"];
+  if (cluster.nodes.empty()) at["nodes"].fail("a list of at least one node");
+  std::vector<std::string> projector_names;
+  for (const DisplayProjector& projector : config.projectors)
+    projector_names.push_back(projector.name);
+  std::map<std::string, std::string> node_of_projector;
+  std::set<std::string> node_names, addresses;
+  for (std::size_t k = 0; k < cluster.nodes.size(); ++k) {
+    const ClusterNode& node = cluster.nodes[k];
+    const At node_at = at["nodes"][k];
+    if (!valid_name(node.name))
+      node_at["name"].fail("a non-empty node name of letters, digits, '_', '-' and '.'");
+    if (!node_names.insert(node.name).second)
+      node_at["name"].fail("a name no other node has, but '" + node.name + "' repeats");
+    if (const std::string problem = cluster_address_problem(node.address); !problem.empty())
+      node_at["address"].fail(problem + ", got '" + node.address + "'");
+    // A node listens on its address and the next one: neither may be another node's.
+    for (const std::string& address : {node.address, cluster_barrier_address(node.address)}) {
+      if (!addresses.insert(address).second)
+        node_at["address"].fail("an address pair of its own, but " + address +
+                                " is another node's (a node listens on its address and on " +
+                                cluster_barrier_address(node.address) + ")");
+    }
+    if (node.projectors.empty())
+      node_at["projectors"].fail("a list of at least one projector name");
+    for (std::size_t p = 0; p < node.projectors.size(); ++p) {
+      const std::string& name = node.projectors[p];
+      const At projector_at = node_at["projectors"][p];
+      if (std::find(projector_names.begin(), projector_names.end(), name) ==
+          projector_names.end()) {
+        const std::string nearest = json_fields::nearest_key(name, projector_names);
+        projector_at.fail("the name of one of the display's projectors, but there is no '" + name +
+                          "'" + (nearest.empty() ? "" : "; did you mean '" + nearest + "'?"));
+      }
+      const auto [owner, added] = node_of_projector.emplace(name, node.name);
+      if (!added)
+        projector_at.fail("a projector of this node only, but '" + name + "' is also on node '" +
+                          owner->second + "'");
+    }
+  }
+  for (const std::string& name : projector_names) {
+    if (!node_of_projector.contains(name))
+      at["nodes"].fail("every projector on one node, but '" + name + "' is on none");
+  }
+  if (cluster.master.empty()) at["master"].fail("the name of the master node");
+  if (!node_names.contains(cluster.master)) {
+    const std::string nearest = json_fields::nearest_key(
+        cluster.master, std::vector<std::string>(node_names.begin(), node_names.end()));
+    at["master"].fail("the name of one of the nodes, but there is no node '" + cluster.master +
+                      "'" + (nearest.empty() ? "" : "; did you mean '" + nearest + "'?"));
+  }
+  if (cluster.deadline_ms &&
+      !(*cluster.deadline_ms > 0 && *cluster.deadline_ms <= kMaxClusterDeadline_ms))
+    at["deadline_ms"].fail("a positive number of milliseconds, at most 600,000");
+}
+
 }  // namespace
+
+std::string cluster_address_problem(const std::string& address) {
+  const std::string expected = "tcp://HOST:PORT with PORT in 1..65534, or ipc://PATH";
+  if (address.starts_with("ipc://"))
+    return address.size() > 6 && address.find('\0') == std::string::npos ? "" : expected;
+  std::string host;
+  int port = 0;
+  if (!split_tcp(address, host, port) || port < 1 || port > 65534) return expected;
+  for (const char c : host) {
+    const bool ok = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') ||
+                    c == '.' || c == '-' || c == '_' || c == '*' || c == '[' || c == ']' ||
+                    c == ':';
+    if (!ok) return expected + " (HOST: a name, an IPv4 address or [IPv6])";
+  }
+  return "";
+}
+
+std::string cluster_barrier_address(const std::string& address) {
+  std::string host;
+  int port = 0;
+  if (split_tcp(address, host, port)) return "tcp://" + host + ":" + std::to_string(port + 1);
+  return address + ".barrier";
+}
 
 void validate_display_config(const DisplayConfig& config, const std::string& source,
                              bool check_files) {
@@ -220,9 +318,54 @@ void validate_display_config(const DisplayConfig& config, const std::string& sou
   if (!(config.render.z_near > 0) || !std::isfinite(config.render.z_near)) {
     render["z_near"].fail("a positive number of metres");
   }
+  if (config.cluster) validate_cluster(config, root);
 }
 
 namespace {
+
+DisplayCluster cluster_from_json(const Json& value, const At& at) {
+  using namespace json_fields;
+  Fields fields(value, at);
+  DisplayCluster cluster;
+  const std::string expected_nodes = "a list of nodes {name, address, projectors, critical}";
+  const Json& nodes = fields.required("nodes", expected_nodes);
+  if (!nodes.is_array()) at["nodes"].fail(expected_nodes, nodes);
+  for (std::size_t k = 0; k < nodes.size(); ++k) {
+    const At node_at = at["nodes"][k];
+    Fields item(nodes[k], node_at);
+    ClusterNode node;
+    node.name = to_string(item.required("name", "the node's name"), node_at["name"]);
+    node.address =
+        to_string(item.required("address", "tcp://HOST:PORT or ipc://PATH"), node_at["address"]);
+    const std::string expected_projectors = "a list of the names of the projectors it drives";
+    const Json& projectors = item.required("projectors", expected_projectors);
+    if (!projectors.is_array()) node_at["projectors"].fail(expected_projectors, projectors);
+    for (std::size_t p = 0; p < projectors.size(); ++p)
+      node.projectors.push_back(to_string(projectors[p], node_at["projectors"][p]));
+    if (const Json* critical = item.optional("critical"))
+      node.critical = to_bool(*critical, node_at["critical"]);
+    item.finish();
+    cluster.nodes.push_back(std::move(node));
+  }
+  cluster.master =
+      to_string(fields.required("master", "the name of the master node"), at["master"]);
+  if (const Json* deadline = fields.optional("deadline_ms"))
+    cluster.deadline_ms = to_number(*deadline, at["deadline_ms"]);
+  fields.finish();
+  return cluster;
+}
+
+Json cluster_to_json(const DisplayCluster& cluster) {
+  Json nodes = Json::array();
+  for (const ClusterNode& node : cluster.nodes)
+    nodes.push_back({{"name", node.name},
+                     {"address", node.address},
+                     {"projectors", node.projectors},
+                     {"critical", node.critical}});
+  Json result = {{"nodes", std::move(nodes)}, {"master", cluster.master}};
+  if (cluster.deadline_ms) result["deadline_ms"] = *cluster.deadline_ms;
+  return result;
+}
 
 DisplayConfig display_from_json(const Json& document, const std::string& source,
                                 const std::filesystem::path& folder, bool check_files) {
@@ -296,6 +439,8 @@ DisplayConfig display_from_json(const Json& document, const std::string& source,
       root["missing_monitor"].fail("\"error\" or \"window\"", *missing);
     }
   }
+  if (const Json* cluster = fields.optional("cluster"))
+    config.cluster = cluster_from_json(*cluster, root["cluster"]);
   fields.finish();
   validate_display_config(config, source, check_files);
   return config;
@@ -327,6 +472,7 @@ Json display_to_json(const DisplayConfig& config) {
                         {"z_near", config.render.z_near}};
   document["missing_monitor"] =
       config.missing_monitor == MissingMonitor::window ? "window" : "error";
+  if (config.cluster) document["cluster"] = cluster_to_json(*config.cluster);
   return document;
 }
 

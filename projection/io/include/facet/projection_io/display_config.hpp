@@ -64,6 +64,42 @@ struct RenderSettings {
 
 enum class MissingMonitor { error, window };
 
+// One render node of a cluster: a machine (or, for a try-out, a process) that drives some of the
+// display's projectors.
+struct ClusterNode {
+  std::string name;  // letters, digits, '_', '-', '.'; unique
+  // Where this node listens: "tcp://HOST:PORT" (PORT in 1..65534) or "ipc://PATH". It uses this
+  // address for the frame states and the next one (PORT + 1, or PATH + ".barrier") for the swap
+  // barrier; the master dials every other node's pair.
+  std::string address;
+  std::vector<std::string> projectors;  // names in DisplayConfig::projectors; at least one
+  bool critical = false;                // losing it stops the whole cluster
+
+  bool operator==(const ClusterNode&) const = default;
+};
+
+// The display's projectors spread over render nodes (display.json "cluster"). Every projector
+// belongs to exactly one node; one node is the master, which owns the frame state and the
+// barrier.
+struct DisplayCluster {
+  std::vector<ClusterNode> nodes;  // at least one
+  std::string master;              // the name of one of the nodes
+  // How long the master waits at the swap barrier for a node before it drops it, and how long
+  // a node waits to hear from the master before it gives up, in ms (> 0, at most 600,000);
+  // nullopt: 3 frame periods (kDefaultClusterDeadlineFrames).
+  std::optional<double> deadline_ms;
+
+  bool operator==(const DisplayCluster&) const = default;
+};
+inline constexpr double kDefaultClusterDeadlineFrames = 3;
+inline constexpr double kMaxClusterDeadline_ms = 600'000;
+
+// The second address a node listens on (the swap barrier's), derived from its address:
+// tcp://HOST:PORT -> tcp://HOST:PORT+1, ipc://PATH -> ipc://PATH.barrier. Expects a valid address.
+std::string cluster_barrier_address(const std::string& address);
+// An empty string when `address` is a valid node address, else what was expected.
+std::string cluster_address_problem(const std::string& address);
+
 struct DisplayConfig {
   // The folder relative paths resolve against (the folder of display.json). Not stored.
   std::filesystem::path folder;
@@ -73,6 +109,7 @@ struct DisplayConfig {
   std::vector<DisplayProjector> projectors;  // at least one
   RenderSettings render;
   MissingMonitor missing_monitor = MissingMonitor::error;
+  std::optional<DisplayCluster> cluster;  // nullopt: one process drives every projector
 
   bool operator==(const DisplayConfig&) const = default;
 
@@ -85,7 +122,9 @@ struct DisplayConfig {
 // stored in the result. When `check_files` is set, every referenced warp, blend and black file
 // must exist under `folder`. Throws InputError(source, field, expected) on the first problem:
 // invalid JSON, missing or mistyped fields, NaN or Inf, unknown enumerated values, duplicate
-// projector names, missing files, and unknown fields ("unknown field 'blnd'; did you mean
+// projector names, missing files, a cluster section that names an unknown projector or master,
+// leaves a projector to no node or gives one to two, or repeats a node or an address, and
+// unknown fields ("unknown field 'blnd'; did you mean
 // 'blend'?"); keys starting with "x-" are free for users' notes.
 DisplayConfig parse_display_config(const std::string& text, const std::string& source,
                                    const std::filesystem::path& folder, bool check_files);
