@@ -107,10 +107,16 @@ void FacetMethodBase::prepare(const Scene& scene, const GpuScene& gpu_scene,
 }
 
 bool FacetMethodBase::update_view(const glm::dmat4& T_eye_world) {
-  if (have_view_ && T_eye_world == last_T_eye_world_) return false;
+  const Scene& scene = *scene_;
+  bool objects_moved = last_T_world_object_.size() != scene.objects.size();
+  for (std::size_t o = 0; !objects_moved && o < scene.objects.size(); ++o)
+    objects_moved = scene.objects[o].T_world_object != last_T_world_object_[o];
+  if (have_view_ && T_eye_world == last_T_eye_world_ && !objects_moved) return false;
   have_view_ = true;
   last_T_eye_world_ = T_eye_world;
-  const Scene& scene = *scene_;
+  last_T_world_object_.resize(scene.objects.size());
+  for (std::size_t o = 0; o < scene.objects.size(); ++o)
+    last_T_world_object_[o] = scene.objects[o].T_world_object;
   std::vector<GpuObjectFrame> frames(std::max<std::size_t>(scene.objects.size(), 1));
   std::vector<glm::dvec3> centre(scene.objects.size());
   std::vector<double> radius(scene.objects.size(), -1);

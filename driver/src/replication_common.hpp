@@ -88,7 +88,7 @@ class FacetMethodBase : public RenderMethod {
     std::uint32_t triangles_sole_piece = 0;      // of those, in entries with a sole piece
     Buffer list_buffer, ranges_buffer;
     Texture list_texels;  // list_buffer as a buffer texture
-    // Replication results, reused while neither view nor scene changes.
+    // Replication results, reused while neither the view nor any object transform changes.
     // stats: visible triangles, pairs, overflow (std430 uints, replication/count.comp).
     Buffer scan, pairs, stats, draw_args;
     // Pass 3's commands: draws_per_material per material, each of at most replicas_per_draw
@@ -105,7 +105,8 @@ class FacetMethodBase : public RenderMethod {
   };
 
   // Uploads the object transforms, culls objects per output and rebuilds the triangle lists when
-  // T_eye_world differs from the last frame's; returns whether it did.
+  // T_eye_world or any object's T_world_object (read from the scene at every call: a moving
+  // scene changes them between frames) differs from the last frame's; returns whether it did.
   bool update_view(const glm::dmat4& T_eye_world);
   // Binds the scene, record and object-frame buffers, and output i's facets and triangle list.
   void bind_output(std::size_t i) const;
@@ -143,6 +144,7 @@ class FacetMethodBase : public RenderMethod {
   std::vector<OutputState> outputs_;
   glm::dmat4 last_T_eye_world_{0.0};
   bool have_view_ = false;
+  std::vector<glm::mat4> last_T_world_object_;  // the transforms of the last update_view
 };
 
 }  // namespace facet::driver::detail

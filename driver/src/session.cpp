@@ -331,12 +331,14 @@ nlohmann::json frame_stats_to_json(const FrameStats& stats) {
           {"outputs", outputs}};
 }
 
-Session::Session(SessionDisplay display, const Scene& scene)
-    : display_(std::move(display)), scene_(&scene), gpu_scene_(upload_scene(scene)) {
+Session::Session(SessionDisplay display, Scene scene)
+    : display_(std::move(display)), scene_(std::move(scene)), gpu_scene_(upload_scene(scene_)) {
+  for (const Object& object : scene_.objects)
+    rest_poses_.push_back({object.T_world_object, object.bounds_world, std::nullopt});
   for (const SessionOutput& output : display_.outputs) {
     const Warp& warp = output.spec.warp;
     std::unique_ptr<RenderMethod> method = make_render_method(display_.method);
-    method->prepare(scene, gpu_scene_, std::span(&output.spec, 1), display_.settings);
+    method->prepare(scene_, gpu_scene_, std::span(&output.spec, 1), display_.settings);
     methods_.push_back(std::move(method));
     targets_.push_back(OutputTarget::create(warp.output_size, display_.settings.msaa_samples));
     blends_.emplace_back(warp.output_size, output.blend, output.encoding);
@@ -386,10 +388,10 @@ Session::~Session() = default;
 bool Session::output_sees_scene(std::size_t index, const glm::dmat4& T_world_eye) const {
   const CoverageCone& cone = cones_.at(index);
   if (cone.half_angle < 0) return false;
-  if (cone.half_angle >= std::numbers::pi) return !scene_->objects.empty();
+  if (cone.half_angle >= std::numbers::pi) return !scene_.objects.empty();
   const glm::dmat4 T_eye_world = glm::inverse(T_world_eye);
   constexpr double kRightAngle = std::numbers::pi / 2;
-  for (const Object& object : scene_->objects) {
+  for (const Object& object : scene_.objects) {
     const Aabb& box = object.bounds_world;
     if (box.empty()) continue;
     if (box.contains(glm::vec3(T_world_eye[3]))) return true;
@@ -411,8 +413,57 @@ bool Session::output_sees_scene(std::size_t index, const glm::dmat4& T_world_eye
   return false;
 }
 
+void Session::place_objects(const std::vector<ObjectPose>& poses) {
+  std::vector<const ObjectPose*> pose_of(scene_.objects.size(), nullptr);
+  for (std::size_t i = 0; i < poses.size(); ++i) {
+    const std::string field = "object_poses[" + std::to_string(i) + "].object";
+    const std::uint32_t o = poses[i].object;
+    if (o >= scene_.objects.size())
+      throw InputError("frame state", field,
+                       "an object index below " + std::to_string(scene_.objects.size()) +
+                           " (the scene's objects); got " + std::to_string(o));
+    if (pose_of[o])
+      throw InputError(
+          "frame state", field,
+          "each object at most once; object " + std::to_string(o) + " is listed twice");
+    pose_of[o] = &poses[i];
+  }
+  for (std::size_t o = 0; o < scene_.objects.size(); ++o) {
+    Object& object = scene_.objects[o];
+    RestPose& rest = rest_poses_[o];
+    const glm::mat4 T_world_object =
+        pose_of[o] ? glm::mat4(pose_of[o]->T_world_object) : rest.T_world_object;
+    if (T_world_object == object.T_world_object) continue;
+    object.T_world_object = T_world_object;
+    if (!pose_of[o]) {
+      object.bounds_world = rest.bounds_world;
+      continue;
+    }
+    if (!rest.bounds_object) {
+      Aabb box;
+      for (std::uint32_t k = 0; k < object.primitive_count; ++k) {
+        const Primitive& primitive = scene_.primitives[object.first_primitive + k];
+        for (std::uint32_t i = 0; i < primitive.index_count; ++i)
+          box.extend(scene_.positions[scene_.indices[primitive.first_index + i]]);
+      }
+      rest.bounds_object = box;
+    }
+    // The box around the moved object-frame box's corners: it holds every moved vertex.
+    object.bounds_world = Aabb{};
+    if (rest.bounds_object->empty()) continue;
+    for (int corner = 0; corner < 8; ++corner) {
+      const glm::vec3 p_object(
+          corner & 1 ? rest.bounds_object->p_max.x : rest.bounds_object->p_min.x,
+          corner & 2 ? rest.bounds_object->p_max.y : rest.bounds_object->p_min.y,
+          corner & 4 ? rest.bounds_object->p_max.z : rest.bounds_object->p_min.z);
+      object.bounds_world.extend(glm::vec3(T_world_object * glm::vec4(p_object, 1.0f)));
+    }
+  }
+}
+
 FrameStats Session::render(const FrameState& state, bool finish) {
   const auto start = std::chrono::steady_clock::now();
+  place_objects(state.object_poses);
   FrameStats stats;
   stats.frame = state.frame;
   stats.time_s = state.time_s;

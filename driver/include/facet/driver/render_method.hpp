@@ -100,9 +100,10 @@ struct RenderStats {
   // and clear of every other piece's (sole_piece_of_sphere), which pass 1 gives that piece
   // without the coverage grid.
   std::uint64_t triangles_sole_piece = 0;
-  std::uint64_t replicas = 0;       // triangle draws issued, summed over outputs
-  std::uint64_t facets = 0;         // facets over all outputs (0 for non-facet methods)
-  bool reused_replication = false;  // passes 1+2 skipped: neither view nor scene changed
+  std::uint64_t replicas = 0;  // triangle draws issued, summed over outputs
+  std::uint64_t facets = 0;    // facets over all outputs (0 for non-facet methods)
+  // Passes 1+2 skipped: neither the view nor any object's transform changed since the last frame.
+  bool reused_replication = false;
   // Per-vertex baseline only: triangles (tessellated pieces) dropped because the warp's P has no
   // value at a corner or they surround or near a singular direction, and draws beyond a
   // triangle's first on a 360° base (seam copies, included in replicas).
@@ -135,7 +136,9 @@ class RenderMethod {
 
   // Renders one frame of every output into `targets` (one per output, same order, already
   // sized). T_eye_world maps world points (metres) into the eye frame of DESIGN.md. Passes are
-  // timed with `timer` when it is given.
+  // timed with `timer` when it is given. Every call reads the objects' T_world_object and
+  // bounds_world from the scene given to prepare (which must outlive the method): objects move
+  // by changing both between frames (Session does, from FrameState::object_poses).
   virtual RenderStats render(const glm::dmat4& T_eye_world, std::span<OutputTarget> targets,
                              class GpuTimer* timer = nullptr) = 0;
 };

@@ -112,17 +112,22 @@ nlohmann::json frame_stats_to_json(const FrameStats& stats);
 class Session {
  public:
   // Uploads the scene and prepares one renderer per output. Needs a current GL context, which
-  // must stay current (on this thread) for the session's life.
-  Session(SessionDisplay display, const Scene& scene);
+  // must stay current (on this thread) for the session's life. The session keeps its own copy of
+  // the scene (move one in to avoid the copy), whose object poses each frame state sets.
+  Session(SessionDisplay display, Scene scene);
   ~Session();
   Session(const Session&) = delete;
   Session& operator=(const Session&) = delete;
 
-  // Renders every output that can see part of the scene, then blends every output. With
-  // `finish`, waits for the GPU so that cpu_ms is the frame's full time.
+  // Places every object (state.object_poses, else the scene's own pose), renders every output
+  // that can see part of the scene, then blends every output. With `finish`, waits for the GPU
+  // so that cpu_ms is the frame's full time. InputError("frame state", ...) for a pose of an
+  // object the scene does not have, or of one object twice; nothing is rendered then.
   FrameStats render(const FrameState& state, bool finish = false);
 
   const SessionDisplay& display() const { return display_; }
+  // The scene with the objects where the last render placed them.
+  const Scene& scene() const { return scene_; }
   std::span<const OutputTarget> targets() const { return targets_; }
 
   // Whether any object's bounds meet the directions output `index` covers, seen from the eye
@@ -135,8 +140,20 @@ class Session {
     double half_angle = 0;      // radians; >= pi covers every direction
   };
 
+  // Sets every object's T_world_object and bounds_world for `poses` (see render).
+  void place_objects(const std::vector<ObjectPose>& poses);
+
+  // An object's pose as the scene was given, and its object-frame box (computed the first time
+  // the object is moved).
+  struct RestPose {
+    glm::mat4 T_world_object{1.0f};
+    Aabb bounds_world;
+    std::optional<Aabb> bounds_object;
+  };
+
   SessionDisplay display_;
-  const Scene* scene_;
+  Scene scene_;
+  std::vector<RestPose> rest_poses_;
   GpuScene gpu_scene_;
   std::vector<std::unique_ptr<RenderMethod>> methods_;
   std::vector<OutputTarget> targets_;
