@@ -103,6 +103,14 @@ bool holds_current_folder(const fs::path& dir) {
   return t == target.end() || t->empty();
 }
 
+// The process's resident set in KiB, from /proc/self/statm; 0 where that cannot be read.
+std::uint64_t resident_set_kib() {
+  std::ifstream statm("/proc/self/statm");
+  std::uint64_t size_pages = 0, resident_pages = 0;
+  if (!(statm >> size_pages >> resident_pages)) return 0;
+  return resident_pages * static_cast<std::uint64_t>(::sysconf(_SC_PAGESIZE)) / 1024;
+}
+
 std::string frame_file_name(std::uint64_t frame) {
   char name[32];
   std::snprintf(name, sizeof name, "%05llu.png", static_cast<unsigned long long>(frame));
@@ -120,6 +128,8 @@ HeadlessRunResult run_headless_session(Session& session, const CameraPath& path,
   if (options.frames < 1 || options.frames > kMaxFrames)
     throw InputError("command line", "--frames",
                      "from 1 to " + std::to_string(kMaxFrames) + " frames");
+  if (options.save_every < 1)
+    throw InputError("command line", "--save-every", "a frame interval of at least 1");
   if (holds_current_folder(out_dir))
     throw InputError(out_dir.string(), "--out",
                      "a folder other than the current folder and its parents");
@@ -157,15 +167,22 @@ HeadlessRunResult run_headless_session(Session& session, const CameraPath& path,
       state.time_s = double(frame) * kFramePeriod_s;
       state.T_world_eye = path(state.time_s);
       FrameStats stats = session.render(state, options.finish_each_frame);
-      stats_file << frame_stats_to_json(stats).dump() << '\n';
-      for (std::size_t i = 0; i < session.targets().size(); ++i) {
+      const bool save = frame % options.save_every == 0 || frame + 1 == options.frames;
+      for (std::size_t i = 0; save && i < session.targets().size(); ++i) {
         const OutputTarget& target = session.targets()[i];
         const fs::path image =
             fs::path(session.display().outputs[i].spec.name) / frame_file_name(frame);
         write_png_rgba8(temporary / image, target.size(), target.read_colour_rgba8());
-        result.images.push_back(out_dir / image);
+        ++result.images_written;
       }
-      result.frames.push_back(std::move(stats));
+      const std::uint64_t rss_kib = resident_set_kib();
+      if (frame == 0) result.rss_first_kib = rss_kib;
+      result.rss_peak_kib = std::max(result.rss_peak_kib, rss_kib);
+      nlohmann::json line = frame_stats_to_json(stats);
+      line["rss_kib"] = rss_kib;
+      stats_file << line.dump() << '\n';
+      result.frames = frame + 1;
+      result.last = std::move(stats);
       if (options.progress) options.progress({"frames", frame + 1, options.frames});
     }
     stats_file.close();

@@ -1,11 +1,13 @@
 // facet run from the command line: a headless session renders the same pixels as facet render,
 // writes non-empty frames for every sample display, and rejects bad displays with exit status 2;
 // --frames outside 1..1,000,000 and windows without a display server are exit 2; SIGINT and
-// SIGTERM stop a headless run with 130 and 143, leaving nothing.
+// SIGTERM stop a headless run with 130 and 143, leaving nothing; a long run keeps a flat resident
+// set.
 #include <OpenImageIO/imageio.h>
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 
+#include <algorithm>
 #include <csignal>
 #include <cstdlib>
 #include <filesystem>
@@ -345,6 +347,65 @@ TEST(RunCli, SigintAndSigtermStopAHeadlessRunAndLeaveNothing) {
     for (const fs::directory_entry& entry : fs::directory_iterator(folder))
       EXPECT_NE(entry.path().filename().string().front(), '.') << entry.path();
   }
+}
+
+// A long headless run keeps what it holds bounded: its resident set after frame 100 grows by at
+// most 4 MiB by frame 299 (a leak of 20 KiB per frame or more fails), every frame is in
+// stats.jsonl, and --save-every writes the images of frames 0, 100, 200 and the last only. The
+// 10,000-frame run of the README is the same command with more frames.
+TEST(RunCli, ALongHeadlessRunKeepsAFlatResidentSet) {
+  const fs::path folder = fresh_folder("soak");
+  // ASan's quarantine of freed memory grows the resident set by design; without it what stays
+  // resident is what the process holds, as in the normal build.
+  const char* asan = std::getenv("ASAN_OPTIONS");
+  const std::string asan_options = (asan ? std::string(asan) + ":" : std::string()) +
+                                   "quarantine_size_mb=0:thread_local_quarantine_size_kb=0";
+  ::setenv("ASAN_OPTIONS", asan_options.c_str(), 1);
+  const fs::path out = folder / "out";
+  const int status =
+      run("run " + (fs::path(FACET_SOURCE_DIR) / "configs/displays/dome4/display.json").string() +
+              " --headless --scale 0.125 --frames 300 --save-every 100 --out " + out.string(),
+          folder / "log");
+  if (asan)
+    ::setenv("ASAN_OPTIONS", asan, 1);
+  else
+    ::unsetenv("ASAN_OPTIONS");
+  ASSERT_EQ(status, 0) << slurp(folder / "log");
+  std::ifstream stats(out / "stats.jsonl");
+  std::vector<std::uint64_t> rss_kib;
+  for (std::string line; std::getline(stats, line);) {
+    const auto frame_at = line.find("\"frame\":");
+    const auto rss_at = line.find("\"rss_kib\":");
+    ASSERT_NE(frame_at, std::string::npos) << line;
+    ASSERT_NE(rss_at, std::string::npos) << line;
+    EXPECT_EQ(std::stoull(line.substr(frame_at + 8)), rss_kib.size());
+    rss_kib.push_back(std::stoull(line.substr(rss_at + 10)));
+  }
+  ASSERT_EQ(rss_kib.size(), 300u);
+  EXPECT_GT(rss_kib[100], 0u);
+  EXPECT_LE(rss_kib[299], rss_kib[100] + 4 * 1024)
+      << "resident set " << rss_kib[100] << " KiB after frame 100, " << rss_kib[299]
+      << " KiB after frame 299";
+  std::vector<std::string> images;
+  for (const auto& entry : fs::recursive_directory_iterator(out))
+    if (entry.path().extension() == ".png")
+      images.push_back(entry.path().parent_path().filename().string() + "/" +
+                       entry.path().filename().string());
+  std::sort(images.begin(), images.end());
+  std::vector<std::string> expected;
+  for (const char* projector : {"p0", "p1", "p2", "p3"})
+    for (const char* frame : {"00000", "00100", "00200", "00299"})
+      expected.push_back(std::string(projector) + "/" + frame + ".png");
+  EXPECT_EQ(images, expected);
+  // An interval below one frame is refused before anything is rendered.
+  EXPECT_EQ(run("run builtin:cylinder360 --headless --size 64x32 --save-every 0 --out " +
+                    (folder / "zero").string(),
+                folder / "log"),
+            2);
+  EXPECT_NE(slurp(folder / "log").find("'--save-every'"), std::string::npos)
+      << slurp(folder / "log");
+  EXPECT_FALSE(fs::exists(folder / "zero"));
+  fs::remove_all(folder);
 }
 
 }  // namespace

@@ -33,6 +33,7 @@ struct RunOptions {
   bool headless = false, windowed = false;
   std::optional<std::int64_t> frames;  // signed, so that a negative count is refused, not wrapped
   std::string out = "out/session";
+  std::int64_t save_every = 1;  // signed, as frames
   bool span = false, overlay = false, no_path = false;
   std::string report;
   bool monitors = false;
@@ -78,6 +79,9 @@ void run(const RunOptions& options) {
     throw InputError("command line", "--headless", "either --headless or --windowed, not both");
   std::optional<std::uint64_t> frames;
   if (options.frames) frames = checked_frames(*options.frames);
+  if (options.save_every < 1 || options.save_every > std::int64_t(driver::kMaxFrames))
+    throw InputError("command line", "--save-every",
+                     "a frame interval from 1 to " + std::to_string(driver::kMaxFrames));
   std::optional<glm::ivec2> size;
   if (!options.size.empty()) size = parse_size(options.size, "--size");
   const auto orientation = builtin_dome_orientation(options.orientation, options.display);
@@ -127,20 +131,19 @@ void run(const RunOptions& options) {
   driver::HeadlessRunOptions headless_options;
   headless_options.frames = frames.value_or(10);
   headless_options.out_dir = options.out;
+  headless_options.save_every = std::uint64_t(options.save_every);
   facet::TerminalProgress progress(stderr, "facet run");
   headless_options.progress = progress.sink();
   const driver::HeadlessRunResult result =
       driver::run_headless_session(session, path, headless_options);
   progress.finish();
-  std::cout << "facet run: " << result.frames.size() << " frames of " << display.outputs.size()
+  std::cout << "facet run: " << result.frames << " frames of " << display.outputs.size()
             << " output(s) (" << context->info().renderer << ", method " << display.method
-            << ") written to " << options.out << "/<output>/<frame>.png; statistics in "
-            << options.out << "/stats.jsonl\n";
-  if (!result.frames.empty()) {
-    const driver::FrameStats& last = result.frames.back();
-    std::cout << "facet run: last frame " << last.cpu_ms << " ms, replication ratio "
-              << last.replication_ratio() << "\n";
-  }
+            << ") rendered; " << result.images_written << " images written to " << options.out
+            << "/<output>/<frame>.png; statistics in " << options.out << "/stats.jsonl\n";
+  std::cout << "facet run: last frame " << result.last.cpu_ms << " ms, replication ratio "
+            << result.last.replication_ratio() << "; resident set " << result.rss_first_kib / 1024
+            << " MiB after the first frame, at most " << result.rss_peak_kib / 1024 << " MiB\n";
 }
 
 const Registration registration{
@@ -158,7 +161,7 @@ const Registration registration{
       command->add_option("--size", options->size, "Output size WxH of a built-in display");
       options->view.add_to(*command);
       command->add_option("--method", options->method,
-                          "facets, facets-gs, naive, cubemap or vertex (default: the display's)");
+                          "facets, facets-gs, tessellated, naive, cubemap or vertex (default: the display's)");
       command->add_option("--tolerance", options->tolerance, "Facet tolerance in output pixels");
       command->add_option("--scale", options->scale,
                           "Preview at this fraction of every output's resolution (0, 1]");
@@ -171,6 +174,9 @@ const Registration registration{
                           "closed)");
       command->add_option("--out", options->out,
                           "Headless: folder for <output>/<frame>.png and stats.jsonl");
+      command->add_option("--save-every", options->save_every,
+                          "Headless: write the images of every N-th frame and of the last "
+                          "(default 1: every frame); stats.jsonl always has every frame");
       command->add_flag("--span", options->span, "One borderless window spanning every output");
       command->add_flag("--overlay", options->overlay, "Start with the overlay shown (key O)");
       command->add_flag("--no-path", options->no_path, "Start still instead of on the path");

@@ -35,24 +35,31 @@ inline constexpr std::uint64_t kMaxFrames = 1'000'000;
 struct HeadlessRunOptions {
   std::uint64_t frames = 1;
   std::filesystem::path out_dir;  // receives <output>/<frame>.png and stats.jsonl
+  std::uint64_t save_every = 1;   // PNGs of frames 0, n, 2n, ... and of the last frame; >= 1
   bool finish_each_frame = true;  // glFinish per frame, so cpu_ms is the frame's whole time
   ProgressSink progress;          // ("frames", done, frames) before the first and after each frame
 };
 
+// What a run leaves in memory stays the same size whatever the frame count: the per-frame
+// statistics go to stats.jsonl only.
 struct HeadlessRunResult {
-  std::vector<FrameStats> frames;
-  std::vector<std::filesystem::path> images;  // every PNG written, in order
+  std::uint64_t frames = 0;          // frames rendered
+  std::uint64_t images_written = 0;  // PNGs written
+  FrameStats last;                   // the last frame's statistics
+  std::uint64_t rss_first_kib = 0;   // resident set after the first frame
+  std::uint64_t rss_peak_kib = 0;    // largest resident set after any frame
 };
 
 // Renders frames 0..frames-1 at times k·kFramePeriod_s along `path` and writes
-// out_dir/<output>/<frame, 5 digits>.png and out_dir/stats.jsonl (one frame_stats_to_json line
-// per frame). The folder is written under a temporary name and renamed when complete. An existing
-// out_dir is replaced only when it is empty or holds exactly an earlier run (stats.jsonl and
-// folders of NNNNN.png, nothing else); a folder with anything else in it, the current folder or
-// one of its parents, and a frame count outside [1, kMaxFrames] are InputErrors, raised
-// before anything is written. After watch_interrupts(), SIGINT or SIGTERM stops the run before
-// the next frame (or before the rename): the temporary folder is removed, out_dir is left as it
-// was, and Interrupted says how many frames were rendered.
+// out_dir/<output>/<frame, 5 digits>.png (every save_every-th frame and the last) and
+// out_dir/stats.jsonl (one frame_stats_to_json line per frame, plus "rss_kib": the process's
+// resident set after the frame). The folder is written under a temporary name and renamed when
+// complete. An existing out_dir is replaced only when it is empty or holds exactly an earlier run
+// (stats.jsonl and folders of NNNNN.png, nothing else); a folder with anything else in it, the
+// current folder or one of its parents, a frame count outside [1, kMaxFrames] and save_every 0 are
+// InputErrors, raised before anything is written. After watch_interrupts(), SIGINT or SIGTERM stops
+// the run before the next frame (or before the rename): the temporary folder is removed, out_dir is
+// left as it was, and Interrupted says how many frames were rendered.
 HeadlessRunResult run_headless_session(Session& session, const CameraPath& path,
                                        const HeadlessRunOptions& options);
 
