@@ -91,9 +91,9 @@ std::string layout_label(const FacetLayout& layout) {
   return format("tol=%gpx", std::get<FacetTolerance>(layout).px);
 }
 
-// The settings of one scenario: facets over `layouts`, facets-gs at `gs_layout` (the
-// geometry-shader form loops over facets per triangle, far slower on a software rasterizer than
-// the compute form, so it gets a small layout), naive over
+// The settings of one scenario: facets over `layouts`, facets-gs and tessellated at `gs_layout`
+// (the geometry-shader and tessellator forms loop over facets per triangle, far slower on a
+// software rasterizer than the compute form, so they get a small layout), naive over
 // `naive_layouts` (naive issues one draw per facet and object run, so layouts of thousands of
 // facets make it draw-call bound and are left out), cube faces of the given edge lengths, vertex
 // with the given tessellation caps.
@@ -108,9 +108,10 @@ std::vector<BenchSetting> sweep(const std::vector<FacetLayout>& layouts,
     s.settings.facets.layout = layout;
     settings.push_back(s);
   }
-  {
+  // The tessellator form takes the geometry-shader form's layout: it walks the same way.
+  for (const char* method : {"facets-gs", "tessellated"}) {
     const std::string label = layout_label(gs_layout);
-    BenchSetting s{"facets-gs", label, {}, label};
+    BenchSetting s{method, label, {}, label};
     s.settings.facets.layout = gs_layout;
     settings.push_back(s);
   }
@@ -515,7 +516,7 @@ BenchReport run_bench(const BenchOptions& options, const std::string& renderer,
         }
       }
       if (setting.method == "facets" || setting.method == "facets-gs" ||
-          setting.method == "naive") {
+          setting.method == "tessellated" || setting.method == "naive") {
         std::tie(row.geometric_max_px, row.geometric_rms_px) = facet_error_of(setting);
         row.geometric_source = "facet error";
       } else if (setting.method == "cubemap") {

@@ -199,6 +199,7 @@ const cv::Scalar kInk(40, 40, 40), kGrid(225, 225, 225);
 cv::Scalar method_colour(const std::string& method) {  // BGR
   if (method == "facets") return {40, 40, 220};
   if (method == "facets-gs") return {0, 150, 250};
+  if (method == "tessellated") return {150, 120, 0};
   if (method == "naive") return {200, 90, 30};
   if (method == "cubemap") return {60, 160, 40};
   return {160, 50, 150};
@@ -525,13 +526,15 @@ std::vector<std::string> bench_notes(const std::vector<BenchRow>& rows,
           "reuses them; paper: under 10%):" +
           line);
     }
-    for (const BenchRow* gs : rows_of(rows, scenario, "facets-gs")) {
-      if (gs->id_pixels_differing_from_facets) {
-        notes.push_back(
-            format("%s: facets-gs at %s: %llu ID pixels differ from facets (%s)", scenario.c_str(),
-                   gs->setting.c_str(),
-                   static_cast<unsigned long long>(*gs->id_pixels_differing_from_facets),
-                   *gs->id_pixels_differing_from_facets == 0 ? "identical" : "NOT identical"));
+    for (const char* method : {"facets-gs", "tessellated"}) {
+      for (const BenchRow* gs : rows_of(rows, scenario, method)) {
+        if (gs->id_pixels_differing_from_facets) {
+          notes.push_back(
+              format("%s: %s at %s: %llu ID pixels differ from facets (%s)", scenario.c_str(),
+                     method, gs->setting.c_str(),
+                     static_cast<unsigned long long>(*gs->id_pixels_differing_from_facets),
+                     *gs->id_pixels_differing_from_facets == 0 ? "identical" : "NOT identical"));
+        }
       }
     }
   }

@@ -7,10 +7,11 @@
 
 namespace facet::driver::detail {
 
-std::unique_ptr<RenderMethod> make_facet_pipeline();     // "facets" (facet_pipeline.cpp)
-std::unique_ptr<RenderMethod> make_facet_gs_pipeline();  // "facets-gs" (facet_gs_pipeline.cpp)
-std::unique_ptr<RenderMethod> make_naive_method();       // "naive" (naive_method.cpp)
-std::unique_ptr<RenderMethod> make_cubemap_method();     // "cubemap" (cubemap_method.cpp)
-std::unique_ptr<RenderMethod> make_vertex_method();      // "vertex" (vertex_method.cpp)
+std::unique_ptr<RenderMethod> make_facet_pipeline();        // "facets" (facet_pipeline.cpp)
+std::unique_ptr<RenderMethod> make_facet_gs_pipeline();     // "facets-gs" (facet_gs_pipeline.cpp)
+std::unique_ptr<RenderMethod> make_tessellated_pipeline();  // "tessellated"
+std::unique_ptr<RenderMethod> make_naive_method();          // "naive" (naive_method.cpp)
+std::unique_ptr<RenderMethod> make_cubemap_method();        // "cubemap" (cubemap_method.cpp)
+std::unique_ptr<RenderMethod> make_vertex_method();         // "vertex" (vertex_method.cpp)
 
 }  // namespace facet::driver::detail

@@ -19,8 +19,8 @@ Program link_replication_program(std::initializer_list<std::string_view> shaders
   for (std::string_view name : shaders) {
     builder.shader(name);
     const ShaderStage stage = stage_from_name(name);
-    if (stage == ShaderStage::vertex || stage == ShaderStage::geometry ||
-        (stage == ShaderStage::compute && !compute_has_lib)) {
+    if (stage == ShaderStage::vertex || stage == ShaderStage::tess_control ||
+        stage == ShaderStage::geometry || (stage == ShaderStage::compute && !compute_has_lib)) {
       builder.source(stage, std::string(lib_name), lib_text);
       if (stage == ShaderStage::compute) compute_has_lib = true;
     }

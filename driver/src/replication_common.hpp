@@ -33,7 +33,8 @@ class TimedPass {
 };
 
 // Links the embedded shaders with the replication function library (replication_lib.comp) added
-// as a second shader object to every vertex, geometry or compute stage among them.
+// as a second shader object to every vertex, tessellation control, geometry or compute stage
+// among them.
 Program link_replication_program(std::initializer_list<std::string_view> shaders,
                                  const std::vector<ShaderDefine>& defines = {});
 

@@ -77,7 +77,8 @@ TEST(BenchCli, QuickWritesJsonCsvAndPlotWithEveryMethod) {
   ASSERT_TRUE(json.contains("scale_fits"));
   EXPECT_TRUE(json["scale_fits"].empty());  // no scale scenario ran
   EXPECT_FALSE(json["notes"].empty());
-  const std::vector<std::string> methods = {"facets", "facets-gs", "cubemap", "naive", "vertex"};
+  const std::vector<std::string> methods = {"facets",  "facets-gs", "tessellated",
+                                            "cubemap", "naive",     "vertex"};
   std::set<std::string> seen;
   for (const auto& row : json["rows"]) {
     ASSERT_FALSE(row.contains("error")) << row.dump();
@@ -108,7 +109,7 @@ TEST(BenchCli, QuickWritesJsonCsvAndPlotWithEveryMethod) {
       EXPECT_LT(row["geometric_max_px"].get<double>(), 2.0);
       EXPECT_LT(mismatch, 0.01);
     }
-    if (row["method"] == "facets-gs") {
+    if (row["method"] == "facets-gs" || row["method"] == "tessellated") {
       ASSERT_TRUE(row.contains("id_pixels_differing_from_facets"));
       EXPECT_EQ(row["id_pixels_differing_from_facets"].get<int>(), 0);
     }
@@ -196,8 +197,8 @@ TEST(BenchScenarios, EveryScenarioHasValidOutputsAndEveryMethod) {
       }
       std::set<std::string> methods;
       for (const auto& setting : scenario.settings) methods.insert(setting.method);
-      EXPECT_EQ(methods,
-                (std::set<std::string>{"facets", "facets-gs", "cubemap", "naive", "vertex"}))
+      EXPECT_EQ(methods, (std::set<std::string>{"facets", "facets-gs", "tessellated", "cubemap",
+                                                "naive", "vertex"}))
           << scenario.name;
     }
     EXPECT_TRUE(names.contains("cylinder"));
@@ -275,10 +276,10 @@ TEST(BenchScenarios, ScaleBuildsItsRowsOverTheSceneSizes) {
       methods.push_back(setting.method);
       labels.push_back(setting.label);
     }
-    EXPECT_EQ(methods,
-              (std::vector<std::string>{"facets", "facets-gs", "naive", "cubemap", "vertex"}));
-    EXPECT_EQ(labels, (std::vector<std::string>{"tol=0.25px", "tol=0.25px", "tol=0.25px", "face=64",
-                                                "tess=1"}));
+    EXPECT_EQ(methods, (std::vector<std::string>{"facets", "facets-gs", "tessellated", "naive",
+                                                 "cubemap", "vertex"}));
+    EXPECT_EQ(labels, (std::vector<std::string>{"tol=0.25px", "tol=0.25px", "tol=0.25px",
+                                                "tol=0.25px", "face=64", "tess=1"}));
   }
   EXPECT_EQ(quick[0].outputs.at(0).warp.output_size, glm::ivec2(200, 150));
   EXPECT_EQ(quick[1].outputs.at(0).warp.output_size, glm::ivec2(256, 256));

@@ -106,11 +106,12 @@ std::size_t count_value(const std::vector<std::uint32_t>& ids, std::uint32_t val
 
 TEST(Pipeline, MethodNamesAndUnknownMethod) {
   const auto names = render_method_names();
-  ASSERT_EQ(names.size(), 5u);
+  ASSERT_EQ(names.size(), 6u);
   EXPECT_EQ(names[0], "facets");
   EXPECT_THROW(make_render_method("bogus"), InputError);
   EXPECT_EQ(make_render_method("facets")->name(), "facets");
   EXPECT_EQ(make_render_method("facets-gs")->name(), "facets-gs");
+  EXPECT_EQ(make_render_method("tessellated")->name(), "tessellated");
   EXPECT_EQ(make_render_method("naive")->name(), "naive");
 }
 
@@ -361,6 +362,42 @@ TEST(Pipeline, ModernAndSeedPipelinesGiveIdenticalIds) {
   EXPECT_EQ(differing, 0u);
   // The city fills the lower half of a street-level view and more.
   EXPECT_GT(modern.ids[0].size() - count_value(modern.ids[0], 0), modern.ids[0].size() / 2);
+}
+
+// The tessellator form draws what `facets` draws: the same IDs pixel for pixel and the same
+// replica count, on strips, on 0.25 px tolerance layouts of the cylinder and the tilted dome (with
+// quads and without), and with the levels capped at 1 so that every replica after a triangle's
+// first comes from a further instance of the draw (as beyond 64² = 4096 replicas uncapped).
+TEST(Pipeline, TessellatedFormGivesTheFacetsIds) {
+  test::shared_context();
+  const Scene scene = small_city();
+  RenderSettings quarter_px;
+  quarter_px.facets.layout = FacetTolerance{0.25};
+  RenderSettings facets_only = quarter_px;
+  facets_only.merge_coplanar_facets = false;
+  RenderSettings capped = strips(40);
+  capped.tessellated_max_level = 1;
+  const glm::dmat4 tilted =
+      glm::dmat4(glm::rotate(glm::dmat4(1.0), -1.2, glm::dvec3(1, 0, 0))) * city_view(2.0);
+  for (const auto& [name, outputs, settings, view] :
+       {std::tuple{"cylinder strips", cylinder(), strips(40), city_view(3.0)},
+        std::tuple{"cylinder strips, levels 1", cylinder(), capped, city_view(3.0)},
+        std::tuple{"cylinder 0.25 px", cylinder(), quarter_px, city_view(5.0)},
+        std::tuple{"dome 0.25 px, facets", dome(), facets_only, tilted}}) {
+    const Rendered modern = render("facets", scene, outputs, settings, view);
+    const Rendered tess = render("tessellated", scene, outputs, settings, view);
+    EXPECT_EQ(tess.stats.replicas, modern.stats.replicas) << name;
+    EXPECT_EQ(tess.stats.triangles_visible, modern.stats.triangles_visible) << name;
+    EXPECT_EQ(tess.stats.triangles_in, modern.stats.triangles_in) << name;
+    ASSERT_EQ(tess.ids[0].size(), modern.ids[0].size());
+    std::size_t differing = 0;
+    for (std::size_t k = 0; k < modern.ids[0].size(); ++k)
+      differing += modern.ids[0][k] != tess.ids[0][k];
+    EXPECT_EQ(differing, 0u) << name;
+    EXPECT_GT(modern.ids[0].size() - count_value(modern.ids[0], 0), modern.ids[0].size() / 4)
+        << name;
+    EXPECT_GT(modern.stats.replication_ratio(), 1.0) << name;
+  }
 }
 
 TEST(Pipeline, NaiveMatchesFacetsExceptOnDepthTies) {

@@ -335,7 +335,8 @@ const Registration registration{
                         "Keep frame 1's view on every frame (the facet methods then reuse "
                         "passes 1 and 2); by default the view moves every frame");
       command
-          ->add_option("--method", options->method, "facets | facets-gs | cubemap | naive | vertex")
+          ->add_option("--method", options->method,
+                       "facets | facets-gs | tessellated | cubemap | naive | vertex")
           ->capture_default_str();
       options->layout.add_to(*command);
       options->view.add_to(*command);

@@ -48,6 +48,10 @@ struct RenderSettings {
   int cube_face_size = 1024;
   // Per-vertex baseline: tessellation level cap (1 = no tessellation).
   int max_tessellation = 1;
+  // Tessellator form: cap on its tessellation levels, 0 for GL_MAX_TESS_GEN_LEVEL (64 or more).
+  // One patch makes at most cap² replicas; a triangle that covers more takes further instances
+  // of the draw. Lower caps exist to test that path cheaply.
+  int tessellated_max_level = 0;
   // Colour samples per pixel (0 or 1: no multisampling). IDs and depth are then resolved from
   // sample 0.
   int msaa_samples = 0;
@@ -125,7 +129,7 @@ struct RenderStats {
 class RenderMethod {
  public:
   virtual ~RenderMethod() = default;
-  // "facets", "facets-gs", "cubemap", "naive", "vertex".
+  // "facets", "facets-gs", "tessellated", "cubemap", "naive", "vertex".
   virtual std::string_view name() const = 0;
 
   // Builds everything that depends only on the outputs and the scene: facets, matrices, cube
