@@ -17,6 +17,7 @@
 #include <string_view>
 
 #include "facet/driver/city.hpp"
+#include "facet/driver/cluster.hpp"
 #include "facet/driver/gl_context.hpp"
 #include "facet/driver/output_images.hpp"
 #include "facet/driver/program.hpp"
@@ -160,14 +161,22 @@ HeadlessRunResult run_headless_session(Session& session, const CameraPath& path,
                                       (replacing ? " (what was there is kept)" : ""));
     };
     if (options.progress) options.progress({"frames", 0, options.frames});
-    for (std::uint64_t frame = 0; frame < options.frames; ++frame) {
-      stop_if_interrupted(frame);
+    for (std::uint64_t done = 0; done < options.frames; ++done) {
+      stop_if_interrupted(done);
       FrameState state;
-      state.frame = frame;
-      state.time_s = double(frame) * kFramePeriod_s;
+      state.frame = done;
+      state.time_s = double(done) * kFramePeriod_s;
       state.T_world_eye = path(state.time_s);
+      if (options.sync) {
+        std::optional<FrameState> next = options.sync->next_frame(state);
+        if (!next) break;
+        state = std::move(*next);
+      }
+      const std::uint64_t frame = state.frame;
       FrameStats stats = session.render(state, options.finish_each_frame);
-      const bool save = frame % options.save_every == 0 || frame + 1 == options.frames;
+      nlohmann::json line = frame_stats_to_json(stats);
+      const bool shown = !options.sync || options.sync->ready_to_swap(state, line);
+      const bool save = shown && (frame % options.save_every == 0 || frame + 1 == options.frames);
       for (std::size_t i = 0; save && i < session.targets().size(); ++i) {
         const OutputTarget& target = session.targets()[i];
         const fs::path image =
@@ -176,14 +185,14 @@ HeadlessRunResult run_headless_session(Session& session, const CameraPath& path,
         ++result.images_written;
       }
       const std::uint64_t rss_kib = resident_set_kib();
-      if (frame == 0) result.rss_first_kib = rss_kib;
+      if (done == 0) result.rss_first_kib = rss_kib;
       result.rss_peak_kib = std::max(result.rss_peak_kib, rss_kib);
-      nlohmann::json line = frame_stats_to_json(stats);
       line["rss_kib"] = rss_kib;
-      stats_file << line.dump() << '\n';
-      result.frames = frame + 1;
+      // Flushed per frame: whoever watches a long run (a cluster's tests) sees it progress.
+      stats_file << line.dump() << '\n' << std::flush;
+      result.frames = done + 1;
       result.last = std::move(stats);
-      if (options.progress) options.progress({"frames", frame + 1, options.frames});
+      if (options.progress) options.progress({"frames", done + 1, options.frames});
     }
     stats_file.close();
     if (!stats_file)
@@ -443,7 +452,18 @@ void run_windowed_session(const SessionDisplay& display, const Scene& scene, con
 
     windows.front().context->make_current();
     FrameState state{frame, time_s, nav.play_path ? T_path : nav.T_world_eye(), {}};
-    stats = session.render(state);
+    bool show = true;
+    if (options.sync) {
+      std::optional<FrameState> next = options.sync->next_frame(state);
+      if (!next) break;
+      state = std::move(*next);
+    }
+    // In a cluster the barrier is for rendered outputs: wait for the GPU first.
+    stats = session.render(state, options.sync != nullptr);
+    if (options.sync) {
+      nlohmann::json line;
+      show = options.sync->ready_to_swap(state, line);
+    }
     // The other contexts read the outputs: make the rendering visible to them first.
     GLsync rendered = glFenceSync(GL_SYNC_GPU_COMMANDS_COMPLETE, 0);
     glFlush();
@@ -460,7 +480,8 @@ void run_windowed_session(const SessionDisplay& display, const Scene& scene, con
       }
     }
     const bool last_frame = options.frames && frame + 1 == *options.frames;
-    for (std::size_t w = 0; w < windows.size(); ++w) {
+    // A frame the cluster went on without is not shown.
+    for (std::size_t w = 0; show && w < windows.size(); ++w) {
       Window& window = windows[w];
       window.context->make_current();
       glWaitSync(rendered, 0, GL_TIMEOUT_IGNORED);

@@ -3,11 +3,13 @@
 #include <iostream>
 #include <memory>
 #include <optional>
+#include <sstream>
 #include <string>
 #include <vector>
 
 #include "command.hpp"
 #include "display_flags.hpp"
+#include "facet/driver/cluster.hpp"
 #include "facet/driver/gl_context.hpp"
 #include "facet/driver/monitors.hpp"
 #include "facet/driver/scene_names.hpp"
@@ -38,7 +40,19 @@ struct RunOptions {
   std::string report;
   bool monitors = false;
   ViewFlags view;
+  std::string node;               // a cluster node of the display
+  double join_timeout_s = 60;     // cluster: how long nodes wait for each other at the start
+  std::optional<double> rate_hz;  // cluster master: at most this many frames a second
 };
+
+// The command-line settings that change a node's pictures, for the cluster's content digest.
+std::string picture_settings(const RunOptions& options, const driver::SessionDisplay& display) {
+  std::ostringstream text;
+  text.precision(17);
+  text << "method=" << display.method << ";scale=" << options.scale.value_or(1.0)
+       << ";tolerance=" << options.tolerance.value_or(0) << ";size=" << options.size;
+  return text.str();
+}
 
 bool have_display_server() {
   const char* x_display = std::getenv("DISPLAY");
@@ -89,6 +103,25 @@ void run(const RunOptions& options) {
   for (auto& output : display.outputs) {
     if (orientation) orient_warp(output.spec.warp, *orientation);
   }
+  // A cluster node renders its own projectors only.
+  std::optional<driver::ClusterNodeShare> cluster_share;
+  if (!options.node.empty()) {
+    if (!options.display.ends_with(".json"))
+      throw InputError("command line", "--node", "a display.json with a cluster section");
+    cluster_share = driver::keep_cluster_node_outputs(display, options.display, options.node);
+    if (!cluster_share->master && options.frames)
+      throw InputError("command line", "--frames",
+                       "no --frames on a secondary node: the master's --frames ends the run on "
+                       "every node");
+    if (!cluster_share->master && options.rate_hz)
+      throw InputError("command line", "--rate", "no --rate on a secondary: the master paces");
+    if (!(options.join_timeout_s > 0 && options.join_timeout_s <= 86400))
+      throw InputError("command line", "--join-timeout", "seconds in (0, 86400]");
+  } else if (options.rate_hz) {
+    throw InputError("command line", "--rate", "--node: --rate paces a cluster's master");
+  }
+  if (options.rate_hz && !(*options.rate_hz > 0 && *options.rate_hz <= 10000))
+    throw InputError("command line", "--rate", "frames per second in (0, 10000]");
   if (options.scale) driver::scale_session_display(display, *options.scale);
   if (!options.method.empty()) display.method = options.method;
   if (options.tolerance) {
@@ -112,6 +145,28 @@ void run(const RunOptions& options) {
   const driver::CameraPath path =
       driver::camera_path(choose_view(scene, view_request, scene_name.builtin_city(), "run"));
 
+  // A cluster node joins its cluster before it renders: a wrong address or an address in use is
+  // found before any GL work.
+  std::unique_ptr<driver::FrameSync> sync;
+  if (cluster_share) {
+    driver::ClusterNodeOptions node_options;
+    node_options.cluster = *cluster_share->config.cluster;
+    node_options.source = options.display;
+    node_options.node = cluster_share->node;
+    node_options.frame_period_s = driver::kFramePeriod_s;
+    node_options.join_timeout =
+        std::chrono::milliseconds(std::int64_t(options.join_timeout_s * 1000));
+    node_options.rate_hz = options.rate_hz;
+    node_options.content_digest =
+        driver::content_digest(cluster_share->config, options.display, scene_name.text,
+                               scene_name.kind == driver::SceneName::Kind::file
+                                   ? std::optional<std::filesystem::path>(scene_name.file)
+                                   : std::nullopt,
+                               picture_settings(options, display));
+    sync = cluster_share->master ? driver::make_cluster_master(node_options)
+                                 : driver::make_cluster_secondary(node_options);
+  }
+
   // From here on SIGINT and SIGTERM stop the run cleanly (Interrupted, exit 128 + signal).
   watch_interrupts();
   if (!headless) {
@@ -121,6 +176,7 @@ void run(const RunOptions& options) {
     window_options.overlay = options.overlay;
     window_options.play_path = !options.no_path;
     if (!options.report.empty()) window_options.report = options.report;
+    window_options.sync = sync.get();
     driver::run_windowed_session(display, scene, path, window_options);
     return;
   }
@@ -132,8 +188,11 @@ void run(const RunOptions& options) {
   headless_options.frames = frames.value_or(10);
   headless_options.out_dir = options.out;
   headless_options.save_every = std::uint64_t(options.save_every);
+  headless_options.sync = sync.get();
+  // A secondary runs until the master ends the run: no count to show progress against.
+  if (cluster_share && !cluster_share->master) headless_options.frames = driver::kMaxFrames;
   facet::TerminalProgress progress(stderr, "facet run");
-  headless_options.progress = progress.sink();
+  if (!cluster_share || cluster_share->master) headless_options.progress = progress.sink();
   const driver::HeadlessRunResult result =
       driver::run_headless_session(session, path, headless_options);
   progress.finish();
@@ -160,8 +219,9 @@ const Registration registration{
           ->capture_default_str();
       command->add_option("--size", options->size, "Output size WxH of a built-in display");
       options->view.add_to(*command);
-      command->add_option("--method", options->method,
-                          "facets, facets-gs, tessellated, naive, cubemap or vertex (default: the display's)");
+      command->add_option(
+          "--method", options->method,
+          "facets, facets-gs, tessellated, naive, cubemap or vertex (default: the display's)");
       command->add_option("--tolerance", options->tolerance, "Facet tolerance in output pixels");
       command->add_option("--scale", options->scale,
                           "Preview at this fraction of every output's resolution (0, 1]");
@@ -182,6 +242,17 @@ const Registration registration{
       command->add_flag("--no-path", options->no_path, "Start still instead of on the path");
       command->add_option("--report", options->report,
                           "Windowed: write window placement and shown-pixel checks to this JSON");
+      command->add_option("--node", options->node,
+                          "Run as this node of the display.json's cluster: its projectors only, "
+                          "frame-locked with the others (see README: Clusters)");
+      command
+          ->add_option("--join-timeout", options->join_timeout_s,
+                       "Cluster: seconds the master waits for the nodes to join, and a node "
+                       "for the master's first word")
+          ->capture_default_str();
+      command->add_option("--rate", options->rate_hz,
+                          "Cluster master: at most this many frames per second (default: as "
+                          "fast as the slowest node)");
       command->add_flag("--monitors", options->monitors,
                         "List the connected monitors (name, size+x+y, refresh) and exit");
       command->callback([options] { run(*options); });

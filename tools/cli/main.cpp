@@ -49,6 +49,9 @@ int main(int argc, char** argv) {
   } catch (const facet::InputError& e) {
     std::cerr << "facet: error: " << e.what() << "\n";
     return 2;
+  } catch (const facet::PeerLost& e) {
+    std::cerr << "facet: stopped: " << e.what() << "\n";
+    return 3;
   } catch (const std::exception& e) {
     std::cerr << "facet: internal error: " << e.what() << "\n";
     return 1;

@@ -16,6 +16,8 @@
 
 namespace facet::driver {
 
+class FrameSync;
+
 // Frames advance scene time by this much: a 60 Hz projector.
 inline constexpr double kFramePeriod_s = 1.0 / 60.0;
 
@@ -37,7 +39,11 @@ struct HeadlessRunOptions {
   std::filesystem::path out_dir;  // receives <output>/<frame>.png and stats.jsonl
   std::uint64_t save_every = 1;   // PNGs of frames 0, n, 2n, ... and of the last frame; >= 1
   bool finish_each_frame = true;  // glFinish per frame, so cpu_ms is the frame's whole time
-  ProgressSink progress;          // ("frames", done, frames) before the first and after each frame
+  // Where the frame states come from and when a frame is shown (cluster.hpp); null: frames
+  // 0..frames-1 along the path, each shown. With a sync, `frames` only bounds the run and names
+  // the last frame for save_every, and a frame the sync does not let swap is not written.
+  FrameSync* sync = nullptr;
+  ProgressSink progress;  // ("frames", done, frames) before the first and after each frame
 };
 
 // What a run leaves in memory stays the same size whatever the frame count: the per-frame
@@ -71,6 +77,8 @@ struct WindowRunOptions {
   // Written when the run ends: per window its placement, its actual position and size, and
   // whether its framebuffer held exactly its output's pixels on the last frame.
   std::optional<std::filesystem::path> report;
+  // A cluster node's frame states and swap barrier (cluster.hpp); null: the session's own.
+  FrameSync* sync = nullptr;
 };
 
 // Opens the windows (one per output on its monitor, or one spanning window), renders until the

@@ -31,6 +31,13 @@ class InputError : public std::runtime_error {
   std::string source_, field_, expected_;
 };
 
+// A run that stopped because a process it works with went away: a cluster's master, or one of
+// its critical nodes. The message names it; the CLI turns it into exit status 3.
+class PeerLost : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
 [[noreturn]] void assertion_failed(const char* function, const char* condition, const char* file,
                                    int line);
 

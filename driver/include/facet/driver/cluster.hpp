@@ -1,0 +1,139 @@
+#pragma once
+// Clusters: one session over many render nodes (display.json "cluster"), frame-locked over NNG
+// (nanomsg-next-generation's scalability protocols).
+//
+// The master owns the frame state. Every frame it
+//   1. publishes FrameState N (pub/sub), together with the digest of the display and scene it
+//      runs; every node renders its own projectors from it;
+//   2. surveys "frame N rendered?" (surveyor/respondent) with the cluster's deadline; each node
+//      answers when its outputs are rendered and about to swap;
+//   3. publishes "swap N" with the nodes that missed the deadline, which are dropped from the
+//      barrier, and the nodes that answered again, which rejoin it. Then every node swaps.
+// Between frames the master publishes a heartbeat every quarter deadline, so that a secondary
+// that hears nothing for a deadline knows the master is gone, whatever the frames cost to render.
+//
+// Addresses: every node listens on its address (frame states) and on
+// cluster_barrier_address(address) (the barrier); the master dials every other node, so nodes
+// may start in any order, and a restarted node is found again by the master's dialer.
+//
+// No hardware swap lock: GLX_NV_swap_group is not used; the barrier is the software one above.
+//
+// No GL here: the wire format and the protocol run in any process.
+#include <chrono>
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "facet/driver/session.hpp"
+#include "facet/projection_io/display_config.hpp"
+
+namespace facet::driver {
+
+// ---- Frame state on the wire ----------------------------------------------------------------
+
+// "FSTA", a version, then every FrameState field, little-endian. A decoder refuses any other
+// version: nodes of one cluster run the same facet.
+inline constexpr std::uint16_t kFrameStateWireVersion = 1;
+
+std::vector<std::uint8_t> encode_frame_state(const FrameState& state);
+// Throws InputError(source, field, ...) for a wrong magic or version, a truncated or overlong
+// message, a non-finite number or more than kMaxObjectPoses object poses.
+FrameState decode_frame_state(std::span<const std::uint8_t> bytes, const std::string& source);
+
+// 64-bit FNV-1a: the digest of a frame state (of its encoding) and of a display and scene.
+class Digest {
+ public:
+  Digest& add(std::span<const std::uint8_t> bytes);
+  Digest& add(std::string_view text);  // its bytes, then its length, so that "ab","c" != "a","bc"
+  // The bytes of a file; InputError when it cannot be read.
+  Digest& add_file(const std::filesystem::path& path);
+  std::uint64_t value() const { return value_; }
+
+ private:
+  std::uint64_t value_ = 0xcbf29ce484222325ull;
+};
+std::string digest_hex(std::uint64_t digest);  // 16 lower-case hex digits
+std::uint64_t frame_state_digest(const FrameState& state);
+
+// What a display and a scene come to, for the master and its nodes to compare: display.json's
+// bytes and those of every warp, blend and black file it names, the scene's name (and the bytes
+// of its file), and `settings`: whatever else changes the pictures (the command line's --scale,
+// --method, ...).
+std::uint64_t content_digest(const projection_io::DisplayConfig& display,
+                             const std::filesystem::path& display_file,
+                             const std::string& scene_name,
+                             const std::optional<std::filesystem::path>& scene_file,
+                             const std::string& settings);
+
+// ---- A node of a running cluster --------------------------------------------------------------
+
+struct ClusterNodeOptions {
+  projection_io::DisplayCluster cluster;
+  std::string source;  // display.json, for messages
+  std::string node;    // this process's node: one of cluster.nodes
+  double frame_period_s = 1.0 / 60.0;
+  std::uint64_t content_digest = 0;
+  // How long the master waits for every node to join before it starts (a critical node that
+  // has not joined by then stops it with PeerLost; the others may join later), and how long a
+  // secondary waits for the first word from the master.
+  std::chrono::milliseconds join_timeout{60'000};
+  // Master: at most this many frames a second (a headless run paced like a show); nullopt: as
+  // fast as the slowest node renders.
+  std::optional<double> rate_hz;
+  std::function<void(const std::string&)> report;  // one line per event; default: stderr
+};
+
+// The cluster's deadline in ms: its deadline_ms, or kDefaultClusterDeadlineFrames frame periods.
+double cluster_deadline_ms(const projection_io::DisplayCluster& cluster, double frame_period_s);
+
+// The node named `node`, or InputError(source, "--node", the names there are).
+const projection_io::ClusterNode& find_cluster_node(const projection_io::DisplayCluster& cluster,
+                                                    const std::string& node,
+                                                    const std::string& source);
+
+// Where a headless or windowed run gets its frames and when it may show them: frame-locked with
+// a cluster.
+class FrameSync {
+ public:
+  virtual ~FrameSync() = default;
+  // The state to render next, given `own`: the state this process would show on its own (its
+  // camera path or navigation at its next frame number). The master broadcasts `own` and
+  // returns it; a secondary returns the newest state the master sent instead. nullopt when the
+  // master says the run is over.
+  virtual std::optional<FrameState> next_frame(const FrameState& own) = 0;
+  // Called when `state`'s outputs are rendered: waits for the cluster, then says whether to show
+  // (swap, write) them. Adds what it knows to `stats` (the frame's stats.jsonl line).
+  virtual bool ready_to_swap(const FrameState& state, nlohmann::json& stats) = 0;
+};
+
+// The master: broadcasts the frame states and runs the barrier. Construction listens on the
+// node's address and dials the others (InputError when the address cannot be listened on, e.g.
+// in use); the first next_frame waits for the nodes to join. Loss of a critical node: PeerLost
+// naming it, after telling every node to stop. The destructor tells the nodes the run is over.
+std::unique_ptr<FrameSync> make_cluster_master(const ClusterNodeOptions& options);
+
+// A secondary: listens on its addresses (InputError when it cannot) and renders what the master
+// sends. PeerLost when the master has been silent for the deadline (or for join_timeout before
+// its first word) or stops the cluster; InputError when the master runs another display or scene
+// (a different content digest).
+std::unique_ptr<FrameSync> make_cluster_secondary(const ClusterNodeOptions& options);
+
+// A node's part of a display: reads the cluster section of `display_file` (a display.json) and
+// keeps in `display` (load_session_display's result for the same file) the outputs of node
+// `node`'s projectors only. InputError when the file has no cluster section or no such node.
+struct ClusterNodeShare {
+  projection_io::DisplayConfig config;
+  std::string node;
+  bool master = false;
+};
+ClusterNodeShare keep_cluster_node_outputs(SessionDisplay& display,
+                                           const std::filesystem::path& display_file,
+                                           const std::string& node);
+
+}  // namespace facet::driver

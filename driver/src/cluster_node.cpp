@@ -1,0 +1,680 @@
+// The cluster protocol over NNG: the master's frame-state broadcast (pub/sub) and swap barrier
+// (surveyor/respondent), and the secondaries' side of both. See cluster.hpp.
+#include <nng/nng.h>
+#include <nng/protocol/pubsub0/pub.h>
+#include <nng/protocol/pubsub0/sub.h>
+#include <nng/protocol/survey0/respond.h>
+#include <nng/protocol/survey0/survey.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <condition_variable>
+#include <cstdio>
+#include <cstring>
+#include <deque>
+#include <map>
+#include <mutex>
+#include <set>
+#include <thread>
+
+#include "facet/driver/cluster.hpp"
+#include "facet/projection/errors.hpp"
+#include "facet/projection/interrupt.hpp"
+
+namespace facet::driver {
+
+using Clock = std::chrono::steady_clock;
+using projection_io::ClusterNode;
+
+double cluster_deadline_ms(const projection_io::DisplayCluster& cluster, double frame_period_s) {
+  return cluster.deadline_ms.value_or(projection_io::kDefaultClusterDeadlineFrames *
+                                      frame_period_s * 1000.0);
+}
+
+const ClusterNode& find_cluster_node(const projection_io::DisplayCluster& cluster,
+                                     const std::string& node, const std::string& source) {
+  std::string names;
+  for (const ClusterNode& candidate : cluster.nodes) {
+    if (candidate.name == node) return candidate;
+    names += (names.empty() ? "" : ", ") + candidate.name;
+  }
+  throw InputError(source, "--node",
+                   "the name of one of the cluster's nodes (" + names + "), got '" + node + "'");
+}
+
+namespace {
+
+// Message kinds. Every published message starts with its kind and the master's content digest.
+enum class Published : std::uint8_t { heartbeat = 1, frame = 2, swap = 3, end = 4, stop = 5 };
+enum class Survey : std::uint8_t { join = 1, ready = 2 };
+
+constexpr auto kPoll = std::chrono::milliseconds(20);  // how often blocked threads look up
+
+double ms_since(Clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
+std::string ms_text(double ms) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.1f ms", ms);
+  return text;
+}
+
+class Bytes {
+ public:
+  template <typename T>
+  Bytes& put(const T& value) {
+    const auto* p = reinterpret_cast<const std::uint8_t*>(&value);
+    data.insert(data.end(), p, p + sizeof value);
+    return *this;
+  }
+  Bytes& put_bytes(std::span<const std::uint8_t> bytes) {
+    data.insert(data.end(), bytes.begin(), bytes.end());
+    return *this;
+  }
+  Bytes& put_text(std::string_view text) {
+    return put_bytes(std::span(reinterpret_cast<const std::uint8_t*>(text.data()), text.size()));
+  }
+  std::vector<std::uint8_t> data;
+};
+
+// Reads a received message front to back; `ok` turns false on a short message.
+class Parse {
+ public:
+  explicit Parse(std::span<const std::uint8_t> bytes) : bytes_(bytes) {}
+  template <typename T>
+  T get() {
+    T value{};
+    if (bytes_.size() - at_ < sizeof value) {
+      ok = false;
+      return value;
+    }
+    std::memcpy(&value, bytes_.data() + at_, sizeof value);
+    at_ += sizeof value;
+    return value;
+  }
+  std::span<const std::uint8_t> rest() const { return bytes_.subspan(at_); }
+  std::string rest_text() const {
+    return std::string(reinterpret_cast<const char*>(bytes_.data() + at_), bytes_.size() - at_);
+  }
+  bool ok = true;
+
+ private:
+  std::span<const std::uint8_t> bytes_;
+  std::size_t at_ = 0;
+};
+
+// One NNG socket, closed with its owner.
+class Socket {
+ public:
+  Socket() = default;
+  ~Socket() {
+    if (open_) nng_close(socket_);
+  }
+  Socket(const Socket&) = delete;
+  Socket& operator=(const Socket&) = delete;
+
+  void open(int (*opener)(nng_socket*), const char* what) {
+    if (const int error = opener(&socket_))
+      throw std::runtime_error(std::string("cannot open an NNG ") + what +
+                               " socket: " + nng_strerror(error));
+    open_ = true;
+  }
+  nng_socket get() const { return socket_; }
+
+  // Listens on `address`; InputError naming the node and the address when it cannot (in use,
+  // no such local address, a path that cannot be made).
+  void listen(const std::string& address, const std::string& source, const std::string& node) {
+    if (const int error = nng_listen(socket_, address.c_str(), nullptr, 0)) {
+      std::string why = nng_strerror(error);
+      if (error == NNG_EADDRINUSE)
+        why += ": another process listens there (is node '" + node + "' running twice?)";
+      throw InputError(source, "cluster.nodes." + node + ".address",
+                       "an address node '" + node + "' can listen on, but " + address + ": " + why);
+    }
+  }
+  // Dials `address` in the background, again and again until it answers and whenever it is lost.
+  void dial(const std::string& address) {
+    const int error = nng_dial(socket_, address.c_str(), nullptr, NNG_FLAG_NONBLOCK);
+    if (error != 0) throw std::runtime_error("cannot dial " + address + ": " + nng_strerror(error));
+  }
+  void set_ms(const char* option, double ms) {
+    nng_socket_set_ms(socket_, option, nng_duration(std::max(1.0, std::ceil(ms))));
+  }
+  void send(const std::vector<std::uint8_t>& bytes) {
+    // A pub socket never blocks; a respondent's answer to an expired survey is dropped by NNG.
+    nng_send(socket_, const_cast<std::uint8_t*>(bytes.data()), bytes.size(), 0);
+  }
+  // A message, or nullopt after the receive timeout (or any other error).
+  std::optional<std::vector<std::uint8_t>> receive(int* error_out = nullptr) {
+    void* buffer = nullptr;
+    std::size_t size = 0;
+    const int error = nng_recv(socket_, &buffer, &size, NNG_FLAG_ALLOC);
+    if (error_out) *error_out = error;
+    if (error != 0) return std::nullopt;
+    const auto* p = static_cast<const std::uint8_t*>(buffer);
+    std::vector<std::uint8_t> bytes(p, p + size);
+    nng_free(buffer, size);
+    return bytes;
+  }
+
+ private:
+  nng_socket socket_ = NNG_SOCKET_INITIALIZER;
+  bool open_ = false;
+};
+
+void default_report(const std::string& line) {
+  std::fprintf(stderr, "facet run: %s\n", line.c_str());
+}
+
+void say_no_swap_group_once(const std::function<void(const std::string&)>& report) {
+  static std::once_flag said;
+  std::call_once(said, [&] {
+    report(
+        "no hardware swap lock (GLX_NV_swap_group is not used): frames are locked by the "
+        "software barrier");
+  });
+}
+
+// One node's part in a frame's barrier, as the master saw it.
+struct Dropped {
+  std::string node;
+  std::uint64_t frame = 0;
+  double waited_ms = 0;
+};
+
+nlohmann::json swap_json(std::uint64_t frame, const std::vector<Dropped>& dropped,
+                         const std::vector<std::string>& rejoined,
+                         const std::vector<std::string>& active) {
+  nlohmann::json dropped_json = nlohmann::json::array();
+  for (const Dropped& d : dropped)
+    dropped_json.push_back({{"node", d.node}, {"frame", d.frame}, {"waited_ms", d.waited_ms}});
+  return {{"frame", frame}, {"dropped", dropped_json}, {"rejoined", rejoined}, {"active", active}};
+}
+
+// ---- Master ------------------------------------------------------------------------------------
+
+class Master final : public FrameSync {
+ public:
+  explicit Master(const ClusterNodeOptions& options)
+      : options_(options),
+        deadline_ms_(cluster_deadline_ms(options.cluster, options.frame_period_s)) {
+    if (!options_.report) options_.report = default_report;
+    const ClusterNode& self = find_cluster_node(options_.cluster, options_.node, options_.source);
+    publisher_.open(nng_pub0_open, "pub");
+    surveyor_.open(nng_surveyor0_open, "surveyor");
+    publisher_.listen(self.address, options_.source, self.name);
+    surveyor_.listen(projection_io::cluster_barrier_address(self.address), options_.source,
+                     self.name);
+    for (Socket* socket : {&publisher_, &surveyor_}) {
+      socket->set_ms(NNG_OPT_RECONNMINT, 10);
+      socket->set_ms(NNG_OPT_RECONNMAXT, 100);
+    }
+    surveyor_.set_ms(NNG_OPT_SURVEYOR_SURVEYTIME, deadline_ms_);
+    surveyor_.set_ms(NNG_OPT_RECVTIMEO, deadline_ms_);
+    for (const ClusterNode& node : options_.cluster.nodes) {
+      if (node.name == self.name) continue;
+      publisher_.dial(node.address);
+      surveyor_.dial(projection_io::cluster_barrier_address(node.address));
+      secondaries_.push_back(&node);
+    }
+    say_no_swap_group_once(options_.report);
+    heartbeat_ = std::thread([this] { beat(); });
+  }
+
+  ~Master() override {
+    {
+      std::lock_guard lock(mutex_);
+      stopping_ = true;
+    }
+    wake_.notify_all();
+    heartbeat_.join();
+    // Said a few times: a subscriber that is reconnecting must not miss the end and wait for a
+    // deadline instead.
+    if (!stopped_) {
+      for (int i = 0; i < 3; ++i) {
+        publish(Published::end, Bytes().put(last_frame_).data);
+        std::this_thread::sleep_for(std::chrono::milliseconds(5));
+      }
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));  // let the last words go out
+  }
+
+  std::optional<FrameState> next_frame(const FrameState& own) override {
+    if (!joined_) wait_for_nodes();
+    if (options_.rate_hz) {
+      const auto due =
+          started_ + std::chrono::duration_cast<Clock::duration>(
+                         std::chrono::duration<double>(double(frames_sent_) / *options_.rate_hz));
+      std::this_thread::sleep_until(due);
+    }
+    ++frames_sent_;
+    last_frame_ = own.frame;
+    const FrameState& state = own;
+    const Clock::time_point start = Clock::now();
+    publish(Published::frame, encode_frame_state(state));
+    last_broadcast_ms_ = ms_since(start);
+    return state;
+  }
+
+  bool ready_to_swap(const FrameState& state, nlohmann::json& stats) override {
+    const Clock::time_point start = Clock::now();
+    surveyor_.send(Bytes().put(Survey::ready).put(state.frame).data);
+    std::set<std::string> answered;
+    std::vector<std::string> rejoined;
+    while (answered.size() < active_.size() + rejoined.size()) {
+      const auto reply = surveyor_.receive();
+      if (!reply) break;  // the survey expired: the deadline has passed
+      const auto answer = parse_answer(*reply, Survey::ready, state.frame);
+      if (!answer) continue;
+      if (active_.contains(*answer) ||
+          std::find(rejoined.begin(), rejoined.end(), *answer) != rejoined.end()) {
+        answered.insert(*answer);
+      } else {
+        rejoined.push_back(*answer);
+        answered.insert(*answer);
+      }
+    }
+    const double barrier_ms = ms_since(start);
+    std::vector<Dropped> dropped;
+    for (const std::string& node : active_) {
+      if (!answered.contains(node)) dropped.push_back({node, state.frame, barrier_ms});
+    }
+    for (const Dropped& d : dropped) {
+      active_.erase(d.node);
+      options_.report("node " + d.node + " missed the barrier of frame " + std::to_string(d.frame) +
+                      ": no answer within " + ms_text(d.waited_ms) + "; dropped, the others go on");
+    }
+    for (const std::string& node : rejoined) {
+      active_.insert(node);
+      options_.report("node " + node + " rejoined at frame " + std::to_string(state.frame));
+    }
+    for (const Dropped& d : dropped) {
+      if (node_named(d.node).critical) {
+        const std::string reason = "critical node " + d.node + " lost at frame " +
+                                   std::to_string(d.frame) + " (no answer within " +
+                                   ms_text(d.waited_ms) + ")";
+        stop(reason);
+        throw PeerLost(reason);
+      }
+    }
+    const std::vector<std::string> active(active_.begin(), active_.end());
+    const nlohmann::json swap = swap_json(state.frame, dropped, rejoined, active);
+    const Clock::time_point release = Clock::now();
+    publish(Published::swap, Bytes().put(state.frame).put_text(swap.dump()).data);
+    const double release_ms = ms_since(release);
+    nlohmann::json cluster = swap;
+    cluster["node"] = options_.node;
+    cluster["role"] = "master";
+    cluster["state_digest"] = digest_hex(frame_state_digest(state));
+    cluster["barrier_ms"] = barrier_ms;
+    cluster["broadcast_ms"] = last_broadcast_ms_ + release_ms;
+    cluster["swapped"] = true;
+    stats["cluster"] = std::move(cluster);
+    return true;
+  }
+
+ private:
+  void publish(Published kind, const std::vector<std::uint8_t>& body) {
+    publisher_.send(Bytes().put(kind).put(options_.content_digest).put_bytes(body).data);
+  }
+
+  void stop(const std::string& reason) {
+    stopped_ = true;
+    for (int i = 0; i < 3; ++i) {
+      publish(Published::stop, Bytes().put_text(reason).data);
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+  }
+
+  const ClusterNode& node_named(const std::string& name) const {
+    return find_cluster_node(options_.cluster, name, options_.source);
+  }
+
+  // The node that answered survey `kind` for `frame`, when it runs our display and scene (and,
+  // when joining, hears our broadcast); the others are reported once each and ignored.
+  std::optional<std::string> parse_answer(const std::vector<std::uint8_t>& reply, Survey kind,
+                                          std::uint64_t frame) {
+    Parse in(reply);
+    const auto answer_kind = in.get<Survey>();
+    const auto answer_frame = in.get<std::uint64_t>();
+    const auto digest = in.get<std::uint64_t>();
+    const auto hears = in.get<std::uint8_t>();
+    const std::string name = in.rest_text();
+    if (!in.ok || answer_kind != kind || answer_frame != frame) return std::nullopt;
+    const bool known = std::any_of(secondaries_.begin(), secondaries_.end(),
+                                   [&](const ClusterNode* node) { return node->name == name; });
+    if (!known) {
+      if (complained_.insert("unknown " + name).second)
+        options_.report("an answer from '" + name + "', which is no secondary of " +
+                        options_.source + "; ignored");
+      return std::nullopt;
+    }
+    if (digest != options_.content_digest) {
+      if (complained_.insert("digest " + name).second)
+        options_.report("node " + name + " runs another display or scene (content digest " +
+                        digest_hex(digest) + ", the master's " +
+                        digest_hex(options_.content_digest) + "): refused");
+      return std::nullopt;
+    }
+    if (kind == Survey::join && !hears) return std::nullopt;  // not subscribed yet
+    return name;
+  }
+
+  void wait_for_nodes() {
+    joined_ = true;
+    const Clock::time_point start = Clock::now();
+    std::string names;
+    for (const ClusterNode* node : secondaries_) names += " " + node->name;
+    if (!secondaries_.empty())
+      options_.report("master " + options_.node + ": waiting up to " +
+                      ms_text(double(options_.join_timeout.count())) + " for nodes" + names);
+    while (active_.size() < secondaries_.size() && Clock::now() - start < options_.join_timeout) {
+      if (const int signal = interrupt_signal())
+        throw Interrupted(signal, "stopped while waiting for the cluster's nodes");
+      surveyor_.set_ms(NNG_OPT_SURVEYOR_SURVEYTIME, 100);
+      publish(Published::heartbeat, {});  // so that a node that has just come hears us at once
+      surveyor_.send(Bytes().put(Survey::join).put(std::uint64_t(0)).data);
+      const Clock::time_point survey_start = Clock::now();
+      while (ms_since(survey_start) < 100) {
+        const auto reply = surveyor_.receive();
+        if (!reply) break;
+        if (const auto name = parse_answer(*reply, Survey::join, 0)) active_.insert(*name);
+      }
+    }
+    surveyor_.set_ms(NNG_OPT_SURVEYOR_SURVEYTIME, deadline_ms_);
+    std::string missing;
+    const ClusterNode* missing_critical = nullptr;
+    for (const ClusterNode* node : secondaries_) {
+      if (active_.contains(node->name)) continue;
+      missing += " " + node->name;
+      if (node->critical && !missing_critical) missing_critical = node;
+    }
+    if (missing_critical) {
+      const std::string reason = "critical node " + missing_critical->name +
+                                 " did not join within " +
+                                 ms_text(double(options_.join_timeout.count()));
+      stop(reason);
+      throw PeerLost(reason);
+    }
+    if (!missing.empty())
+      options_.report("starting without" + missing + " (not joined within " +
+                      ms_text(double(options_.join_timeout.count())) + "; they join when ready)");
+    else if (!secondaries_.empty())
+      options_.report("all " + std::to_string(secondaries_.size() + 1) + " nodes joined in " +
+                      ms_text(ms_since(start)) + "; deadline " + ms_text(deadline_ms_));
+    started_ = Clock::now();
+  }
+
+  void beat() {
+    const auto period = std::chrono::duration_cast<Clock::duration>(
+        std::chrono::duration<double, std::milli>(std::max(1.0, deadline_ms_ / 4)));
+    std::unique_lock lock(mutex_);
+    while (!stopping_) {
+      publish(Published::heartbeat, {});
+      wake_.wait_for(lock, period, [this] { return stopping_; });
+    }
+  }
+
+  ClusterNodeOptions options_;
+  double deadline_ms_;
+  Socket publisher_, surveyor_;
+  std::vector<const ClusterNode*> secondaries_;
+  std::set<std::string> active_;  // secondaries in the barrier
+  std::set<std::string> complained_;
+  bool joined_ = false, stopped_ = false;
+  std::uint64_t frames_sent_ = 0, last_frame_ = 0;
+  double last_broadcast_ms_ = 0;
+  Clock::time_point started_ = Clock::now();
+  std::mutex mutex_;
+  std::condition_variable wake_;
+  bool stopping_ = false;
+  std::thread heartbeat_;
+};
+
+// ---- Secondary ---------------------------------------------------------------------------------
+
+class Secondary final : public FrameSync {
+ public:
+  explicit Secondary(const ClusterNodeOptions& options)
+      : options_(options),
+        deadline_ms_(cluster_deadline_ms(options.cluster, options.frame_period_s)),
+        self_(find_cluster_node(options_.cluster, options_.node, options_.source)),
+        master_(options_.cluster.master) {
+    if (!options_.report) options_.report = default_report;
+    subscriber_.open(nng_sub0_open, "sub");
+    respondent_.open(nng_respondent0_open, "respondent");
+    nng_socket_set(subscriber_.get(), NNG_OPT_SUB_SUBSCRIBE, "", 0);
+    nng_socket_set_int(subscriber_.get(), NNG_OPT_RECVBUF, 1024);
+    subscriber_.set_ms(NNG_OPT_RECVTIMEO, double(kPoll.count()));
+    respondent_.set_ms(NNG_OPT_RECVTIMEO, double(kPoll.count()));
+    subscriber_.listen(self_.address, options_.source, self_.name);
+    respondent_.listen(projection_io::cluster_barrier_address(self_.address), options_.source,
+                       self_.name);
+    say_no_swap_group_once(options_.report);
+    options_.report("node " + self_.name + ": listening on " + self_.address + " for master " +
+                    master_);
+    listener_ = std::thread([this] { listen(); });
+    responder_ = std::thread([this] { respond(); });
+  }
+
+  ~Secondary() override {
+    {
+      std::lock_guard lock(mutex_);
+      stopping_ = true;
+    }
+    changed_.notify_all();
+    listener_.join();
+    responder_.join();
+  }
+
+  std::optional<FrameState> next_frame(const FrameState&) override {
+    std::unique_lock lock(mutex_);
+    for (;;) {
+      check();
+      // The newest frame state wins: a node that fell behind catches up at once.
+      std::optional<std::vector<std::uint8_t>> newest;
+      bool ended = false;
+      while (!inbox_.empty()) {
+        auto [kind, body] = std::move(inbox_.front());
+        inbox_.pop_front();
+        if (kind == Published::frame) newest = std::move(body);
+        if (kind == Published::end) ended = true;
+      }
+      if (ended) return std::nullopt;
+      if (newest) {
+        FrameState state = decode_frame_state(*newest, "frame state from master " + master_);
+        if (rendered_ && state.frame <= *rendered_) continue;  // old news
+        return state;
+      }
+      wait(lock);
+    }
+  }
+
+  bool ready_to_swap(const FrameState& state, nlohmann::json& stats) override {
+    std::unique_lock lock(mutex_);
+    rendered_ = state.frame;
+    changed_.notify_all();
+    for (;;) {
+      check();
+      while (!inbox_.empty()) {
+        auto& [kind, body] = inbox_.front();
+        if (kind == Published::frame || kind == Published::end) {
+          // The master went on without this frame (it was dropped, or fell behind): not shown.
+          record(stats, state, false, nlohmann::json());
+          return false;
+        }
+        if (kind == Published::swap) {
+          Parse in(body);
+          const auto frame = in.get<std::uint64_t>();
+          if (in.ok && frame == state.frame) {
+            nlohmann::json swap = nlohmann::json::parse(in.rest_text(), nullptr, false);
+            inbox_.pop_front();
+            report_swap(swap);
+            record(stats, state, true, swap);
+            return true;
+          }
+        }
+        inbox_.pop_front();
+      }
+      wait(lock);
+    }
+  }
+
+ private:
+  void record(nlohmann::json& stats, const FrameState& state, bool swapped,
+              const nlohmann::json& swap) {
+    nlohmann::json cluster = {{"node", self_.name},
+                              {"role", "secondary"},
+                              {"frame", state.frame},
+                              {"state_digest", digest_hex(frame_state_digest(state))},
+                              {"swapped", swapped}};
+    if (swap.is_object()) {
+      for (const char* key : {"dropped", "rejoined", "active"})
+        if (swap.contains(key)) cluster[key] = swap[key];
+    }
+    stats["cluster"] = std::move(cluster);
+  }
+
+  void report_swap(const nlohmann::json& swap) {
+    if (!swap.is_object()) return;
+    for (const nlohmann::json& d : swap.value("dropped", nlohmann::json::array()))
+      options_.report("master " + master_ + " dropped node " + d.value("node", "?") + " at frame " +
+                      std::to_string(d.value("frame", std::uint64_t(0))) + " (no answer within " +
+                      ms_text(d.value("waited_ms", 0.0)) + ")");
+    for (const nlohmann::json& node : swap.value("rejoined", nlohmann::json::array()))
+      options_.report("node " + node.get<std::string>() + " rejoined");
+  }
+
+  // Throws for what the listener has seen: the master's stop, another display, silence.
+  void check() {
+    if (const int signal = interrupt_signal())
+      throw Interrupted(signal, "stopped as a node of the cluster");
+    if (!stop_reason_.empty()) throw PeerLost("master " + master_ + " stopped: " + stop_reason_);
+    if (foreign_digest_)
+      throw InputError(options_.source, "cluster",
+                       "the display and scene master " + master_ + " runs (content digest " +
+                           digest_hex(*foreign_digest_) + "), but this node's differ (" +
+                           digest_hex(options_.content_digest) +
+                           "): run the same display.json, warps, blends, scene and options on "
+                           "every node");
+    if (!last_heard_) {
+      if (ms_since(started_) > double(options_.join_timeout.count()))
+        throw PeerLost("master " + master_ + " not heard from within " +
+                       ms_text(double(options_.join_timeout.count())) + " of the start");
+    } else if (const double silent = ms_since(*last_heard_); silent > deadline_ms_) {
+      throw PeerLost("master " + master_ + " lost: silent for " + ms_text(silent) + " (deadline " +
+                     ms_text(deadline_ms_) + ")");
+    }
+  }
+
+  void wait(std::unique_lock<std::mutex>& lock) {
+    changed_.wait_for(lock, std::chrono::milliseconds(5));
+  }
+
+  void listen() {
+    for (;;) {
+      {
+        std::lock_guard lock(mutex_);
+        if (stopping_) return;
+      }
+      const auto message = subscriber_.receive();
+      if (!message) continue;
+      Parse in(*message);
+      const auto kind = in.get<Published>();
+      const auto digest = in.get<std::uint64_t>();
+      if (!in.ok) continue;
+      std::lock_guard lock(mutex_);
+      last_heard_ = Clock::now();
+      if (digest != options_.content_digest) foreign_digest_ = digest;
+      if (kind == Published::stop) stop_reason_ = in.rest_text();
+      if (kind != Published::heartbeat)
+        inbox_.emplace_back(kind, std::vector<std::uint8_t>(in.rest().begin(), in.rest().end()));
+      changed_.notify_all();
+    }
+  }
+
+  void respond() {
+    for (;;) {
+      {
+        std::lock_guard lock(mutex_);
+        if (stopping_) return;
+      }
+      const auto survey = respondent_.receive();
+      if (!survey) continue;
+      Parse in(*survey);
+      const auto kind = in.get<Survey>();
+      const auto frame = in.get<std::uint64_t>();
+      if (!in.ok) continue;
+      bool answer = kind == Survey::join;
+      bool hears = false;
+      {
+        std::unique_lock lock(mutex_);
+        hears = last_heard_.has_value();
+        if (kind == Survey::ready) {
+          // Answered once this node's outputs of `frame` are rendered; not when it skipped it.
+          changed_.wait(lock, [&] { return stopping_ || (rendered_ && *rendered_ >= frame); });
+          answer = !stopping_ && rendered_ && *rendered_ == frame;
+        }
+      }
+      if (answer)
+        respondent_.send(Bytes()
+                             .put(kind)
+                             .put(frame)
+                             .put(options_.content_digest)
+                             .put(std::uint8_t(hears))
+                             .put_text(self_.name)
+                             .data);
+    }
+  }
+
+  ClusterNodeOptions options_;
+  double deadline_ms_;
+  const ClusterNode& self_;
+  std::string master_;
+  Socket subscriber_, respondent_;
+  std::mutex mutex_;
+  std::condition_variable changed_;
+  std::deque<std::pair<Published, std::vector<std::uint8_t>>> inbox_;
+  std::optional<Clock::time_point> last_heard_;
+  Clock::time_point started_ = Clock::now();
+  std::optional<std::uint64_t> rendered_;
+  std::optional<std::uint64_t> foreign_digest_;
+  std::string stop_reason_;
+  bool stopping_ = false;
+  std::thread listener_, responder_;
+};
+
+}  // namespace
+
+std::unique_ptr<FrameSync> make_cluster_master(const ClusterNodeOptions& options) {
+  return std::make_unique<Master>(options);
+}
+
+ClusterNodeShare keep_cluster_node_outputs(SessionDisplay& display,
+                                           const std::filesystem::path& display_file,
+                                           const std::string& node) {
+  ClusterNodeShare share;
+  share.config = projection_io::read_display_config(display_file);
+  if (!share.config.cluster)
+    throw InputError(display_file.string(), "cluster",
+                     "a cluster section for --node (nodes, their projectors and the master)");
+  const ClusterNode& self = find_cluster_node(*share.config.cluster, node, display_file.string());
+  share.node = self.name;
+  share.master = share.config.cluster->master == self.name;
+  std::vector<SessionOutput> kept;
+  for (std::size_t i = 0; i < share.config.projectors.size() && i < display.outputs.size(); ++i) {
+    const std::vector<std::string>& mine = self.projectors;
+    if (std::find(mine.begin(), mine.end(), share.config.projectors[i].name) != mine.end())
+      kept.push_back(std::move(display.outputs[i]));
+  }
+  display.outputs = std::move(kept);
+  return share;
+}
+
+std::unique_ptr<FrameSync> make_cluster_secondary(const ClusterNodeOptions& options) {
+  return std::make_unique<Secondary>(options);
+}
+
+}  // namespace facet::driver

@@ -1,0 +1,401 @@
+// Clusters without GL: the frame state's wire format, and the protocol (broadcast, barrier,
+// drop, rejoin, loss of the master, a foreign display, an address in use) between a master and
+// secondaries on threads of this process, over ipc://.
+#include "facet/driver/cluster.hpp"
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <limits>
+#include <mutex>
+#include <random>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "facet/projection/errors.hpp"
+
+namespace facet::driver {
+namespace {
+
+namespace fs = std::filesystem;
+namespace pio = facet::projection_io;
+
+// Every field filled with random values, object poses included.
+FrameState random_state(std::mt19937_64& random) {
+  std::uniform_real_distribution<double> number(-1e3, 1e3);
+  auto matrix = [&] {
+    glm::dmat4 m;
+    for (int c = 0; c < 4; ++c)
+      for (int r = 0; r < 4; ++r) m[c][r] = number(random);
+    return m;
+  };
+  FrameState state;
+  state.frame = random();
+  state.time_s = number(random);
+  state.T_world_eye = matrix();
+  state.object_poses.resize(random() % 6);
+  for (ObjectPose& pose : state.object_poses) {
+    pose.object = std::uint32_t(random());
+    pose.T_world_object = matrix();
+  }
+  return state;
+}
+
+std::string decode_error(const std::vector<std::uint8_t>& bytes) {
+  try {
+    decode_frame_state(bytes, "wire");
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "no error";
+}
+
+TEST(ClusterWire, FrameStatesRoundTripBitForBit) {
+  std::mt19937_64 random(15);
+  for (int i = 0; i < 200; ++i) {
+    const FrameState state = random_state(random);
+    const std::vector<std::uint8_t> bytes = encode_frame_state(state);
+    EXPECT_EQ(bytes.size(), 4 + 2 + 8 + 8 + 128 + 4 + state.object_poses.size() * (4 + 128));
+    EXPECT_EQ(decode_frame_state(bytes, "wire"), state) << "state " << i;
+    EXPECT_EQ(frame_state_digest(decode_frame_state(bytes, "wire")), frame_state_digest(state));
+  }
+  // Each field shows in the digest.
+  std::mt19937_64 again(16);
+  const FrameState state = random_state(again);
+  FrameState changed = state;
+  changed.frame += 1;
+  EXPECT_NE(frame_state_digest(changed), frame_state_digest(state));
+  changed = state;
+  changed.time_s = std::nextafter(state.time_s, 1e9);
+  EXPECT_NE(frame_state_digest(changed), frame_state_digest(state));
+  changed = state;
+  changed.T_world_eye[2][1] += 1e-9;
+  EXPECT_NE(frame_state_digest(changed), frame_state_digest(state));
+  changed = state;
+  changed.object_poses.push_back(ObjectPose{});
+  EXPECT_NE(frame_state_digest(changed), frame_state_digest(state));
+}
+
+TEST(ClusterWire, BadMessagesAreRefusedWithTheirField) {
+  std::mt19937_64 random(17);
+  FrameState state = random_state(random);
+  state.object_poses.resize(2);
+  const std::vector<std::uint8_t> good = encode_frame_state(state);
+  // Cut anywhere: refused, never read past the end.
+  for (std::size_t size = 0; size < good.size(); ++size) {
+    const std::vector<std::uint8_t> cut(good.begin(), good.begin() + std::ptrdiff_t(size));
+    EXPECT_NE(decode_error(cut), "no error") << size;
+  }
+  std::vector<std::uint8_t> bytes = good;
+  bytes[4] = 2;  // version 2
+  EXPECT_NE(decode_error(bytes).find("field 'version': frame state version 1"), std::string::npos)
+      << decode_error(bytes);
+  bytes = good;
+  bytes[0] = 'X';
+  EXPECT_NE(decode_error(bytes).find("field 'magic'"), std::string::npos);
+  bytes = good;
+  bytes.push_back(0);
+  EXPECT_NE(decode_error(bytes).find("1 more bytes follow"), std::string::npos);
+  // A pose count far beyond what the message holds is refused before any allocation.
+  bytes = good;
+  const std::size_t count_at = 4 + 2 + 8 + 8 + 128;
+  bytes[count_at + 3] = 0x7f;
+  EXPECT_NE(decode_error(bytes).find("field 'object_poses'"), std::string::npos);
+  // Not a number.
+  bytes = good;
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  std::memcpy(bytes.data() + 4 + 2 + 8, &nan, sizeof nan);
+  EXPECT_NE(decode_error(bytes).find("field 'time_s'"), std::string::npos);
+}
+
+TEST(ClusterWire, DigestsTellContentsApart) {
+  EXPECT_NE(Digest().add("ab").add("c").value(), Digest().add("a").add("bc").value());
+  EXPECT_EQ(Digest().add("abc").value(), Digest().add("abc").value());
+  EXPECT_EQ(digest_hex(0x1234), "0000000000001234");
+}
+
+// ---- The protocol, on threads -----------------------------------------------------------------
+
+struct Scratch {
+  fs::path path = fs::temp_directory_path() / ("facet-cluster-test-" + std::to_string(::getpid()));
+  Scratch() { fs::create_directories(path); }
+  ~Scratch() {
+    std::error_code ignored;
+    fs::remove_all(path, ignored);
+  }
+};
+
+// Nodes a (master), b and c on ipc:// sockets in `folder`; c critical when asked.
+pio::DisplayCluster test_cluster(const fs::path& folder, double deadline_ms,
+                                 bool c_critical = false) {
+  pio::DisplayCluster cluster;
+  for (const char* name : {"a", "b", "c"})
+    cluster.nodes.push_back({name,
+                             "ipc://" + (folder / name).string(),
+                             {std::string("p") + name},
+                             std::string(name) == "c" && c_critical});
+  cluster.master = "a";
+  cluster.deadline_ms = deadline_ms;
+  return cluster;
+}
+
+struct Log {
+  std::mutex mutex;
+  std::vector<std::string> lines;
+  std::function<void(const std::string&)> sink(const std::string& who) {
+    return [this, who](const std::string& line) {
+      std::lock_guard lock(mutex);
+      lines.push_back(who + ": " + line);
+    };
+  }
+  bool contains(const std::string& text) {
+    std::lock_guard lock(mutex);
+    for (const std::string& line : lines)
+      if (line.find(text) != std::string::npos) return true;
+    return false;
+  }
+  std::string all() {
+    std::lock_guard lock(mutex);
+    std::string text;
+    for (const std::string& line : lines) text += line + "\n";
+    return text;
+  }
+};
+
+ClusterNodeOptions node_options(const pio::DisplayCluster& cluster, const std::string& node,
+                                Log& log, std::uint64_t digest = 42) {
+  ClusterNodeOptions options;
+  options.cluster = cluster;
+  options.source = "display.json";
+  options.node = node;
+  options.content_digest = digest;
+  options.join_timeout = std::chrono::milliseconds(20'000);
+  options.report = log.sink(node);
+  return options;
+}
+
+FrameState state_of(std::uint64_t frame) {
+  FrameState state;
+  state.frame = frame;
+  state.time_s = double(frame) / 60;
+  state.T_world_eye[3] = glm::dvec4(double(frame), 1.5, -2.0, 1.0);
+  state.object_poses = {ObjectPose{std::uint32_t(frame % 3), glm::dmat4(2.0)}};
+  return state;
+}
+
+// What one node did: per frame it rendered, the state digest and whether it swapped.
+struct NodeRun {
+  std::vector<std::uint64_t> swapped;
+  std::vector<std::string> digests;
+  std::vector<nlohmann::json> cluster_stats;
+  std::string error;  // "PeerLost: ...", "InputError: ..."
+};
+
+// Runs a secondary until the master ends the run, or `stop_after` frames swapped (then it goes
+// silent, as a killed process would).
+NodeRun run_secondary(const ClusterNodeOptions& options,
+                      std::optional<std::size_t> stop_after = std::nullopt) {
+  NodeRun run;
+  try {
+    const std::unique_ptr<FrameSync> sync = make_cluster_secondary(options);
+    while (const std::optional<FrameState> state = sync->next_frame(FrameState{})) {
+      if (stop_after && run.swapped.size() >= *stop_after) break;
+      nlohmann::json stats;
+      if (sync->ready_to_swap(*state, stats)) {
+        run.swapped.push_back(state->frame);
+        run.digests.push_back(stats["cluster"]["state_digest"]);
+        run.cluster_stats.push_back(stats["cluster"]);
+      }
+    }
+  } catch (const PeerLost& e) {
+    run.error = std::string("PeerLost: ") + e.what();
+  } catch (const InputError& e) {
+    run.error = std::string("InputError: ") + e.what();
+  }
+  return run;
+}
+
+NodeRun run_master(const ClusterNodeOptions& options, std::uint64_t frames,
+                   std::chrono::milliseconds frame_time = std::chrono::milliseconds(2)) {
+  NodeRun run;
+  try {
+    const std::unique_ptr<FrameSync> sync = make_cluster_master(options);
+    for (std::uint64_t frame = 0; frame < frames; ++frame) {
+      const std::optional<FrameState> state = sync->next_frame(state_of(frame));
+      if (!state) break;
+      std::this_thread::sleep_for(frame_time);  // "rendering"
+      nlohmann::json stats;
+      if (sync->ready_to_swap(*state, stats)) {
+        run.swapped.push_back(state->frame);
+        run.digests.push_back(stats["cluster"]["state_digest"]);
+        run.cluster_stats.push_back(stats["cluster"]);
+      }
+    }
+  } catch (const PeerLost& e) {
+    run.error = std::string("PeerLost: ") + e.what();
+  } catch (const InputError& e) {
+    run.error = std::string("InputError: ") + e.what();
+  }
+  return run;
+}
+
+std::vector<std::uint64_t> frames_upto(std::uint64_t count) {
+  std::vector<std::uint64_t> frames(count);
+  for (std::uint64_t i = 0; i < count; ++i) frames[i] = i;
+  return frames;
+}
+
+TEST(ClusterProtocol, EveryNodeSwapsEveryFrameWithTheSameState) {
+  const Scratch scratch;
+  const pio::DisplayCluster cluster = test_cluster(scratch.path, 2000);
+  Log log;
+  NodeRun b, c, a;
+  std::thread tb([&] { b = run_secondary(node_options(cluster, "b", log)); });
+  std::thread tc([&] { c = run_secondary(node_options(cluster, "c", log)); });
+  a = run_master(node_options(cluster, "a", log), 40);
+  tb.join();
+  tc.join();
+  EXPECT_EQ(a.error, "");
+  EXPECT_EQ(b.error, "");
+  EXPECT_EQ(c.error, "");
+  EXPECT_EQ(a.swapped, frames_upto(40)) << log.all();
+  EXPECT_EQ(b.swapped, a.swapped);
+  EXPECT_EQ(c.swapped, a.swapped);
+  EXPECT_EQ(b.digests, a.digests);
+  EXPECT_EQ(c.digests, a.digests);
+  EXPECT_EQ(a.digests[7], digest_hex(frame_state_digest(state_of(7))));
+  for (const nlohmann::json& stats : a.cluster_stats) {
+    EXPECT_EQ(stats["dropped"].size(), 0u);
+    EXPECT_EQ(stats["active"], nlohmann::json({"b", "c"}));
+  }
+  std::vector<double> barrier_ms;
+  for (const nlohmann::json& stats : a.cluster_stats) barrier_ms.push_back(stats["barrier_ms"]);
+  std::sort(barrier_ms.begin(), barrier_ms.end());
+  std::printf("barrier of 3 nodes: median %.3f ms, worst %.3f ms (not asserted)\n",
+              barrier_ms[barrier_ms.size() / 2], barrier_ms.back());
+}
+
+TEST(ClusterProtocol, ASilentSecondaryIsDroppedAndRejoins) {
+  const Scratch scratch;
+  const pio::DisplayCluster cluster = test_cluster(scratch.path, 300);
+  Log log;
+  NodeRun b, c1, c2, a;
+  std::atomic<bool> c_gone = false;
+  std::thread tb([&] { b = run_secondary(node_options(cluster, "b", log)); });
+  std::thread tc([&] {
+    c1 = run_secondary(node_options(cluster, "c", log), 10);
+    c_gone = true;
+    c2 = run_secondary(node_options(cluster, "c", log));  // restarted
+  });
+  // Slow enough frames that the restarted c finds the run still going.
+  a = run_master(node_options(cluster, "a", log), 80, std::chrono::milliseconds(10));
+  tb.join();
+  tc.join();
+  EXPECT_EQ(a.error, "") << log.all();
+  EXPECT_EQ(b.error, "");
+  EXPECT_EQ(a.swapped, frames_upto(80)) << log.all();
+  EXPECT_EQ(b.swapped, a.swapped);
+  EXPECT_EQ(c1.swapped, frames_upto(10));
+  // The master dropped c at one frame, said how long it waited, and took it back later.
+  std::optional<std::uint64_t> dropped_at, rejoined_at;
+  for (std::size_t i = 0; i < a.cluster_stats.size(); ++i) {
+    const nlohmann::json& stats = a.cluster_stats[i];
+    for (const nlohmann::json& d : stats["dropped"]) {
+      EXPECT_EQ(d["node"], "c");
+      EXPECT_GE(d["waited_ms"].get<double>(), 300.0 * 0.9);
+      dropped_at = d["frame"].get<std::uint64_t>();
+    }
+    if (!stats["rejoined"].empty()) rejoined_at = a.swapped[i];
+  }
+  ASSERT_TRUE(dropped_at.has_value()) << log.all();
+  ASSERT_TRUE(rejoined_at.has_value()) << log.all();
+  EXPECT_GE(*dropped_at, 10u);
+  EXPECT_GT(*rejoined_at, *dropped_at);
+  EXPECT_TRUE(log.contains("a: node c missed the barrier of frame")) << log.all();
+  // b heard of it from the master.
+  EXPECT_TRUE(log.contains("b: master a dropped node c at frame")) << log.all();
+  // The restarted c swapped every frame from its rejoining on, with the master's states.
+  ASSERT_FALSE(c2.swapped.empty());
+  EXPECT_LE(c2.swapped.front(), *rejoined_at);
+  EXPECT_EQ(c2.swapped.back(), 79u);
+  EXPECT_EQ(c2.swapped.size(), 80 - c2.swapped.front()) << "c missed frames after rejoining";
+  for (std::size_t i = 0; i < c2.swapped.size(); ++i)
+    EXPECT_EQ(c2.digests[i], a.digests[c2.swapped[i]]);
+}
+
+TEST(ClusterProtocol, LosingACriticalNodeStopsEveryone) {
+  const Scratch scratch;
+  const pio::DisplayCluster cluster = test_cluster(scratch.path, 300, true);
+  Log log;
+  NodeRun b, c, a;
+  std::thread tb([&] { b = run_secondary(node_options(cluster, "b", log)); });
+  std::thread tc([&] { c = run_secondary(node_options(cluster, "c", log), 5); });
+  a = run_master(node_options(cluster, "a", log), 1000);
+  tb.join();
+  tc.join();
+  EXPECT_NE(a.error.find("PeerLost: critical node c lost at frame"), std::string::npos) << a.error;
+  EXPECT_NE(b.error.find("PeerLost: master a stopped: critical node c lost"), std::string::npos)
+      << b.error;
+  EXPECT_LT(a.swapped.size(), 1000u);
+}
+
+TEST(ClusterProtocol, ASecondaryWithoutAMasterGivesUp) {
+  // A master that is killed mid-run is the CLI test's (cluster_cli_test.cpp); here none comes.
+  const Scratch scratch;
+  const pio::DisplayCluster cluster = test_cluster(scratch.path, 100);
+  Log log;
+  ClusterNodeOptions options = node_options(cluster, "b", log);
+  options.join_timeout = std::chrono::milliseconds(300);
+  const NodeRun b = run_secondary(options);
+  EXPECT_NE(b.error.find("PeerLost: master a not heard from within 300.0 ms"), std::string::npos)
+      << b.error;
+}
+
+TEST(ClusterProtocol, ANodeOfAnotherDisplayIsRefused) {
+  const Scratch scratch;
+  const pio::DisplayCluster cluster = test_cluster(scratch.path, 300);
+  Log log;
+  NodeRun b, c, a;
+  std::thread tb([&] { b = run_secondary(node_options(cluster, "b", log)); });
+  std::thread tc([&] { c = run_secondary(node_options(cluster, "c", log, 43)); });
+  ClusterNodeOptions master = node_options(cluster, "a", log);
+  master.join_timeout = std::chrono::milliseconds(1000);
+  a = run_master(master, 5);
+  tb.join();
+  tc.join();
+  EXPECT_NE(c.error.find("InputError: display.json: field 'cluster': the display and scene "
+                         "master a runs (content digest 000000000000002a), but this node's "
+                         "differ (000000000000002b)"),
+            std::string::npos)
+      << c.error;
+  EXPECT_TRUE(log.contains("a: starting without c")) << log.all();
+  // c is not critical: the others run without it.
+  EXPECT_EQ(a.error, "");
+  EXPECT_EQ(b.swapped, frames_upto(5));
+}
+
+TEST(ClusterProtocol, AnAddressInUseIsAnInputError) {
+  const Scratch scratch;
+  const pio::DisplayCluster cluster = test_cluster(scratch.path, 300);
+  Log log;
+  const std::unique_ptr<FrameSync> first = make_cluster_secondary(node_options(cluster, "b", log));
+  try {
+    make_cluster_secondary(node_options(cluster, "b", log));
+    ADD_FAILURE() << "a second node b listened too";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("is node 'b' running twice?"), std::string::npos)
+        << e.what();
+  }
+  EXPECT_THROW(find_cluster_node(cluster, "d", "display.json"), InputError);
+}
+
+}  // namespace
+}  // namespace facet::driver
