@@ -1,0 +1,122 @@
+#pragma once
+// Content playback (`facet play`): a still image or a video shown on every projector output of a
+// display through the exact warp (ContentPass), then blended as sessions blend.
+//
+// Timing comes from the show clock, FrameState::time_s: video frame k is on screen from k/fps
+// to (k+1)/fps after the start, so every node of a cluster given the same FrameState shows the
+// same video frame. Source frames whose whole time passes between two output frames are dropped
+// and counted.
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "facet/driver/blend_pass.hpp"
+#include "facet/driver/content_media.hpp"
+#include "facet/driver/content_pass.hpp"
+#include "facet/driver/session.hpp"
+#include "facet/driver/session_runner.hpp"
+
+namespace facet::driver {
+
+// Which source frame is on screen at show time `time_s` (seconds from the start, >= 0): the
+// unwrapped index start_frame + floor(time_s · fps), then wrapped modulo frame_count when
+// looping, else held at the last frame. A billionth of a frame of slack takes times such as
+// 2/60 s at 30 fps to their frame despite rounding.
+struct PlayClock {
+  double fps = 30;
+  std::int64_t frame_count = 1;
+  std::int64_t start_frame = 0;
+  bool loop = false;
+
+  std::int64_t unwrapped_frame(double time_s) const;
+  std::int64_t source_frame(double time_s) const;
+  // Source frames that were never on screen between the output frames at `previous_s` and
+  // `now_s` (now_s > previous_s); past the end of a non-looping video nothing more is dropped.
+  std::int64_t dropped_between(double previous_s, double now_s) const;
+};
+
+struct PlaybackOptions {
+  ContentProjection projection;  // fisheye_content() by default
+  bool loop = false;
+  std::int64_t start_frame = 0;  // InputError("command line", "--start-frame") beyond the video
+  ResampleOptions resample;
+};
+
+struct PlayFrameStats {
+  std::uint64_t frame = 0;
+  double time_s = 0;
+  std::int64_t source_frame = 0;   // the content frame shown
+  std::int64_t dropped = 0;        // source frames skipped since the previous output frame
+  std::int64_t dropped_total = 0;  // since the start
+  bool seeked = false;             // the decoder had to seek (a loop, a start frame)
+  double decode_ms = 0;            // decoding (0 when the frame was already decoded)
+  double upload_ms = 0;            // texture upload and mip levels (0 when unchanged)
+  double resample_ms = 0;          // every output's resample and blend, to glFinish when asked
+  double cpu_ms = 0;               // the whole ContentPlayer::render
+  std::vector<std::size_t> blend_tiles;  // per output
+};
+nlohmann::json play_frame_stats_to_json(const PlayFrameStats& stats);
+
+class ContentPlayer {
+ public:
+  // Opens nothing: `media` is the opened file. Builds the direction lookups and blend passes of
+  // every output. Needs a current GL context for the player's life. InputError for a content
+  // format that does not fit the media (check_content_format) or a start frame beyond its end.
+  ContentPlayer(SessionDisplay display, std::unique_ptr<ContentMedia> media,
+                PlaybackOptions options);
+
+  // Shows the source frame for `state.time_s` on every output: decode if it changed, upload,
+  // resample through the warp, blend. With `finish`, waits for the GPU (for timings).
+  PlayFrameStats render(const FrameState& state, bool finish = false);
+
+  const SessionDisplay& display() const { return display_; }
+  std::span<const OutputTarget> targets() const { return targets_; }
+  const ContentMedia& media() const { return *media_; }
+  const PlayClock& clock() const { return clock_; }
+  const ContentPass& pass() const { return pass_; }
+
+ private:
+  SessionDisplay display_;
+  std::unique_ptr<ContentMedia> media_;
+  PlaybackOptions options_;
+  PlayClock clock_;
+  ContentPass pass_;
+  ContentTexture texture_;
+  std::vector<OutputTarget> targets_;
+  std::vector<BlendPass> blends_;
+  std::int64_t uploaded_ = -1;  // the source frame in texture_
+  std::optional<double> previous_time_s_;
+  std::int64_t dropped_total_ = 0;
+};
+
+struct HeadlessPlayResult {
+  std::vector<PlayFrameStats> frames;
+  std::vector<std::filesystem::path> images;
+};
+
+// Shows frames 0..frames−1 at show times k·kFramePeriod_s and writes
+// out_dir/<output>/<frame, 5 digits>.png and out_dir/stats.jsonl (play_frame_stats_to_json per
+// frame), with run_headless_session's rules for out_dir (an earlier run there is replaced, any
+// other folder refused; written under a temporary name; SIGINT and SIGTERM stop it cleanly).
+HeadlessPlayResult run_headless_play(ContentPlayer& player, const HeadlessRunOptions& options);
+
+// The frames one pass of the media takes at kFramePeriod_s: 1 for a still image, else enough
+// output frames for every source frame from the start frame to the end, capped at kMaxFrames.
+std::uint64_t frames_for_one_pass(const PlayClock& clock);
+
+struct WindowPlayOptions {
+  std::optional<std::uint64_t> frames;  // stop after this many frames; else until closed
+  bool span = false;                    // one borderless window over every output
+};
+
+// A window per output on its monitor (or one spanning window), showing the content on the
+// wall clock from the first frame; Space pauses, Escape quits. Stats lines go to `stats_path`
+// when given. GlContextError without a display server; Interrupted after watch_interrupts().
+void run_windowed_play(const SessionDisplay& display, std::unique_ptr<ContentMedia> media,
+                       const PlaybackOptions& options, const WindowPlayOptions& window_options);
+
+}  // namespace facet::driver

@@ -1,0 +1,434 @@
+#include "facet/driver/content_player.hpp"
+
+#include <epoxy/gl.h>
+#define GLFW_INCLUDE_NONE
+#include <GLFW/glfw3.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <limits>
+#include <string_view>
+
+#include "facet/driver/gl_context.hpp"
+#include "facet/driver/monitors.hpp"
+#include "facet/driver/output_images.hpp"
+#include "facet/driver/program.hpp"
+#include "facet/projection/errors.hpp"
+#include "facet/projection/interrupt.hpp"
+
+namespace facet::driver {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+// A billionth of a source frame of slack against rounding in time_s · fps.
+constexpr double kFrameSlack = 1e-9;
+
+double ms_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+      .count();
+}
+
+}  // namespace
+
+std::int64_t PlayClock::unwrapped_frame(double time_s) const {
+  const double frames = std::floor(std::max(0.0, time_s) * fps + kFrameSlack);
+  return start_frame + std::int64_t(std::min(frames, 1e15));
+}
+
+std::int64_t PlayClock::source_frame(double time_s) const {
+  const std::int64_t k = unwrapped_frame(time_s);
+  const std::int64_t count = std::max<std::int64_t>(1, frame_count);
+  return loop ? k % count : std::min(k, count - 1);
+}
+
+std::int64_t PlayClock::dropped_between(double previous_s, double now_s) const {
+  std::int64_t before = unwrapped_frame(previous_s), now = unwrapped_frame(now_s);
+  if (!loop) {
+    const std::int64_t last = std::max<std::int64_t>(1, frame_count) - 1;
+    before = std::min(before, last);
+    now = std::min(now, last);
+  }
+  return std::max<std::int64_t>(0, now - before - 1);
+}
+
+std::uint64_t frames_for_one_pass(const PlayClock& clock) {
+  if (clock.frame_count <= 1) return 1;
+  const double seconds = double(clock.frame_count - clock.start_frame) / clock.fps;
+  const double frames = std::ceil(seconds / kFramePeriod_s - 1e-6);
+  return std::uint64_t(std::clamp(frames, 1.0, double(kMaxFrames)));
+}
+
+nlohmann::json play_frame_stats_to_json(const PlayFrameStats& stats) {
+  return {{"frame", stats.frame},
+          {"time_s", stats.time_s},
+          {"source_frame", stats.source_frame},
+          {"dropped", stats.dropped},
+          {"dropped_total", stats.dropped_total},
+          {"seeked", stats.seeked},
+          {"decode_ms", stats.decode_ms},
+          {"upload_ms", stats.upload_ms},
+          {"resample_ms", stats.resample_ms},
+          {"cpu_ms", stats.cpu_ms},
+          {"blend_tiles", stats.blend_tiles}};
+}
+
+ContentPlayer::ContentPlayer(SessionDisplay display, std::unique_ptr<ContentMedia> media,
+                             PlaybackOptions options)
+    : display_(std::move(display)), media_(std::move(media)), options_(std::move(options)) {
+  FACET_ASSERT(media_ != nullptr);
+  const std::string source = media_->path().string();
+  options_.projection.validate("command line");
+  if (options_.projection.format != ContentFormat::perspective)
+    check_content_format(media_->size(), options_.projection.format, source);
+  clock_.fps = media_->is_video() ? media_->fps() : 1;
+  clock_.frame_count = media_->frame_count();
+  clock_.loop = options_.loop;
+  clock_.start_frame = options_.start_frame;
+  if (options_.start_frame < 0 || options_.start_frame >= media_->frame_count())
+    throw InputError("command line", "--start-frame",
+                     "a frame from 0 to " + std::to_string(media_->frame_count() - 1) + " of " +
+                         source + "; got " + std::to_string(options_.start_frame));
+
+  std::vector<OutputSpec> specs;
+  for (const SessionOutput& output : display_.outputs) specs.push_back(output.spec);
+  pass_ = ContentPass(specs, options_.resample);
+  texture_ = ContentTexture(options_.projection.format, media_->size(), media_->pixels(), source);
+  for (const SessionOutput& output : display_.outputs) {
+    targets_.push_back(OutputTarget::create(output.spec.warp.output_size));
+    blends_.emplace_back(output.spec.warp.output_size, output.blend, output.encoding);
+  }
+}
+
+PlayFrameStats ContentPlayer::render(const FrameState& state, bool finish) {
+  const auto start = std::chrono::steady_clock::now();
+  PlayFrameStats stats;
+  stats.frame = state.frame;
+  stats.time_s = state.time_s;
+  if (previous_time_s_ && state.time_s > *previous_time_s_)
+    stats.dropped = clock_.dropped_between(*previous_time_s_, state.time_s);
+  previous_time_s_ = state.time_s;
+  dropped_total_ += stats.dropped;
+  stats.dropped_total = dropped_total_;
+
+  const ContentMedia::Decoded decoded = media_->frame(clock_.source_frame(state.time_s));
+  // The real end may have been met: the clock wraps and holds by the frames decoded.
+  clock_.frame_count = media_->frame_count();
+  stats.source_frame = decoded.index;
+  stats.seeked = decoded.seeked;
+  stats.decode_ms = decoded.decode_ms;
+  if (decoded.index != uploaded_) {
+    const auto upload_start = std::chrono::steady_clock::now();
+    texture_.upload(*decoded.image);
+    uploaded_ = decoded.index;
+    if (finish) glFinish();
+    stats.upload_ms = ms_since(upload_start);
+  }
+
+  const auto resample_start = std::chrono::steady_clock::now();
+  for (std::size_t i = 0; i < targets_.size(); ++i) {
+    targets_[i].clear();
+    targets_[i].bind();
+    pass_.draw(i, texture_, options_.projection);
+    blends_[i].apply(targets_[i].colour());
+    stats.blend_tiles.push_back(blends_[i].tiles_listed());
+  }
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  if (finish) glFinish();
+  stats.resample_ms = ms_since(resample_start);
+  stats.cpu_ms = ms_since(start);
+  return stats;
+}
+
+namespace {
+
+// A frame image's name: five or more digits, then ".png".
+bool is_frame_file_name(const std::string& name) {
+  constexpr std::string_view kSuffix = ".png";
+  if (name.size() < 5 + kSuffix.size() || !name.ends_with(kSuffix)) return false;
+  return std::all_of(name.begin(), name.end() - kSuffix.size(),
+                     [](char c) { return c >= '0' && c <= '9'; });
+}
+
+// Nothing there, an empty folder, or exactly a stats.jsonl and folders of frame images.
+bool holds_earlier_run_or_nothing(const fs::path& dir) {
+  const fs::file_status status = fs::symlink_status(dir);
+  if (!fs::exists(status)) return true;
+  if (!fs::is_directory(status)) return false;
+  bool has_stats = false, empty = true;
+  for (const fs::directory_entry& entry : fs::directory_iterator(dir)) {
+    empty = false;
+    const fs::file_status entry_status = entry.symlink_status();
+    if (entry.path().filename() == "stats.jsonl" && fs::is_regular_file(entry_status)) {
+      has_stats = true;
+      continue;
+    }
+    if (!fs::is_directory(entry_status)) return false;
+    for (const fs::directory_entry& frame : fs::directory_iterator(entry.path())) {
+      if (!fs::is_regular_file(frame.symlink_status()) ||
+          !is_frame_file_name(frame.path().filename().string()))
+        return false;
+    }
+  }
+  return empty || has_stats;
+}
+
+// `dir` is the current folder or one of its parents.
+bool holds_current_folder(const fs::path& dir) {
+  std::error_code error;
+  const fs::path target = fs::weakly_canonical(dir, error);
+  const fs::path current = fs::current_path(error);
+  if (error) return false;
+  auto t = target.begin(), c = current.begin();
+  for (; t != target.end() && c != current.end(); ++t, ++c) {
+    if (t->empty()) break;
+    if (*t != *c) return false;
+  }
+  return t == target.end() || t->empty();
+}
+
+std::string frame_file_name(std::uint64_t frame) {
+  char name[32];
+  std::snprintf(name, sizeof name, "%05llu.png", static_cast<unsigned long long>(frame));
+  return name;
+}
+
+}  // namespace
+
+HeadlessPlayResult run_headless_play(ContentPlayer& player, const HeadlessRunOptions& options) {
+  fs::path out_dir = options.out_dir.lexically_normal();
+  if (!out_dir.has_filename()) out_dir = out_dir.parent_path();
+  if (out_dir.empty()) throw InputError("command line", "--out", "expected an output folder");
+  if (options.frames < 1 || options.frames > kMaxFrames)
+    throw InputError("command line", "--frames",
+                     "from 1 to " + std::to_string(kMaxFrames) + " frames");
+  if (holds_current_folder(out_dir))
+    throw InputError(out_dir.string(), "--out",
+                     "a folder other than the current folder and its parents");
+  if (!holds_earlier_run_or_nothing(out_dir))
+    throw InputError(out_dir.string(), "--out",
+                     "a new path, an empty folder, or a folder from an earlier 'facet play' or "
+                     "'facet run' (stats.jsonl and folders of NNNNN.png, nothing else)");
+  const fs::path parent = out_dir.has_parent_path() ? out_dir.parent_path() : fs::path(".");
+  fs::create_directories(parent);
+  const fs::path temporary =
+      parent / ("." + out_dir.filename().string() + ".tmp" + std::to_string(::getpid()));
+  fs::remove_all(temporary);
+
+  HeadlessPlayResult result;
+  try {
+    fs::create_directories(temporary);
+    for (const SessionOutput& output : player.display().outputs)
+      fs::create_directories(temporary / output.spec.name);
+    std::ofstream stats_file(temporary / "stats.jsonl");
+    const bool replacing = fs::exists(fs::symlink_status(out_dir));
+    auto stop_if_interrupted = [&](std::uint64_t done) {
+      if (const int signal = interrupt_signal())
+        throw Interrupted(signal, "stopped after " + std::to_string(done) + " of " +
+                                      std::to_string(options.frames) +
+                                      " frames; nothing written to " + out_dir.string() +
+                                      (replacing ? " (what was there is kept)" : ""));
+    };
+    if (options.progress) options.progress({"frames", 0, options.frames});
+    for (std::uint64_t frame = 0; frame < options.frames; ++frame) {
+      stop_if_interrupted(frame);
+      FrameState state;
+      state.frame = frame;
+      state.time_s = double(frame) * kFramePeriod_s;
+      PlayFrameStats stats = player.render(state, options.finish_each_frame);
+      stats_file << play_frame_stats_to_json(stats).dump() << '\n';
+      for (std::size_t i = 0; i < player.targets().size(); ++i) {
+        const OutputTarget& target = player.targets()[i];
+        const fs::path image =
+            fs::path(player.display().outputs[i].spec.name) / frame_file_name(frame);
+        write_png_rgba8(temporary / image, target.size(), target.read_colour_rgba8());
+        result.images.push_back(out_dir / image);
+      }
+      result.frames.push_back(std::move(stats));
+      if (options.progress) options.progress({"frames", frame + 1, options.frames});
+    }
+    stats_file.close();
+    if (!stats_file)
+      throw std::runtime_error((out_dir / "stats.jsonl").string() + ": write failed");
+    stop_if_interrupted(options.frames);
+    const fs::path earlier =
+        parent / ("." + out_dir.filename().string() + ".old" + std::to_string(::getpid()));
+    if (replacing) fs::rename(out_dir, earlier);
+    try {
+      fs::rename(temporary, out_dir);
+    } catch (...) {
+      if (replacing) fs::rename(earlier, out_dir);
+      throw;
+    }
+    if (replacing) fs::remove_all(earlier);
+  } catch (...) {
+    std::error_code ignored;
+    fs::remove_all(temporary, ignored);
+    throw;
+  }
+  return result;
+}
+
+namespace {
+
+struct PlayKeys {
+  bool quit = false;
+  bool paused = false;
+};
+
+void on_play_key(GLFWwindow* window, int key, int, int action, int) {
+  auto& keys = *static_cast<PlayKeys*>(glfwGetWindowUserPointer(window));
+  if (action != GLFW_PRESS) return;
+  if (key == GLFW_KEY_ESCAPE) keys.quit = true;
+  if (key == GLFW_KEY_SPACE) keys.paused = !keys.paused;
+}
+
+struct PlayWindow {
+  std::unique_ptr<GlfwWindowContext> context;
+  std::vector<std::size_t> outputs;
+  std::vector<glm::ivec4> viewports;  // GL viewport per output: x, y from the bottom-left, w, h
+  VertexArray vertex_array;
+};
+
+}  // namespace
+
+void run_windowed_play(const SessionDisplay& display, std::unique_ptr<ContentMedia> media,
+                       const PlaybackOptions& options, const WindowPlayOptions& window_options) {
+  const std::vector<MonitorInfo> monitors = list_monitors();
+  std::vector<OutputPlacement> placements;
+  for (std::size_t i = 0; i < display.outputs.size(); ++i)
+    placements.push_back(place_output(display.outputs[i].placement, monitors,
+                                      display.missing_monitor,
+                                      display.outputs[i].spec.warp.output_size, display.source,
+                                      "projectors[" + std::to_string(i) + "].output.monitor"));
+  PlayKeys keys;
+  std::vector<PlayWindow> windows;
+  auto open_window = [&](WindowOptions o) {
+    PlayWindow window;
+    o.share = windows.empty() ? nullptr : windows.front().context.get();
+    o.title = "facet play";
+    window.context = std::make_unique<GlfwWindowContext>(o);
+    auto* native = static_cast<GLFWwindow*>(window.context->native_window());
+    glfwSetWindowUserPointer(native, &keys);
+    glfwSetKeyCallback(native, on_play_key);
+    return window;
+  };
+  if (window_options.span) {
+    glm::ivec2 low(std::numeric_limits<int>::max()), high(std::numeric_limits<int>::min());
+    for (const OutputPlacement& p : placements) {
+      low = glm::min(low, glm::ivec2(p.rect.x, p.rect.y));
+      high = glm::max(high, glm::ivec2(p.rect.x + p.rect.z, p.rect.y + p.rect.w));
+    }
+    WindowOptions spanning;
+    spanning.position = low;
+    spanning.width = high.x - low.x;
+    spanning.height = high.y - low.y;
+    spanning.decorated = false;
+    PlayWindow window = open_window(spanning);
+    for (std::size_t i = 0; i < placements.size(); ++i) {
+      const glm::ivec4& r = placements[i].rect;
+      window.outputs.push_back(i);
+      window.viewports.emplace_back(r.x - low.x, high.y - (r.y + r.w), r.z, r.w);
+    }
+    windows.push_back(std::move(window));
+  } else {
+    for (const OutputPlacement& placement : placements) {
+      WindowOptions one;
+      apply_placement(placement, one);
+      PlayWindow window = open_window(one);
+      const glm::ivec2 size = window.context->framebuffer_size();
+      window.outputs.push_back(windows.size());
+      window.viewports.emplace_back(0, 0, size.x, size.y);
+      windows.push_back(std::move(window));
+    }
+  }
+
+  windows.front().context->make_current();
+  ContentPlayer player(display, std::move(media), options);
+  std::vector<Texture> raw_views;
+  for (const OutputTarget& target : player.targets())
+    raw_views.push_back(Texture::create_view(target.colour(), GL_RGBA8));
+  const Program present =
+      ProgramBuilder().shader("output/present.vert").shader("output/present.frag").link();
+  for (PlayWindow& window : windows) {
+    window.context->make_current();
+    window.vertex_array = VertexArray::create();
+  }
+  windows.front().context->make_current();
+
+  const auto start = std::chrono::steady_clock::now();
+  double paused_s = 0, show_s = 0;
+  auto last = start;
+  int interrupted_by = 0;
+  std::uint64_t frames_shown = 0;
+  std::int64_t dropped_total = 0;
+  for (std::uint64_t frame = 0; !window_options.frames || frame < *window_options.frames; ++frame) {
+    glfwPollEvents();
+    interrupted_by = interrupt_signal();
+    if (interrupted_by) break;
+    bool closing = keys.quit;
+    for (const PlayWindow& window : windows) closing = closing || window.context->should_close();
+    if (closing) break;
+    const auto now = std::chrono::steady_clock::now();
+    const double dt = std::chrono::duration<double>(now - last).count();
+    last = now;
+    if (keys.paused) paused_s += dt;
+    // The show clock: wall time since the first frame, less the time paused.
+    show_s = std::chrono::duration<double>(now - start).count() - paused_s;
+    windows.front().context->make_current();
+    FrameState state;
+    state.frame = frame;
+    state.time_s = show_s;
+    const PlayFrameStats stats = player.render(state);
+    if (frame == 0)
+      std::printf(
+          "facet play: first frame after %.0f ms\n",
+          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+              .count());
+    dropped_total = stats.dropped_total;
+    GLsync rendered = glFenceSync(GL_SYNC_GPU_COMMANDS_COMPLETE, 0);
+    glFlush();
+    for (PlayWindow& window : windows) {
+      window.context->make_current();
+      glWaitSync(rendered, 0, GL_TIMEOUT_IGNORED);
+      glBindFramebuffer(GL_FRAMEBUFFER, 0);
+      glDisable(GL_FRAMEBUFFER_SRGB);
+      const glm::ivec2 size = window.context->framebuffer_size();
+      glViewport(0, 0, size.x, size.y);
+      glClearColor(0, 0, 0, 1);
+      glClear(GL_COLOR_BUFFER_BIT);
+      present.use();
+      glBindVertexArray(window.vertex_array.id());
+      for (std::size_t k = 0; k < window.outputs.size(); ++k) {
+        const glm::ivec4& v = window.viewports[k];
+        const glm::ivec2 output_size = player.targets()[window.outputs[k]].size();
+        glViewport(v.x, v.y, v.z, v.w);
+        glUniform2i(0, v.x, v.y);
+        glUniform2f(1, float(output_size.x) / float(v.z), float(output_size.y) / float(v.w));
+        raw_views[window.outputs[k]].bind_unit(0);
+        glDrawArrays(GL_TRIANGLES, 0, 3);
+      }
+      window.context->swap_buffers();
+    }
+    windows.front().context->make_current();
+    glDeleteSync(rendered);
+    frames_shown = frame + 1;
+  }
+  for (PlayWindow& window : windows) {
+    window.context->make_current();
+    window.vertex_array.reset();
+  }
+  windows.front().context->make_current();
+  raw_views.clear();
+  std::printf("facet play: %llu frames shown, %lld source frames dropped\n",
+              static_cast<unsigned long long>(frames_shown), static_cast<long long>(dropped_total));
+  if (interrupted_by)
+    throw Interrupted(interrupted_by, "stopped after " + std::to_string(frames_shown) + " frames");
+}
+
+}  // namespace facet::driver

@@ -1,0 +1,251 @@
+// Mode 2 (content through the exact warp) on llvmpipe, against the warp's exact forward map:
+//  - a coordinate texture (each texel holds the content coordinates of its centre, float) read
+//    back from a float target, turned into a direction by the content's map and projected by
+//    the warp, lands on the pixel it was drawn at: worst and RMS distance in output pixels;
+//  - a generated 8-bit dome master with dots on a known angular grid: each dot's centroid in the
+//    output against the warp's projection of the dot's direction, in output pixels.
+#include "facet/driver/content_pass.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+#include <vector>
+
+#include "facet/driver/session.hpp"
+#include "facet/projection/warp_inverse.hpp"
+#include "gl_test_context.hpp"
+
+namespace facet::driver {
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+
+// dome4 (a real four-projector dome with measured warps), at a quarter of its size.
+std::vector<OutputSpec> dome4_outputs() {
+  SessionDisplay display =
+      load_session_display(std::string(FACET_SOURCE_DIR) + "/configs/displays/dome4/display.json");
+  scale_session_display(display, 0.25);
+  std::vector<OutputSpec> outputs;
+  for (const SessionOutput& output : display.outputs) outputs.push_back(output.spec);
+  return outputs;
+}
+
+// RGBA32F texels holding (s, t) of their centres, or, for a cube strip, the point of the cube's
+// surface a_m + (2s−1)·a_s + (2t−1)·a_t (bilinear in st, so filtering keeps it exact).
+ContentImage coordinate_image(ContentFormat format, glm::ivec2 size) {
+  ContentImage image;
+  image.size = size;
+  image.channels = 4;
+  image.pixels = ContentImage::Pixels::linear_f32;
+  image.values.resize(std::size_t(size.x) * size.y * 4);
+  const int face = size.y;
+  for (int y = 0; y < size.y; ++y) {
+    for (int x = 0; x < size.x; ++x) {
+      float* texel = &image.values[(std::size_t(y) * size.x + x) * 4];
+      if (format == ContentFormat::cubemap) {
+        const CubeFaceAxes& axes = kCubeFaces[std::size_t(x / face)];
+        const double s = ((x % face) + 0.5) / face, t = (y + 0.5) / face;
+        const glm::dvec3 p = axes.a_m + (2 * s - 1) * axes.a_s + (2 * t - 1) * axes.a_t;
+        texel[0] = float(p.x), texel[1] = float(p.y), texel[2] = float(p.z), texel[3] = 1;
+      } else {
+        texel[0] = float((x + 0.5) / size.x), texel[1] = float((y + 0.5) / size.y);
+        texel[2] = 0, texel[3] = 1;
+      }
+    }
+  }
+  return image;
+}
+
+struct ErrorStats {
+  double worst_px = 0, rms_px = 0;
+  std::size_t pixels = 0;
+};
+
+// Draws every output into an RGBA32F target and measures where each pixel's sample says it is.
+// Pixels whose exact content point (through the warp inverse) lies within `border` texels of the
+// image's edge (where filtering clamps), of a cube face's edge or of an equirect seam (where the
+// coordinates jump) are skipped: the filter's reach, which grows with the mip level.
+ErrorStats measure(const std::vector<OutputSpec>& outputs, const ContentProjection& projection,
+                   glm::ivec2 image_size, const ResampleOptions& options, double border = 3.0) {
+  test::shared_context();
+  ContentPass pass(outputs, options);
+  ContentTexture texture(projection.format, image_size, ContentImage::Pixels::linear_f32, "test",
+                         true);
+  texture.upload(coordinate_image(projection.format, image_size));
+  double sum_sq = 0;
+  ErrorStats stats;
+  for (std::size_t o = 0; o < outputs.size(); ++o) {
+    const glm::ivec2 size = outputs[o].warp.output_size;
+    const WarpInverse inverse(outputs[o].warp);
+    Texture target = Texture::create_2d(GL_RGBA32F, size.x, size.y);
+    Framebuffer framebuffer = Framebuffer::create();
+    framebuffer.attach(GL_COLOR_ATTACHMENT0, target);
+    glBindFramebuffer(GL_FRAMEBUFFER, framebuffer.id());
+    const float clear[4] = {-1, -1, -1, 0};
+    glClearNamedFramebufferfv(framebuffer.id(), GL_COLOR, 0, clear);
+    pass.draw(o, texture, projection);
+    std::vector<float> pixels(std::size_t(size.x) * size.y * 4);
+    glReadPixels(0, 0, size.x, size.y, GL_RGBA, GL_FLOAT, pixels.data());
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    for (int gy = 0; gy < size.y; ++gy) {
+      for (int x = 0; x < size.x; ++x) {
+        const float* p = &pixels[(std::size_t(gy) * size.x + x) * 4];
+        if (p[0] == -1.0f || p[3] == 0.0f) continue;  // not covered
+        const glm::dvec2 q_pixel(x + 0.5, size.y - gy - 0.5);
+        // Where the pixel's sample should come from: skip it near the image's edges and seam.
+        const auto inverted = inverse.invert(q_pixel);
+        if (!inverted) continue;
+        const auto expected = projection.point_from_v_eye(inverted->v_eye);
+        if (!expected) continue;
+        const glm::dvec2 edge_texels =
+            glm::min(expected->st, 1.0 - expected->st) *
+            (projection.format == ContentFormat::cubemap ? glm::dvec2(image_size.y)
+                                                         : glm::dvec2(image_size));
+        if (std::min(edge_texels.x, edge_texels.y) < border) continue;
+        if (projection.format == ContentFormat::fisheye &&
+            glm::length(expected->st - glm::dvec2(0.5)) * image_size.x > image_size.x / 2 - border)
+          continue;
+        ContentPoint point;
+        if (projection.format == ContentFormat::cubemap) {
+          const glm::dvec3 surface(p[0], p[1], p[2]);
+          point = *projection.point_from_v_eye(projection.R_eye_content * surface);
+        } else {
+          point.st = glm::dvec2(p[0], p[1]);
+        }
+        const glm::dvec3 v = projection.v_eye_from_point(point);
+        const auto projected = outputs[o].warp.project(v);
+        EXPECT_TRUE(projected);
+        if (!projected) continue;
+        const double error = glm::length(projected->q - q_pixel);
+        stats.worst_px = std::max(stats.worst_px, error);
+        sum_sq += error * error;
+        ++stats.pixels;
+      }
+    }
+  }
+  stats.rms_px = stats.pixels ? std::sqrt(sum_sq / double(stats.pixels)) : 0;
+  return stats;
+}
+
+void expect_mode2_accuracy(const ErrorStats& stats, const char* what) {
+  EXPECT_GT(stats.pixels, 10000u) << what;
+  EXPECT_LE(stats.worst_px, 0.5) << what << ": worst, output pixels";
+  EXPECT_LE(stats.rms_px, 0.1) << what << ": RMS, output pixels";
+  std::printf("%s: %zu pixels, worst %.4f px, RMS %.4f px\n", what, stats.pixels, stats.worst_px,
+              stats.rms_px);
+}
+
+TEST(ContentPass, FisheyeThroughDome4MatchesTheExactWarp) {
+  const std::vector<OutputSpec> outputs = dome4_outputs();
+  const ContentProjection master = fisheye_content(220, DomeOrientation{10, 30});
+  // Coarser than the outputs (bicubic) and finer (mip levels, anisotropic).
+  expect_mode2_accuracy(measure(outputs, master, {200, 200}, {}), "fisheye 200² (magnified)");
+  expect_mode2_accuracy(measure(outputs, master, {2048, 2048}, {}), "fisheye 2048² (minified)");
+}
+
+TEST(ContentPass, EquirectAndCubeMapThroughACylinderMatchTheExactWarp) {
+  const OutputSpec cylinder{
+      "cylinder",
+      Warp::analytic(BaseProjection::cylindrical(-180, 180, 1, -1), {400, 200}, {9, 5})};
+  const std::vector<OutputSpec> outputs{cylinder};
+  const ContentProjection panorama = equirect_content(DomeOrientation{15, 0});
+  expect_mode2_accuracy(measure(outputs, panorama, {512, 256}, {}), "equirect 512×256");
+  // About 5 texels an output pixel across: the mip levels and taps reach some 16 texels.
+  expect_mode2_accuracy(measure(outputs, panorama, {2048, 1024}, {}, 24.0), "equirect 2048×1024");
+  const ContentProjection cube = cubemap_content(DomeOrientation{0, 20});
+  expect_mode2_accuracy(measure(outputs, cube, {6 * 256, 256}, {}), "cube map 256² faces");
+}
+
+TEST(ContentPass, PerspectiveContentInTheProjectorsFrustum) {
+  const std::vector<OutputSpec> outputs = dome4_outputs();
+  for (std::size_t o = 0; o < outputs.size(); ++o) {
+    const Frustum frustum = covering_frustum(outputs[o].warp, outputs[o].name);
+    const std::vector<OutputSpec> one{outputs[o]};
+    const ErrorStats stats = measure(one, frustum.content(), {512, 512}, {});
+    EXPECT_GT(stats.pixels, 5000u);
+    EXPECT_LE(stats.worst_px, 0.5) << outputs[o].name;
+    EXPECT_LE(stats.rms_px, 0.1) << outputs[o].name;
+  }
+}
+
+double srgb_decode(double e) {
+  return e <= 0.04045 ? e / 12.92 : std::pow((e + 0.055) / 1.055, 2.4);
+}
+
+TEST(ContentPass, DomeMasterDotsLandWhereTheWarpSays) {
+  test::shared_context();
+  const std::vector<OutputSpec> outputs = dome4_outputs();
+  // A 1024² 180° dome master with Gaussian dots (σ = 5 texels, linear light) every 30° of
+  // azimuth on the circles 15°, 35° and 55° above the spring line, every 90° on the 75° one.
+  const int n = 1024;
+  const double sigma = 5;
+  const ContentProjection master = fisheye_content();
+  std::vector<glm::dvec3> dots;
+  for (double elevation : {15.0, 35.0, 55.0, 75.0})
+    for (double azimuth = 0; azimuth < 360; azimuth += elevation < 70 ? 30 : 90) {
+      const double e = elevation * kPi / 180, a = azimuth * kPi / 180;
+      dots.emplace_back(std::cos(e) * std::sin(a), std::sin(e), -std::cos(e) * std::cos(a));
+    }
+  std::vector<double> linear(std::size_t(n) * n, 0.0);
+  for (const glm::dvec3& dot : dots) {
+    const glm::dvec2 c = master.point_from_v_eye(dot)->st * double(n);
+    for (int y = int(c.y) - 20; y <= int(c.y) + 20; ++y)
+      for (int x = int(c.x) - 20; x <= int(c.x) + 20; ++x) {
+        const double d2 = (x + 0.5 - c.x) * (x + 0.5 - c.x) + (y + 0.5 - c.y) * (y + 0.5 - c.y);
+        linear[std::size_t(y) * n + x] += std::exp(-d2 / (2 * sigma * sigma));
+      }
+  }
+  ContentImage image;
+  image.size = {n, n};
+  image.channels = 1;
+  image.bytes.resize(linear.size());
+  for (std::size_t i = 0; i < linear.size(); ++i) {
+    const double l = std::min(1.0, linear[i]);
+    const double e = l <= 0.0031308 ? 12.92 * l : 1.055 * std::pow(l, 1 / 2.4) - 0.055;
+    image.bytes[i] = std::uint8_t(std::lround(e * 255));
+  }
+  ContentPass pass(outputs);
+  ContentTexture texture(ContentFormat::fisheye, image.size, image.pixels, "dots");
+  texture.upload(image);
+
+  int found = 0;
+  double worst_px = 0;
+  for (std::size_t o = 0; o < outputs.size(); ++o) {
+    const Warp& warp = outputs[o].warp;
+    OutputTarget target = OutputTarget::create(warp.output_size);
+    target.clear(glm::vec4(0, 0, 0, 0));  // alpha 0 marks pixels the warp does not cover
+    target.bind();
+    pass.draw(o, texture, master);
+    const std::vector<std::uint8_t> rgba = target.read_colour_rgba8();
+    const glm::ivec2 size = warp.output_size;
+    for (const glm::dvec3& dot : dots) {
+      const auto projected = warp.project(dot);
+      if (!projected || !projected->covered) continue;
+      const glm::dvec2 q = projected->q;
+      const int r = 9;  // window half-size in output pixels
+      if (q.x < r + 1 || q.y < r + 1 || q.x > size.x - r - 1 || q.y > size.y - r - 1) continue;
+      glm::dvec2 moment(0.0);
+      double mass = 0;
+      bool whole = true;
+      for (int y = int(q.y) - r; y <= int(q.y) + r; ++y)
+        for (int x = int(q.x) - r; x <= int(q.x) + r; ++x) {
+          whole = whole && rgba[(std::size_t(y) * size.x + x) * 4 + 3] != 0;
+          const double l = srgb_decode(rgba[(std::size_t(y) * size.x + x) * 4] / 255.0);
+          moment += l * glm::dvec2(x + 0.5, y + 0.5);
+          mass += l;
+        }
+      if (!whole) continue;  // the coverage's edge cuts the window
+      ASSERT_GT(mass, 1.0) << outputs[o].name << ": no dot near " << q.x << ", " << q.y;
+      const double error = glm::length(moment / mass - q);
+      EXPECT_LE(error, 0.5) << outputs[o].name << ": dot at " << q.x << ", " << q.y;
+      worst_px = std::max(worst_px, error);
+      ++found;
+    }
+  }
+  EXPECT_GE(found, 24);
+  std::printf("dome master dots: %d measured, worst centroid error %.3f px\n", found, worst_px);
+}
+
+}  // namespace
+}  // namespace facet::driver

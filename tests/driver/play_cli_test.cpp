@@ -1,0 +1,198 @@
+// facet play through the CLI: a generated video whose frames carry their number in binary
+// blocks plays frame-accurately from the show clock (60 Hz output frames), loops, seeks, reports
+// dropped frames, and bad input exits 2 with a message naming what is wrong.
+#include <OpenImageIO/imageio.h>
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <opencv2/videoio.hpp>
+#include <string>
+#include <vector>
+
+#include "cli_process.hpp"
+
+namespace facet {
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr int kSide = 128;  // a square dome master, shown 1:1 on builtin:dome180 at 128x128
+constexpr int kBits = 8;
+constexpr int kBlock = 16;
+
+// The block of bit b: a 4 × 2 grid around the image centre (inside the fisheye circle).
+cv::Point block_origin(int bit) { return {32 + (bit % 4) * kBlock, 48 + (bit / 4) * kBlock}; }
+
+class PlayCli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() /
+           ("facet_play_test_" + std::to_string(::getpid()) + "_" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  // A video of `frames` frames at `fps` whose frame k shows k in binary blocks (white = 1).
+  fs::path write_video(const std::string& name, int frames, double fps) {
+    const fs::path path = dir_ / name;
+    cv::VideoWriter writer(path.string(), cv::CAP_FFMPEG,
+                           cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), fps,
+                           cv::Size(kSide, kSide));
+    EXPECT_TRUE(writer.isOpened());
+    for (int k = 0; k < frames; ++k) {
+      cv::Mat frame(kSide, kSide, CV_8UC3, cv::Scalar(40, 40, 40));
+      for (int b = 0; b < kBits; ++b) {
+        const cv::Scalar colour = (k >> b) & 1 ? cv::Scalar(255, 255, 255) : cv::Scalar(0, 0, 0);
+        cv::rectangle(frame, cv::Rect(block_origin(b), cv::Size(kBlock, kBlock)), colour,
+                      cv::FILLED);
+      }
+      writer.write(frame);
+    }
+    writer.release();
+    return path;
+  }
+
+  // The number an output frame shows.
+  static int shown_number(const fs::path& png) {
+    auto input = OIIO::ImageInput::open(png.string());
+    EXPECT_TRUE(input) << png;
+    if (!input) return -1;
+    const OIIO::ImageSpec& spec = input->spec();
+    std::vector<std::uint8_t> pixels(std::size_t(spec.width) * spec.height * spec.nchannels);
+    input->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::UINT8, pixels.data());
+    int number = 0;
+    for (int b = 0; b < kBits; ++b) {
+      const cv::Point c = block_origin(b) + cv::Point(kBlock / 2, kBlock / 2);
+      const std::uint8_t value = pixels[(std::size_t(c.y) * spec.width + c.x) * spec.nchannels];
+      if (value > 128) number |= 1 << b;
+    }
+    return number;
+  }
+
+  static std::vector<nlohmann::json> stats(const fs::path& out) {
+    std::vector<nlohmann::json> lines;
+    std::ifstream file(out / "stats.jsonl");
+    for (std::string line; std::getline(file, line);) lines.push_back(nlohmann::json::parse(line));
+    return lines;
+  }
+
+  int play(const std::string& arguments) {
+    return test::run_facet("play " + arguments + " --display builtin:dome180 --size 128x128",
+                           dir_ / "log.txt");
+  }
+  std::string log() const { return test::slurp(dir_ / "log.txt"); }
+
+  fs::path dir_;
+};
+
+TEST_F(PlayCli, VideoPlaysFrameAccuratelyOnTheShowClock) {
+  const fs::path video = write_video("count.avi", 40, 30);
+  const fs::path out = dir_ / "out";
+  // 60 Hz output frames: video frame k is on screen for output frames 2k and 2k + 1; past the
+  // end the last frame stays.
+  ASSERT_EQ(play(video.string() + " --headless --frames 84 --out " + out.string()), 0) << log();
+  const std::vector<nlohmann::json> lines = stats(out);
+  ASSERT_EQ(lines.size(), 84u);
+  for (int n = 0; n < 84; ++n) {
+    const int expected = std::min(n / 2, 39);
+    char name[16];
+    std::snprintf(name, sizeof name, "%05d.png", n);
+    EXPECT_EQ(shown_number(out / "dome180" / name), expected) << "output frame " << n;
+    EXPECT_EQ(lines[std::size_t(n)]["source_frame"].get<int>(), expected);
+    EXPECT_EQ(lines[std::size_t(n)]["dropped"].get<int>(), 0);
+  }
+}
+
+TEST_F(PlayCli, LoopsAndStartsAtAFrame) {
+  const fs::path video = write_video("count.avi", 40, 30);
+  const fs::path out = dir_ / "out";
+  ASSERT_EQ(play(video.string() + " --headless --loop --start-frame 30 --frames 40 --out " +
+                 out.string()),
+            0)
+      << log();
+  for (int n = 0; n < 40; ++n) {
+    char name[16];
+    std::snprintf(name, sizeof name, "%05d.png", n);
+    EXPECT_EQ(shown_number(out / "dome180" / name), (30 + n / 2) % 40) << "output frame " << n;
+  }
+}
+
+TEST_F(PlayCli, AFasterVideoDropsFramesAndSaysSo) {
+  // 120 frames a second on a 60 Hz show clock: every other source frame is never on screen.
+  const fs::path video = write_video("fast.avi", 40, 120);
+  const fs::path out = dir_ / "out";
+  ASSERT_EQ(play(video.string() + " --headless --out " + out.string()), 0) << log();
+  const std::vector<nlohmann::json> lines = stats(out);
+  ASSERT_EQ(lines.size(), 20u) << "one pass of the video by default";
+  for (int n = 0; n < 20; ++n) {
+    char name[16];
+    std::snprintf(name, sizeof name, "%05d.png", n);
+    EXPECT_EQ(shown_number(out / "dome180" / name), 2 * n) << "output frame " << n;
+    EXPECT_EQ(lines[std::size_t(n)]["dropped"].get<int>(), n == 0 ? 0 : 1);
+  }
+  EXPECT_EQ(lines.back()["dropped_total"].get<int>(), 19);
+}
+
+TEST_F(PlayCli, BadInputExitsTwoWithAClearMessage) {
+  const fs::path out = dir_ / "out";
+  EXPECT_EQ(play((dir_ / "missing.mp4").string() + " --headless --out " + out.string()), 2);
+  EXPECT_NE(log().find("no such file"), std::string::npos) << log();
+
+  std::ofstream(dir_ / "text.mp4") << "not a video at all\n";
+  EXPECT_EQ(play((dir_ / "text.mp4").string() + " --headless --out " + out.string()), 2);
+  EXPECT_NE(log().find("video"), std::string::npos) << log();
+
+  // A real video cut after its header: no frame can be decoded.
+  const fs::path video = write_video("count.avi", 40, 30);
+  const std::string bytes = test::slurp(video);
+  std::ofstream(dir_ / "cut.avi", std::ios::binary) << bytes.substr(0, 600);
+  EXPECT_EQ(play((dir_ / "cut.avi").string() + " --headless --out " + out.string()), 2);
+  EXPECT_NE(log().find("cut.avi"), std::string::npos) << log();
+
+  const cv::Mat wide(100, 160, CV_8UC3, cv::Scalar(10, 20, 30));
+  cv::imwrite((dir_ / "wide.png").string(), wide);
+  EXPECT_EQ(
+      play((dir_ / "wide.png").string() + " --format fisheye --headless --out " + out.string()), 2);
+  EXPECT_NE(log().find("square dome master"), std::string::npos) << log();
+  EXPECT_EQ(
+      play((dir_ / "wide.png").string() + " --format equirect --headless --out " + out.string()),
+      2);
+  EXPECT_NE(log().find("twice as wide as high"), std::string::npos) << log();
+  EXPECT_EQ(play((dir_ / "wide.png").string() + " --headless --out " + out.string()), 2);
+  EXPECT_NE(log().find("give --format"), std::string::npos) << log();
+
+  EXPECT_EQ(play(video.string() + " --start-frame 40 --headless --out " + out.string()), 2);
+  EXPECT_NE(log().find("--start-frame"), std::string::npos) << log();
+  EXPECT_FALSE(fs::exists(out)) << "nothing is written on bad input";
+}
+
+TEST_F(PlayCli, StillEquirectOnACylinder) {
+  // A 2:1 panorama, white above the horizon and black below: the cylinder's top half is lit.
+  cv::Mat panorama(64, 128, CV_8UC3, cv::Scalar(0, 0, 0));
+  panorama(cv::Rect(0, 0, 128, 32)).setTo(cv::Scalar(255, 255, 255));
+  cv::imwrite((dir_ / "sky.png").string(), panorama);
+  const fs::path out = dir_ / "out";
+  ASSERT_EQ(test::run_facet("play " + (dir_ / "sky.png").string() +
+                                " --display builtin:cylinder360 --size 160x120 --headless --out " +
+                                out.string(),
+                            dir_ / "log.txt"),
+            0)
+      << log();
+  auto input = OIIO::ImageInput::open((out / "cylinder360" / "00000.png").string());
+  ASSERT_TRUE(input);
+  std::vector<std::uint8_t> pixels(160 * 120 * 4);
+  input->read_image(0, 0, 0, 4, OIIO::TypeDesc::UINT8, pixels.data());
+  EXPECT_GT(pixels[(std::size_t(20) * 160 + 80) * 4], 250);  // above the horizon
+  EXPECT_LT(pixels[(std::size_t(100) * 160 + 80) * 4], 5);   // below
+}
+
+}  // namespace
+}  // namespace facet

@@ -1,0 +1,163 @@
+// facet play: a dome master, panorama or cube map (still or video) on a display, through its
+// exact warp and blend; windows per projector, or headless frames to files.
+#include <cstdlib>
+#include <iostream>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "command.hpp"
+#include "display_flags.hpp"
+#include "facet/driver/content_media.hpp"
+#include "facet/driver/content_player.hpp"
+#include "facet/driver/gl_context.hpp"
+#include "facet/driver/session.hpp"
+#include "facet/projection/content_projection.hpp"
+#include "facet/projection/errors.hpp"
+#include "facet/projection/interrupt.hpp"
+#include "facet/projection/progress.hpp"
+#include "frames_flag.hpp"
+
+namespace facet::cli {
+namespace {
+
+struct PlayOptions {
+  std::string file;
+  std::string display = "builtin:dome180";
+  std::string size;
+  std::optional<double> scale;
+  std::string format;  // empty: from the aspect ratio
+  std::optional<double> fov;
+  DomeOrientationFlags orientation;
+  bool headless = false, windowed = false, span = false, loop = false;
+  std::optional<std::int64_t> frames;
+  std::int64_t start_frame = 0;
+  std::string out = "out/play";
+};
+
+bool have_display_server() {
+  const char* x_display = std::getenv("DISPLAY");
+  const char* wayland_display = std::getenv("WAYLAND_DISPLAY");
+  return (x_display && *x_display) || (wayland_display && *wayland_display);
+}
+
+void play(const PlayOptions& options) {
+  if (options.headless && options.windowed)
+    throw InputError("command line", "--headless", "either --headless or --windowed, not both");
+  std::optional<std::uint64_t> frames;
+  if (options.frames) frames = checked_frames(*options.frames);
+  std::optional<glm::ivec2> size;
+  if (!options.size.empty()) size = parse_size(options.size, "--size");
+  std::optional<ContentFormat> format;
+  if (!options.format.empty())
+    format = content_format_from_string(options.format, "command line", "--format");
+  const DomeOrientation orientation = options.orientation.value();
+  if (options.fov && format && *format != ContentFormat::fisheye)
+    throw InputError("command line", "--fov", "a field of view for --format fisheye only");
+
+  driver::SessionDisplay display = driver::load_session_display(options.display, size);
+  if (options.scale) driver::scale_session_display(display, *options.scale);
+
+  auto media = driver::ContentMedia::open(options.file);
+  const ContentFormat chosen = driver::check_content_format(media->size(), format, options.file);
+  driver::PlaybackOptions playback;
+  switch (chosen) {
+    case ContentFormat::fisheye:
+      playback.projection = fisheye_content(options.fov.value_or(180), orientation);
+      break;
+    case ContentFormat::equirect:
+      playback.projection = equirect_content(orientation);
+      break;
+    default:
+      playback.projection = cubemap_content(orientation);
+      break;
+  }
+  playback.projection.validate("command line");
+  playback.loop = options.loop;
+  playback.start_frame = options.start_frame;
+  if (options.start_frame < 0 || options.start_frame >= media->frame_count())
+    throw InputError("command line", "--start-frame",
+                     "a frame from 0 to " + std::to_string(media->frame_count() - 1) + " of " +
+                         options.file + "; got " + std::to_string(options.start_frame));
+  std::cout << "facet play: " << options.file << ": " << media->size().x << "x" << media->size().y
+            << " " << to_string(chosen)
+            << (media->is_video() ? ", video at " + std::to_string(media->fps()) + " fps, " +
+                                        std::to_string(media->frame_count()) + " frames"
+                                  : std::string(", still image"))
+            << "\n";
+
+  const bool headless = options.headless || (!options.windowed && !have_display_server());
+  watch_interrupts();
+  if (!headless) {
+    if (!have_display_server())
+      throw InputError("command line", "--windowed",
+                       "a display server (X11) for windows; none was found (DISPLAY is not set): "
+                       "use --headless to render frames to files");
+    driver::WindowPlayOptions window_options;
+    window_options.frames = frames;
+    window_options.span = options.span;
+    driver::run_windowed_play(display, std::move(media), playback, window_options);
+    return;
+  }
+  if (!options.headless)
+    std::cerr << "facet play: no display server (DISPLAY is not set): playing headless\n";
+  auto context = driver::create_headless_context();
+  driver::ContentPlayer player(std::move(display), std::move(media), playback);
+  driver::HeadlessRunOptions headless_options;
+  headless_options.frames = frames.value_or(driver::frames_for_one_pass(player.clock()));
+  headless_options.out_dir = options.out;
+  facet::TerminalProgress progress(stderr, "facet play");
+  headless_options.progress = progress.sink();
+  const driver::HeadlessPlayResult result = driver::run_headless_play(player, headless_options);
+  progress.finish();
+  std::int64_t dropped = result.frames.empty() ? 0 : result.frames.back().dropped_total;
+  std::cout << "facet play: " << result.frames.size() << " frames of "
+            << player.display().outputs.size() << " output(s) (" << context->info().renderer
+            << ") written to " << options.out << "/<output>/<frame>.png; statistics in "
+            << options.out << "/stats.jsonl; " << dropped << " source frames dropped\n";
+}
+
+const Registration registration{
+    42, [](CLI::App& app) {
+      auto options = std::make_shared<PlayOptions>();
+      auto* command = app.add_subcommand(
+          "play",
+          "Play a dome master, equirectangular panorama or cube map (PNG, JPEG, EXR or a video) "
+          "on a display through its exact warp and blend");
+      command->add_option("file", options->file, "Still image (.png .jpg .exr ...) or video")
+          ->required();
+      command->add_option("--display", options->display,
+                          "builtin:dome180 (default), builtin:cylinder360, builtin:wall2x2, a "
+                          ".warp.exr or a display.json");
+      command->add_option("--size", options->size, "Output size WxH of a built-in display");
+      command->add_option("--scale", options->scale,
+                          "Preview at this fraction of every output's resolution (0, 1]");
+      command->add_option("--format", options->format,
+                          "fisheye (square dome master), equirect (2:1) or cubemap (6:1 strip: "
+                          "+x -x +y -y +z -z in OpenGL's orientation); default from the aspect");
+      command->add_option("--fov", options->fov,
+                          "Fisheye: the dome master's full field of view in degrees (default 180)");
+      command->add_option("--tilt", options->orientation.tilt,
+                          "The content's zenith tilted forward by DEG, in [-90, 90] (default 0)");
+      command->add_option("--orientation", options->orientation.orientation,
+                          "The content turned by DEG about the vertical, its front toward the "
+                          "right, in [-360, 360] (default 0)");
+      command->add_flag("--headless", options->headless, "Render through EGL to --out");
+      command->add_flag("--windowed", options->windowed,
+                        "Open windows (the default when DISPLAY is set)");
+      command->add_flag("--span", options->span, "One borderless window spanning every output");
+      command->add_option("--frames", options->frames,
+                          "Output frames at 60 Hz, 1 to 1000000 (headless default: one pass of "
+                          "the video, 1 for a still; windowed: until closed)");
+      command->add_flag("--loop", options->loop, "Loop the video");
+      command->add_option("--start-frame", options->start_frame,
+                          "Video frame shown at time 0 (default 0)");
+      command
+          ->add_option("--out", options->out,
+                       "Headless: folder for <output>/<frame>.png and stats.jsonl")
+          ->capture_default_str();
+      command->callback([options] { play(*options); });
+    }};
+
+}  // namespace
+}  // namespace facet::cli
