@@ -12,6 +12,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
@@ -405,6 +406,39 @@ TEST(RunCli, ALongHeadlessRunKeepsAFlatResidentSet) {
   EXPECT_NE(slurp(folder / "log").find("'--save-every'"), std::string::npos)
       << slurp(folder / "log");
   EXPECT_FALSE(fs::exists(folder / "zero"));
+  fs::remove_all(folder);
+}
+
+// facet preview of the shipped dome4 about its 30°-tilted zenith: every direction above the spring
+// line covered, blends summing to 1 within 0.005; bad flags are exit 2 with nothing written.
+TEST(PreviewCli, Dome4IsCoveredAndBadFlagsWriteNothing) {
+  const fs::path folder = fresh_folder("preview");
+  const std::string dome4 =
+      (fs::path(FACET_SOURCE_DIR) / "configs/displays/dome4/display.json").string();
+  const fs::path image = folder / "dome4.png";
+  ASSERT_EQ(run("preview " + dome4 + " --tilt 30 --preview-size 128 --show blend --json --out " +
+                    image.string(),
+                folder / "log"),
+            0)
+      << slurp(folder / "log");
+  const std::string log = slurp(folder / "log");
+  const auto json = nlohmann::json::parse(log.substr(log.find('{')));
+  EXPECT_EQ(json["view"], "fisheye");
+  EXPECT_EQ(json["uncovered_sr"], 0.0);
+  EXPECT_LE(json["blend_sum_worst_error"].get<double>(), 0.005);
+  EXPECT_EQ(json["projectors"].size(), 4u);
+  const Png png = read_png(image);
+  EXPECT_EQ(png.width, 128);
+  EXPECT_EQ(png.height, 128);
+  for (const std::string flags :
+       {"--show colours", "--view cube", "--preview-size 4", "--fov 400"}) {
+    SCOPED_TRACE(flags);
+    const fs::path bad = folder / "bad.png";
+    EXPECT_EQ(run("preview " + dome4 + " " + flags + " --out " + bad.string(), folder / "log"), 2);
+    EXPECT_NE(slurp(folder / "log").find(flags.substr(0, flags.find(' '))), std::string::npos)
+        << slurp(folder / "log");
+    EXPECT_FALSE(fs::exists(bad));
+  }
   fs::remove_all(folder);
 }
 
