@@ -44,7 +44,9 @@ class GltfReader {
       for (std::size_t i = 0; i < model_.nodes.size(); ++i)
         if (!is_child[i]) roots.push_back(static_cast<int>(i));
     }
-    for (const int root : roots) visit(scene, root, glm::dmat4(1.0), 0);
+    animated_ = !model_.animations.empty();
+    for (const int root : roots) visit(scene, root, glm::dmat4(1.0), 0, -1);
+    if (animated_) read_animations(scene);
     if (needs_default_material_) {
       Material fallback;
       fallback.name = "default";
@@ -59,6 +61,7 @@ class GltfReader {
 
  private:
   static constexpr std::uint32_t no_material = 0xffffffffu;
+  bool animated_ = false;  // the file has animations: record the node graph
 
   [[noreturn]] void fail(const std::string& field, const std::string& expected) const {
     throw InputError(source_, field, expected);
@@ -133,7 +136,69 @@ class GltfReader {
     return out;
   }
 
-  void visit(Scene& scene, int node_index, const glm::dmat4& T_world_parent, int depth) {
+  // glTF animations: every node visit becomes an AnimationNode, every channel an
+  // AnimationChannel (morph target weights are skipped).
+  void read_animations(Scene& scene) const {
+    for (std::size_t i = 0; i < model_.animations.size(); ++i) {
+      const auto& in = model_.animations[i];
+      const std::string field = "animations[" + std::to_string(i) + "]";
+      AnimationClip clip;
+      clip.name = in.name.empty() ? field : in.name;
+      for (std::size_t j = 0; j < in.channels.size(); ++j) {
+        const auto& channel = in.channels[j];
+        const std::string channel_field = field + ".channels[" + std::to_string(j) + "]";
+        if (channel.target_path == "weights" || channel.target_node < 0) continue;
+        if (channel.target_node >= static_cast<int>(model_.nodes.size()))
+          fail(channel_field + ".target.node",
+               "a node index below " + std::to_string(model_.nodes.size()));
+        AnimationChannel out;
+        out.node = static_cast<std::uint32_t>(channel.target_node);
+        if (channel.target_path == "translation")
+          out.path = AnimationPath::translation;
+        else if (channel.target_path == "rotation")
+          out.path = AnimationPath::rotation;
+        else if (channel.target_path == "scale")
+          out.path = AnimationPath::scale;
+        else
+          fail(channel_field + ".target.path", "translation, rotation, scale or weights");
+        if (channel.sampler < 0 || channel.sampler >= static_cast<int>(in.samplers.size()))
+          fail(channel_field + ".sampler",
+               "a sampler index below " + std::to_string(in.samplers.size()));
+        const auto& sampler = in.samplers[static_cast<std::size_t>(channel.sampler)];
+        const std::string sampler_field =
+            field + ".samplers[" + std::to_string(channel.sampler) + "]";
+        if (sampler.interpolation.empty() || sampler.interpolation == "LINEAR")
+          out.interpolation = AnimationInterpolation::linear;
+        else if (sampler.interpolation == "STEP")
+          out.interpolation = AnimationInterpolation::step;
+        else if (sampler.interpolation == "CUBICSPLINE")
+          out.interpolation = AnimationInterpolation::cubic_spline;
+        else
+          fail(sampler_field + ".interpolation", "LINEAR, STEP or CUBICSPLINE");
+        out.times_s = read_floats(sampler.input, 1, sampler_field + ".input");
+        if (out.times_s.empty()) fail(sampler_field + ".input", "at least one key time");
+        for (std::size_t k = 0; k < out.times_s.size(); ++k)
+          if (!(out.times_s[k] >= 0) || (k > 0 && !(out.times_s[k] > out.times_s[k - 1])))
+            fail(sampler_field + ".input", "key times >= 0 seconds, strictly increasing");
+        const int components = out.path == AnimationPath::rotation ? 4 : 3;
+        out.values = read_floats(sampler.output, components, sampler_field + ".output");
+        const std::size_t per_key =
+            out.interpolation == AnimationInterpolation::cubic_spline ? 3 : 1;
+        if (out.values.size() != out.times_s.size() * per_key * std::size_t(components))
+          fail(sampler_field + ".output",
+               std::to_string(out.times_s.size() * per_key) + " values (" +
+                   (per_key == 3 ? "in-tangent, value, out-tangent per key" : "one per key") +
+                   "), as many as its input's key times");
+        clip.duration_s = std::max(clip.duration_s, double(out.times_s.back()));
+        clip.channels.push_back(std::move(out));
+      }
+      if (!clip.channels.empty()) scene.animation.clips.push_back(std::move(clip));
+    }
+    if (scene.animation.clips.empty()) scene.animation = {};
+  }
+
+  void visit(Scene& scene, int node_index, const glm::dmat4& T_world_parent, int depth,
+             std::int32_t parent_entry) {
     const std::string field = "nodes[" + std::to_string(node_index) + "]";
     if (node_index < 0 || node_index >= static_cast<int>(model_.nodes.size()))
       fail(field, "a node index below " + std::to_string(model_.nodes.size()));
@@ -141,6 +206,24 @@ class GltfReader {
     if (depth > static_cast<int>(model_.nodes.size())) fail(field, "an acyclic node hierarchy");
     const auto& node = model_.nodes[static_cast<std::size_t>(node_index)];
     const glm::dmat4 T_world_node = T_world_parent * local_transform(node, field);
+    std::int32_t entry = -1;
+    if (animated_) {
+      AnimationNode record;
+      record.gltf_node = static_cast<std::uint32_t>(node_index);
+      record.parent = parent_entry;
+      record.has_matrix = !node.matrix.empty();
+      if (record.has_matrix) record.matrix = local_transform(node, field);
+      if (node.translation.size() == 3)
+        record.translation =
+            glm::dvec3(node.translation[0], node.translation[1], node.translation[2]);
+      if (node.rotation.size() == 4)
+        record.rotation = glm::normalize(
+            glm::dquat(node.rotation[3], node.rotation[0], node.rotation[1], node.rotation[2]));
+      if (node.scale.size() == 3)
+        record.scale = glm::dvec3(node.scale[0], node.scale[1], node.scale[2]);
+      entry = static_cast<std::int32_t>(scene.animation.nodes.size());
+      scene.animation.nodes.push_back(record);
+    }
     if (node.mesh >= 0) {
       if (node.mesh >= static_cast<int>(model_.meshes.size()))
         fail(field + ".mesh", "a mesh index below " + std::to_string(model_.meshes.size()));
@@ -151,6 +234,7 @@ class GltfReader {
       object.first_primitive = first;
       object.primitive_count = count;
       scene.objects.push_back(std::move(object));
+      if (animated_) scene.animation.object_node.push_back(entry);
     }
     if (node.camera >= 0) {
       if (node.camera >= static_cast<int>(model_.cameras.size()))
@@ -163,7 +247,7 @@ class GltfReader {
       out.orthographic = camera.type == "orthographic";
       scene.cameras.push_back(std::move(out));
     }
-    for (const int child : node.children) visit(scene, child, T_world_node, depth + 1);
+    for (const int child : node.children) visit(scene, child, T_world_node, depth + 1, entry);
   }
 
   // The rotation and translation of a node transform: its axes made orthonormal (scale and

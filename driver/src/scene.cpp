@@ -63,6 +63,7 @@ Scene subdivide_triangles(const Scene& scene, int n) {
   out.materials = scene.materials;
   out.images = scene.images;
   out.cameras = scene.cameras;
+  out.animation = scene.animation;
   const std::uint64_t pieces = std::uint64_t(n) * std::uint64_t(n);
   const std::uint64_t corners = std::uint64_t(n + 1) * std::uint64_t(n + 2) / 2;
   std::uint64_t triangles = 0;

@@ -413,7 +413,8 @@ bool Session::output_sees_scene(std::size_t index, const glm::dmat4& T_world_eye
   return false;
 }
 
-void Session::place_objects(const std::vector<ObjectPose>& poses) {
+void Session::place_objects(const std::vector<ObjectPose>& poses,
+                            const std::vector<ObjectPose>& animated) {
   std::vector<const ObjectPose*> pose_of(scene_.objects.size(), nullptr);
   for (std::size_t i = 0; i < poses.size(); ++i) {
     const std::string field = "object_poses[" + std::to_string(i) + "].object";
@@ -428,6 +429,8 @@ void Session::place_objects(const std::vector<ObjectPose>& poses) {
           "each object at most once; object " + std::to_string(o) + " is listed twice");
     pose_of[o] = &poses[i];
   }
+  for (const ObjectPose& pose : animated)
+    if (pose.object < pose_of.size() && !pose_of[pose.object]) pose_of[pose.object] = &pose;
   for (std::size_t o = 0; o < scene_.objects.size(); ++o) {
     Object& object = scene_.objects[o];
     RestPose& rest = rest_poses_[o];
@@ -463,7 +466,7 @@ void Session::place_objects(const std::vector<ObjectPose>& poses) {
 
 FrameStats Session::render(const FrameState& state, bool finish) {
   const auto start = std::chrono::steady_clock::now();
-  place_objects(state.object_poses);
+  place_objects(state.object_poses, animated_object_poses(scene_.animation, state.time_s));
   FrameStats stats;
   stats.frame = state.frame;
   stats.time_s = state.time_s;

@@ -9,7 +9,9 @@
 #include <filesystem>
 #include <fstream>
 #include <glm/gtc/matrix_transform.hpp>
+#include <nlohmann/json.hpp>
 #include <numbers>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -153,6 +155,130 @@ void expect_input_error(const fs::path& file, const std::string& field_part) {
     EXPECT_NE(std::string(e.what()).find(file.string()), std::string::npos) << e.what();
     EXPECT_NE(e.field().find(field_part), std::string::npos) << e.what();
   }
+}
+
+// square_gltf with one animation over keys at 0, 1 and 2 s: node "first" jumps (STEP) to
+// x = 5 m for the second second, and node "parent" turns (LINEAR) about +y by 90° a second,
+// carrying "second" with it. `interpolation` replaces the rotation sampler's.
+std::string animated_square_gltf(const std::string& interpolation = "LINEAR") {
+  std::string text = square_gltf();
+  std::vector<unsigned char> buffer;
+  for (const float t : {0.0f, 1.0f, 2.0f}) append(buffer, t);
+  for (const float x : {0.0f, 5.0f, 0.0f})
+    for (const float v : {x, 0.0f, 0.0f}) append(buffer, v);
+  const float s = std::sqrt(0.5f);
+  const float rotations[3][4] = {{0, 0, 0, 1}, {0, s, 0, s}, {0, 1, 0, 0}};
+  for (const auto& q : rotations)
+    for (const float v : q) append(buffer, v);
+  nlohmann::json gltf = nlohmann::json::parse(text);
+  gltf["buffers"].push_back({{"byteLength", buffer.size()},
+                             {"uri", "data:application/octet-stream;base64," + base64(buffer)}});
+  gltf["bufferViews"].push_back({{"buffer", 1}, {"byteOffset", 0}, {"byteLength", 12}});
+  gltf["bufferViews"].push_back({{"buffer", 1}, {"byteOffset", 12}, {"byteLength", 36}});
+  gltf["bufferViews"].push_back({{"buffer", 1}, {"byteOffset", 48}, {"byteLength", 48}});
+  gltf["accessors"].push_back({{"bufferView", 3},
+                               {"componentType", 5126},
+                               {"count", 3},
+                               {"type", "SCALAR"},
+                               {"min", {0}},
+                               {"max", {2}}});
+  gltf["accessors"].push_back(
+      {{"bufferView", 4}, {"componentType", 5126}, {"count", 3}, {"type", "VEC3"}});
+  gltf["accessors"].push_back(
+      {{"bufferView", 5}, {"componentType", 5126}, {"count", 3}, {"type", "VEC4"}});
+  const auto channel = [](int sampler, int node, const char* path) {
+    return nlohmann::json{{"sampler", sampler}, {"target", {{"node", node}, {"path", path}}}};
+  };
+  gltf["animations"] = {
+      {{"name", "turn"},
+       {"channels",
+        {channel(0, 0, "translation"), channel(1, 1, "rotation"), channel(1, 1, "weights")}},
+       {"samplers",
+        {{{"input", 3}, {"output", 4}, {"interpolation", "STEP"}},
+         {{"input", 3}, {"output", 5}, {"interpolation", interpolation}}}}}};
+  return gltf.dump(1);
+}
+
+// The pose of object `o` at `time_s`, or nothing when the animation does not move it.
+std::optional<glm::dmat4> pose_at(const Scene& scene, std::uint32_t o, double time_s) {
+  for (const ObjectPose& pose : animated_object_poses(scene.animation, time_s))
+    if (pose.object == o) return pose.T_world_object;
+  return std::nullopt;
+}
+
+TEST(Gltf, NodeAnimationsMoveTheirObjectsAndLoop) {
+  TempDir dir;
+  const Scene scene = load_gltf(dir.write("animated.gltf", animated_square_gltf()));
+  ASSERT_EQ(scene.animation.clips.size(), 1u);
+  EXPECT_EQ(scene.animation.clips[0].name, "turn");
+  EXPECT_EQ(scene.animation.clips[0].channels.size(), 2u);  // weights skipped
+  EXPECT_DOUBLE_EQ(scene.animation.duration_s(), 2.0);
+  ASSERT_EQ(scene.animation.object_node.size(), 2u);
+  // The rest pose stays in the objects.
+  EXPECT_EQ(scene.objects[1].T_world_object * glm::vec4(1, 1, 0, 1), glm::vec4(22, 2, 0, 1));
+  // STEP: the first key's value until 1 s, then the second's.
+  const auto moved = [&](std::uint32_t o, double t, glm::dvec3 p) {
+    const auto pose = pose_at(scene, o, t);
+    return pose ? glm::dvec3(*pose * glm::dvec4(p, 1.0)) : glm::dvec3(NAN);
+  };
+  EXPECT_NEAR(glm::distance(moved(0, 0.5, {1, 1, 0}), glm::dvec3(1, 1, 0)), 0, 1e-12);
+  EXPECT_NEAR(glm::distance(moved(0, 1.5, {1, 1, 0}), glm::dvec3(6, 1, 0)), 0, 1e-12);
+  // LINEAR rotation is a slerp: 45° at 0.5 s, 135° at 1.5 s, about +y, through the parent's
+  // scale of 2: (1, 1, 0) of "second" sits at 2 · (11, 1, 0) before turning. The keys are
+  // float quaternions: good to about 1e-7 of the 22 m radius.
+  for (const double t : {0.5, 1.5}) {
+    const double angle = std::numbers::pi / 2 * t;
+    const glm::dvec3 expected(22 * std::cos(angle), 2, -22 * std::sin(angle));
+    EXPECT_NEAR(glm::distance(moved(1, t, {1, 1, 0}), expected), 0, 1e-6) << t;
+    // Looping: a whole period later, and a period before, the same pose.
+    EXPECT_NEAR(glm::distance(moved(1, t + 2, {1, 1, 0}), expected), 0, 1e-6) << t;
+    EXPECT_NEAR(glm::distance(moved(1, t - 2, {1, 1, 0}), expected), 0, 1e-6) << t;
+  }
+  // A still scene has no animation and no poses.
+  const Scene still = load_gltf(dir.write("still.gltf", square_gltf()));
+  EXPECT_TRUE(still.animation.empty());
+  EXPECT_TRUE(animated_object_poses(still.animation, 1.0).empty());
+}
+
+TEST(Gltf, BadAnimationsNameTheField) {
+  TempDir dir;
+  std::string text = animated_square_gltf("SMOOTH");
+  expect_input_error(dir.write("interpolation.gltf", text), "samplers[1].interpolation");
+  // CUBICSPLINE needs three elements a key: 3 rotations are too few for 3 keys.
+  text = animated_square_gltf("CUBICSPLINE");
+  expect_input_error(dir.write("cubic.gltf", text), "samplers[1].output");
+  text = animated_square_gltf();
+  text.replace(text.find("\"rotation\""), 10, "\"shear\"");
+  expect_input_error(dir.write("path.gltf", text), "channels[1].target.path");
+}
+
+// Cubic Hermite keys: with zero tangents the value halfway is the mean of the keys; with equal
+// tangents m and values 0, 0 it is m · dt / 8 · ... (u = 1/2: (u³ - 2u² + u - u³ + u²) dt m).
+TEST(Animation, CubicSplineAndStepSampling) {
+  SceneAnimation animation;
+  animation.nodes.push_back({});
+  animation.object_node = {0};
+  AnimationChannel channel;
+  channel.path = AnimationPath::translation;
+  channel.interpolation = AnimationInterpolation::cubic_spline;
+  channel.times_s = {0, 2};
+  // Key 0: in (0,0,0), value (0,0,0), out (1,0,0); key 1: in (1,0,0), value (0,0,0), out 0.
+  channel.values = {0, 0, 0, 0, 0, 0, 1, 0, 0, 1, 0, 0, 0, 0, 0, 0, 0, 0};
+  AnimationClip clip;
+  clip.duration_s = 2;
+  clip.channels = {channel};
+  animation.clips = {clip};
+  auto x_at = [&](double t) {
+    return animated_object_poses(animation, t).at(0).T_world_object[3].x;
+  };
+  // (u - 2u² + u³) dt + (u³ - u²) dt at u = 1/2, dt = 2: (1/8) · 2 + (-1/8) · 2 = 0.
+  EXPECT_NEAR(x_at(1.0), 0.0, 1e-12);
+  // At u = 1/4: (1/4 - 1/8 + 1/64) · 2 + (1/64 - 1/16) · 2 = 0.28125 - 0.09375 = 0.1875.
+  EXPECT_NEAR(x_at(0.5), 0.1875, 1e-7);
+  animation.clips[0].channels[0].interpolation = AnimationInterpolation::step;
+  animation.clips[0].channels[0].values = {1, 0, 0, 3, 0, 0};
+  EXPECT_EQ(x_at(1.99), 1.0);
+  EXPECT_EQ(x_at(2.0), 1.0);  // the loop's end is its start
 }
 
 TEST(Gltf, MalformedJsonNamesTheFile) {

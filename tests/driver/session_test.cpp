@@ -151,15 +151,25 @@ void add_cube(Scene& scene, const std::string& name, float side, const glm::mat4
   scene.update_bounds();
 }
 
-// A cube circling the zenith of the 180° dome (45° up, turning about itself as it goes) over a
-// still one: every frame the session draws both where the exact ray cast sees them, coverage
-// runs again whenever the cube moves, and is reused while nothing moves.
+// A cube circling the zenith of the 180° dome (45° up, turning about itself as it goes), one the
+// scene's animation slides overhead, and a still one: every frame the session draws both where the
+// exact ray cast sees them, coverage runs again whenever the cube moves, and is reused while
+// nothing moves.
 TEST(Session, MovingObjectIsDrawnWhereTheReferenceSeesIt) {
   test::shared_context();
   Scene scene;
   scene.name = "orbit";
   add_cube(scene, "still", 1.5f, glm::translate(glm::mat4(1.0f), glm::vec3(0, 4, -2)));
   add_cube(scene, "moving", 1.0f, glm::mat4(1.0f));  // at the eye until posed: never drawn there
+  // A third cube the scene's own animation slides from x = -3 to 3 m over 2 s, 4 m up.
+  add_cube(scene, "animated", 1.0f, glm::mat4(1.0f));
+  AnimationChannel slide;
+  slide.node = 0;
+  slide.times_s = {0, 2};
+  slide.values = {-3, 4, 1, 3, 4, 1};
+  scene.animation.nodes = {AnimationNode{}};
+  scene.animation.object_node = {-1, -1, 0};
+  scene.animation.clips = {AnimationClip{"slide", 2.0, {slide}}};
   Session session(load_session_display("builtin:dome180", glm::ivec2(128, 128)), scene);
   const Warp& warp = session.display().outputs[0].spec.warp;
   const WarpInverse inverse(warp);
@@ -168,6 +178,7 @@ TEST(Session, MovingObjectIsDrawnWhereTheReferenceSeesIt) {
     const double angle = frame * 0.7;
     FrameState state;
     state.frame = std::uint64_t(frame);
+    state.time_s = frame * 0.3;
     ObjectPose pose;
     pose.object = 1;
     pose.T_world_object = glm::rotate(
@@ -184,6 +195,7 @@ TEST(Session, MovingObjectIsDrawnWhereTheReferenceSeesIt) {
                               glm::vec4(scene.positions[scene.indices[i]], 1.0f));
       ASSERT_TRUE(session.scene().objects[1].bounds_world.contains(p_world, 1e-4f));
     }
+    EXPECT_NEAR(session.scene().objects[2].T_world_object[3].x, -3 + 3 * state.time_s, 1e-5);
     const std::vector<std::uint32_t> tested = session.targets()[0].read_ids();
     const std::vector<std::uint32_t> reference =
         ReferenceRaycaster(session.scene()).ids(inverse, glm::dmat4(1.0));
@@ -196,6 +208,7 @@ TEST(Session, MovingObjectIsDrawnWhereTheReferenceSeesIt) {
     };
     EXPECT_GT(shows(reference, 13, 24), 20) << "frame " << frame;
     EXPECT_GT(shows(reference, 1, 12), 20) << "frame " << frame;
+    EXPECT_GT(shows(reference, 25, 36), 20) << "frame " << frame;
     EXPECT_LE(comparison.id_mismatch, 0.002)
         << "frame " << frame << ": " << comparison.mismatched_pixels << " of "
         << comparison.compared_pixels << " pixels";
@@ -209,9 +222,14 @@ TEST(Session, MovingObjectIsDrawnWhereTheReferenceSeesIt) {
   EXPECT_TRUE(session.render(still, true).outputs[0].render.reused_replication);
   EXPECT_FALSE(session.render(FrameState{}, true).outputs[0].render.reused_replication);
   EXPECT_EQ(session.scene().objects[1].T_world_object, glm::mat4(1.0f));
+  // The animation moves the third cube over time: a new time alone reruns coverage.
+  FrameState later;
+  later.time_s = 0.5;
+  EXPECT_FALSE(session.render(later, true).outputs[0].render.reused_replication);
+  EXPECT_TRUE(session.render(later, true).outputs[0].render.reused_replication);
   // Poses of objects the scene lacks, or twice, render nothing and say which.
   FrameState bad;
-  bad.object_poses = {{2, glm::dmat4(1.0)}};
+  bad.object_poses = {{3, glm::dmat4(1.0)}};
   EXPECT_THROW(session.render(bad), InputError);
   bad.object_poses = {{0, glm::dmat4(1.0)}, {0, glm::dmat4(1.0)}};
   EXPECT_THROW(session.render(bad), InputError);

@@ -22,6 +22,10 @@ namespace facet::driver {
 // - Cameras: every node of the scene with a camera (perspective or orthographic) becomes a
 //   SceneCamera with the node's world transform, scale removed; the camera's own projection is
 //   not used: the display decides what is seen.
+// - Animations: translation, rotation and scale channels (STEP, LINEAR, CUBICSPLINE) go into
+//   Scene::animation with the node graph they move; all clips play at once, each looping over
+//   its own length. Objects keep their rest pose in T_world_object. Morph target weights are
+//   skipped; nodes given by a matrix do not move.
 //
 // Throws facet::InputError naming the file (and the glTF field, where known) for unreadable,
 // malformed or unsupported input: bad JSON, out-of-range indices or accessors, missing POSITION,

@@ -13,6 +13,8 @@
 #include <string>
 #include <vector>
 
+#include "facet/driver/animation.hpp"
+
 namespace facet::driver {
 
 // Axis-aligned box. Empty (p_min > p_max) until a point is added.
@@ -80,6 +82,9 @@ struct Scene {
   std::vector<Material> materials;
   std::vector<Image> images;
   std::vector<SceneCamera> cameras;  // in the order the scene graph is visited
+  // Keyframed node animations (glTF); empty for a still scene. Object::T_world_object stays the
+  // rest pose; Session places animated objects at each frame's time.
+  SceneAnimation animation;
 
   // Triangles drawn, counting each instance: sum over objects of their primitives' triangles.
   std::size_t triangle_count() const;

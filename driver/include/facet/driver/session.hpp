@@ -59,16 +59,6 @@ void scale_session_display(SessionDisplay& display, double factor);
 void write_session_display(const SessionDisplay& display, const std::string& name,
                            const std::filesystem::path& folder);
 
-// Where one scene object is this frame. Objects are identified by their index in
-// Scene::objects (the order of the triangle-ID numbering, render_method.hpp), which the glTF
-// loader and the API keep stable for a scene's life.
-struct ObjectPose {
-  std::uint32_t object = 0;        // index into Scene::objects
-  glm::dmat4 T_world_object{1.0};  // object-frame points into the world frame (metres); affine
-
-  bool operator==(const ObjectPose&) const = default;
-};
-
 // The most object poses one FrameState may carry (the JSON reader refuses more).
 inline constexpr std::size_t kMaxObjectPoses = std::size_t(1) << 20;
 
@@ -77,10 +67,11 @@ struct FrameState {
   std::uint64_t frame = 0;
   double time_s = 0;            // scene time, seconds
   glm::dmat4 T_world_eye{1.0};  // eye pose: eye-frame points into the world frame (metres)
-  // The objects that stand elsewhere than the scene places them, each at most once, in any
-  // order. An object not listed stands where the scene itself puts it (Object::T_world_object
-  // as loaded or built), so every FrameState is complete on its own: a node that missed earlier
-  // frames renders this one right.
+  // The objects that stand elsewhere than the scene places them (ObjectPose, animation.hpp),
+  // each at most once, in any order. An object not listed stands where the scene itself puts it
+  // at time_s: its node animation (Scene::animation, looping) where it has one, else
+  // Object::T_world_object as loaded or built. So every FrameState is complete on its own: a node
+  // that missed earlier frames renders this one right.
   std::vector<ObjectPose> object_poses;
 
   bool operator==(const FrameState&) const = default;
@@ -119,7 +110,8 @@ class Session {
   Session(const Session&) = delete;
   Session& operator=(const Session&) = delete;
 
-  // Places every object (state.object_poses, else the scene's own pose), renders every output
+  // Places every object (state.object_poses, else the scene's animation at state.time_s, else
+  // the scene's own pose), renders every output
   // that can see part of the scene, then blends every output. With `finish`, waits for the GPU
   // so that cpu_ms is the frame's full time. InputError("frame state", ...) for a pose of an
   // object the scene does not have, or of one object twice; nothing is rendered then.
@@ -140,8 +132,9 @@ class Session {
     double half_angle = 0;      // radians; >= pi covers every direction
   };
 
-  // Sets every object's T_world_object and bounds_world for `poses` (see render).
-  void place_objects(const std::vector<ObjectPose>& poses);
+  // Sets every object's T_world_object and bounds_world for `poses`, then `animated` for the
+  // objects `poses` leaves out (see render).
+  void place_objects(const std::vector<ObjectPose>& poses, const std::vector<ObjectPose>& animated);
 
   // An object's pose as the scene was given, and its object-frame box (computed the first time
   // the object is moved).
