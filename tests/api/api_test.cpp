@@ -1,0 +1,296 @@
+// facet::facet, the application API: a scene built from the application's arrays renders the
+// same triangle IDs as the same scene loaded from glTF; objects move through the API; mode 2
+// warps an application's perspective image into the outputs the right way up; bad input throws.
+#include <epoxy/gl.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <glm/gtc/matrix_transform.hpp>
+#include <glm/gtc/type_ptr.hpp>
+#include <nlohmann/json.hpp>
+
+#include "facet/driver/reference.hpp"
+#include "facet/driver/scene_names.hpp"
+#include "facet/facet.hpp"
+
+namespace facet {
+namespace {
+
+namespace fs = std::filesystem;
+
+Context& context() {
+  static Context shared = Context::headless();
+  return shared;
+}
+
+// A unit cube's 24 vertices and 36 indices, faces outwards.
+struct Cube {
+  std::vector<glm::vec3> positions, normals;
+  std::vector<glm::vec2> uvs;
+  std::vector<std::uint32_t> indices;
+};
+
+Cube cube(float side) {
+  Cube c;
+  const float h = side / 2;
+  const glm::vec3 normals[6] = {{1, 0, 0},  {-1, 0, 0}, {0, 1, 0},
+                                {0, -1, 0}, {0, 0, 1},  {0, 0, -1}};
+  for (const glm::vec3& n : normals) {
+    const glm::vec3 u = std::abs(n.x) > 0 ? glm::vec3(0, 1, 0) : glm::vec3(1, 0, 0);
+    const glm::vec3 w = glm::cross(n, u);
+    const auto base = std::uint32_t(c.positions.size());
+    for (const glm::vec2& k :
+         {glm::vec2(-1, -1), glm::vec2(1, -1), glm::vec2(1, 1), glm::vec2(-1, 1)}) {
+      c.positions.push_back(h * (n + k.x * u + k.y * w));
+      c.normals.push_back(n);
+      c.uvs.push_back(0.5f * (k + 1.0f));
+    }
+    for (std::uint32_t i : {0u, 1u, 2u, 0u, 2u, 3u}) c.indices.push_back(base + i);
+  }
+  return c;
+}
+
+std::string base64(const std::vector<unsigned char>& bytes) {
+  static constexpr char alphabet[] =
+      "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::string out;
+  for (std::size_t i = 0; i < bytes.size(); i += 3) {
+    const std::uint32_t b0 = bytes[i], b1 = i + 1 < bytes.size() ? bytes[i + 1] : 0u,
+                        b2 = i + 2 < bytes.size() ? bytes[i + 2] : 0u;
+    const std::uint32_t triple = (b0 << 16) | (b1 << 8) | b2;
+    out += alphabet[(triple >> 18) & 63];
+    out += alphabet[(triple >> 12) & 63];
+    out += i + 1 < bytes.size() ? alphabet[(triple >> 6) & 63] : '=';
+    out += i + 2 < bytes.size() ? alphabet[triple & 63] : '=';
+  }
+  return out;
+}
+
+// The poses of the test's objects: cubes of two sizes around the dome's zenith.
+std::vector<glm::dmat4> object_poses() {
+  std::vector<glm::dmat4> poses;
+  for (int k = 0; k < 5; ++k) {
+    const double angle = k * 1.2;
+    poses.push_back(glm::rotate(
+        glm::translate(glm::dmat4(1.0),
+                       glm::dvec3(3 * std::cos(angle), 3 + 0.3 * k, 3 * std::sin(angle))),
+        0.4 * k, glm::dvec3(0, 1, 0.3)));
+  }
+  return poses;
+}
+
+// The same scene as a .gltf: two meshes (a big and a small cube) with one material each, nodes
+// with the poses as matrices, in the same order.
+fs::path write_gltf(const fs::path& folder, const Cube& big, const Cube& small) {
+  std::vector<unsigned char> buffer;
+  nlohmann::json views = nlohmann::json::array(), accessors = nlohmann::json::array();
+  auto add = [&](const void* data, std::size_t bytes, int component_type, std::size_t count,
+                 const char* type) {
+    views.push_back({{"buffer", 0}, {"byteOffset", buffer.size()}, {"byteLength", bytes}});
+    const auto* p = static_cast<const unsigned char*>(data);
+    buffer.insert(buffer.end(), p, p + bytes);
+    accessors.push_back({{"bufferView", views.size() - 1},
+                         {"componentType", component_type},
+                         {"count", count},
+                         {"type", type}});
+    return int(accessors.size() - 1);
+  };
+  nlohmann::json meshes = nlohmann::json::array();
+  int material = 0;
+  for (const Cube* c : {&big, &small}) {
+    const int p =
+        add(c->positions.data(), c->positions.size() * 12, 5126, c->positions.size(), "VEC3");
+    accessors[std::size_t(p)]["min"] = {-1, -1, -1};
+    accessors[std::size_t(p)]["max"] = {1, 1, 1};
+    const int n = add(c->normals.data(), c->normals.size() * 12, 5126, c->normals.size(), "VEC3");
+    const int t = add(c->uvs.data(), c->uvs.size() * 8, 5126, c->uvs.size(), "VEC2");
+    const int i = add(c->indices.data(), c->indices.size() * 4, 5125, c->indices.size(), "SCALAR");
+    meshes.push_back({{"primitives",
+                       {{{"attributes", {{"POSITION", p}, {"NORMAL", n}, {"TEXCOORD_0", t}}},
+                         {"indices", i},
+                         {"material", material++}}}}});
+  }
+  nlohmann::json nodes = nlohmann::json::array(), roots = nlohmann::json::array();
+  const auto poses = object_poses();
+  for (std::size_t k = 0; k < poses.size(); ++k) {
+    std::vector<double> matrix(glm::value_ptr(poses[k]), glm::value_ptr(poses[k]) + 16);
+    nodes.push_back({{"name", "cube" + std::to_string(k)}, {"mesh", k % 2}, {"matrix", matrix}});
+    roots.push_back(k);
+  }
+  const nlohmann::json gltf = {
+      {"asset", {{"version", "2.0"}}},
+      {"scene", 0},
+      {"scenes", {{{"nodes", roots}}}},
+      {"nodes", nodes},
+      {"meshes", meshes},
+      {"materials",
+       {{{"pbrMetallicRoughness", {{"baseColorFactor", {0.8, 0.2, 0.2, 1}}}}},
+        {{"pbrMetallicRoughness", {{"baseColorFactor", {0.2, 0.8, 0.2, 1}}}}}}},
+      {"accessors", accessors},
+      {"bufferViews", views},
+      {"buffers",
+       {{{"byteLength", buffer.size()},
+         {"uri", "data:application/octet-stream;base64," + base64(buffer)}}}}};
+  const fs::path path = folder / "cubes.gltf";
+  std::ofstream(path) << gltf.dump();
+  return path;
+}
+
+fs::path fresh_folder(const std::string& name) {
+  const fs::path folder = fs::temp_directory_path() / ("facet_api_test_" + name);
+  fs::remove_all(folder);
+  fs::create_directories(folder);
+  return folder;
+}
+
+TEST(Api, SceneFromArraysRendersTheSameIdsAsFromGltf) {
+  context();
+  const fs::path folder = fresh_folder("round_trip");
+  const Cube big = cube(1.5f), small = cube(0.8f);
+  SceneBuilder builder;
+  const int red = builder.add_material({.base_colour = {0.8f, 0.2f, 0.2f, 1}});
+  const int green = builder.add_material({.base_colour = {0.2f, 0.8f, 0.2f, 1}});
+  const int meshes[2] = {
+      builder.add_mesh({big.positions, big.normals, big.uvs, big.indices}, red),
+      builder.add_mesh({small.positions, small.normals, small.uvs, small.indices}, green)};
+  const auto poses = object_poses();
+  for (std::size_t k = 0; k < poses.size(); ++k)
+    EXPECT_EQ(builder.add_object(meshes[k % 2], poses[k], "cube" + std::to_string(k)), ObjectId(k));
+  const Scene built = std::move(builder).build();
+  const Scene loaded = Scene::load(write_gltf(folder, big, small).string());
+  ASSERT_EQ(built.object_count(), loaded.object_count());
+  ASSERT_EQ(built.triangle_count(), loaded.triangle_count());
+  EXPECT_EQ(loaded.find_object("cube3"), ObjectId(3));
+
+  Display display = Display::open("builtin:dome180", glm::ivec2(128, 128));
+  Renderer from_arrays(display, built), from_gltf(display, loaded);
+  for (Renderer* r : {&from_arrays, &from_gltf}) r->render(true);
+  const auto a = from_arrays.read_output_ids(0), b = from_gltf.read_output_ids(0);
+  std::size_t drawn = 0, differing = 0;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    drawn += a[i] != 0;
+    differing += a[i] != b[i];
+  }
+  std::printf("API vs glTF, dome180 128x128: %zu drawn pixels, %zu differ\n", drawn, differing);
+  EXPECT_GT(drawn, 500u);  // every cube in view
+  EXPECT_EQ(differing, 0u);
+  // And the colours: the same materials.
+  EXPECT_EQ(from_arrays.read_output_rgba8(0), from_gltf.read_output_rgba8(0));
+  fs::remove_all(folder);
+}
+
+TEST(Api, MovedObjectsAndTheirErrors) {
+  context();
+  const Cube c = cube(1.0f);
+  SceneBuilder builder;
+  const int white = builder.add_material({});
+  const int mesh = builder.add_mesh({c.positions, {}, {}, c.indices}, white);  // normals computed
+  const ObjectId ball =
+      builder.add_object(mesh, glm::translate(glm::dmat4(1.0), glm::dvec3(0, 4, -2)));
+  const Scene scene = std::move(builder).build();
+  Renderer renderer(Display::open("builtin:dome180", glm::ivec2(96, 96)), scene);
+  const auto lit_pixels = [&] {
+    const auto ids = renderer.read_output_ids(0);
+    double x_sum = 0;
+    std::size_t n = 0;
+    for (std::size_t i = 0; i < ids.size(); ++i)
+      if (ids[i] != 0) {
+        x_sum += double(i % 96);
+        ++n;
+      }
+    return std::pair(n, n ? x_sum / double(n) : 0.0);
+  };
+  renderer.render(true);
+  const auto [n0, x0] = lit_pixels();
+  EXPECT_GT(n0, 20u);
+  // Moved to the other side: drawn there, coverage recomputed, then reused while still.
+  renderer.set_object_transform(ball, glm::translate(glm::dmat4(1.0), glm::dvec3(0, 4, 2)));
+  EXPECT_FALSE(renderer.render(true).outputs[0].reused_coverage);
+  EXPECT_TRUE(renderer.render(true).outputs[0].reused_coverage);
+  const auto [n1, x1] = lit_pixels();
+  EXPECT_GT(n1, 20u);
+  const std::vector<std::uint32_t> ids = renderer.read_output_ids(0);
+  renderer.reset_object_transform(ball);
+  renderer.render(true);
+  EXPECT_NE(renderer.read_output_ids(0), ids);
+  EXPECT_THROW(renderer.set_object_transform(1, glm::dmat4(1.0)), InputError);
+  glm::dmat4 projective(1.0);
+  projective[0][3] = 0.5;
+  EXPECT_THROW(renderer.set_object_transform(ball, projective), InputError);
+  // Builder errors name the field.
+  SceneBuilder bad;
+  try {
+    bad.add_mesh({c.positions, {}, {}, c.indices}, 0);
+    FAIL() << "expected InputError";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("meshes[0].material"), std::string::npos) << e.what();
+  }
+  const int m = bad.add_material({});
+  std::vector<std::uint32_t> wrong = {0, 1, 99};
+  EXPECT_THROW(bad.add_mesh({c.positions, {}, {}, wrong}, m), InputError);
+  EXPECT_THROW(bad.add_object(5, glm::dmat4(1.0)), InputError);
+  const std::vector<std::uint8_t> short_rgba(10);
+  EXPECT_THROW(bad.add_texture({2, 2, short_rgba}), InputError);
+  EXPECT_THROW(Display::open("builtin:nothing"), InputError);
+  Display display = Display::open("builtin:wall2x2", glm::ivec2(64, 48));
+  EXPECT_THROW(display.set_method("warp-it"), InputError);
+}
+
+// Mode 2: on builtin:wall2x2, each projector's frustum rendered by the "application" as a
+// texture whose top half is red and bottom half blue comes out with red above blue in every
+// output, where the frustum's middle row maps.
+TEST(Api, WarpPerspectiveKeepsTheApplicationsImageUpright) {
+  context();
+  const Display display = Display::open("builtin:wall2x2", glm::ivec2(96, 72));
+  Renderer renderer(display);
+  ASSERT_EQ(renderer.output_count(), 4u);
+  const glm::ivec2 size(64, 64);
+  std::vector<std::uint8_t> rgba(std::size_t(size.x) * size.y * 4);
+  // GL row 0 is the bottom: rows below the middle blue, above it red.
+  for (int y = 0; y < size.y; ++y)
+    for (int x = 0; x < size.x; ++x) {
+      std::uint8_t* p = &rgba[(std::size_t(y) * size.x + x) * 4];
+      const bool top = y >= size.y / 2;
+      p[0] = top ? 255 : 0;
+      p[1] = 0;
+      p[2] = top ? 0 : 255;
+      p[3] = 255;
+    }
+  GLuint texture = 0;
+  glCreateTextures(GL_TEXTURE_2D, 1, &texture);
+  glTextureStorage2D(texture, 1, GL_SRGB8_ALPHA8, size.x, size.y);
+  glTextureSubImage2D(texture, 0, 0, 0, size.x, size.y, GL_RGBA, GL_UNSIGNED_BYTE, rgba.data());
+  for (std::size_t o = 0; o < 4; ++o) {
+    const Display::Frustum frustum = display.frustum(o);
+    EXPECT_LT(frustum.tan_extent[0], frustum.tan_extent[1]);
+    EXPECT_GT(frustum.tan_extent[2], frustum.tan_extent[3]);
+    renderer.warp_perspective(o, texture);
+    const auto image = renderer.read_output_rgba8(o);
+    const glm::ivec2 out = renderer.output_size(o);
+    // The column through the middle: red pixels all above blue ones.
+    int last_red = -1, first_blue = out.y;
+    for (int y = 0; y < out.y; ++y) {
+      const std::uint8_t* p = &image[(std::size_t(y) * out.x + out.x / 2) * 4];
+      if (p[0] > 200 && p[2] < 50) last_red = y;
+      if (p[2] > 200 && p[0] < 50) first_blue = std::min(first_blue, y);
+    }
+    EXPECT_GE(last_red, 0) << o;
+    EXPECT_LT(first_blue, out.y) << o;
+    EXPECT_LT(last_red, first_blue) << "output " << o;
+  }
+  glDeleteTextures(1, &texture);
+  Renderer with_scene(display, Scene::load("builtin:city"));
+  EXPECT_THROW(with_scene.warp_perspective(0, 1), InputError);
+}
+
+TEST(Api, BorrowsTheCurrentContext) {
+  context();
+  const Context borrowed = Context::borrow_current();
+  EXPECT_TRUE(borrowed.is_borrowed());
+  EXPECT_FALSE(borrowed.renderer().empty());
+}
+
+}  // namespace
+}  // namespace facet
