@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "cli_process.hpp"
+#include "xorg_dummy.hpp"
 
 namespace facet {
 namespace {
@@ -192,6 +193,26 @@ TEST_F(PlayCli, StillEquirectOnACylinder) {
   input->read_image(0, 0, 0, 4, OIIO::TypeDesc::UINT8, pixels.data());
   EXPECT_GT(pixels[(std::size_t(20) * 160 + 80) * 4], 250);  // above the horizon
   EXPECT_LT(pixels[(std::size_t(100) * 160 + 80) * 4], 5);   // below
+}
+
+// Windows on an X server (Xorg's dummy driver): the same video in a window for 12 frames on the
+// wall clock. Leak checking is off as for facet run's windowed tests (Mesa's GLX driver is
+// unloaded before LeakSanitizer runs).
+TEST_F(PlayCli, PlaysInAWindowOnAnXServer) {
+  test::XorgDummyServer server;
+  const std::string display = ":" + std::to_string(230 + ::getpid() % 20);
+  const std::string reason = server.start(dir_, display, 1024, 768, 32000);
+  if (!reason.empty()) GTEST_SKIP() << reason;
+  const fs::path video = write_video("count.avi", 40, 30);
+  const int status = test::run_shell("ASAN_OPTIONS=detect_leaks=0 DISPLAY=" + display + " " +
+                                     FACET_CLI + " play " + video.string() +
+                                     " --display builtin:dome180 --size 128x128 --windowed "
+                                     "--frames 12 > " +
+                                     (dir_ / "log.txt").string() + " 2>&1");
+  server.stop();
+  EXPECT_EQ(status, 0) << log();
+  EXPECT_NE(log().find("first frame after"), std::string::npos) << log();
+  EXPECT_NE(log().find("12 frames shown"), std::string::npos) << log();
 }
 
 }  // namespace
