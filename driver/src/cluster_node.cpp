@@ -51,6 +51,10 @@ enum class Survey : std::uint8_t { join = 1, ready = 2 };
 
 constexpr auto kPoll = std::chrono::milliseconds(20);  // how often blocked threads look up
 
+Clock::duration period(double seconds) {
+  return std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(seconds));
+}
+
 double ms_since(Clock::time_point start) {
   return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
 }
@@ -105,6 +109,13 @@ class Parse {
   std::size_t at_ = 0;
 };
 
+// "cluster.nodes[K].address" of node `node`, as display.json's reader names it.
+std::string address_field(const projection_io::DisplayCluster& cluster, const std::string& node) {
+  for (std::size_t k = 0; k < cluster.nodes.size(); ++k)
+    if (cluster.nodes[k].name == node) return "cluster.nodes[" + std::to_string(k) + "].address";
+  return "cluster.nodes";
+}
+
 // One NNG socket, closed with its owner.
 class Socket {
  public:
@@ -125,12 +136,28 @@ class Socket {
 
   // Listens on `address`; InputError naming the node and the address when it cannot (in use,
   // no such local address, a path that cannot be made).
-  void listen(const std::string& address, const std::string& source, const std::string& node) {
+  // `peer` opens the protocol that dials this socket (pub for a sub): an ipc:// address is
+  // dialled with it first, since NNG, finding the path in use, probes it with a bare connection
+  // that leaves the listener there deaf.
+  void listen(const std::string& address, const std::string& source, const std::string& field,
+              const std::string& node, int (*peer)(nng_socket*)) {
+    if (address.starts_with("ipc://")) {
+      nng_socket probe = NNG_SOCKET_INITIALIZER;
+      if (peer(&probe) == 0) {
+        const int dialled = nng_dial(probe, address.c_str(), nullptr, 0);
+        nng_close(probe);
+        if (dialled == 0)
+          throw InputError(source, field,
+                           "an address node '" + node + "' can listen on, but " + address +
+                               ": another process listens there (is node '" + node +
+                               "' running twice?)");
+      }
+    }
     if (const int error = nng_listen(socket_, address.c_str(), nullptr, 0)) {
       std::string why = nng_strerror(error);
       if (error == NNG_EADDRINUSE)
         why += ": another process listens there (is node '" + node + "' running twice?)";
-      throw InputError(source, "cluster.nodes." + node + ".address",
+      throw InputError(source, field,
                        "an address node '" + node + "' can listen on, but " + address + ": " + why);
     }
   }
@@ -204,9 +231,10 @@ class Master final : public FrameSync {
     const ClusterNode& self = find_cluster_node(options_.cluster, options_.node, options_.source);
     publisher_.open(nng_pub0_open, "pub");
     surveyor_.open(nng_surveyor0_open, "surveyor");
-    publisher_.listen(self.address, options_.source, self.name);
-    surveyor_.listen(projection_io::cluster_barrier_address(self.address), options_.source,
-                     self.name);
+    const std::string field = address_field(options_.cluster, self.name);
+    publisher_.listen(self.address, options_.source, field, self.name, nng_sub0_open);
+    surveyor_.listen(projection_io::cluster_barrier_address(self.address), options_.source, field,
+                     self.name, nng_respondent0_open);
     for (Socket* socket : {&publisher_, &surveyor_}) {
       socket->set_ms(NNG_OPT_RECONNMINT, 10);
       socket->set_ms(NNG_OPT_RECONNMAXT, 100);
@@ -244,10 +272,11 @@ class Master final : public FrameSync {
   std::optional<FrameState> next_frame(const FrameState& own) override {
     if (!joined_) wait_for_nodes();
     if (options_.rate_hz) {
-      const auto due =
-          started_ + std::chrono::duration_cast<Clock::duration>(
-                         std::chrono::duration<double>(double(frames_sent_) / *options_.rate_hz));
-      std::this_thread::sleep_until(due);
+      // A frame period after the last frame began, or at once when that has passed (after a
+      // wait for a lost node): a late cluster goes on at its pace, it does not rush to catch up.
+      if (frames_sent_ > 0)
+        std::this_thread::sleep_until(last_start_ + period(1 / *options_.rate_hz));
+      last_start_ = Clock::now();
     }
     ++frames_sent_;
     last_frame_ = own.frame;
@@ -404,16 +433,14 @@ class Master final : public FrameSync {
     else if (!secondaries_.empty())
       options_.report("all " + std::to_string(secondaries_.size() + 1) + " nodes joined in " +
                       ms_text(ms_since(start)) + "; deadline " + ms_text(deadline_ms_));
-    started_ = Clock::now();
   }
 
   void beat() {
-    const auto period = std::chrono::duration_cast<Clock::duration>(
-        std::chrono::duration<double, std::milli>(std::max(1.0, deadline_ms_ / 4)));
+    const Clock::duration every = period(std::max(1.0, deadline_ms_ / 4) / 1000);
     std::unique_lock lock(mutex_);
     while (!stopping_) {
       publish(Published::heartbeat, {});
-      wake_.wait_for(lock, period, [this] { return stopping_; });
+      wake_.wait_for(lock, every, [this] { return stopping_; });
     }
   }
 
@@ -426,7 +453,7 @@ class Master final : public FrameSync {
   bool joined_ = false, stopped_ = false;
   std::uint64_t frames_sent_ = 0, last_frame_ = 0;
   double last_broadcast_ms_ = 0;
-  Clock::time_point started_ = Clock::now();
+  Clock::time_point last_start_;
   std::mutex mutex_;
   std::condition_variable wake_;
   bool stopping_ = false;
@@ -449,9 +476,10 @@ class Secondary final : public FrameSync {
     nng_socket_set_int(subscriber_.get(), NNG_OPT_RECVBUF, 1024);
     subscriber_.set_ms(NNG_OPT_RECVTIMEO, double(kPoll.count()));
     respondent_.set_ms(NNG_OPT_RECVTIMEO, double(kPoll.count()));
-    subscriber_.listen(self_.address, options_.source, self_.name);
+    const std::string field = address_field(options_.cluster, self_.name);
+    subscriber_.listen(self_.address, options_.source, field, self_.name, nng_pub0_open);
     respondent_.listen(projection_io::cluster_barrier_address(self_.address), options_.source,
-                       self_.name);
+                       field, self_.name, nng_surveyor0_open);
     say_no_swap_group_once(options_.report);
     options_.report("node " + self_.name + ": listening on " + self_.address + " for master " +
                     master_);
