@@ -14,6 +14,7 @@
 #include "facet/calibration/camera_model.hpp"
 #include "facet/calibration/capture.hpp"
 #include "facet/calibration/image_io.hpp"
+#include "facet/projection/display_preview.hpp"
 #include "facet/projection/errors.hpp"
 #include "facet/projection/interrupt.hpp"
 #include "facet/projection/warp_inverse.hpp"
@@ -72,30 +73,11 @@ std::vector<char> unlit_inside_mask(const std::vector<float>& weight, glm::ivec2
   return unlit;
 }
 
-// The colour scale of report/<p>.residual.png (calibration/README.md): RMS residual in output
-// pixels → RGB, linear between the stops, white from 4 px on.
-struct ResidualStop {
-  double px;
-  cv::Vec3b rgb;
-};
-const ResidualStop kResidualScale[] = {{0.0, {0, 0, 255}},
-                                       {0.5, {0, 255, 0}},
-                                       {1.0, {255, 255, 0}},
-                                       {2.0, {255, 0, 0}},
-                                       {4.0, {255, 255, 255}}};
-
+// The colour of report/<p>.residual.png and report/preview.png (calibration/README.md): RMS
+// residual in output pixels on the preview's heat scale.
 cv::Vec3b residual_colour(double px) {
-  if (!(px > kResidualScale[0].px)) return kResidualScale[0].rgb;
-  for (std::size_t n = 1; n < std::size(kResidualScale); ++n) {
-    const ResidualStop &low = kResidualScale[n - 1], &high = kResidualScale[n];
-    if (px > high.px) continue;
-    const double f = (px - low.px) / (high.px - low.px);
-    cv::Vec3b rgb;
-    for (int c = 0; c < 3; ++c)
-      rgb[c] = cv::saturate_cast<std::uint8_t>((1 - f) * low.rgb[c] + f * high.rgb[c]);
-    return rgb;
-  }
-  return kResidualScale[std::size(kResidualScale) - 1].rgb;
+  const glm::u8vec3 rgb = residual_heat_srgb(px);
+  return {rgb.x, rgb.y, rgb.z};
 }
 
 // Colours of report/<p>.coverage.png (calibration/README.md).
@@ -123,6 +105,45 @@ cv::Mat residual_image(const FitReport& fit, glm::ivec2 size) {
                   kWorstRegionOutline, 1);
   }
   return image;
+}
+
+// What the audience sees from the eye, every projector composited on fitted_preview_view, each
+// direction coloured by the fit residual of the projector with the largest blend weight there:
+// CV_8UC3, RGB, 768 rows.
+cv::Mat residual_preview(const std::vector<Warp>& warps,
+                         const std::vector<projection_io::BlendMap>& alpha,
+                         const CalibrationReport& report) {
+  std::vector<cv::Mat> residuals(warps.size());
+  std::vector<PreviewProjector> projectors;
+  for (std::size_t p = 0; p < warps.size(); ++p) {
+    const FitReport& fit = report.projectors[p].fit;
+    residuals[p] = fit.residual_map.isContinuous() ? fit.residual_map : fit.residual_map.clone();
+    PreviewProjector projector;
+    projector.name = report.projectors[p].name;
+    projector.warp = &warps[p];
+    projector.alpha_size = alpha[p].size;
+    projector.alpha_channels = alpha[p].channels;
+    projector.alpha = alpha[p].values;
+    if (!residuals[p].empty()) {
+      projector.residual_blocks = {residuals[p].cols, residuals[p].rows};
+      projector.residual_block_px = FitReport::kResidualBlockPx;
+      projector.residual_px = {residuals[p].ptr<float>(), residuals[p].total()};
+    }
+    projectors.push_back(projector);
+  }
+  PreviewOptions options;
+  options.view = fitted_preview_view(projectors);
+  options.height_px = 768;
+  const DisplayPreview preview = preview_display(projectors, options, "calibration");
+  const std::vector<std::uint8_t> rgba =
+      render_preview(preview, PreviewShow::residual, options.view);
+  cv::Mat rgb(preview.size.y, preview.size.x, CV_8UC3);
+  for (int y = 0; y < preview.size.y; ++y)
+    for (int x = 0; x < preview.size.x; ++x) {
+      const std::uint8_t* pixel = &rgba[(std::size_t(y) * preview.size.x + x) * 4];
+      rgb.at<cv::Vec3b>(y, x) = {pixel[0], pixel[1], pixel[2]};
+    }
+  return rgb;
 }
 
 // Lit pixels grey, unlit black; over them, at each node's output position, a disc half a node
@@ -471,6 +492,8 @@ CalibrationReport calibrate(const fs::path& capture_path, const fs::path& out,
       write_rgb_image(pictures / (name + ".coverage.png"),
                       coverage_image(warps[p], node_origins[p], blend.alpha[p]));
     }
+    throw_if_interrupted(stopped);
+    write_rgb_image(pictures / "preview.png", residual_preview(warps, blend.alpha, report));
     throw_if_interrupted(stopped);
     std::error_code error;
     if (fs::exists(out, error)) fs::remove(out);  // checked empty above

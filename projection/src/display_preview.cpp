@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <cstring>
 #include <functional>
+#include <limits>
 #include <numbers>
 #include <thread>
 
@@ -116,7 +117,85 @@ void fill_rect(std::vector<std::uint8_t>& rgba, glm::ivec2 size, glm::ivec4 rect
       std::copy_n(&colour[0], 4, &rgba[(std::size_t(py) * size.x + px) * 4]);
 }
 
+// The smallest value below which `fraction` of the total weight lies; sorts `values`. 0 when
+// empty.
+double weighted_quantile(std::vector<std::pair<double, double>>& values, double fraction) {
+  std::sort(values.begin(), values.end());
+  double total = 0;
+  for (const auto& value : values) total += value.second;
+  double below = 0, result = 0;
+  for (const auto& [value, weight] : values) {
+    below += weight;
+    result = value;
+    if (below >= fraction * total * (1 - 1e-12)) break;
+  }
+  return result;
+}
+
+// sRGB byte → linear.
+float srgb_to_linear(std::uint8_t byte) {
+  const float c = float(byte) / 255;
+  return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f);
+}
+
+glm::vec3 linear_of(glm::u8vec3 srgb) {
+  return {srgb_to_linear(srgb.x), srgb_to_linear(srgb.y), srgb_to_linear(srgb.z)};
+}
+
 }  // namespace
+
+glm::u8vec3 residual_heat_srgb(double residual_px) {
+  struct Stop {
+    double px;
+    glm::u8vec3 rgb;
+  };
+  static const Stop stops[] = {{0.0, {0, 0, 255}},
+                               {0.5, {0, 255, 0}},
+                               {1.0, {255, 255, 0}},
+                               {2.0, {255, 0, 0}},
+                               {4.0, {255, 255, 255}}};
+  if (!(residual_px > stops[0].px)) return stops[0].rgb;
+  for (std::size_t n = 1; n < std::size(stops); ++n) {
+    const Stop &low = stops[n - 1], &high = stops[n];
+    if (residual_px > high.px) continue;
+    const double f = (residual_px - low.px) / (high.px - low.px);
+    glm::u8vec3 rgb;
+    for (int c = 0; c < 3; ++c)
+      rgb[c] = std::uint8_t(std::lround((1 - f) * low.rgb[c] + f * high.rgb[c]));
+    return rgb;
+  }
+  return stops[std::size(stops) - 1].rgb;
+}
+
+ContentProjection fitted_preview_view(std::span<const PreviewProjector> projectors) {
+  constexpr int kSamples = 65;
+  std::vector<glm::dvec3> directions;
+  glm::dvec3 sum{0.0};
+  for (const PreviewProjector& projector : projectors)
+    for (int j = 0; j < kSamples; ++j)
+      for (int i = 0; i < kSamples; ++i) {
+        const glm::dvec2 st{double(i) / (kSamples - 1), double(j) / (kSamples - 1)};
+        if (!(projector.warp->coverage_at(st) >= 0.5)) continue;
+        const glm::dvec3 v = glm::normalize(projector.warp->v_eye_from_st(st));
+        if (!(std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z))) continue;
+        directions.push_back(v);
+        sum += v;
+      }
+  const double length = glm::length(sum);
+  if (directions.empty() || !(length > 1e-6 * double(directions.size()))) return equirect_content();
+  const glm::dvec3 axis = sum / length;
+  double widest = 0;
+  for (const glm::dvec3& v : directions)
+    widest = std::max(widest, std::acos(std::clamp(glm::dot(v, axis), -1.0, 1.0)));
+  const double fov_deg = std::ceil(2 * widest * 180 / kPi / 10 - 1e-9) * 10;
+  if (fov_deg > 270) return equirect_content();
+  // The dome orientation whose zenith (sin o·sin t, cos t, −cos o·sin t) is the axis.
+  DomeOrientation orientation;
+  orientation.tilt_deg = std::acos(std::clamp(axis.y, -1.0, 1.0)) * 180 / kPi;
+  orientation.orientation_deg =
+      std::hypot(axis.x, axis.z) > 1e-9 ? std::atan2(axis.x, -axis.z) * 180 / kPi : 0.0;
+  return fisheye_content(std::max(fov_deg, 10.0), orientation);
+}
 
 std::string to_string(PreviewShow show) {
   switch (show) {
@@ -128,16 +207,19 @@ std::string to_string(PreviewShow show) {
       return "blend";
     case PreviewShow::uncovered:
       return "uncovered";
+    case PreviewShow::residual:
+      return "residual";
   }
   return "projectors";
 }
 
 PreviewShow preview_show_from_string(const std::string& name, const std::string& source,
                                      const std::string& field) {
-  for (PreviewShow show :
-       {PreviewShow::projectors, PreviewShow::overlap, PreviewShow::blend, PreviewShow::uncovered})
+  for (PreviewShow show : {PreviewShow::projectors, PreviewShow::overlap, PreviewShow::blend,
+                           PreviewShow::uncovered, PreviewShow::residual})
     if (name == to_string(show)) return show;
-  throw InputError(source, field, "projectors, overlap, blend or uncovered, got '" + name + "'");
+  throw InputError(source, field,
+                   "projectors, overlap, blend, uncovered or residual, got '" + name + "'");
 }
 
 glm::vec3 preview_projector_colour(std::size_t index) {
@@ -173,6 +255,18 @@ DisplayPreview preview_display(std::span<const PreviewProjector> projectors,
                            std::to_string(projector.warp->output_size.y));
   }
 
+  for (const PreviewProjector& projector : projectors) {
+    if (projector.residual_px.empty()) continue;
+    const int block = projector.residual_block_px;
+    const glm::ivec2 blocks = projector.residual_blocks;
+    const glm::ivec2 output = projector.warp->output_size;
+    if (block < 1 || blocks.x != (output.x + block - 1) / block ||
+        blocks.y != (output.y + block - 1) / block ||
+        projector.residual_px.size() != std::size_t(blocks.x) * std::size_t(blocks.y))
+      throw std::invalid_argument("preview_display: " + projector.name +
+                                  "'s residual map does not tile its output");
+  }
+
   DisplayPreview preview;
   const int height = options.height_px;
   preview.size = {view.format == ContentFormat::fisheye ? height : 2 * height, height};
@@ -183,6 +277,7 @@ DisplayPreview preview_display(std::span<const PreviewProjector> projectors,
   preview.blend_sum.assign(pixels, 0.0f);
   preview.strongest.assign(pixels, -1);
   preview.rgb_by_projector.assign(pixels, {0.0f, 0.0f, 0.0f});
+  preview.residual_px.assign(pixels, std::numeric_limits<float>::quiet_NaN());
   preview.solid_angle_sr.assign(pixels, 0.0);
 
   // Rows are independent: split them over the hardware threads, each summing the solid angle
@@ -200,6 +295,7 @@ DisplayPreview preview_display(std::span<const PreviewProjector> projectors,
         preview.solid_angle_sr[i] = pixel_solid_angle(view, preview.size, point.st);
         const glm::dvec3 v_eye = view.v_eye_from_point(point);
         double strongest_alpha = -1;
+        glm::dvec2 strongest_q{0.0};
         for (std::size_t p = 0; p < projectors.size(); ++p) {
           const Warp& warp = *projectors[p].warp;
           const auto projected = warp.project(v_eye);
@@ -215,9 +311,18 @@ DisplayPreview preview_display(std::span<const PreviewProjector> projectors,
           for (int c = 0; c < 3; ++c) preview.rgb_by_projector[i][std::size_t(c)] += colour[c];
           if (alpha > strongest_alpha) {
             strongest_alpha = alpha;
+            strongest_q = q;
             preview.strongest[i] = std::int16_t(p);
           }
         }
+        if (preview.strongest[i] < 0) continue;
+        const PreviewProjector& strongest = projectors[std::size_t(preview.strongest[i])];
+        if (strongest.residual_px.empty()) continue;
+        const int block = strongest.residual_block_px;
+        const int bx = std::clamp(int(strongest_q.x) / block, 0, strongest.residual_blocks.x - 1);
+        const int by = std::clamp(int(strongest_q.y) / block, 0, strongest.residual_blocks.y - 1);
+        preview.residual_px[i] =
+            strongest.residual_px[std::size_t(by) * strongest.residual_blocks.x + bx];
       }
   };
   std::vector<std::thread> workers;
@@ -247,12 +352,15 @@ DisplayPreview preview_display(std::span<const PreviewProjector> projectors,
     if (off > kBlendTolerance) figures.blend_off_sr += sr;
     off_weights.emplace_back(off, sr);
   }
-  std::sort(off_weights.begin(), off_weights.end());
-  double below = 0;
-  for (const auto& [off, sr] : off_weights) {
-    below += sr;
-    figures.blend_p99 = off;
-    if (below >= 0.99 * figures.covered_sr) break;
+  figures.blend_p99 = weighted_quantile(off_weights, 0.99);
+  std::vector<std::pair<double, double>> residual_weights;  // (residual, solid angle)
+  for (std::size_t i = 0; i < pixels; ++i)
+    if (std::isfinite(preview.residual_px[i]))
+      residual_weights.emplace_back(preview.residual_px[i], preview.solid_angle_sr[i]);
+  if (!residual_weights.empty()) {
+    figures.residual_p50_px = weighted_quantile(residual_weights, 0.5);
+    figures.residual_p99_px = weighted_quantile(residual_weights, 0.99);
+    figures.residual_worst_px = weighted_quantile(residual_weights, 1.0);
   }
   return preview;
 }
@@ -296,6 +404,12 @@ std::vector<std::uint8_t> render_preview(const DisplayPreview& preview, PreviewS
         case PreviewShow::uncovered:
           colour = count ? glm::vec3(0.2f) : glm::vec3(1.0f, 0.0f, 0.0f);
           break;
+        case PreviewShow::residual:
+          colour = !count ? glm::vec3(0.0f)
+                   : std::isfinite(preview.residual_px[i])
+                       ? linear_of(residual_heat_srgb(preview.residual_px[i]))
+                       : glm::vec3(0.06f);
+          break;
       }
       // The grid: within half a pixel's angle of a multiple of 30° in elevation or azimuth.
       const glm::dvec3 v = view.v_eye_from_point(pixel_point(preview, x, y));
@@ -338,6 +452,19 @@ std::vector<std::uint8_t> render_preview(const DisplayPreview& preview, PreviewS
     case PreviewShow::uncovered:
       entries.emplace_back(glm::vec3(0.2f), "covered");
       entries.emplace_back(glm::vec3(1.0f, 0.0f, 0.0f), "uncovered");
+      break;
+    case PreviewShow::residual:
+      for (const double px : {0.0, 0.5, 1.0, 2.0, 4.0})
+        entries.emplace_back(linear_of(residual_heat_srgb(px)),
+                             "fit residual " +
+                                 std::string(px == 0.0   ? "0"
+                                             : px == 0.5 ? "0.5"
+                                             : px == 1.0 ? "1"
+                                             : px == 2.0 ? "2"
+                                                         : "4 or more") +
+                                 " px (RMS per block)");
+      entries.emplace_back(glm::vec3(0.06f), "no sample");
+      entries.emplace_back(glm::vec3(0.0f), "uncovered");
       break;
   }
   entries.emplace_back(glm::vec3(0.6f), "grid every 30 degrees");

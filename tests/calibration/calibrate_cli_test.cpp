@@ -279,7 +279,8 @@ std::array<int, 3> rgb_at(const fs::path& path, int x, int y) {
 
 }  // namespace
 
-// report/: per projector a residual heat map and a coverage map at the output's size. On
+// report/: per projector a residual heat map and a coverage map at the output's size, and the
+// residual seen from the eye. On
 // procam-board the black square whose undecoded middle sits near output pixel (280, 328) is a
 // filled hole (blue 0, 110, 255), the wall left of the board is covered and plain (grey 160), the
 // wall above it unlit (black); the residual map is black where no sample falls and, on the plain
@@ -304,4 +305,13 @@ TEST(CliCalibrate, RealBoardReportHasResidualAndCoverageMaps) {
   EXPECT_EQ(wall[0], 0);
   EXPECT_NEAR(wall[1], 255 * rms / 0.5, 1.0) << rms << " px";
   EXPECT_NEAR(wall[2], 255 * (1 - rms / 0.5), 1.0) << rms << " px";
+  // report/preview.png: the display as seen from the eye (a fisheye about the projector's mean
+  // direction, 768 rows) coloured by the residual; its centre is covered, its corner outside the
+  // fisheye's disc black.
+  const fs::path preview = board.out / "report/preview.png";
+  const auto info = facet::calibration::read_image_info(preview);
+  EXPECT_EQ(info.size, glm::ivec2(768, 768));
+  EXPECT_EQ(info.channels, 3);
+  EXPECT_NE(rgb_at(preview, 384, 384), (std::array<int, 3>{0, 0, 0}));
+  EXPECT_EQ(rgb_at(preview, 767, 767), (std::array<int, 3>{0, 0, 0}));
 }

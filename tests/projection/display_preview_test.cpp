@@ -25,6 +25,19 @@ Warp square_frustum(const glm::dmat3& R_eye_base = glm::dmat3(1.0)) {
   return Warp::analytic(BaseProjection::perspective(-1, 1, 1, -1), {64, 64}, {2, 2}, R_eye_base);
 }
 
+// A projector showing `warp` with blend weights `alpha` (output-sized, one channel; empty: 1).
+PreviewProjector projector(const std::string& name, const Warp& warp,
+                           std::span<const float> alpha = {}) {
+  PreviewProjector result;
+  result.name = name;
+  result.warp = &warp;
+  if (!alpha.empty()) {
+    result.alpha_size = warp.output_size;
+    result.alpha = alpha;
+  }
+  return result;
+}
+
 // −z (ahead) turned to +y (the zenith): a rotation of +90° about x.
 const glm::dmat3 kLookUp(glm::dvec3(1, 0, 0), glm::dvec3(0, 0, 1), glm::dvec3(0, -1, 0));
 
@@ -36,7 +49,7 @@ TEST(DisplayPreview, ASquareFrustumCoversItsClosedFormSolidAngle) {
     PreviewOptions options;
     options.view = equirect_content();
     options.height_px = 512;
-    const PreviewProjector projectors[] = {{"ahead", &ahead, {0, 0}, {}, 1}};
+    const PreviewProjector projectors[] = {projector("ahead", ahead)};
     const DisplayPreview preview = preview_display(projectors, options, "test");
     EXPECT_EQ(preview.size, glm::ivec2(1024, 512));
     EXPECT_NEAR(preview.figures.view_sr, 4 * kPi, 4 * kPi * 1e-3);
@@ -49,7 +62,7 @@ TEST(DisplayPreview, ASquareFrustumCoversItsClosedFormSolidAngle) {
     PreviewOptions options;
     options.view = fisheye_content(180);
     options.height_px = 512;
-    const PreviewProjector projectors[] = {{"up", &up, {0, 0}, {}, 1}};
+    const PreviewProjector projectors[] = {projector("up", up)};
     const DisplayPreview preview = preview_display(projectors, options, "test");
     EXPECT_NEAR(preview.figures.view_sr, 2 * kPi, 2 * kPi * 2e-3);
     EXPECT_NEAR(preview.figures.covered_sr, exact_sr, exact_sr * 0.005);
@@ -59,6 +72,26 @@ TEST(DisplayPreview, ASquareFrustumCoversItsClosedFormSolidAngle) {
   }
 }
 
+// The fitted view of a frustum looks along it, wide enough for its corners (54.7° off axis: a
+// 110° fisheye); a 360° cylinder gets the equirect panorama.
+TEST(DisplayPreview, TheFittedViewHoldsEveryCoveredDirection) {
+  const Warp ahead = square_frustum(kLookUp);
+  const PreviewProjector frustum[] = {projector("up", ahead)};
+  const ContentProjection view = fitted_preview_view(frustum);
+  ASSERT_EQ(view.format, ContentFormat::fisheye);
+  EXPECT_EQ(view.fov_deg, 110);
+  const glm::dvec3 centre = view.v_eye_from_point({0, {0.5, 0.5}});
+  EXPECT_NEAR(centre.y, 1, 1e-9);
+  PreviewOptions options;
+  options.view = view;
+  options.height_px = 256;
+  EXPECT_NEAR(preview_display(frustum, options, "test").figures.covered_sr, 2 * kPi / 3,
+              2 * kPi / 3 * 0.01);
+  const Warp cylinder = Warp::analytic(BaseProjection::cylindrical(-180, 180, 1, -1), {256, 64});
+  const PreviewProjector around[] = {projector("cylinder", cylinder)};
+  EXPECT_EQ(fitted_preview_view(around).format, ContentFormat::equirect);
+}
+
 TEST(DisplayPreview, OverlapAndBlendSumsFollowTheAlphaMaps) {
   const Warp ahead = square_frustum();
   const std::vector<float> half(64 * 64, 0.5f), quarter(64 * 64, 0.25f);
@@ -66,8 +99,8 @@ TEST(DisplayPreview, OverlapAndBlendSumsFollowTheAlphaMaps) {
   options.view = equirect_content();
   options.height_px = 128;
   {
-    const PreviewProjector projectors[] = {{"a", &ahead, {64, 64}, half, 1},
-                                           {"b", &ahead, {64, 64}, half, 1}};
+    const PreviewProjector projectors[] = {projector("a", ahead, half),
+                                           projector("b", ahead, half)};
     const DisplayPreview preview = preview_display(projectors, options, "test");
     EXPECT_GT(preview.figures.covered_sr, 2.0);
     EXPECT_DOUBLE_EQ(preview.figures.overlap_sr, preview.figures.covered_sr);
@@ -75,16 +108,45 @@ TEST(DisplayPreview, OverlapAndBlendSumsFollowTheAlphaMaps) {
     EXPECT_EQ(preview.figures.blend_off_sr, 0);
   }
   {
-    const PreviewProjector projectors[] = {{"a", &ahead, {64, 64}, half, 1},
-                                           {"b", &ahead, {64, 64}, quarter, 1}};
+    const PreviewProjector projectors[] = {projector("a", ahead, half),
+                                           projector("b", ahead, quarter)};
     const DisplayPreview preview = preview_display(projectors, options, "test");
     EXPECT_NEAR(preview.figures.blend_worst, 0.25, 1e-6);
     EXPECT_NEAR(preview.figures.blend_p99, 0.25, 1e-6);
     EXPECT_DOUBLE_EQ(preview.figures.blend_off_sr, preview.figures.covered_sr);
   }
+  {
+    // A calibration's residual, 0.25 px on the left half of the output and 1.5 px on the right:
+    // the solid-angle median is either, the worst 1.5 px.
+    std::vector<float> residual(8 * 8);
+    for (int by = 0; by < 8; ++by)
+      for (int bx = 0; bx < 8; ++bx) residual[std::size_t(by * 8 + bx)] = bx < 4 ? 0.25f : 1.5f;
+    PreviewProjector with_residual = projector("a", ahead, half);
+    with_residual.residual_blocks = {8, 8};
+    with_residual.residual_px = residual;
+    const PreviewProjector projectors[] = {with_residual};
+    const DisplayPreview preview = preview_display(projectors, options, "test");
+    EXPECT_EQ(preview.figures.residual_worst_px, 1.5);
+    EXPECT_EQ(preview.figures.residual_p99_px, 1.5);
+    EXPECT_TRUE(preview.figures.residual_p50_px == 0.25 || preview.figures.residual_p50_px == 1.5);
+    // The image: the residual's heat colour where covered.
+    const std::vector<std::uint8_t> rgba =
+        render_preview(preview, PreviewShow::residual, options.view);
+    const glm::u8vec3 red = residual_heat_srgb(2.0), blue = residual_heat_srgb(0.0);
+    EXPECT_EQ(red, glm::u8vec3(255, 0, 0));
+    EXPECT_EQ(blue, glm::u8vec3(0, 0, 255));
+    EXPECT_EQ(residual_heat_srgb(0.25), glm::u8vec3(0, 128, 128));
+    std::size_t heat = 0;
+    for (std::size_t i = 0; i < rgba.size(); i += 4)
+      heat += glm::u8vec3(rgba[i], rgba[i + 1], rgba[i + 2]) == residual_heat_srgb(0.25);
+    EXPECT_GT(heat, 100u);
+  }
   // A map of the wrong size is refused, naming the projector's blend.
   const std::vector<float> small(32 * 32, 1.0f);
-  const PreviewProjector wrong[] = {{"a", &ahead, {32, 32}, small, 1}};
+  PreviewProjector wrong_size = projector("a", ahead);
+  wrong_size.alpha_size = {32, 32};
+  wrong_size.alpha = small;
+  const PreviewProjector wrong[] = {wrong_size};
   try {
     preview_display(wrong, options, "display.json");
     ADD_FAILURE() << "a 32x32 blend map for a 64x64 output was accepted";
@@ -112,8 +174,7 @@ TEST(DisplayPreview, Dome4IsCoveredAboveItsSpringLineAndBlendsToOne) {
   }
   std::vector<PreviewProjector> projectors;
   for (std::size_t p = 0; p < warps.size(); ++p)
-    projectors.push_back({config.projectors[p].name, &warps[p], blends[p].size, blends[p].values,
-                          blends[p].channels});
+    projectors.push_back(projector(config.projectors[p].name, warps[p], blends[p].values));
   PreviewOptions options;
   options.height_px = 256;
   options.view = fisheye_content(180, DomeOrientation{30, 0});
@@ -123,6 +184,13 @@ TEST(DisplayPreview, Dome4IsCoveredAboveItsSpringLineAndBlendsToOne) {
   EXPECT_GT(tilted.figures.overlap_sr, 0.5);
   options.view = fisheye_content(180);
   const DisplayPreview untilted = preview_display(projectors, options, file.string());
+  // The fitted view is a fisheye about the tilted zenith (0, cos 30°, −sin 30°), within 3°.
+  const ContentProjection fitted = fitted_preview_view(projectors);
+  ASSERT_EQ(fitted.format, ContentFormat::fisheye);
+  const glm::dvec3 centre = fitted.v_eye_from_point({0, {0.5, 0.5}});
+  EXPECT_LT(std::acos(glm::dot(centre, glm::dvec3(0, std::cos(kPi / 6), -std::sin(kPi / 6)))),
+            3 * kPi / 180);
+  EXPECT_GE(fitted.fov_deg, 180);
   EXPECT_GT(untilted.figures.uncovered_sr, 0.1);
   // The uncovered directions are behind the viewer: the fisheye's top rows (its bottom is the
   // front).

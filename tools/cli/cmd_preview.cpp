@@ -24,7 +24,7 @@ struct PreviewCommandOptions {
   std::string display = "builtin:dome180";
   std::string size;
   DomeOrientationFlags orientation;  // the dome's: builtin:dome180 and the fisheye view
-  std::string view;                  // fisheye | equirect; empty: by the display's screen
+  std::string view;                  // fit | fisheye | equirect; empty: fit, or fisheye with --tilt
   double fov_deg = 180;
   std::string show = "projectors";
   int preview_size = 1024;
@@ -32,20 +32,19 @@ struct PreviewCommandOptions {
   bool json = false;
 };
 
-// A dome's preview is a fisheye about its zenith; anything else an equirectangular panorama. A
-// display is a dome when it is a built-in dome or its display.json's screen is a sphere.
-bool looks_like_dome(const std::string& display) {
-  if (display.rfind("builtin:dome", 0) == 0) return true;
-  if (display.size() < 5 || display.compare(display.size() - 5, 5, ".json") != 0) return false;
-  const auto config = projection_io::read_display_config(display, false);
-  return config.screen && config.screen->type == Screen::Type::sphere;
-}
-
 double percent(double part, double whole) { return whole > 0 ? 100 * part / whole : 0; }
 
 void preview(const PreviewCommandOptions& options) {
   if (options.out.empty()) throw InputError("command line", "--out", "a PNG file to write");
   const PreviewShow show = preview_show_from_string(options.show, "command line", "--show");
+  if (show == PreviewShow::residual)
+    throw InputError("command line", "--show",
+                     "projectors, overlap, blend or uncovered: a display has no fit residual "
+                     "(facet calibrate draws it in report/preview.png)");
+  std::string view_name = options.view;
+  if (view_name.empty()) view_name = options.orientation.given() ? "fisheye" : "fit";
+  if (view_name != "fit" && view_name != "fisheye" && view_name != "equirect")
+    throw InputError("command line", "--view", "fit, fisheye or equirect, got '" + view_name + "'");
   std::optional<glm::ivec2> size;
   if (!options.size.empty()) size = parse_size(options.size, "--size");
   // --tilt and --orientation say how the dome sits: a built-in dome is built so, and the fisheye
@@ -59,18 +58,6 @@ void preview(const PreviewCommandOptions& options) {
   for (auto& output : display.outputs)
     if (orientation) orient_warp(output.spec.warp, *orientation);
 
-  std::string view_name = options.view;
-  if (view_name.empty()) view_name = looks_like_dome(options.display) ? "fisheye" : "equirect";
-  PreviewOptions preview_options;
-  if (view_name == "fisheye") {
-    preview_options.view = fisheye_content(options.fov_deg, view_orientation);
-  } else if (view_name == "equirect") {
-    preview_options.view = equirect_content();
-  } else {
-    throw InputError("command line", "--view", "fisheye or equirect, got '" + view_name + "'");
-  }
-  preview_options.height_px = options.preview_size;
-
   std::vector<PreviewProjector> projectors;
   for (const driver::SessionOutput& output : display.outputs) {
     PreviewProjector projector;
@@ -83,6 +70,17 @@ void preview(const PreviewCommandOptions& options) {
     }
     projectors.push_back(projector);
   }
+  PreviewOptions preview_options;
+  if (view_name == "fit") {
+    preview_options.view = fitted_preview_view(projectors);
+    view_name = preview_options.view.format == ContentFormat::fisheye ? "fisheye" : "equirect";
+  } else if (view_name == "fisheye") {
+    preview_options.view = fisheye_content(options.fov_deg, view_orientation);
+  } else {
+    preview_options.view = equirect_content();
+  }
+  preview_options.height_px = options.preview_size;
+
   const DisplayPreview result = preview_display(projectors, preview_options, "command line");
   driver::write_png_rgba8(options.out, result.size,
                           render_preview(result, show, preview_options.view));
@@ -92,6 +90,7 @@ void preview(const PreviewCommandOptions& options) {
     nlohmann::json json;
     json["display"] = options.display;
     json["view"] = view_name;
+    if (view_name == "fisheye") json["fov_deg"] = preview_options.view.fov_deg;
     json["view_sr"] = f.view_sr;
     json["covered_sr"] = f.covered_sr;
     json["overlap_sr"] = f.overlap_sr;
@@ -108,7 +107,7 @@ void preview(const PreviewCommandOptions& options) {
   std::cout << "facet preview: " << display.outputs.size() << " projector(s) of " << options.display
             << ", " << view_name
             << (view_name == "fisheye"
-                    ? " " + std::to_string(int(std::lround(options.fov_deg))) + "°"
+                    ? " " + std::to_string(int(std::lround(preview_options.view.fov_deg))) + "°"
                     : std::string(" 360°×180°"))
             << " view (" << f.view_sr << " sr)\n";
   std::cout << "  covered " << percent(f.covered_sr, f.view_sr) << "% of the view, by two or more "
@@ -138,7 +137,9 @@ const Registration registration{
       command->add_option("--size", options->size, "Output size WxH of a built-in display");
       options->orientation.add_to(*command);
       command->add_option("--view", options->view,
-                          "fisheye or equirect (default: fisheye for domes, else equirect)");
+                          "fit (default; fisheye with --tilt or --orientation), fisheye or "
+                          "equirect: fit is a fisheye about the mean covered direction wide "
+                          "enough for every covered one, or equirect beyond 270 degrees");
       command->add_option(
           "--fov", options->fov_deg,
           "Fisheye view: the full field of view in degrees, (0, 360] (default 180)");

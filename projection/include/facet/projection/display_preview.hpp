@@ -25,6 +25,12 @@ struct PreviewProjector {
   glm::ivec2 alpha_size{0, 0};   // size of `alpha`: the output size, or (0, 0) for α = 1
   std::span<const float> alpha;  // blend weight per output pixel, row-major, alpha_channels each
   int alpha_channels = 1;        // 1, or 3 (R, G, B: their mean is used)
+  // Optional: a calibration's fit residual (RMS, output pixels) per block of residual_block_px ×
+  // residual_block_px output pixels, row-major over residual_blocks (which tile the output);
+  // NaN where no sample fell.
+  glm::ivec2 residual_blocks{0, 0};
+  int residual_block_px = 8;
+  std::span<const float> residual_px;
 };
 
 struct PreviewOptions {
@@ -35,9 +41,10 @@ struct PreviewOptions {
 };
 
 // The colourings of a preview (render_preview).
-enum class PreviewShow { projectors, overlap, blend, uncovered };
+enum class PreviewShow { projectors, overlap, blend, uncovered, residual };
 std::string to_string(PreviewShow show);
-// "projectors", "overlap", "blend", "uncovered"; InputError(source, field, ...) otherwise.
+// "projectors", "overlap", "blend", "uncovered", "residual"; InputError(source, field, ...)
+// otherwise.
 PreviewShow preview_show_from_string(const std::string& name, const std::string& source,
                                      const std::string& field);
 
@@ -50,6 +57,9 @@ struct DisplayPreview {
   std::vector<float> blend_sum;         // Σ α over the covering projectors
   std::vector<std::int16_t> strongest;  // the covering projector of largest α, or −1
   std::vector<std::array<float, 3>> rgb_by_projector;  // Σ α·colour(projector), linear
+  // The strongest covering projector's fit residual at the direction (output pixels); NaN where
+  // it has no residual map or no sample fell in that block.
+  std::vector<float> residual_px;
   std::vector<double> solid_angle_sr;  // solid angle of each pixel (0 outside the view)
 
   struct Figures {
@@ -61,6 +71,9 @@ struct DisplayPreview {
     // and the solid angle where |Σ α − 1| > 0.005.
     double blend_worst = 0, blend_p99 = 0, blend_off_sr = 0;
     std::vector<double> projector_sr;  // per projector: the solid angle it covers
+    // Over the directions with a residual: solid-angle weighted median and 99th percentile, and
+    // the worst (output pixels); 0 without residual maps.
+    double residual_p50_px = 0, residual_p99_px = 0, residual_worst_px = 0;
   } figures;
 };
 
@@ -69,6 +82,18 @@ struct DisplayPreview {
 // alpha map whose size disagrees with its warp's output size.
 DisplayPreview preview_display(std::span<const PreviewProjector> projectors,
                                const PreviewOptions& options, const std::string& source);
+
+// The view that shows every covered direction of `projectors` largest: a fisheye about the
+// normalised mean of their covered directions (sampled on each base image's 65 × 65 grid where
+// its coverage is at least 0.5), its field of view twice the largest angle from that axis rounded
+// up to 10°, its front the eye's −z made perpendicular to the axis; an equirect panorama when
+// that field of view would exceed 270° (a 360° cylinder). Domes come out centred on their
+// zenith, walls zoomed in.
+ContentProjection fitted_preview_view(std::span<const PreviewProjector> projectors);
+
+// The residual heat scale (sRGB): blue at 0, green at 0.5 px, yellow at 1, red at 2, white from 4
+// px on, linear between. calibrate's report pictures use it too.
+glm::u8vec3 residual_heat_srgb(double residual_px);
 
 // The preview as an sRGB RGBA8 image (size() × 4 bytes): the chosen colouring, a latitude and
 // longitude grid every 30° of the view's frame, and a legend (projector colours, overlap counts,
