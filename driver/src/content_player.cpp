@@ -299,6 +299,7 @@ struct PlayWindow {
 
 void run_windowed_play(const SessionDisplay& display, std::unique_ptr<ContentMedia> media,
                        const PlaybackOptions& options, const WindowPlayOptions& window_options) {
+  const auto entered = std::chrono::steady_clock::now();
   const std::vector<MonitorInfo> monitors = list_monitors();
   std::vector<OutputPlacement> placements;
   for (std::size_t i = 0; i < display.outputs.size(); ++i)
@@ -361,6 +362,18 @@ void run_windowed_play(const SessionDisplay& display, std::unique_ptr<ContentMed
   }
   windows.front().context->make_current();
 
+  std::ofstream stats_file;
+  const fs::path stats_temporary =
+      window_options.stats
+          ? window_options.stats->parent_path() / ("." + window_options.stats->filename().string() +
+                                                   ".tmp" + std::to_string(::getpid()))
+          : fs::path();
+  if (window_options.stats) {
+    stats_file.open(stats_temporary);
+    if (!stats_file)
+      throw InputError(window_options.stats->string(), "--stats", "a file that can be written");
+  }
+
   const auto start = std::chrono::steady_clock::now();
   double paused_s = 0, show_s = 0;
   auto last = start;
@@ -388,9 +401,10 @@ void run_windowed_play(const SessionDisplay& display, std::unique_ptr<ContentMed
     if (frame == 0)
       std::printf(
           "facet play: first frame after %.0f ms\n",
-          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - entered)
               .count());
     dropped_total = stats.dropped_total;
+    if (stats_file.is_open()) stats_file << play_frame_stats_to_json(stats).dump() << '\n';
     GLsync rendered = glFenceSync(GL_SYNC_GPU_COMMANDS_COMPLETE, 0);
     glFlush();
     for (PlayWindow& window : windows) {
@@ -427,6 +441,18 @@ void run_windowed_play(const SessionDisplay& display, std::unique_ptr<ContentMed
   raw_views.clear();
   std::printf("facet play: %llu frames shown, %lld source frames dropped\n",
               static_cast<unsigned long long>(frames_shown), static_cast<long long>(dropped_total));
+  if (stats_file.is_open()) {
+    stats_file.close();
+    // Interrupted: no statistics file, as nothing is written then.
+    if (interrupted_by || !stats_file) {
+      std::error_code ignored;
+      fs::remove(stats_temporary, ignored);
+      if (!interrupted_by)
+        throw std::runtime_error(window_options.stats->string() + ": write failed");
+    } else {
+      fs::rename(stats_temporary, *window_options.stats);
+    }
+  }
   if (interrupted_by)
     throw Interrupted(interrupted_by, "stopped after " + std::to_string(frames_shown) + " frames");
 }

@@ -42,11 +42,10 @@ class PlayCli : public ::testing::Test {
   void TearDown() override { fs::remove_all(dir_); }
 
   // A video of `frames` frames at `fps` whose frame k shows k in binary blocks (white = 1).
-  fs::path write_video(const std::string& name, int frames, double fps) {
+  fs::path write_video(const std::string& name, int frames, double fps,
+                       int fourcc = cv::VideoWriter::fourcc('M', 'J', 'P', 'G')) {
     const fs::path path = dir_ / name;
-    cv::VideoWriter writer(path.string(), cv::CAP_FFMPEG,
-                           cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), fps,
-                           cv::Size(kSide, kSide));
+    cv::VideoWriter writer(path.string(), cv::CAP_FFMPEG, fourcc, fps, cv::Size(kSide, kSide));
     EXPECT_TRUE(writer.isOpened());
     for (int k = 0; k < frames; ++k) {
       cv::Mat frame(kSide, kSide, CV_8UC3, cv::Scalar(40, 40, 40));
@@ -207,12 +206,35 @@ TEST_F(PlayCli, PlaysInAWindowOnAnXServer) {
   const int status = test::run_shell("ASAN_OPTIONS=detect_leaks=0 DISPLAY=" + display + " " +
                                      FACET_CLI + " play " + video.string() +
                                      " --display builtin:dome180 --size 128x128 --windowed "
-                                     "--frames 12 > " +
+                                     "--frames 12 --stats " +
+                                     (dir_ / "stats.jsonl").string() + " > " +
                                      (dir_ / "log.txt").string() + " 2>&1");
   server.stop();
   EXPECT_EQ(status, 0) << log();
   EXPECT_NE(log().find("first frame after"), std::string::npos) << log();
   EXPECT_NE(log().find("12 frames shown"), std::string::npos) << log();
+  // The wall clock: frames in order, each no earlier than the one before.
+  const std::vector<nlohmann::json> lines = stats(dir_);
+  ASSERT_EQ(lines.size(), 12u);
+  for (std::size_t n = 1; n < lines.size(); ++n)
+    EXPECT_GE(lines[n]["source_frame"].get<int>(), lines[n - 1]["source_frame"].get<int>());
+}
+
+// A video coded with predicted frames (MPEG-4 part 2, a key frame every 12): a start frame
+// between key frames is still the exact frame.
+TEST_F(PlayCli, SeeksExactlyInAVideoWithPredictedFrames) {
+  const fs::path video =
+      write_video("count.mp4", 40, 30, cv::VideoWriter::fourcc('m', 'p', '4', 'v'));
+  const fs::path out = dir_ / "out";
+  ASSERT_EQ(play(video.string() + " --headless --start-frame 17 --frames 10 --loop --out " +
+                 out.string()),
+            0)
+      << log();
+  for (int n = 0; n < 10; ++n) {
+    char name[16];
+    std::snprintf(name, sizeof name, "%05d.png", n);
+    EXPECT_EQ(shown_number(out / "dome180" / name), 17 + n / 2) << "output frame " << n;
+  }
 }
 
 }  // namespace

@@ -12,6 +12,7 @@
 #include "facet/driver/content_player.hpp"
 #include "facet/driver/gl_context.hpp"
 #include "facet/driver/session.hpp"
+#include "facet/projection/atomic_file.hpp"
 #include "facet/projection/content_projection.hpp"
 #include "facet/projection/errors.hpp"
 #include "facet/projection/interrupt.hpp"
@@ -33,6 +34,7 @@ struct PlayOptions {
   std::optional<std::int64_t> frames;
   std::int64_t start_frame = 0;
   std::string out = "out/play";
+  std::string stats;  // windowed: the statistics file
 };
 
 bool have_display_server() {
@@ -87,6 +89,10 @@ void play(const PlayOptions& options) {
             << "\n";
 
   const bool headless = options.headless || (!options.windowed && !have_display_server());
+  if (headless && !options.stats.empty())
+    throw InputError("command line", "--stats",
+                     "windows: headless runs write stats.jsonl into --out");
+  if (!options.stats.empty()) refuse_output_over_inputs(options.stats, "--stats", {options.file});
   watch_interrupts();
   if (!headless) {
     if (!have_display_server())
@@ -96,6 +102,7 @@ void play(const PlayOptions& options) {
     driver::WindowPlayOptions window_options;
     window_options.frames = frames;
     window_options.span = options.span;
+    if (!options.stats.empty()) window_options.stats = options.stats;
     driver::run_windowed_play(display, std::move(media), playback, window_options);
     return;
   }
@@ -156,6 +163,8 @@ const Registration registration{
           ->add_option("--out", options->out,
                        "Headless: folder for <output>/<frame>.png and stats.jsonl")
           ->capture_default_str();
+      command->add_option("--stats", options->stats,
+                          "Windowed: write per-frame statistics (stats.jsonl lines) to this file");
       command->callback([options] { play(*options); });
     }};
 

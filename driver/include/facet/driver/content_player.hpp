@@ -111,11 +111,14 @@ std::uint64_t frames_for_one_pass(const PlayClock& clock);
 struct WindowPlayOptions {
   std::optional<std::uint64_t> frames;  // stop after this many frames; else until closed
   bool span = false;                    // one borderless window over every output
+  // play_frame_stats_to_json per frame shown, written under a temporary name and renamed when
+  // the windows close (not when interrupted).
+  std::optional<std::filesystem::path> stats;
 };
 
 // A window per output on its monitor (or one spanning window), showing the content on the
-// wall clock from the first frame; Space pauses, Escape quits. Stats lines go to `stats_path`
-// when given. GlContextError without a display server; Interrupted after watch_interrupts().
+// wall clock from the first frame; Space pauses, Escape quits. GlContextError without a display
+// server; Interrupted after watch_interrupts().
 void run_windowed_play(const SessionDisplay& display, std::unique_ptr<ContentMedia> media,
                        const PlaybackOptions& options, const WindowPlayOptions& window_options);
 
