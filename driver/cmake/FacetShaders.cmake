@@ -27,12 +27,18 @@ function(facet_embed_shaders target)
     file(RELATIVE_PATH name ${ARG_DIR} ${shader})
     string(MAKE_C_IDENTIFIER "shader_${name}" symbol)
     set(out ${gen_dir}/${symbol}.cpp)
+    # Materials and the shading that calls them are compiled with the material interface in
+    # front (driver/material_shader.hpp), and so validated.
+    set(prelude "")
+    if(name STREQUAL "scene/material.frag" OR name MATCHES "^scene/materials/")
+      set(prelude ${ARG_DIR}/scene/material_interface.frag)
+    endif()
     add_custom_command(
       OUTPUT ${out}
       COMMAND ${CMAKE_COMMAND} -DSHADER=${shader} -DNAME=${name} -DSYMBOL=${symbol}
-              -DOUT_CPP=${out} -DCHECK_DIR=${gen_dir}/check
+              -DOUT_CPP=${out} -DCHECK_DIR=${gen_dir}/check -DPRELUDE=${prelude}
               -DVALIDATOR=${FACET_GLSLANG_VALIDATOR} -P ${FACET_EMBED_SHADER_SCRIPT}
-      DEPENDS ${shader} ${FACET_EMBED_SHADER_SCRIPT}
+      DEPENDS ${shader} ${prelude} ${FACET_EMBED_SHADER_SCRIPT}
       COMMENT "Validating and embedding shaders/${name}"
       VERBATIM)
     list(APPEND generated ${out})

@@ -8,7 +8,8 @@
 #
 # The shader is validated first, so a GLSL error fails the build and no generated file is left
 # behind. Files without `#version` get the runtime's `#version 450 core` prepended for the check,
-# followed by `#line 1` so that glslang's line numbers are those of the original file.
+# followed by `#line 1` so that glslang's line numbers are those of the original file. With
+# PRELUDE (a file), its text goes between the two, as the runtime composes material shaders.
 cmake_minimum_required(VERSION 3.25)
 
 foreach(var SHADER NAME SYMBOL OUT_CPP CHECK_DIR VALIDATOR)
@@ -20,13 +21,17 @@ endforeach()
 file(READ "${SHADER}" text)
 string(REGEX MATCH "(^|\n)[ \t]*#[ \t]*version[ \t]" has_version "${text}")
 
-if(has_version)
+set(prelude_text "")
+if(PRELUDE)
+  file(READ "${PRELUDE}" prelude_text)
+endif()
+if(has_version AND NOT PRELUDE)
   set(check_file "${SHADER}")
 else()
   set(check_file "${CHECK_DIR}/${NAME}")
   get_filename_component(check_parent "${check_file}" DIRECTORY)
   file(MAKE_DIRECTORY "${check_parent}")
-  file(WRITE "${check_file}" "#version 450 core\n#line 1\n${text}")
+  file(WRITE "${check_file}" "#version 450 core\n${prelude_text}\n#line 1\n${text}")
 endif()
 
 execute_process(COMMAND "${VALIDATOR}" "${check_file}"

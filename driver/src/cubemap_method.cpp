@@ -8,6 +8,7 @@
 #include <glm/gtc/type_ptr.hpp>
 
 #include "facet/driver/gpu_timer.hpp"
+#include "facet/driver/material_shader.hpp"
 #include "facet/driver/program.hpp"
 #include "facet/driver/shader_library.hpp"
 #include "facet/projection/errors.hpp"
@@ -118,13 +119,16 @@ class CubemapMethod final : public RenderMethod {
     face_framebuffer_.attach(GL_DEPTH_ATTACHMENT, face_depth_);
     if (!empty_vao_) empty_vao_ = VertexArray::create();
 
-    if (!face_program_) {
-      face_program_ = ProgramBuilder()
-                          .define("WRITE_TRIANGLE_ID", "1")
-                          .shader("baselines/cube_face.vert")
-                          .shader("baselines/pull_scene.vert")
-                          .shader("scene/material.frag")
-                          .link();
+    if (!face_program_ || linked_material_ != settings.material) {
+      ProgramBuilder face;
+      face.define("WRITE_TRIANGLE_ID", "1")
+          .shader("baselines/cube_face.vert")
+          .shader("baselines/pull_scene.vert");
+      add_material_stages(face, settings.material);
+      face_program_ = link_with_material(face, settings.material);
+      linked_material_ = settings.material;
+    }
+    if (!lookup_program_) {
       lookup_program_ = ProgramBuilder()
                             .shader("baselines/fullscreen.vert")
                             .shader("baselines/cube_lookup.frag")
@@ -185,6 +189,8 @@ class CubemapMethod final : public RenderMethod {
         const glm::mat4 T_clip_object(T_clip_eye * T_eye_world * glm::dmat4(object.T_world_object));
         glUniformMatrix4fv(0, 1, GL_FALSE, glm::value_ptr(T_clip_object));
         glUniformMatrix4fv(1, 1, GL_FALSE, glm::value_ptr(object.T_world_object));
+        const glm::mat4 T_eye_object(T_eye_world * glm::dmat4(object.T_world_object));
+        glUniformMatrix4fv(4, 1, GL_FALSE, glm::value_ptr(T_eye_object));
         std::uint32_t id = triangle_base_[o] + 1;
         for (std::uint32_t k = 0; k < object.primitive_count; ++k) {
           const Primitive& primitive = scene.primitives[object.first_primitive + k];
@@ -258,6 +264,7 @@ class CubemapMethod final : public RenderMethod {
   Framebuffer face_framebuffer_;
   VertexArray empty_vao_;
   Program face_program_, lookup_program_;
+  MaterialShader linked_material_;  // face_program_'s
 };
 
 }  // namespace

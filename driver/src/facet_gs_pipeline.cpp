@@ -24,11 +24,13 @@ class FacetGsPipeline final : public FacetMethodBase {
           link_replication_program({"replication/triangle_index.vert", "replication/count.geom"});
       replicate_ = build_program({"replication/replicate.comp"});
       args_ = build_program({"replication/draw_args.comp"}, {{"VERTICES_PER_REPLICA", "1"}});
-      draw_ = link_replication_program(
-          {"replication/triangle_index.vert", "replication/draw.geom", "scene/material.frag"},
-          {{"WRITE_TRIANGLE_ID", "1"}});
       scan_.prepare();
       feedback_ = TransformFeedback::create();
+    }
+    if (!draw_ || linked_material_ != settings.material) {
+      draw_ = link_replication_program({"replication/triangle_index.vert", "replication/draw.geom"},
+                                       {{"WRITE_TRIANGLE_ID", "1"}}, &settings.material);
+      linked_material_ = settings.material;
     }
   }
 
@@ -111,6 +113,7 @@ class FacetGsPipeline final : public FacetMethodBase {
   }
 
   Program count_, replicate_, args_, draw_;
+  MaterialShader linked_material_;  // draw_'s
   PrefixScan scan_;
   TransformFeedback feedback_;
 };

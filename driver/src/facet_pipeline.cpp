@@ -43,9 +43,12 @@ class FacetPipeline final : public FacetMethodBase {
           link_replication_program({"replication/count.comp"}, {{"WALK_EVERY_TRIANGLE", "1"}});
       scatter_ = link_replication_program({"replication/scatter.comp"});
       args_ = build_program({"replication/draw_args.comp"}, {{"VERTICES_PER_REPLICA", "3"}});
-      draw_ = link_replication_program({"replication/draw.vert", "scene/material.frag"},
-                                       {{"WRITE_TRIANGLE_ID", "1"}});
       scan_.prepare();
+    }
+    if (!draw_ || linked_material_ != settings.material) {
+      draw_ = link_replication_program({"replication/draw.vert"}, {{"WRITE_TRIANGLE_ID", "1"}},
+                                       &settings.material);
+      linked_material_ = settings.material;
     }
     // The grid pass is built for each output's kind of grid (replication_lib.comp, grid_chart).
     for (const OutputState& out : outputs_) {
@@ -194,6 +197,7 @@ class FacetPipeline final : public FacetMethodBase {
   }
 
   Program count_, walk_, count_walk_, scatter_, args_, draw_;
+  MaterialShader linked_material_;                  // draw_'s
   std::map<std::uint32_t, Program> grid_programs_;  // the grid pass per grid_kind
   PrefixScan scan_;
 };

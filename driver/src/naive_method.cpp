@@ -19,9 +19,10 @@ class NaiveMethod final : public FacetMethodBase {
   void prepare(const Scene& scene, const GpuScene& gpu_scene, std::span<const OutputSpec> outputs,
                const RenderSettings& settings) override {
     FacetMethodBase::prepare(scene, gpu_scene, outputs, settings);
-    if (!draw_) {
-      draw_ = link_replication_program({"replication/naive.vert", "scene/material.frag"},
-                                       {{"WRITE_TRIANGLE_ID", "1"}});
+    if (!draw_ || linked_material_ != settings.material) {
+      draw_ = link_replication_program({"replication/naive.vert"}, {{"WRITE_TRIANGLE_ID", "1"}},
+                                       &settings.material);
+      linked_material_ = settings.material;
     }
   }
 
@@ -90,6 +91,7 @@ class NaiveMethod final : public FacetMethodBase {
 
  private:
   Program draw_;
+  MaterialShader linked_material_;  // draw_'s
 };
 
 }  // namespace

@@ -10,7 +10,8 @@
 namespace facet::driver::detail {
 
 Program link_replication_program(std::initializer_list<std::string_view> shaders,
-                                 const std::vector<ShaderDefine>& defines) {
+                                 const std::vector<ShaderDefine>& defines,
+                                 const MaterialShader* material) {
   ProgramBuilder builder;
   for (const ShaderDefine& d : defines) builder.define(d.name, d.value);
   const std::string_view lib_name = "replication/replication_lib.comp";
@@ -25,7 +26,9 @@ Program link_replication_program(std::initializer_list<std::string_view> shaders
       if (stage == ShaderStage::compute) compute_has_lib = true;
     }
   }
-  return builder.link();
+  if (!material) return builder.link();
+  add_material_stages(builder, *material);
+  return link_with_material(builder, *material);
 }
 
 void ensure_capacity(Buffer& buffer, std::size_t bytes) {

@@ -9,6 +9,7 @@
 
 #include "facet/driver/facet_gpu.hpp"
 #include "facet/driver/gpu_timer.hpp"
+#include "facet/driver/material_shader.hpp"
 #include "facet/driver/program.hpp"
 #include "facet/driver/render_method.hpp"
 
@@ -35,8 +36,10 @@ class TimedPass {
 // Links the embedded shaders with the replication function library (replication_lib.comp) added
 // as a second shader object to every vertex, tessellation control, geometry or compute stage
 // among them.
+// With `material`, scene/material.frag and the material form the fragment stage.
 Program link_replication_program(std::initializer_list<std::string_view> shaders,
-                                 const std::vector<ShaderDefine>& defines = {});
+                                 const std::vector<ShaderDefine>& defines = {},
+                                 const MaterialShader* material = nullptr);
 
 // Grows `buffer` (contents lost) to hold at least `bytes`, doubling to keep reallocations rare.
 void ensure_capacity(Buffer& buffer, std::size_t bytes);

@@ -34,19 +34,22 @@ class TessellatedPipeline final : public FacetMethodBase {
     }
     if (settings.tessellated_max_level > 0)
       max_level_ = std::min(max_level_, std::uint32_t(settings.tessellated_max_level));
+    if (linked_material_ != settings.material) programs_.clear();
+    linked_material_ = settings.material;
     // The grid code is specialised per kind of grid, as for `facets`' grid pass.
     for (const OutputState& out : outputs_) {
       const CoverageGrid& grid = out.facets.grid;
       const std::uint32_t kind = grid_kind(grid);
       if (programs_.contains(kind)) continue;
-      programs_.emplace(kind, link_replication_program(
-                                  {"replication/tess_patch.vert", "replication/tess_replicas.tesc",
-                                   "replication/tess_replicas.tese",
-                                   "replication/tess_replicas.geom", "scene/material.frag"},
-                                  {{"WRITE_TRIANGLE_ID", "1"},
-                                   {"GRID_CHART", std::to_string(std::uint32_t(grid.chart()))},
-                                   {"GRID_PERIODIC", grid.periodic() ? "1" : "0"},
-                                   {"GRID_CELL_BUCKETS", grid.cell_buckets() ? "1" : "0"}}));
+      programs_.emplace(kind,
+                        link_replication_program(
+                            {"replication/tess_patch.vert", "replication/tess_replicas.tesc",
+                             "replication/tess_replicas.tese", "replication/tess_replicas.geom"},
+                            {{"WRITE_TRIANGLE_ID", "1"},
+                             {"GRID_CHART", std::to_string(std::uint32_t(grid.chart()))},
+                             {"GRID_PERIODIC", grid.periodic() ? "1" : "0"},
+                             {"GRID_CELL_BUCKETS", grid.cell_buckets() ? "1" : "0"}},
+                            &settings.material));
     }
   }
 
@@ -115,6 +118,7 @@ class TessellatedPipeline final : public FacetMethodBase {
 
   std::uint32_t max_level_ = 64;
   std::map<std::uint32_t, Program> programs_;  // per grid_kind
+  MaterialShader linked_material_;             // programs_'
 };
 
 }  // namespace

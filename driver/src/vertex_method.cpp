@@ -15,6 +15,7 @@
 #include <string>
 
 #include "facet/driver/gpu_timer.hpp"
+#include "facet/driver/material_shader.hpp"
 #include "facet/driver/program.hpp"
 #include "facet/driver/shader_library.hpp"
 #include "facet/projection/errors.hpp"
@@ -34,7 +35,8 @@ constexpr std::uint32_t kCounters = 4;  // VertexCounters in vertex.geom
 double radians(double degrees) { return degrees * std::numbers::pi / 180.0; }
 
 // Links `names` with the projection library added to every stage that projects.
-Program link_vertex_program(std::initializer_list<std::string_view> names, bool tessellated) {
+Program link_vertex_program(std::initializer_list<std::string_view> names, bool tessellated,
+                            const MaterialShader& material) {
   ProgramBuilder builder;
   builder.define("WRITE_TRIANGLE_ID", "1").define("TESSELLATED", tessellated ? "1" : "0");
   const std::string_view lib_name = "baselines/vertex_projection.vert";
@@ -46,7 +48,8 @@ Program link_vertex_program(std::initializer_list<std::string_view> names, bool 
       builder.source(stage, std::string(lib_name), lib_text);
     }
   }
-  return builder.link();
+  add_material_stages(builder, material);
+  return link_with_material(builder, material);
 }
 
 // Everything about one output that the shaders need, made in prepare().
@@ -192,15 +195,20 @@ class VertexMethod final : public RenderMethod {
     if (!counters_) counters_ = Buffer::create(kCounters * sizeof(std::uint32_t));
     const bool tessellated = settings.max_tessellation > 1;
     Program& draw = tessellated ? tess_program_ : plain_program_;
+    if (linked_material_ != settings.material) {
+      plain_program_ = Program();
+      tess_program_ = Program();
+      linked_material_ = settings.material;
+    }
     if (!draw) {
       draw = tessellated
-                 ? link_vertex_program({"baselines/vertex.vert", "baselines/pull_scene.vert",
-                                        "baselines/vertex.tesc", "baselines/vertex.tese",
-                                        "baselines/vertex.geom", "scene/material.frag"},
-                                       true)
+                 ? link_vertex_program(
+                       {"baselines/vertex.vert", "baselines/pull_scene.vert",
+                        "baselines/vertex.tesc", "baselines/vertex.tese", "baselines/vertex.geom"},
+                       true, settings.material)
                  : link_vertex_program({"baselines/vertex.vert", "baselines/pull_scene.vert",
-                                        "baselines/vertex.geom", "scene/material.frag"},
-                                       false);
+                                        "baselines/vertex.geom"},
+                                       false, settings.material);
     }
     if (!mask_program_) {
       mask_program_ = ProgramBuilder()
@@ -347,6 +355,7 @@ class VertexMethod final : public RenderMethod {
   VertexArray empty_vao_;
   Buffer counters_;
   Program plain_program_, tess_program_, mask_program_;
+  MaterialShader linked_material_;  // plain_program_'s and tess_program_'s
 };
 
 }  // namespace

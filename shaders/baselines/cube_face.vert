@@ -4,9 +4,13 @@
 layout(location = 0) uniform mat4 T_clip_object;  // face projection · T_eye_object
 layout(location = 1) uniform mat4 T_world_object;
 layout(location = 3) uniform uint first_id;
+layout(location = 4) uniform mat4 T_eye_object;
 
 out vec3 v_n_world;
 out vec2 v_uv;
+out vec3 v_p_world;
+out vec3 v_p_eye;
+out vec3 v_barycentric;
 flat out uint v_triangle_id;
 
 uint pulled_vertex();
@@ -16,8 +20,13 @@ vec2 pulled_uv(uint v);
 
 void main() {
   uint v = pulled_vertex();
-  gl_Position = T_clip_object * vec4(pulled_position(v), 1.0);
+  vec4 p_object = vec4(pulled_position(v), 1.0);
+  gl_Position = T_clip_object * p_object;
   v_n_world = mat3(T_world_object) * pulled_normal(v);
   v_uv = pulled_uv(v);
+  v_p_world = (T_world_object * p_object).xyz;
+  v_p_eye = (T_eye_object * p_object).xyz;
+  uint corner = uint(gl_VertexID) % 3u;
+  v_barycentric = vec3(corner == 0u, corner == 1u, corner == 2u);
   v_triangle_id = first_id + uint(gl_VertexID) / 3u;
 }

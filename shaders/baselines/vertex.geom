@@ -25,10 +25,15 @@ layout(triangle_strip, max_vertices = 9) out;
 in vec3 g_p_eye[];
 in vec3 g_n_world[];
 in vec2 g_uv[];
+in vec3 g_p_world[];
+in vec3 g_barycentric[];
 flat in uint g_triangle_id[];
 
 out vec3 v_n_world;
 out vec2 v_uv;
+out vec3 v_p_world;
+out vec3 v_p_eye;
+out vec3 v_barycentric;
 flat out uint v_triangle_id;
 
 layout(location = 23) uniform vec2 output_size;  // as in vertex_projection.vert
@@ -66,6 +71,9 @@ bool emit(vec3 st[3], float shift) {
     gl_Position = vec4(ndc, z_near / length(g_p_eye[k]), 1.0);
     v_n_world = g_n_world[k];
     v_uv = g_uv[k];
+    v_p_world = g_p_world[k];
+    v_p_eye = g_p_eye[k];
+    v_barycentric = g_barycentric[k];
     v_triangle_id = g_triangle_id[0];
     EmitVertex();
   }

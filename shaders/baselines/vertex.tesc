@@ -13,11 +13,15 @@ layout(vertices = 3) out;
 in vec3 g_p_eye[];
 in vec3 g_n_world[];
 in vec2 g_uv[];
+in vec3 g_p_world[];
+in vec3 g_barycentric[];
 flat in uint g_triangle_id[];
 
 out vec3 tc_p_eye[];
 out vec3 tc_n_world[];
 out vec2 tc_uv[];
+out vec3 tc_p_world[];
+out vec3 tc_barycentric[];
 flat out uint tc_triangle_id[];
 
 layout(location = 26) uniform bool cull_back_faces;
@@ -48,6 +52,8 @@ void main() {
   tc_p_eye[gl_InvocationID] = g_p_eye[gl_InvocationID];
   tc_n_world[gl_InvocationID] = g_n_world[gl_InvocationID];
   tc_uv[gl_InvocationID] = g_uv[gl_InvocationID];
+  tc_p_world[gl_InvocationID] = g_p_world[gl_InvocationID];
+  tc_barycentric[gl_InvocationID] = g_barycentric[gl_InvocationID];
   tc_triangle_id[gl_InvocationID] = g_triangle_id[gl_InvocationID];
   if (gl_InvocationID != 0) return;
 

@@ -5,6 +5,9 @@ layout(location = 45) uniform uint record;
 
 out vec3 v_n_world;
 out vec2 v_uv;
+out vec3 v_p_world;
+out vec3 v_p_eye;
+out vec3 v_barycentric;
 flat out uint v_triangle_id;
 out float gl_ClipDistance[4];
 
@@ -13,6 +16,7 @@ uint record_object(uint r);
 uint record_first_id(uint r);
 vec3 eye_position(uint object, uint v);
 vec3 world_normal(uint object, uint v);
+vec3 world_position(uint object, uint v);
 vec2 vertex_uv(uint v);
 vec4 facet_clip(uint f, vec3 p_eye);
 float facet_clip_distance(uint f, int k, vec3 p_eye);
@@ -25,5 +29,9 @@ void main() {
   for (int k = 0; k < 4; ++k) gl_ClipDistance[k] = facet_clip_distance(facet, k, p_eye);
   v_n_world = world_normal(object, v);
   v_uv = vertex_uv(v);
+  v_p_world = world_position(object, v);
+  v_p_eye = p_eye;
+  uint corner = uint(gl_VertexID) % 3u;
+  v_barycentric = vec3(corner == 0u, corner == 1u, corner == 2u);
   v_triangle_id = record_first_id(record) + uint(gl_VertexID) / 3u;
 }

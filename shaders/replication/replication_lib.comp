@@ -97,6 +97,15 @@ vec3 eye_position(uint object, uint v) {
   return p.xyz;
 }
 
+vec3 world_position(uint object, uint v) {
+  int at = 8 * int(object) + 4;
+  mat4 T_world_object = mat4(texelFetch(object_frame_texels, at),
+                             texelFetch(object_frame_texels, at + 1),
+                             texelFetch(object_frame_texels, at + 2),
+                             texelFetch(object_frame_texels, at + 3));
+  return (T_world_object * vec4(texelFetch(position_texels, int(v)).xyz, 1.0)).xyz;
+}
+
 vec3 world_normal(uint object, uint v) {
   int at = 8 * int(object) + 4;
   mat3 R_world_object = mat3(texelFetch(object_frame_texels, at).xyz,

@@ -9,6 +9,9 @@ in vec2 te_uv[];
 flat in uvec4 te_replicas[];  // (triangle, first replica, replicas, segments per line)
 out vec3 v_n_world;
 out vec2 v_uv;
+out vec3 v_p_world;
+out vec3 v_p_eye;
+out vec3 v_barycentric;
 flat out uint v_triangle_id;
 out float gl_ClipDistance[4];
 
@@ -17,6 +20,7 @@ uint triangle_id(uint e, uint t);
 uint object_of(uint e);
 vec3 eye_position(uint object, uint v);
 vec3 world_normal(uint object, uint v);
+vec3 world_position(uint object, uint v);
 vec2 vertex_uv(uint v);
 vec4 facet_clip(uint f, vec3 p_eye);
 float facet_clip_distance(uint f, int k, vec3 p_eye);
@@ -46,6 +50,9 @@ void main() {
     for (int i = 0; i < 4; ++i) gl_ClipDistance[i] = facet_clip_distance(f, i, p_eye);
     v_n_world = world_normal(object, v);
     v_uv = vertex_uv(v);
+    v_p_world = world_position(object, v);
+    v_p_eye = p_eye;
+    v_barycentric = vec3(c == 0u, c == 1u, c == 2u);
     v_triangle_id = triangle_id(e, t);
     EmitVertex();
   }

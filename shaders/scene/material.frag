@@ -1,8 +1,14 @@
-// Material shading shared by every renderer: base colour times texture, lit by a fixed sun and
-// sky, or shown as authored for unlit materials. Knows nothing of facets or projections, so every
-// method shades the same. Output is linear RGB.
+// Material shading shared by every renderer: gathers MaterialInput (scene/material_interface.frag)
+// from the vertex stage's outputs and the scene material's uniforms, calls shade() of the
+// material linked beside it as a second fragment shader object (scene/materials/*.frag or a
+// user's file: driver/material_shader.hpp), and writes the colour (linear RGB) and the triangle
+// ID. Knows nothing of facets or projections, so every method shades the same; compiled with the
+// interface in front, as every material is.
 in vec3 v_n_world;
 in vec2 v_uv;
+in vec3 v_p_world;
+in vec3 v_p_eye;
+in vec3 v_barycentric;
 
 layout(location = 8) uniform vec4 base_colour;  // linear RGBA
 layout(location = 9) uniform bool has_texture;
@@ -26,19 +32,37 @@ layout(location = 1) out uint out_triangle_id;
 
 const vec3 d_world_sun = normalize(vec3(0.35, 0.85, 0.4));
 
+vec3 sun_and_sky(MaterialInput m) {
+  if (m.unlit) return m.base_colour.rgb;
+  float sun = max(dot(m.n_world, d_world_sun), 0.0);
+  float sky = 0.55 + 0.45 * m.n_world.y;
+  return m.base_colour.rgb * (0.75 * sun + 0.35 * sky);
+}
+
 void main() {
-  vec4 albedo = base_colour;
-  if (has_texture) albedo *= texture(base_texture, v_uv);
-  float light = 1.0;
-  if (unlit == 0u) {
-    vec3 n = normalize(v_n_world);
-    // Two-sided: thin geometry (leaves, signs) is lit from whichever side faces the viewer.
-    if (!gl_FrontFacing) n = -n;
-    float sun = max(dot(n, d_world_sun), 0.0);
-    float sky = 0.55 + 0.45 * n.y;
-    light = 0.75 * sun + 0.35 * sky;
-  }
-  out_colour = vec4(albedo.rgb * light, albedo.a);
+  MaterialInput m;
+  m.p_world = v_p_world;
+  vec3 n = normalize(v_n_world);
+  // Two-sided: thin geometry (leaves, signs) is lit from whichever side faces the viewer.
+  m.n_world = gl_FrontFacing ? n : -n;
+  m.uv = v_uv;
+  m.barycentric = v_barycentric;
+  // Derivatives here, in uniform control flow, whatever the material does with them.
+  vec3 gradient = sqrt(dFdx(v_barycentric) * dFdx(v_barycentric) +
+                       dFdy(v_barycentric) * dFdy(v_barycentric));
+  m.edge_px = v_barycentric / max(gradient, vec3(1e-9));
+  m.distance_m = length(v_p_eye);
+  m.depth = gl_FragCoord.z;
+  m.q_px = gl_FragCoord.xy;
+#if WRITE_TRIANGLE_ID
+  m.triangle_id = v_triangle_id;
+#else
+  m.triangle_id = 0u;
+#endif
+  m.base_colour = base_colour;
+  if (has_texture) m.base_colour *= texture(base_texture, v_uv);
+  m.unlit = unlit != 0u;
+  out_colour = shade(m);
 #if WRITE_TRIANGLE_ID
   out_triangle_id = v_triangle_id;
 #endif

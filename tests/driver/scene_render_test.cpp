@@ -9,6 +9,7 @@
 
 #include "facet/driver/city.hpp"
 #include "facet/driver/gpu_scene.hpp"
+#include "facet/driver/material_shader.hpp"
 #include "facet/driver/program.hpp"
 #include "gl_test_context.hpp"
 
@@ -76,7 +77,10 @@ TEST(SceneRender, CityFromTheCameraPath) {
   EXPECT_EQ(gpu.indices.size(), scene.indices.size() * sizeof(std::uint32_t));
   EXPECT_EQ(gpu.textures.size(), scene.images.size());
   EXPECT_EQ(gpu.objects.size(), scene.objects.size() * sizeof(GpuObject));
-  const Program program = build_program({"scene/mesh.vert", "scene/material.frag"});
+  ProgramBuilder builder;
+  builder.shader("scene/mesh.vert");
+  add_material_stages(builder, MaterialShader{});
+  const Program program = builder.link();
   const CityCameraPath path(options);
   const glm::mat4 T_world_eye(path.T_world_eye(0.3 * path.period_s()));
 

@@ -19,6 +19,7 @@
 #include "facet/driver/gl_context.hpp"
 #include "facet/driver/gpu_scene.hpp"
 #include "facet/driver/gpu_timer.hpp"
+#include "facet/driver/material_shader.hpp"
 #include "facet/driver/output_images.hpp"
 #include "facet/driver/reference.hpp"
 #include "facet/driver/render_method.hpp"
@@ -46,6 +47,7 @@ struct RenderOptions {
   int msaa = 0;
   float anisotropy = kAutomaticAnisotropy;
   std::string coverage = "grid";
+  std::string material = "lit";
   DomeOrientationFlags orientation;
   bool ids = false, depth = false, reference = false, json = false, static_view = false;
 };
@@ -181,12 +183,14 @@ void run(const RenderOptions& options) {
   if (options.anisotropy != kAutomaticAnisotropy && !(options.anisotropy >= 1.0f)) {
     throw InputError("command line", "--anisotropy", "expected 0 (automatic) or a level >= 1");
   }
+  settings.material = load_material_shader(options.material);
   const ViewRequest view_request = options.view.request();  // malformed flags before the scene
   const SceneName scene_name = parse_scene_name(options.scene);
   const Scene scene = load_scene(scene_name);
   const SceneView view = choose_view(scene, view_request, scene_name.builtin_city(), "render");
 
   auto context = create_headless_context();
+  check_material_shader(settings.material);  // its own compile errors name its file (exit 2)
   auto method = make_render_method(options.method);
   const GpuScene gpu_scene = upload_scene(scene, options.anisotropy);
   method->prepare(scene, gpu_scene, outputs, settings);
@@ -337,6 +341,11 @@ const Registration registration{
       command
           ->add_option("--method", options->method,
                        "facets | facets-gs | tessellated | cubemap | naive | vertex")
+          ->capture_default_str();
+      command
+          ->add_option("--material", options->material,
+                       "lit | solid-wireframe | pen-and-ink | procedural | FILE.frag (a GLSL "
+                       "shade() against shaders/scene/material_interface.frag)")
           ->capture_default_str();
       options->layout.add_to(*command);
       options->view.add_to(*command);

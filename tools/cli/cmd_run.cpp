@@ -11,6 +11,7 @@
 #include "display_flags.hpp"
 #include "facet/driver/cluster.hpp"
 #include "facet/driver/gl_context.hpp"
+#include "facet/driver/material_shader.hpp"
 #include "facet/driver/monitors.hpp"
 #include "facet/driver/scene_names.hpp"
 #include "facet/driver/session.hpp"
@@ -29,6 +30,7 @@ struct RunOptions {
   std::string scene = "builtin:city";
   std::string size;
   std::string method;
+  std::string material = "lit";
   std::optional<double> tolerance;
   std::optional<double> scale;
   DomeOrientationFlags orientation;  // builtin:dome180 only
@@ -129,6 +131,7 @@ void run(const RunOptions& options) {
       throw InputError("command line", "--tolerance", "a positive number of output pixels");
     display.settings.facets.layout = FacetTolerance{*options.tolerance};
   }
+  display.settings.material = driver::load_material_shader(options.material);
   // Check the method name before any scene work; one from display.json is reported there.
   try {
     driver::check_render_method(display.method);
@@ -223,6 +226,10 @@ const Registration registration{
           "--method", options->method,
           "facets, facets-gs, tessellated, naive, cubemap or vertex (default: the display's)");
       command->add_option("--tolerance", options->tolerance, "Facet tolerance in output pixels");
+      command
+          ->add_option("--material", options->material,
+                       "lit | solid-wireframe | pen-and-ink | procedural | FILE.frag (GLSL)")
+          ->capture_default_str();
       command->add_option("--scale", options->scale,
                           "Preview at this fraction of every output's resolution (0, 1]");
       options->orientation.add_to(*command);

@@ -19,6 +19,7 @@
 
 #include "facet/driver/gl_objects.hpp"
 #include "facet/driver/gpu_scene.hpp"
+#include "facet/driver/material_shader.hpp"
 #include "facet/driver/scene.hpp"
 #include "facet/projection/facets.hpp"
 #include "facet/projection/warp.hpp"
@@ -59,6 +60,8 @@ struct RenderSettings {
   bool cull_back_faces = true;
   // Near distance in metres along the facet normal (reversed-Z: depth = z_near / (n·X)).
   double z_near = 0.05;
+  // The fragment shading of every method (driver/material_shader.hpp); IDs do not depend on it.
+  MaterialShader material;
 };
 
 // The GPU images of one output, all at the warp's output size. Colour is SRGB8_ALPHA8, IDs

@@ -1,0 +1,350 @@
+// Materials (driver/material_shader.hpp): the built-ins and a user's FILE.frag compile against the
+// interface, a broken one is an InputError naming its file and line, the triangle IDs do not
+// depend on the material, and the solid wireframe's strokes keep their width in output pixels
+// across facet seams, where the cube map's resampling changes it.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "cli_process.hpp"
+#include "facet/driver/city.hpp"
+#include "facet/driver/display_outputs.hpp"
+#include "facet/driver/material_shader.hpp"
+#include "facet/driver/render_method.hpp"
+#include "facet/projection/errors.hpp"
+#include "gl_test_context.hpp"
+
+namespace facet::driver {
+namespace {
+
+namespace fs = std::filesystem;
+
+// A scratch folder removed at the end of the test.
+struct Scratch {
+  fs::path path = fs::temp_directory_path() / ("facet_material_" + std::to_string(getpid()));
+  Scratch() {
+    fs::remove_all(path);
+    fs::create_directories(path);
+  }
+  ~Scratch() {
+    std::error_code error;
+    fs::remove_all(path, error);
+  }
+  fs::path write(const std::string& name, const std::string& text) const {
+    std::ofstream(path / name) << text;
+    return path / name;
+  }
+};
+
+struct Rendered {
+  std::vector<std::vector<std::uint32_t>> ids;
+  std::vector<std::vector<std::uint8_t>> colour;  // sRGB RGBA, top row first
+};
+
+Rendered render(std::string_view method, const Scene& scene, const std::vector<OutputSpec>& outputs,
+                const RenderSettings& settings, const glm::dmat4& T_eye_world) {
+  const GpuScene gpu = upload_scene(scene);
+  auto renderer = make_render_method(method);
+  renderer->prepare(scene, gpu, outputs, settings);
+  std::vector<OutputTarget> targets;
+  for (const auto& output : outputs)
+    targets.push_back(OutputTarget::create(output.warp.output_size));
+  renderer->render(T_eye_world, targets);
+  Rendered result;
+  for (const auto& target : targets) {
+    result.ids.push_back(target.read_ids());
+    result.colour.push_back(target.read_colour_rgba8());
+  }
+  check_gl_error("render");
+  return result;
+}
+
+Scene small_city() {
+  CityOptions options;
+  options.blocks_per_side = 1;
+  options.texture_size = 8;
+  return build_city(options);
+}
+
+glm::dmat4 city_view(double t) {
+  CityOptions options;
+  options.blocks_per_side = 1;
+  return glm::inverse(CityCameraPath(options).T_world_eye(t));
+}
+
+// An inward-facing UV sphere of `radius` metres about the eye in one unlit white material: the
+// edges between its stacks are circles of latitude, the middle one the horizon (y = 0).
+Scene unlit_sphere(int slices, int stacks, float radius) {
+  Scene scene;
+  Material white;
+  white.unlit = true;
+  scene.materials.push_back(white);
+  for (int j = 0; j <= stacks; ++j) {
+    const double theta = M_PI * j / stacks;
+    for (int i = 0; i <= slices; ++i) {
+      const double phi = 2 * M_PI * i / slices;
+      const glm::vec3 d(float(std::sin(theta) * std::cos(phi)), float(std::cos(theta)),
+                        float(std::sin(theta) * std::sin(phi)));
+      scene.positions.push_back(radius * d);
+      scene.normals.push_back(-d);
+      scene.uvs.push_back({float(i) / float(slices), float(j) / float(stacks)});
+    }
+  }
+  for (int j = 0; j < stacks; ++j) {
+    for (int i = 0; i < slices; ++i) {
+      const std::uint32_t a = std::uint32_t(j * (slices + 1) + i), b = a + 1,
+                          c = a + std::uint32_t(slices + 1), d = c + 1;
+      for (std::uint32_t v : {a, c, b, b, c, d}) scene.indices.push_back(v);
+    }
+  }
+  scene.primitives.push_back({0, std::uint32_t(scene.indices.size()), 0});
+  Object object;
+  object.primitive_count = 1;
+  scene.objects.push_back(object);
+  scene.update_bounds();
+  return scene;
+}
+
+TEST(Materials, BuiltinsLoadAndUnknownNamesAreInputErrors) {
+  ASSERT_EQ(builtin_material_names().size(), 4u);
+  for (std::string_view name : builtin_material_names()) {
+    const MaterialShader material = load_material_shader(name);
+    EXPECT_EQ(material.name, name);
+    EXPECT_NE(material.text.find("shade("), std::string::npos) << name;
+  }
+  EXPECT_THROW(load_material_shader("chalk"), InputError);
+  EXPECT_THROW(load_material_shader("/no/such/material.frag"), InputError);
+}
+
+TEST(Materials, UserFilesCompileAndBrokenOnesNameTheirFileAndLine) {
+  test::shared_context();
+  const Scratch scratch;
+  // Barycentric colours: uses the interface's inputs.
+  const fs::path good =
+      scratch.write("good.frag",
+                    "// A user material.\nvec4 shade(MaterialInput m) {\n  return "
+                    "vec4(m.barycentric * (m.edge_px.x > 1.0 ? 1.0 : 0.5), 1.0);\n}\n");
+  EXPECT_NO_THROW(check_material_shader(load_material_shader(good.string())));
+  for (std::string_view name : builtin_material_names())
+    EXPECT_NO_THROW(check_material_shader(load_material_shader(name))) << name;
+
+  const fs::path broken = scratch.write(
+      "broken.frag", "// Line 1.\nvec4 shade(MaterialInput m) {\n  return m.colour;\n}\n");
+  try {
+    check_material_shader(load_material_shader(broken.string()));
+    ADD_FAILURE() << "a broken material compiled";
+  } catch (const InputError& e) {
+    const std::string message = e.what();
+    EXPECT_NE(message.find(broken.string()), std::string::npos) << message;
+    EXPECT_NE(message.find("line 3"), std::string::npos) << message;
+    EXPECT_NE(message.find("colour"), std::string::npos) << message;
+  }
+  // No shade(): the link fails, named by the file.
+  const fs::path empty = scratch.write("empty.frag", "const float unused = 1.0;\n");
+  try {
+    check_material_shader(load_material_shader(empty.string()));
+    ADD_FAILURE() << "a material without shade() linked";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find(empty.string()), std::string::npos) << e.what();
+  }
+  // discard and gl_FragDepth would change IDs and depth: refused before compiling; comments may
+  // say them.
+  const fs::path discards = scratch.write(
+      "discards.frag",
+      "// discard is mentioned here\nvec4 shade(MaterialInput m) {\n  if (m.uv.x > 0.5) "
+      "discard;\n  return vec4(1.0);\n}\n");
+  try {
+    load_material_shader(discards.string());
+    ADD_FAILURE() << "discard was taken";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("line 3"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(load_material_shader(
+                   scratch.write("depth.frag", "void f() { gl_FragDepth = 0.5; }").string()),
+               InputError);
+  EXPECT_THROW(load_material_shader(scratch.path.string() + "/good.glsl"), InputError);
+}
+
+// The material shades; the replication and the IDs never see it.
+TEST(Materials, IdsDoNotDependOnTheMaterial) {
+  test::shared_context();
+  const Scene scene = small_city();
+  const auto outputs = load_display_outputs("builtin:cylinder360", glm::ivec2(192, 144));
+  RenderSettings settings;
+  settings.facets.layout = FacetStrips{24};
+  const glm::dmat4 view = city_view(3.0);
+  for (std::string_view method : {"facets", "cubemap"}) {
+    const Rendered lit = render(method, scene, outputs, settings, view);
+    for (std::string_view name : {"solid-wireframe", "pen-and-ink", "procedural"}) {
+      RenderSettings styled = settings;
+      styled.material = load_material_shader(name);
+      const Rendered r = render(method, scene, outputs, styled, view);
+      EXPECT_EQ(r.ids[0], lit.ids[0]) << method << " " << name;
+      EXPECT_NE(r.colour[0], lit.colour[0]) << method << " " << name;
+    }
+  }
+}
+
+double linear_from_srgb(std::uint8_t value) {
+  const double c = value / 255.0;
+  return c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4);
+}
+
+struct StrokeWidths {
+  std::vector<double> width_px;  // per column; NaN where another stroke crosses
+  double row = 0;                // the stroke's middle row
+};
+
+// The width of the horizon's stroke in every column of an unlit white image: the ink summed over
+// the rows within 8 px of it (solid-wireframe's stroke is antialiased over one pixel, so its ink
+// sums to its width). Columns near other strokes (meridians and diagonals of the sphere) are NaN.
+StrokeWidths horizon_stroke(const std::vector<std::uint8_t>& rgba, glm::ivec2 size) {
+  const double ink_luminance = 0.0207;  // solid-wireframe.frag's kInk
+  auto ink = [&](int x, int y) {
+    const std::size_t at = 4 * (std::size_t(y) * std::size_t(size.x) + std::size_t(x));
+    const double l = 0.2126 * linear_from_srgb(rgba[at]) + 0.7152 * linear_from_srgb(rgba[at + 1]) +
+                     0.0722 * linear_from_srgb(rgba[at + 2]);
+    return std::clamp((1.0 - l) / (1.0 - ink_luminance), 0.0, 1.0);
+  };
+  // The horizon's row: the most ink summed over all columns.
+  std::vector<double> row_ink(std::size_t(size.y), 0.0);
+  for (int y = 0; y < size.y; ++y)
+    for (int x = 0; x < size.x; ++x) row_ink[std::size_t(y)] += ink(x, y);
+  const int middle = int(std::max_element(row_ink.begin(), row_ink.end()) - row_ink.begin());
+  StrokeWidths result;
+  result.row = middle;
+  std::vector<double> width(std::size_t(size.x), 0.0);
+  std::vector<bool> crossed(std::size_t(size.x), false);
+  for (int x = 0; x < size.x; ++x) {
+    for (int y = std::max(0, middle - 8); y <= std::min(size.y - 1, middle + 8); ++y) {
+      width[std::size_t(x)] += ink(x, y);
+      // Ink at the window's border is another stroke crossing.
+      if ((y == middle - 8 || y == middle + 8) && ink(x, y) > 0.01) crossed[std::size_t(x)] = true;
+    }
+  }
+  result.width_px.assign(std::size_t(size.x), std::nan(""));
+  for (int x = 0; x < size.x; ++x) {
+    bool near_crossing = false;
+    for (int k = -6; k <= 6; ++k) near_crossing |= crossed[std::size_t((x + k + size.x) % size.x)];
+    if (!near_crossing) result.width_px[std::size_t(x)] = width[std::size_t(x)];
+  }
+  return result;
+}
+
+// Largest spread (max - min) of the stroke width over the 4 columns about each seam column
+// (the seam between columns s - 1 and s), skipping seams where a column is NaN; and how many
+// seams were measured.
+std::pair<double, int> spread_across_seams(const std::vector<double>& width,
+                                           const std::vector<int>& seams) {
+  double worst = 0;
+  int measured = 0;
+  const int n = int(width.size());
+  for (int s : seams) {
+    double lo = 1e9, hi = -1e9;
+    bool ok = true;
+    for (int x = s - 2; x <= s + 1; ++x) {
+      const double w = width[std::size_t((x + n) % n)];
+      if (std::isnan(w)) ok = false;
+      lo = std::min(lo, w);
+      hi = std::max(hi, w);
+    }
+    if (!ok) continue;
+    worst = std::max(worst, hi - lo);
+    ++measured;
+  }
+  return {worst, measured};
+}
+
+std::pair<double, double> range_of(const std::vector<double>& width) {
+  double lo = 1e9, hi = -1e9;
+  for (double w : width)
+    if (!std::isnan(w)) lo = std::min(lo, w), hi = std::max(hi, w);
+  return {lo, hi};
+}
+
+// The solid wireframe's horizon at 15 m (2 px wide: 30 / distance) on the 360° cylinder,
+// 512x384. Facets (32 strips) draw it with each facet's own projection and keep it 2 px wide
+// across every seam; the cube map (384-px faces: a face texel is an output row at the face's
+// centre) draws it 2 face texels wide and resamples it, so its width follows the faces'
+// magnification, 2 cos(azimuth from the face's centre) output px. Reported for both; asserted for
+// facets: the width varies by at most 0.5 px across each seam (and along the whole stroke).
+TEST(Materials, WireframeStrokesKeepTheirWidthAcrossFacetSeams) {
+  test::shared_context();
+  const Scene sphere = unlit_sphere(12, 6, 15.0f);
+  const glm::ivec2 size(512, 384);
+  const auto outputs = load_display_outputs("builtin:cylinder360", size);
+  const Warp& warp = outputs[0].warp;
+  RenderSettings settings;
+  const int strips = 32;
+  settings.facets.layout = FacetStrips{strips};
+  settings.material = load_material_shader("solid-wireframe");
+  settings.cube_face_size = 384;
+
+  std::vector<int> facet_seams;
+  for (int k = 1; k < strips; ++k) facet_seams.push_back(int(std::lround(k * size.x / strips)));
+  // The cube's faces meet round the horizon at the eye frame's diagonals.
+  std::vector<int> cube_seams;
+  for (const glm::dvec3 v :
+       {glm::dvec3(1, 0, 1), glm::dvec3(1, 0, -1), glm::dvec3(-1, 0, 1), glm::dvec3(-1, 0, -1)}) {
+    const auto projected = warp.project(v);
+    if (projected) cube_seams.push_back(int(std::lround(projected->q.x)));
+  }
+  ASSERT_EQ(cube_seams.size(), 4u);
+
+  const Rendered facets = render("facets", sphere, outputs, settings, glm::dmat4(1.0));
+  const Rendered cube = render("cubemap", sphere, outputs, settings, glm::dmat4(1.0));
+  const StrokeWidths f = horizon_stroke(facets.colour[0], size);
+  const StrokeWidths c = horizon_stroke(cube.colour[0], size);
+  const auto [f_seam, f_seams] = spread_across_seams(f.width_px, facet_seams);
+  const auto [c_seam, c_seams] = spread_across_seams(c.width_px, cube_seams);
+  const auto [f_lo, f_hi] = range_of(f.width_px);
+  const auto [c_lo, c_hi] = range_of(c.width_px);
+  std::printf(
+      "solid wireframe, 2 px stroke at 15 m, cylinder 512x384: facets (32 strips) width %.3f to "
+      "%.3f px, worst spread across %d facet seams %.3f px; cube map (384 px faces) width %.3f "
+      "to %.3f px, worst spread across %d cube seams %.3f px\n",
+      f_lo, f_hi, f_seams, f_seam, c_lo, c_hi, c_seams, c_seam);
+  EXPECT_GE(f_seams, strips / 4);  // seams clear of the sphere's meridians and diagonals
+  EXPECT_LE(f_seam, 0.5);
+  EXPECT_LE(f_hi - f_lo, 0.5);
+  EXPECT_NEAR(0.5 * (f_lo + f_hi), 2.0, 0.25);
+  EXPECT_GT(c_hi, 0.0);  // the cube map drew the stroke (its width is reported, not asserted)
+}
+
+// facet render --material: a user's file that does not compile exits 2 naming the file and the
+// line; a built-in renders.
+TEST(Materials, RenderCliTakesMaterials) {
+  const Scratch scratch;
+  const fs::path broken =
+      scratch.write("broken.frag", "vec4 shade(MaterialInput m) {\n  return vec3(1.0);\n}\n");
+  std::string output;
+  EXPECT_EQ(facet::test::run_facet(
+                "render --display builtin:cylinder360 --size 64x48 --material " + broken.string(),
+                &output),
+            2)
+      << output;
+  EXPECT_NE(output.find(broken.string()), std::string::npos) << output;
+  EXPECT_NE(output.find("line 2"), std::string::npos) << output;
+  EXPECT_EQ(facet::test::run_facet(
+                "render --display builtin:cylinder360 --size 64x48 --material pen-and-ink "
+                "--out " +
+                    (scratch.path / "out").string(),
+                &output),
+            0)
+      << output;
+  EXPECT_TRUE(fs::exists(scratch.path / "out" / "cylinder360.png"));
+  EXPECT_EQ(facet::test::run_facet(
+                "render --display builtin:cylinder360 --size 64x48 --material chalk", &output),
+            2)
+      << output;
+}
+
+}  // namespace
+}  // namespace facet::driver
