@@ -25,7 +25,7 @@ struct PreviewCommandOptions {
   std::string size;
   DomeOrientationFlags orientation;  // the dome's: builtin:dome180 and the fisheye view
   std::string view;                  // fit | fisheye | equirect; empty: fit, or fisheye with --tilt
-  double fov_deg = 180;
+  std::optional<double> fov_deg;     // the fisheye's; 180 when not given
   std::string show = "projectors";
   int preview_size = 1024;
   std::string out;
@@ -42,7 +42,12 @@ void preview(const PreviewCommandOptions& options) {
                      "projectors, overlap, blend or uncovered: a display has no fit residual "
                      "(facet calibrate draws it in report/preview.png)");
   std::string view_name = options.view;
-  if (view_name.empty()) view_name = options.orientation.given() ? "fisheye" : "fit";
+  if (view_name.empty())
+    view_name = options.orientation.given() || options.fov_deg ? "fisheye" : "fit";
+  if (options.fov_deg && !(*options.fov_deg > 0 && *options.fov_deg <= 360))
+    throw InputError(
+        "command line", "--fov",
+        "a fisheye field of view in (0, 360] degrees, got " + std::to_string(*options.fov_deg));
   if (view_name != "fit" && view_name != "fisheye" && view_name != "equirect")
     throw InputError("command line", "--view", "fit, fisheye or equirect, got '" + view_name + "'");
   std::optional<glm::ivec2> size;
@@ -75,7 +80,7 @@ void preview(const PreviewCommandOptions& options) {
     preview_options.view = fitted_preview_view(projectors);
     view_name = preview_options.view.format == ContentFormat::fisheye ? "fisheye" : "equirect";
   } else if (view_name == "fisheye") {
-    preview_options.view = fisheye_content(options.fov_deg, view_orientation);
+    preview_options.view = fisheye_content(options.fov_deg.value_or(180), view_orientation);
   } else {
     preview_options.view = equirect_content();
   }
@@ -137,7 +142,7 @@ const Registration registration{
       command->add_option("--size", options->size, "Output size WxH of a built-in display");
       options->orientation.add_to(*command);
       command->add_option("--view", options->view,
-                          "fit (default; fisheye with --tilt or --orientation), fisheye or "
+                          "fit (default; fisheye with --tilt, --orientation or --fov), fisheye or "
                           "equirect: fit is a fisheye about the mean covered direction wide "
                           "enough for every covered one, or equirect beyond 270 degrees");
       command->add_option(

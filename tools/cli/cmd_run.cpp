@@ -144,7 +144,7 @@ void run(const RunOptions& options) {
   if (!headless) monitors_of_display_server("--windowed");
   const driver::ViewRequest view_request = options.view.request();
   const driver::SceneName scene_name = driver::parse_scene_name(options.scene);
-  const driver::Scene scene = driver::load_scene(scene_name);
+  driver::Scene scene = driver::load_scene(scene_name);  // moved into the headless Session
   const driver::CameraPath path =
       driver::camera_path(choose_view(scene, view_request, scene_name.builtin_city(), "run"));
 
@@ -186,7 +186,7 @@ void run(const RunOptions& options) {
   if (!options.headless)
     std::cerr << "facet run: no display server (DISPLAY is not set): running headless\n";
   auto context = driver::create_headless_context();
-  driver::Session session(display, scene);
+  driver::Session session(display, std::move(scene));
   driver::HeadlessRunOptions headless_options;
   headless_options.frames = frames.value_or(10);
   headless_options.out_dir = options.out;
