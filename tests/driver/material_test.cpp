@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
@@ -319,7 +320,8 @@ TEST(Materials, WireframeStrokesKeepTheirWidthAcrossFacetSeams) {
 }
 
 // facet render --material: a user's file that does not compile exits 2 naming the file and the
-// line; a built-in renders.
+// line; a built-in renders; --reference reports the same id_mismatch whatever the material;
+// facet run refuses the broken file too.
 TEST(Materials, RenderCliTakesMaterials) {
   const Scratch scratch;
   const fs::path broken =
@@ -343,7 +345,30 @@ TEST(Materials, RenderCliTakesMaterials) {
   EXPECT_EQ(facet::test::run_facet(
                 "render --display builtin:cylinder360 --size 64x48 --material chalk", &output),
             2)
+      << output;  // The reference compares IDs, which the material does not touch.
+  double mismatch[2] = {-1, -2};
+  for (int k = 0; k < 2; ++k) {
+    const std::string material = k == 0 ? "lit" : "solid-wireframe";
+    ASSERT_EQ(facet::test::run_facet("render --display builtin:dome180 --size 64x64 --reference "
+                                     "--json --material " +
+                                         material,
+                                     &output),
+              0)
+        << output;
+    const auto json = nlohmann::json::parse(output.substr(output.find('{')));
+    mismatch[k] = json["reference"]["id_mismatch"].get<double>();
+  }
+  EXPECT_EQ(mismatch[0], mismatch[1]);
+  // facet run reports a broken material the same way, and writes nothing.
+  EXPECT_EQ(
+      facet::test::run_facet("run builtin:cylinder360 --size 64x48 --headless --frames 1 "
+                             "--material " +
+                                 broken.string() + " --out " + (scratch.path / "run").string(),
+                             &output),
+      2)
       << output;
+  EXPECT_NE(output.find(broken.string()), std::string::npos) << output;
+  EXPECT_FALSE(fs::exists(scratch.path / "run"));
 }
 
 }  // namespace

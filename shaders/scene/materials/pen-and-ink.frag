@@ -1,8 +1,10 @@
-// Pen-and-ink hatching in screen space: the lit tone (sRGB-encoded luminance, so that steps are
-// even to the eye) is drawn as up to three layers of parallel lines in output pixels (one
-// diagonal below 0.7, the other diagonal below 0.45, horizontal below 0.25) in ink on paper. Lines are 1 px wide every 6 px, antialiased over one
-// pixel; being laid out in output pixels, they run on unbroken over facet seams.
+// Pen-and-ink hatching in screen space: the tone, the lighting of the surface (sun and sky) times
+// half the sRGB-encoded lightness of its colour, is drawn as up to three layers of parallel lines
+// in output pixels (one diagonal below 0.7, the other diagonal below 0.45, horizontal below
+// 0.25) in ink on paper. Lines are 1 px wide every 6 px, antialiased over one pixel; being laid
+// out in output pixels, they run on unbroken over facet seams.
 const vec3 kPaper = vec3(0.96, 0.94, 0.88), kInk = vec3(0.05, 0.05, 0.08);
+const vec3 kLuma = vec3(0.2126, 0.7152, 0.0722);
 const float kSpacingPx = 6.0, kLinePx = 1.0;
 
 // Ink of the lines perpendicular to the unit vector `across`, one every kSpacingPx.
@@ -13,7 +15,11 @@ float hatch(vec2 q_px, vec2 across) {
 }
 
 vec4 shade(MaterialInput m) {
-  float tone = pow(dot(sun_and_sky(m), vec3(0.2126, 0.7152, 0.0722)), 1.0 / 2.2);
+  MaterialInput white = m;
+  white.base_colour = vec4(1.0);
+  float light = dot(sun_and_sky(white), kLuma);
+  float lightness = pow(dot(m.base_colour.rgb, kLuma), 1.0 / 2.2);
+  float tone = light * mix(1.0, lightness, 0.5);
   float ink = 0.0;
   if (tone < 0.7) ink = max(ink, hatch(m.q_px, vec2(0.70710678, 0.70710678)));
   if (tone < 0.45) ink = max(ink, hatch(m.q_px, vec2(0.70710678, -0.70710678)));
