@@ -194,6 +194,29 @@ TEST_F(PlayCli, StillEquirectOnACylinder) {
   EXPECT_LT(pixels[(std::size_t(100) * 160 + 80) * 4], 5);   // below
 }
 
+TEST_F(PlayCli, BlendsLikeASession) {
+  // White everywhere on the 2 × 2 wall: the top-left projector is full white at its top-left
+  // corner and blended down to a weight of about 0.02 at its right edge, inside the overlap.
+  const cv::Mat white(64, 128, CV_8UC3, cv::Scalar(255, 255, 255));
+  cv::imwrite((dir_ / "white.png").string(), white);
+  const fs::path out = dir_ / "out";
+  ASSERT_EQ(test::run_facet("play " + (dir_ / "white.png").string() +
+                                " --display builtin:wall2x2 --size 160x100 --headless --out " +
+                                out.string(),
+                            dir_ / "log.txt"),
+            0)
+      << log();
+  auto input = OIIO::ImageInput::open((out / "wall_r0c0" / "00000.png").string());
+  ASSERT_TRUE(input);
+  std::vector<std::uint8_t> pixels(160 * 100 * 4);
+  input->read_image(0, 0, 0, 4, OIIO::TypeDesc::UINT8, pixels.data());
+  EXPECT_GT(pixels[(std::size_t(5) * 160 + 5) * 4], 250);
+  EXPECT_LT(pixels[(std::size_t(5) * 160 + 157) * 4], 60);
+  const std::vector<nlohmann::json> lines = stats(out);
+  ASSERT_EQ(lines.size(), 1u);
+  EXPECT_GT(lines[0]["blend_tiles"][0].get<int>(), 0);
+}
+
 // Windows on an X server (Xorg's dummy driver): the same video in a window for 12 frames on the
 // wall clock. Leak checking is off as for facet run's windowed tests (Mesa's GLX driver is
 // unloaded before LeakSanitizer runs).
