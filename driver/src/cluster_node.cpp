@@ -120,8 +120,11 @@ std::string address_field(const projection_io::DisplayCluster& cluster, const st
 class Socket {
  public:
   Socket() = default;
-  ~Socket() {
+  ~Socket() { close(); }
+  // Closes it now; a receive blocked on it returns at once.
+  void close() {
     if (open_) nng_close(socket_);
+    open_ = false;
   }
   Socket(const Socket&) = delete;
   Socket& operator=(const Socket&) = delete;
@@ -285,6 +288,17 @@ class Master final : public FrameSync {
     publish(Published::frame, encode_frame_state(state));
     last_broadcast_ms_ = ms_since(start);
     return state;
+  }
+
+  void fall_silent() {
+    {
+      std::lock_guard lock(mutex_);
+      stopping_ = true;
+    }
+    wake_.notify_all();
+    heartbeat_.join();
+    heartbeat_ = std::thread([] {});
+    stopped_ = true;
   }
 
   bool ready_to_swap(const FrameState& state, nlohmann::json& stats) override {
@@ -493,6 +507,8 @@ class Secondary final : public FrameSync {
       stopping_ = true;
     }
     changed_.notify_all();
+    subscriber_.close();
+    respondent_.close();
     listener_.join();
     responder_.join();
   }
@@ -597,8 +613,14 @@ class Secondary final : public FrameSync {
     }
   }
 
+  // Until something arrives, or at most 5 ms, or the moment the master's silence would pass the
+  // deadline, so that check() sees the loss on time.
   void wait(std::unique_lock<std::mutex>& lock) {
-    changed_.wait_for(lock, std::chrono::milliseconds(5));
+    Clock::time_point until = Clock::now() + std::chrono::milliseconds(5);
+    if (last_heard_)
+      until = std::min(until,
+                       *last_heard_ + period(deadline_ms_ / 1000) + std::chrono::microseconds(100));
+    changed_.wait_until(lock, until);
   }
 
   void listen() {
@@ -703,6 +725,10 @@ ClusterNodeShare keep_cluster_node_outputs(SessionDisplay& display,
 
 std::unique_ptr<FrameSync> make_cluster_secondary(const ClusterNodeOptions& options) {
   return std::make_unique<Secondary>(options);
+}
+
+void silence_cluster_master(FrameSync& master) {
+  if (auto* m = dynamic_cast<Master*>(&master)) m->fall_silent();
 }
 
 }  // namespace facet::driver

@@ -397,5 +397,28 @@ TEST(ClusterProtocol, AnAddressInUseIsAnInputError) {
   EXPECT_THROW(find_cluster_node(cluster, "d", "display.json"), InputError);
 }
 
+TEST(ClusterBench, ReportsEveryNodeCountAndBothLosses) {
+  const Scratch scratch;
+  ClusterBenchOptions options;
+  options.node_counts = {2, 3};
+  options.frames = 20;
+  options.folder = scratch.path;
+  std::vector<std::string> lines;
+  const std::vector<ClusterBenchRow> rows =
+      bench_cluster(options, [&](const std::string& line) { lines.push_back(line); });
+  ASSERT_EQ(rows.size(), 4u);  // ipc and tcp, 2 and 3 nodes
+  EXPECT_EQ(lines.size(), 4u);
+  for (const ClusterBenchRow& row : rows) {
+    EXPECT_GT(row.median_ms, 0) << row.transport << " " << row.nodes;
+    EXPECT_LE(row.median_ms, row.p99_ms);
+    // Nobody is declared lost before the deadline has passed (the survey's own timer allows a
+    // little rounding); the 2-node row has no secondary to lose besides the one the master needs.
+    if (row.nodes == 3) {
+      EXPECT_GE(row.secondary_loss_ms, options.deadline_ms * 0.9);
+    }
+    EXPECT_GE(row.master_loss_ms, options.deadline_ms * 0.5);
+  }
+}
+
 }  // namespace
 }  // namespace facet::driver

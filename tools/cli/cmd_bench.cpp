@@ -4,12 +4,16 @@
 #include <cstdint>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
 #include <string>
 
 #include "command.hpp"
 #include "facet/driver/bench.hpp"
+#include "facet/driver/cluster.hpp"
 #include "facet/driver/gl_context.hpp"
 #include "facet/driver/scene_names.hpp"
+#include "facet/projection/atomic_file.hpp"
 #include "facet/projection/errors.hpp"
 #include "facet/projection/interrupt.hpp"
 #include "frames_flag.hpp"
@@ -29,7 +33,43 @@ struct BenchCommandOptions {
   bool quick = false, static_view = false;
 };
 
+// --scenario cluster: the cluster protocol alone, no GL (cluster.hpp's bench_cluster).
+void run_cluster(const BenchCommandOptions& command) {
+  ClusterBenchOptions options;
+  if (command.frames != BenchCommandOptions{}.frames)
+    options.frames = int(checked_frames(command.frames));
+  if (command.quick) {
+    options.frames = 50;
+    options.node_counts = {2, 3};
+  }
+  std::filesystem::create_directories(command.out);
+  options.folder = std::filesystem::absolute(command.out);
+  watch_interrupts();
+  const std::vector<ClusterBenchRow> rows = bench_cluster(options, [](const std::string& line) {
+    std::printf("%s\n", line.c_str());
+    std::fflush(stdout);
+    throw_if_interrupted("stopped before the end; nothing written");
+  });
+  nlohmann::json json = nlohmann::json::array();
+  for (const ClusterBenchRow& row : rows)
+    json.push_back({{"nodes", row.nodes},
+                    {"transport", row.transport},
+                    {"frame_overhead_median_ms", row.median_ms},
+                    {"frame_overhead_p99_ms", row.p99_ms},
+                    {"frame_overhead_worst_ms", row.worst_ms},
+                    {"deadline_ms", options.deadline_ms},
+                    {"frames", options.frames},
+                    {"secondary_loss_detected_ms", row.secondary_loss_ms},
+                    {"master_loss_detected_ms", row.master_loss_ms}});
+  const std::filesystem::path file = std::filesystem::path(command.out) / "cluster.json";
+  write_atomically(file, [&](const std::filesystem::path& temporary) {
+    std::ofstream(temporary) << json.dump(2) << '\n';
+  });
+  std::printf("wrote %s\n", file.string().c_str());
+}
+
 void run(const BenchCommandOptions& command) {
+  if (command.scenario == "cluster") return run_cluster(command);
   BenchOptions options;
   if (command.scenario != "all") options.scenarios = {command.scenario};
   options.frames = int(checked_frames(command.frames));
@@ -73,8 +113,10 @@ const Registration registration{
       command
           ->add_option("--scenario", options->scenario,
                        "cylinder | deformation[-80x60|-128x128] | dome | dome-master | dome4 | "
-                       "scale | all (all: cylinder, deformation, dome; scale: every method over "
-                       "builtin:city, :4, :8 on the cylinder and the dome)")
+                       "scale | cluster | all (all: cylinder, deformation, dome; scale: every "
+                       "method over builtin:city, :4, :8 on the cylinder and the dome; cluster: "
+                       "the cluster protocol's cost per frame and loss detection at 2, 4, 8 "
+                       "nodes, no rendering)")
           ->capture_default_str();
       command
           ->add_option("--frames", options->frames,

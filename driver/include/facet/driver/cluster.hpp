@@ -124,6 +124,33 @@ std::unique_ptr<FrameSync> make_cluster_master(const ClusterNodeOptions& options
 // (a different content digest).
 std::unique_ptr<FrameSync> make_cluster_secondary(const ClusterNodeOptions& options);
 
+// For tests and benchmarks: the master (make_cluster_master's) stops speaking, heartbeat and
+// end of run included, as if its process had died.
+void silence_cluster_master(FrameSync& master);
+
+// ---- Benchmark --------------------------------------------------------------------------------
+
+// facet bench --scenario cluster: a master and nodes-1 secondaries on threads of one process,
+// rendering nothing, over ipc:// or tcp:// on the loopback.
+struct ClusterBenchOptions {
+  std::vector<int> node_counts = {2, 4, 8};
+  std::vector<std::string> transports = {"ipc", "tcp"};
+  int frames = 600;
+  double deadline_ms = 50;       // 3 frame periods at 60 Hz, the default
+  std::filesystem::path folder;  // for ipc:// sockets; must exist
+};
+struct ClusterBenchRow {
+  int nodes = 0;
+  std::string transport;
+  // Per frame, as the master sees it: broadcast, then the barrier until every node answered.
+  double median_ms = 0, p99_ms = 0, worst_ms = 0;
+  double secondary_loss_ms = 0;  // a secondary falls silent: the master's wait until it drops it
+  double master_loss_ms = 0;     // the master falls silent: until the last secondary gives up
+};
+// One row per node count and transport; `progress` gets a line per row.
+std::vector<ClusterBenchRow> bench_cluster(const ClusterBenchOptions& options,
+                                           const std::function<void(const std::string&)>& progress);
+
 // A node's part of a display: reads the cluster section of `display_file` (a display.json) and
 // keeps in `display` (load_session_display's result for the same file) the outputs of node
 // `node`'s projectors only. InputError when the file has no cluster section or no such node.
