@@ -464,6 +464,24 @@ void Session::place_objects(const std::vector<ObjectPose>& poses,
   }
 }
 
+void Session::set_pattern(std::optional<TestPattern> pattern) {
+  pattern_rows_up_.clear();
+  pattern_ = pattern;
+  if (!pattern) return;
+  for (std::size_t i = 0; i < display_.outputs.size(); ++i) {
+    const SessionOutput& output = display_.outputs[i];
+    const std::vector<std::uint8_t> rows_down =
+        test_pattern_image(*pattern, output.spec.warp, i, output.spec.name);
+    const glm::ivec2 size = output.spec.warp.output_size;
+    const std::size_t row_bytes = std::size_t(size.x) * 4;
+    std::vector<std::uint8_t> rows_up(rows_down.size());
+    for (int y = 0; y < size.y; ++y)
+      std::copy_n(&rows_down[std::size_t(size.y - 1 - y) * row_bytes], row_bytes,
+                  &rows_up[std::size_t(y) * row_bytes]);
+    pattern_rows_up_.push_back(std::move(rows_up));
+  }
+}
+
 FrameStats Session::render(const FrameState& state, bool finish) {
   const auto start = std::chrono::steady_clock::now();
   place_objects(state.object_poses, animated_object_poses(scene_.animation, state.time_s));
@@ -474,6 +492,20 @@ FrameStats Session::render(const FrameState& state, bool finish) {
   for (std::size_t i = 0; i < methods_.size(); ++i) {
     OutputFrameStats output;
     output.name = display_.outputs[i].spec.name;
+    if (pattern_) {
+      const glm::ivec2 size = targets_[i].size();
+      glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+      glTextureSubImage2D(targets_[i].colour().id(), 0, 0, 0, size.x, size.y, GL_RGBA,
+                          GL_UNSIGNED_BYTE, pattern_rows_up_[i].data());
+      if (test_pattern_is_blended(*pattern_)) {
+        auto scope = timer_.scope("blend");
+        blends_[i].apply(targets_[i].colour());
+        output.blend_tiles = blends_[i].tiles_listed();
+      }
+      output.rendered = true;
+      stats.outputs.push_back(std::move(output));
+      continue;
+    }
     targets_[i].clear();
     if (output_sees_scene(i, state.T_world_eye)) {
       output.rendered = true;

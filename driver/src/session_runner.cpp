@@ -223,6 +223,7 @@ namespace {
 struct Navigation {
   bool play_path = true;
   bool overlay = false;
+  int pattern_steps = 0;  // presses of T not yet acted on
   bool quit = false;
   glm::dvec3 position{0.0};
   double yaw = 0, pitch = 0;  // radians; yaw about world up, pitch about the eye's x
@@ -256,6 +257,7 @@ void on_key(GLFWwindow* window, int key, int, int action, int) {
   if (key == GLFW_KEY_ESCAPE) nav.quit = true;
   if (key == GLFW_KEY_P) nav.play_path = !nav.play_path;
   if (key == GLFW_KEY_O) nav.overlay = !nav.overlay;
+  if (key == GLFW_KEY_T) ++nav.pattern_steps;
 }
 
 void on_mouse_button(GLFWwindow* window, int button, int action, int) {
@@ -409,6 +411,7 @@ void run_windowed_session(const SessionDisplay& display, const Scene& scene, con
 
   windows.front().context->make_current();
   Session session(display, scene);
+  session.set_pattern(options.pattern);
   std::vector<Texture> raw_views;
   for (const OutputTarget& target : session.targets())
     raw_views.push_back(Texture::create_view(target.colour(), GL_RGBA8));
@@ -451,6 +454,19 @@ void run_windowed_session(const SessionDisplay& display, const Scene& scene, con
     if (nav.play_path) time_s += options.frames ? kFramePeriod_s : dt;
 
     windows.front().context->make_current();
+    for (; nav.pattern_steps > 0; --nav.pattern_steps) {
+      // The scene, then every pattern in order, then the scene again.
+      const auto& patterns = all_test_patterns();
+      const auto at = session.pattern()
+                          ? std::find(patterns.begin(), patterns.end(), *session.pattern())
+                          : patterns.end();
+      const auto next = at == patterns.end() ? patterns.begin() : at + 1;
+      session.set_pattern(next == patterns.end() ? std::nullopt
+                                                 : std::optional<TestPattern>(*next));
+      std::printf("facet run: showing %s\n",
+                  session.pattern() ? to_string(*session.pattern()).c_str() : "the scene");
+      std::fflush(stdout);
+    }
     FrameState state{frame, time_s, nav.play_path ? T_path : nav.T_world_eye(), {}};
     bool show = true;
     if (options.sync) {

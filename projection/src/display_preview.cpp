@@ -1,17 +1,15 @@
 #include "facet/projection/display_preview.hpp"
 
-#include <stb/stb_easy_font.h>
-
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <cstring>
 #include <functional>
 #include <limits>
 #include <numbers>
 #include <thread>
 
 #include "facet/projection/errors.hpp"
+#include "raster.hpp"
 
 namespace facet {
 namespace {
@@ -61,15 +59,6 @@ double pixel_solid_angle(const ContentProjection& view, glm::ivec2 size, glm::dv
   return std::cos(elevation) * (2 * kPi / size.x) * (kPi / size.y);
 }
 
-glm::u8vec4 srgb8(glm::vec3 linear) {
-  auto encode = [](float c) {
-    c = std::clamp(c, 0.0f, 1.0f);
-    const float e = c <= 0.0031308f ? 12.92f * c : 1.055f * std::pow(c, 1 / 2.4f) - 0.055f;
-    return std::uint8_t(std::lround(e * 255));
-  };
-  return {encode(linear.x), encode(linear.y), encode(linear.z), 255};
-}
-
 // The colour of an overlap count in the overlap colouring (linear).
 glm::vec3 overlap_colour(int count) {
   static const glm::vec3 colours[] = {{0.35f, 0.0f, 0.0f},
@@ -88,33 +77,6 @@ glm::vec3 blend_colour(double sum) {
   const float k = float(std::clamp(std::abs(off) / 0.1, 0.15, 1.0));
   return off < 0 ? glm::vec3(0.05f, 0.1f + 0.2f * k, 0.3f + 0.7f * k)
                  : glm::vec3(0.3f + 0.7f * k, 0.05f, 0.05f);
-}
-
-// Draws `text` at pixel (x, y) (top-left) in `colour`, `scale` pixels per font unit.
-void draw_text(std::vector<std::uint8_t>& rgba, glm::ivec2 size, int x, int y,
-               const std::string& text, glm::u8vec4 colour, int scale) {
-  // stb_easy_font writes 4 vertices (x, y, z, colour: 16 bytes) per quad.
-  std::vector<char> buffer(text.size() * 64 * 16 + 1024);
-  std::string copy = text;
-  const int quads =
-      stb_easy_font_print(0, 0, copy.data(), nullptr, buffer.data(), int(buffer.size()));
-  for (int q = 0; q < quads; ++q) {
-    float v[16];  // the quad's 4 vertices: x, y, z and a packed colour each
-    std::memcpy(v, buffer.data() + std::size_t(q) * sizeof v, sizeof v);
-    const float k = float(scale);
-    const int x0 = x + int(std::lround(v[0] * k)), y0 = y + int(std::lround(v[1] * k));
-    const int x1 = x + int(std::lround(v[8] * k)), y1 = y + int(std::lround(v[9] * k));
-    for (int py = std::max(y0, 0); py < std::min(y1, size.y); ++py)
-      for (int px = std::max(x0, 0); px < std::min(x1, size.x); ++px)
-        std::copy_n(&colour[0], 4, &rgba[(std::size_t(py) * size.x + px) * 4]);
-  }
-}
-
-void fill_rect(std::vector<std::uint8_t>& rgba, glm::ivec2 size, glm::ivec4 rect,
-               glm::u8vec4 colour) {
-  for (int py = std::max(rect.y, 0); py < std::min(rect.y + rect.w, size.y); ++py)
-    for (int px = std::max(rect.x, 0); px < std::min(rect.x + rect.z, size.x); ++px)
-      std::copy_n(&colour[0], 4, &rgba[(std::size_t(py) * size.x + px) * 4]);
 }
 
 // The smallest value below which `fraction` of the total weight lies; sorts `values`. 0 when
@@ -423,7 +385,7 @@ std::vector<std::uint8_t> render_preview(const DisplayPreview& preview, PreviewS
       if (near_line(elevation, 1.0) ||
           (std::cos(elevation) > 0.2 && near_line(azimuth, std::cos(elevation))))
         colour = 0.6f * colour + glm::vec3(0.4f);
-      const glm::u8vec4 encoded = srgb8(colour);
+      const glm::u8vec4 encoded = raster::srgb8(colour);
       std::copy_n(&encoded[0], 4, &rgba[i * 4]);
     }
 
@@ -470,9 +432,9 @@ std::vector<std::uint8_t> render_preview(const DisplayPreview& preview, PreviewS
   entries.emplace_back(glm::vec3(0.6f), "grid every 30 degrees");
   int y = 4 * scale;
   for (const auto& [colour, label] : entries) {
-    fill_rect(rgba, size, {4 * scale, y, swatch, swatch}, srgb8(colour));
-    draw_text(rgba, size, 4 * scale + swatch + 4 * scale, y + scale, label, {255, 255, 255, 255},
-              scale);
+    raster::fill_rect(rgba, size, {4 * scale, y, swatch, swatch}, raster::srgb8(colour));
+    raster::draw_text(rgba, size, 4 * scale + swatch + 4 * scale, y + scale, label,
+                      {255, 255, 255, 255}, scale);
     y += row;
   }
   return rgba;

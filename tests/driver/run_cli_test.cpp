@@ -442,5 +442,28 @@ TEST(PreviewCli, Dome4IsCoveredAndBadFlagsWriteNothing) {
   fs::remove_all(folder);
 }
 
+// --pattern shows a test pattern instead of the scene; an unknown one is exit 2 naming the flag,
+// with nothing written.
+TEST(RunCli, APatternReplacesTheScene) {
+  const fs::path folder = fresh_folder("pattern");
+  const fs::path out = folder / "out";
+  ASSERT_EQ(run("run builtin:wall2x2 --size 96x64 --headless --frames 1 --pattern projector-ids "
+                "--out " +
+                    out.string(),
+                folder / "log"),
+            0)
+      << slurp(folder / "log");
+  const Png png = read_png(out / "wall_r1c1" / "00000.png");
+  ASSERT_EQ(png.width, 96);
+  EXPECT_EQ(lit_fraction(png), 1.0);
+  EXPECT_EQ(run("run builtin:wall2x2 --size 96x64 --headless --frames 1 --pattern stripes --out " +
+                    (folder / "bad").string(),
+                folder / "log"),
+            2);
+  EXPECT_NE(slurp(folder / "log").find("'--pattern'"), std::string::npos) << slurp(folder / "log");
+  EXPECT_FALSE(fs::exists(folder / "bad"));
+  fs::remove_all(folder);
+}
+
 }  // namespace
 }  // namespace facet

@@ -5,10 +5,12 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <glm/gtc/matrix_transform.hpp>
 #include <nlohmann/json.hpp>
+#include <numbers>
 
 #include "facet/driver/reference.hpp"
 #include "facet/driver/session_runner.hpp"
@@ -399,6 +401,58 @@ TEST(HeadlessRun, WritesFramesPerOutputAndStatistics) {
   // Nothing of the runs is left beside them.
   for (const fs::directory_entry& entry : fs::directory_iterator(folder))
     EXPECT_NE(entry.path().filename().string().front(), '.') << entry.path();
+}
+
+// The byte of sRGB-encoded linear value c in [0, 1].
+int srgb_byte(double c) {
+  const double e = c <= 0.0031308 ? 12.92 * c : 1.055 * std::pow(c, 1 / 2.4) - 0.055;
+  return int(std::lround(e * 255));
+}
+
+// Test patterns replace the scene: latlong's lines land where the exact warp puts their
+// directions (a 30° crossing white, the front meridian red, the middle of a 10° cell black);
+// white goes through the blend, so each pixel shows its blend weight; T steps back to the scene.
+TEST(SessionPatterns, LatlongFollowsTheWarpAndWhiteShowsTheBlend) {
+  test::shared_context();
+  SessionDisplay dome = load_session_display("builtin:dome180", glm::ivec2(256, 256));
+  const Warp warp = dome.outputs[0].spec.warp;
+  Session session(std::move(dome), wall_scene());
+  session.set_pattern(TestPattern::latlong);
+  session.render(FrameState{});
+  const std::vector<std::uint8_t> rgba = session.targets()[0].read_colour_rgba8();
+  auto pixel_at = [&](double elevation_deg, double azimuth_deg) {
+    const double e = elevation_deg * std::numbers::pi / 180,
+                 a = azimuth_deg * std::numbers::pi / 180;
+    const glm::dvec3 v{std::cos(e) * std::sin(a), std::sin(e), -std::cos(e) * std::cos(a)};
+    const auto projected = warp.project(v);
+    EXPECT_TRUE(projected && projected->covered) << elevation_deg << ", " << azimuth_deg;
+    const glm::ivec2 q = glm::ivec2(glm::floor(projected->q));
+    const std::uint8_t* p = &rgba[(std::size_t(q.y) * 256 + std::size_t(q.x)) * 4];
+    return glm::ivec3(p[0], p[1], p[2]);
+  };
+  EXPECT_EQ(pixel_at(30, 60), glm::ivec3(255, 255, 255));
+  EXPECT_EQ(pixel_at(45, 0), glm::ivec3(255, 0, 0));
+  EXPECT_EQ(pixel_at(35, 25), glm::ivec3(0, 0, 0));
+  EXPECT_EQ(pixel_at(55, -115), glm::ivec3(0, 0, 0));
+
+  SessionDisplay wall = load_session_display("builtin:wall2x2", glm::ivec2(96, 64));
+  const BlendMaps blend = wall.outputs[0].blend;
+  ASSERT_FALSE(blend.alpha.empty());
+  Session walls(std::move(wall), wall_scene());
+  walls.set_pattern(TestPattern::white);
+  walls.render(FrameState{});
+  const std::vector<std::uint8_t> white = walls.targets()[0].read_colour_rgba8();
+  int below_one = 0;
+  for (int y = 0; y < 64; y += 3)
+    for (int x = 0; x < 96; x += 3) {
+      const double alpha = blend.alpha[std::size_t(y) * 96 + std::size_t(x)];
+      below_one += alpha < 0.99;
+      EXPECT_NEAR(white[(std::size_t(y) * 96 + std::size_t(x)) * 4], srgb_byte(alpha), 1)
+          << x << ", " << y << ": alpha " << alpha;
+    }
+  EXPECT_GT(below_one, 10);
+  walls.set_pattern(std::nullopt);
+  EXPECT_FALSE(walls.pattern());
 }
 
 }  // namespace

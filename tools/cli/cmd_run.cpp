@@ -19,6 +19,7 @@
 #include "facet/projection/errors.hpp"
 #include "facet/projection/interrupt.hpp"
 #include "facet/projection/progress.hpp"
+#include "facet/projection/test_pattern.hpp"
 #include "frames_flag.hpp"
 #include "view_flags.hpp"
 
@@ -38,6 +39,7 @@ struct RunOptions {
   std::optional<std::int64_t> frames;  // signed, so that a negative count is refused, not wrapped
   std::string out = "out/session";
   std::int64_t save_every = 1;  // signed, as frames
+  std::string pattern;          // a test pattern instead of the scene; empty: the scene
   bool span = false, overlay = false, no_path = false;
   std::string report;
   bool monitors = false;
@@ -95,6 +97,9 @@ void run(const RunOptions& options) {
     throw InputError("command line", "--headless", "either --headless or --windowed, not both");
   std::optional<std::uint64_t> frames;
   if (options.frames) frames = checked_frames(*options.frames);
+  std::optional<TestPattern> pattern;
+  if (!options.pattern.empty())
+    pattern = test_pattern_from_string(options.pattern, "command line", "--pattern");
   if (options.save_every < 1 || options.save_every > std::int64_t(driver::kMaxFrames))
     throw InputError("command line", "--save-every",
                      "a frame interval from 1 to " + std::to_string(driver::kMaxFrames));
@@ -178,6 +183,7 @@ void run(const RunOptions& options) {
     window_options.span = options.span;
     window_options.overlay = options.overlay;
     window_options.play_path = !options.no_path;
+    window_options.pattern = pattern;
     if (!options.report.empty()) window_options.report = options.report;
     window_options.sync = sync.get();
     driver::run_windowed_session(display, scene, path, window_options);
@@ -187,6 +193,7 @@ void run(const RunOptions& options) {
     std::cerr << "facet run: no display server (DISPLAY is not set): running headless\n";
   auto context = driver::create_headless_context();
   driver::Session session(display, std::move(scene));
+  session.set_pattern(pattern);
   driver::HeadlessRunOptions headless_options;
   headless_options.frames = frames.value_or(10);
   headless_options.out_dir = options.out;
@@ -241,6 +248,10 @@ const Registration registration{
                           "closed)");
       command->add_option("--out", options->out,
                           "Headless: folder for <output>/<frame>.png and stats.jsonl");
+      command->add_option("--pattern", options->pattern,
+                          "Show a test pattern instead of the scene: grid, latlong, "
+                          "projector-ids, white, black or checker (windowed: T steps through "
+                          "them)");
       command->add_option("--save-every", options->save_every,
                           "Headless: write the images of every N-th frame and of the last "
                           "(default 1: every frame); stats.jsonl always has every frame");

@@ -21,6 +21,7 @@
 #include "facet/driver/gpu_timer.hpp"
 #include "facet/driver/render_method.hpp"
 #include "facet/driver/scene.hpp"
+#include "facet/projection/test_pattern.hpp"
 #include "facet/projection_io/display_config.hpp"
 
 namespace facet::driver {
@@ -117,6 +118,12 @@ class Session {
   // object the scene does not have, or of one object twice; nothing is rendered then.
   FrameStats render(const FrameState& state, bool finish = false);
 
+  // Shows `pattern` on every output instead of the scene from the next render on (nullopt: the
+  // scene again). The images are drawn once here (latlong inverts every output's warp); blended
+  // patterns then go through each output's blend and black-level pass as the scene does.
+  void set_pattern(std::optional<TestPattern> pattern);
+  std::optional<TestPattern> pattern() const { return pattern_; }
+
   const SessionDisplay& display() const { return display_; }
   // The scene with the objects where the last render placed them.
   const Scene& scene() const { return scene_; }
@@ -154,6 +161,8 @@ class Session {
   std::vector<CoverageCone> cones_;
   GpuTimer timer_;
   std::vector<PassTime> last_pass_ms_;
+  std::optional<TestPattern> pattern_;
+  std::vector<std::vector<std::uint8_t>> pattern_rows_up_;  // per output, sRGB RGBA8, GL row order
 };
 
 }  // namespace facet::driver

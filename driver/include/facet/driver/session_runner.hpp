@@ -79,12 +79,15 @@ struct WindowRunOptions {
   std::optional<std::filesystem::path> report;
   // A cluster node's frame states and swap barrier (cluster.hpp); null: the session's own.
   FrameSync* sync = nullptr;
+  // Start on this test pattern instead of the scene (T cycles: the scene, then every pattern).
+  std::optional<TestPattern> pattern;
 };
 
 // Opens the windows (one per output on its monitor, or one spanning window), renders until the
 // windows close or `frames` have been shown. Keys: W/S forward and back, A/D sideways, Q/E down
 // and up, arrows or dragging with the left mouse button turn, P toggles the camera path,
-// O toggles the overlay (fps, replication, ms per pass), Escape quits. Monitors that disappear
+// O toggles the overlay (fps, replication, ms per pass), T steps from the scene through the test
+// patterns (all_test_patterns) and back, Escape quits. Monitors that disappear
 // during the session are reported on stderr and their windows kept. After watch_interrupts(),
 // SIGINT or SIGTERM closes the windows and throws Interrupted, writing no report. Needs a display
 // server: GlContextError without one. InputError when a monitor the display needs is missing and
