@@ -390,6 +390,27 @@ struct Renderer::Impl {
 };
 
 namespace {
+
+// The application's framebuffer bindings and viewport, put back when facet is done.
+class KeepFramebuffers {
+ public:
+  KeepFramebuffers() {
+    glGetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &draw_);
+    glGetIntegerv(GL_READ_FRAMEBUFFER_BINDING, &read_);
+    glGetIntegerv(GL_VIEWPORT, viewport_);
+  }
+  KeepFramebuffers(const KeepFramebuffers&) = delete;
+  KeepFramebuffers& operator=(const KeepFramebuffers&) = delete;
+  ~KeepFramebuffers() {
+    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, GLuint(draw_));
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, GLuint(read_));
+    glViewport(viewport_[0], viewport_[1], viewport_[2], viewport_[3]);
+  }
+
+ private:
+  GLint draw_ = 0, read_ = 0, viewport_[4] = {0, 0, 0, 0};
+};
+
 void require_context() {
   if (epoxy_gl_version() == 0)
     throw ContextError("facet::Renderer: no GL context is current on this thread");
@@ -437,6 +458,7 @@ void Renderer::reset_object_transform(ObjectId object) {
 }
 
 FrameReport Renderer::render(bool finish) {
+  const KeepFramebuffers keep;
   FrameReport report;
   report.frame = impl_->state.frame;
   if (!impl_->session) {
@@ -474,6 +496,7 @@ void Renderer::warp_perspective(std::size_t output, unsigned int texture) {
   glGetTextureLevelParameteriv(texture, 0, GL_TEXTURE_INTERNAL_FORMAT, &format);
   if (width < 1 || height < 1 || (format != GL_RGBA8 && format != GL_SRGB8_ALPHA8))
     throw InputError("API", source, "an RGBA8 or SRGB8_ALPHA8 2D texture with pixels");
+  const KeepFramebuffers keep;
   if (!impl_->content_pass) {
     std::vector<driver::OutputSpec> specs;
     for (const driver::SessionOutput& out : impl_->display->outputs) {
@@ -512,7 +535,6 @@ void Renderer::warp_perspective(std::size_t output, unsigned int texture) {
   target.clear();
   target.bind();
   impl_->content_pass->draw(output, it->second, projection);
-  glBindFramebuffer(GL_FRAMEBUFFER, 0);
   impl_->blends[output].apply(target.colour());
 }
 

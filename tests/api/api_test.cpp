@@ -285,6 +285,55 @@ TEST(Api, WarpPerspectiveKeepsTheApplicationsImageUpright) {
   EXPECT_THROW(with_scene.warp_perspective(0, 1), InputError);
 }
 
+// The application's framebuffer stays bound through render(); present() then draws the
+// output's bytes into it exactly (rows bottom-up, as GL stores them), and output_texture names
+// the texture holding them.
+TEST(Api, PresentsIntoTheApplicationsFramebuffer) {
+  context();
+  const Cube c = cube(1.0f);
+  SceneBuilder builder;
+  const int mesh = builder.add_mesh({c.positions, c.normals, c.uvs, c.indices},
+                                    builder.add_material({.base_colour = {0.9f, 0.5f, 0.1f, 1}}));
+  builder.add_object(mesh, glm::translate(glm::dmat4(1.0), glm::dvec3(0.5, 3, -1)));
+  Renderer renderer(Display::open("builtin:dome180", glm::ivec2(64, 64)),
+                    std::move(builder).build());
+  GLuint app_texture = 0, app_framebuffer = 0;
+  glCreateTextures(GL_TEXTURE_2D, 1, &app_texture);
+  glTextureStorage2D(app_texture, 1, GL_RGBA8, 80, 70);
+  glCreateFramebuffers(1, &app_framebuffer);
+  glNamedFramebufferTexture(app_framebuffer, GL_COLOR_ATTACHMENT0, app_texture, 0);
+  glBindFramebuffer(GL_FRAMEBUFFER, app_framebuffer);
+  glViewport(1, 2, 3, 4);
+  renderer.render(true);
+  GLint bound = 0, viewport[4] = {0, 0, 0, 0};
+  glGetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &bound);
+  glGetIntegerv(GL_VIEWPORT, viewport);
+  EXPECT_EQ(GLuint(bound), app_framebuffer);
+  EXPECT_EQ(viewport[2], 3);
+  renderer.present(0, {10, 5, 64, 64});
+  std::vector<std::uint8_t> shown(64 * 64 * 4);
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  glReadPixels(10, 5, 64, 64, GL_RGBA, GL_UNSIGNED_BYTE, shown.data());
+  const std::vector<std::uint8_t> expected = renderer.read_output_rgba8(0);
+  std::size_t mismatched = 0, lit = 0;
+  for (int y = 0; y < 64; ++y)
+    for (int x = 0; x < 64; ++x)
+      for (int k = 0; k < 3; ++k) {
+        const std::uint8_t e =
+            expected[(std::size_t(63 - y) * 64 + std::size_t(x)) * 4 + std::size_t(k)];
+        mismatched += shown[(std::size_t(y) * 64 + std::size_t(x)) * 4 + std::size_t(k)] != e;
+        lit += e > 0;
+      }
+  EXPECT_GT(lit, 100u);
+  EXPECT_EQ(mismatched, 0u);
+  GLint width = 0;
+  glGetTextureLevelParameteriv(renderer.output_texture(0), 0, GL_TEXTURE_WIDTH, &width);
+  EXPECT_EQ(width, 64);
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  glDeleteFramebuffers(1, &app_framebuffer);
+  glDeleteTextures(1, &app_texture);
+}
+
 TEST(Api, BorrowsTheCurrentContext) {
   context();
   const Context borrowed = Context::borrow_current();

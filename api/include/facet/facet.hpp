@@ -25,7 +25,10 @@
 //
 // Threads and GL. Every call that touches GL (Renderer's, Context's) needs the context it was
 // made with current on the calling thread. facet makes no context current behind the caller's
-// back, except that Context::headless() makes its new context current.
+// back, except that Context::headless() and Context::window() make their new context current.
+// Renderer calls leave the framebuffer bindings and the viewport as they found them; other GL
+// state (program, vertex array, textures, depth, blending, culling) is left as facet's passes
+// set it, so an application that draws in the same context sets what it relies on.
 //
 // Errors. Bad input (a file, a field, an index, a size) throws facet::InputError, whose message
 // names the file or argument, the field and what was expected; no GL context throws
