@@ -13,6 +13,7 @@
 #include <limits>
 #include <string_view>
 
+#include "facet/driver/cluster.hpp"
 #include "facet/driver/gl_context.hpp"
 #include "facet/driver/monitors.hpp"
 #include "facet/driver/output_images.hpp"
@@ -235,14 +236,23 @@ HeadlessPlayResult run_headless_play(ContentPlayer& player, const HeadlessRunOpt
                                       (replacing ? " (what was there is kept)" : ""));
     };
     if (options.progress) options.progress({"frames", 0, options.frames});
-    for (std::uint64_t frame = 0; frame < options.frames; ++frame) {
-      stop_if_interrupted(frame);
+    for (std::uint64_t done = 0; done < options.frames; ++done) {
+      stop_if_interrupted(done);
       FrameState state;
-      state.frame = frame;
-      state.time_s = double(frame) * kFramePeriod_s;
-      PlayFrameStats stats = player.render(state, options.finish_each_frame);
-      stats_file << play_frame_stats_to_json(stats).dump() << '\n';
-      for (std::size_t i = 0; i < player.targets().size(); ++i) {
+      state.frame = done;
+      state.time_s = double(done) * kFramePeriod_s;
+      // In a cluster the master's frame state decides which video frame every node shows.
+      if (options.sync) {
+        std::optional<FrameState> next = options.sync->next_frame(state);
+        if (!next) break;
+        state = std::move(*next);
+      }
+      const std::uint64_t frame = state.frame;
+      PlayFrameStats stats = player.render(state, options.finish_each_frame || options.sync);
+      nlohmann::json line = play_frame_stats_to_json(stats);
+      const bool shown = !options.sync || options.sync->ready_to_swap(state, line);
+      stats_file << line.dump() << '\n' << std::flush;
+      for (std::size_t i = 0; shown && i < player.targets().size(); ++i) {
         const OutputTarget& target = player.targets()[i];
         const fs::path image =
             fs::path(player.display().outputs[i].spec.name) / frame_file_name(frame);
@@ -250,7 +260,7 @@ HeadlessPlayResult run_headless_play(ContentPlayer& player, const HeadlessRunOpt
         result.images.push_back(out_dir / image);
       }
       result.frames.push_back(std::move(stats));
-      if (options.progress) options.progress({"frames", frame + 1, options.frames});
+      if (options.progress) options.progress({"frames", done + 1, options.frames});
     }
     stats_file.close();
     if (!stats_file)
@@ -397,17 +407,25 @@ void run_windowed_play(const SessionDisplay& display, std::unique_ptr<ContentMed
     FrameState state;
     state.frame = frame;
     state.time_s = show_s;
-    const PlayFrameStats stats = player.render(state);
+    if (window_options.sync) {
+      std::optional<FrameState> next = window_options.sync->next_frame(state);
+      if (!next) break;
+      state = std::move(*next);
+    }
+    const PlayFrameStats stats = player.render(state, window_options.sync != nullptr);
+    nlohmann::json line = play_frame_stats_to_json(stats);
+    const bool show = !window_options.sync || window_options.sync->ready_to_swap(state, line);
     if (frame == 0)
       std::printf(
           "facet play: first frame after %.0f ms\n",
           std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - entered)
               .count());
     dropped_total = stats.dropped_total;
-    if (stats_file.is_open()) stats_file << play_frame_stats_to_json(stats).dump() << '\n';
+    if (stats_file.is_open()) stats_file << line.dump() << '\n';
     GLsync rendered = glFenceSync(GL_SYNC_GPU_COMMANDS_COMPLETE, 0);
     glFlush();
     for (PlayWindow& window : windows) {
+      if (!show) break;  // a frame the cluster's barrier did not let swap
       window.context->make_current();
       glWaitSync(rendered, 0, GL_TIMEOUT_IGNORED);
       glBindFramebuffer(GL_FRAMEBUFFER, 0);

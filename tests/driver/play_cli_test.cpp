@@ -3,10 +3,14 @@
 // dropped frames, and bad input exits 2 with a message naming what is wrong.
 #include <OpenImageIO/imageio.h>
 #include <gtest/gtest.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
+#include <chrono>
+#include <csignal>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
@@ -215,6 +219,88 @@ TEST_F(PlayCli, BlendsLikeASession) {
   const std::vector<nlohmann::json> lines = stats(out);
   ASSERT_EQ(lines.size(), 1u);
   EXPECT_GT(lines[0]["blend_tiles"][0].get<int>(), 0);
+}
+
+// A cluster of dome4 over ipc:// sockets (node a: p0 and p1, the master; b: p2 and p3): every
+// node shows the video frame the master's show clock says, and its images are the one-process
+// run's, byte for byte.
+TEST_F(PlayCli, ClusterNodesShowTheSameVideoFrame) {
+  const fs::path video = write_video("count.avi", 40, 30);
+  const fs::path source = fs::path(FACET_SOURCE_DIR) / "configs/displays/dome4";
+  const fs::path folder = dir_ / "dome4";
+  fs::create_directories(folder);
+  for (const auto& entry : fs::directory_iterator(source))
+    if (entry.path().extension() == ".exr")
+      fs::copy_file(entry.path(), folder / entry.path().filename());
+  nlohmann::json display = nlohmann::json::parse(test::slurp(source / "display.json"));
+  auto address = [&](const char* node) { return "ipc://" + (dir_ / node).string() + ".sock"; };
+  display["cluster"] = {
+      {"nodes",
+       {{{"name", "a"}, {"address", address("a")}, {"projectors", {"p0", "p1"}}},
+        {{"name", "b"}, {"address", address("b")}, {"projectors", {"p2", "p3"}}}}},
+      {"master", "a"},
+      {"deadline_ms", 5000}};
+  std::ofstream(folder / "display.json") << display.dump(2);
+  const std::string common = "play " + video.string() + " --display " +
+                             (folder / "display.json").string() + " --headless --scale 0.125";
+  ASSERT_EQ(
+      test::run_facet(common + " --frames 12 --out " + (dir_ / "one").string(), dir_ / "one.log"),
+      0)
+      << test::slurp(dir_ / "one.log");
+  auto node_arguments = [&](const std::string& node, std::vector<std::string> extra) {
+    std::vector<std::string> arguments = {"play",
+                                          video.string(),
+                                          "--display",
+                                          (folder / "display.json").string(),
+                                          "--headless",
+                                          "--scale",
+                                          "0.125",
+                                          "--node",
+                                          node,
+                                          "--out",
+                                          (dir_ / node).string()};
+    arguments.insert(arguments.end(), extra.begin(), extra.end());
+    return arguments;
+  };
+  const std::vector<std::string> b_arguments = node_arguments("b", {});
+  const std::vector<std::string> a_arguments = node_arguments("a", {"--frames", "12"});
+  const pid_t b = test::start_facet(b_arguments, dir_ / "b.log");
+  const pid_t a = test::start_facet(a_arguments, dir_ / "a.log");
+  auto finish = [](pid_t pid) {
+    int status = 0;
+    if (!test::wait_until([&] { return ::waitpid(pid, &status, WNOHANG) == pid; },
+                          std::chrono::seconds(120))) {
+      ::kill(pid, SIGKILL);
+      ::waitpid(pid, &status, 0);
+      return -2;
+    }
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  };
+  EXPECT_EQ(finish(a), 0) << test::slurp(dir_ / "a.log");
+  EXPECT_EQ(finish(b), 0) << test::slurp(dir_ / "b.log");
+
+  const std::vector<nlohmann::json> one = stats(dir_ / "one");
+  ASSERT_EQ(one.size(), 12u);
+  for (const char* node : {"a", "b"}) {
+    const std::vector<nlohmann::json> lines = stats(dir_ / node);
+    ASSERT_EQ(lines.size(), 12u) << node;
+    for (std::size_t n = 0; n < lines.size(); ++n) {
+      EXPECT_EQ(lines[n]["source_frame"], one[n]["source_frame"]) << node << " frame " << n;
+      EXPECT_EQ(lines[n]["cluster"]["swapped"], true) << node << " frame " << n;
+    }
+  }
+  const std::map<std::string, std::string> node_of = {
+      {"p0", "a"}, {"p1", "a"}, {"p2", "b"}, {"p3", "b"}};
+  for (const auto& [projector, node] : node_of) {
+    for (int n = 0; n < 12; ++n) {
+      char name[16];
+      std::snprintf(name, sizeof name, "%05d.png", n);
+      const std::string expected = test::slurp(dir_ / "one" / projector / name);
+      ASSERT_FALSE(expected.empty()) << projector << "/" << name;
+      EXPECT_TRUE(test::slurp(dir_ / node / projector / name) == expected)
+          << projector << "/" << name << " differs";
+    }
+  }
 }
 
 // Windows on an X server (Xorg's dummy driver): the same video in a window for 12 frames on the

@@ -1,13 +1,17 @@
 // facet play: a dome master, panorama or cube map (still or video) on a display, through its
 // exact warp and blend; windows per projector, or headless frames to files.
+#include <chrono>
 #include <cstdlib>
+#include <filesystem>
 #include <iostream>
 #include <memory>
 #include <optional>
+#include <sstream>
 #include <string>
 
 #include "command.hpp"
 #include "display_flags.hpp"
+#include "facet/driver/cluster.hpp"
 #include "facet/driver/content_media.hpp"
 #include "facet/driver/content_player.hpp"
 #include "facet/driver/gl_context.hpp"
@@ -35,7 +39,26 @@ struct PlayOptions {
   std::int64_t start_frame = 0;
   std::string out = "out/play";
   std::string stats;  // windowed: the statistics file
+  std::string node;   // a cluster node of the display
+  double join_timeout_s = 60;
+  std::optional<double> rate_hz;
 };
+
+// What changes a node's pictures besides the display, for the cluster's content digest: the
+// content file by name and size (not its bytes: a show's video may be gigabytes) and the flags.
+std::string picture_settings(const PlayOptions& options) {
+  std::ostringstream text;
+  text.precision(17);
+  std::error_code error;
+  const auto bytes = std::filesystem::file_size(options.file, error);
+  text << "play=" << std::filesystem::path(options.file).filename().string()
+       << ";bytes=" << (error ? 0 : bytes) << ";format=" << options.format
+       << ";fov=" << options.fov.value_or(180) << ";tilt=" << options.orientation.tilt
+       << ";orientation=" << options.orientation.orientation << ";loop=" << options.loop
+       << ";start=" << options.start_frame << ";scale=" << options.scale.value_or(1.0)
+       << ";size=" << options.size;
+  return text.str();
+}
 
 bool have_display_server() {
   const char* x_display = std::getenv("DISPLAY");
@@ -59,6 +82,25 @@ void play(const PlayOptions& options) {
 
   driver::SessionDisplay display = driver::load_session_display(options.display, size);
   if (options.scale) driver::scale_session_display(display, *options.scale);
+  // A cluster node shows its own projectors only.
+  std::optional<driver::ClusterNodeShare> cluster_share;
+  if (!options.node.empty()) {
+    if (!options.display.ends_with(".json"))
+      throw InputError("command line", "--node", "a display.json with a cluster section");
+    cluster_share = driver::keep_cluster_node_outputs(display, options.display, options.node);
+    if (!cluster_share->master && options.frames)
+      throw InputError("command line", "--frames",
+                       "no --frames on a secondary node: the master's --frames ends the run on "
+                       "every node");
+    if (!cluster_share->master && options.rate_hz)
+      throw InputError("command line", "--rate", "no --rate on a secondary: the master paces");
+    if (!(options.join_timeout_s > 0 && options.join_timeout_s <= 86400))
+      throw InputError("command line", "--join-timeout", "seconds in (0, 86400]");
+  } else if (options.rate_hz) {
+    throw InputError("command line", "--rate", "--node: --rate paces a cluster's master");
+  }
+  if (options.rate_hz && !(*options.rate_hz > 0 && *options.rate_hz <= 10000))
+    throw InputError("command line", "--rate", "frames per second in (0, 10000]");
 
   auto media = driver::ContentMedia::open(options.file);
   const ContentFormat chosen = driver::check_content_format(media->size(), format, options.file);
@@ -93,6 +135,23 @@ void play(const PlayOptions& options) {
     throw InputError("command line", "--stats",
                      "windows: headless runs write stats.jsonl into --out");
   if (!options.stats.empty()) refuse_output_over_inputs(options.stats, "--stats", {options.file});
+  // A cluster node joins its cluster before any GL work.
+  std::unique_ptr<driver::FrameSync> sync;
+  if (cluster_share) {
+    driver::ClusterNodeOptions node_options;
+    node_options.cluster = *cluster_share->config.cluster;
+    node_options.source = options.display;
+    node_options.node = cluster_share->node;
+    node_options.frame_period_s = driver::kFramePeriod_s;
+    node_options.join_timeout =
+        std::chrono::milliseconds(std::int64_t(options.join_timeout_s * 1000));
+    node_options.rate_hz = options.rate_hz;
+    node_options.content_digest = driver::content_digest(
+        cluster_share->config, options.display, "play", std::nullopt, picture_settings(options));
+    sync = cluster_share->master ? driver::make_cluster_master(node_options)
+                                 : driver::make_cluster_secondary(node_options);
+  }
+
   watch_interrupts();
   if (!headless) {
     if (!have_display_server())
@@ -103,6 +162,7 @@ void play(const PlayOptions& options) {
     window_options.frames = frames;
     window_options.span = options.span;
     if (!options.stats.empty()) window_options.stats = options.stats;
+    window_options.sync = sync.get();
     driver::run_windowed_play(display, std::move(media), playback, window_options);
     return;
   }
@@ -113,8 +173,11 @@ void play(const PlayOptions& options) {
   driver::HeadlessRunOptions headless_options;
   headless_options.frames = frames.value_or(driver::frames_for_one_pass(player.clock()));
   headless_options.out_dir = options.out;
+  headless_options.sync = sync.get();
+  // A secondary plays until the master ends the run.
+  if (cluster_share && !cluster_share->master) headless_options.frames = driver::kMaxFrames;
   facet::TerminalProgress progress(stderr, "facet play");
-  headless_options.progress = progress.sink();
+  if (!cluster_share || cluster_share->master) headless_options.progress = progress.sink();
   const driver::HeadlessPlayResult result = driver::run_headless_play(player, headless_options);
   progress.finish();
   std::int64_t dropped = result.frames.empty() ? 0 : result.frames.back().dropped_total;
@@ -165,6 +228,16 @@ const Registration registration{
           ->capture_default_str();
       command->add_option("--stats", options->stats,
                           "Windowed: write per-frame statistics (stats.jsonl lines) to this file");
+      command->add_option("--node", options->node,
+                          "Play as this node of the display.json's cluster: its projectors only, "
+                          "frame-locked with the others (the master's show clock)");
+      command
+          ->add_option("--join-timeout", options->join_timeout_s,
+                       "Cluster: seconds the master waits for the nodes to join, and a node "
+                       "for the master's first word")
+          ->capture_default_str();
+      command->add_option("--rate", options->rate_hz,
+                          "Cluster master: at most this many frames per second");
       command->callback([options] { play(*options); });
     }};
 

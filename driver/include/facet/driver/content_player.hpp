@@ -102,6 +102,9 @@ struct HeadlessPlayResult {
 // out_dir/<output>/<frame, 5 digits>.png and out_dir/stats.jsonl (play_frame_stats_to_json per
 // frame), with run_headless_session's rules for out_dir (an earlier run there is replaced, any
 // other folder refused; written under a temporary name; SIGINT and SIGTERM stop it cleanly).
+// With options.sync the frame states are the cluster master's (so every node shows the same
+// video frame), `frames` only bounds the run, and a frame the barrier does not let swap is
+// listed in stats.jsonl but not written. save_every is not used: every frame is written.
 HeadlessPlayResult run_headless_play(ContentPlayer& player, const HeadlessRunOptions& options);
 
 // The frames one pass of the media takes at kFramePeriod_s: 1 for a still image, else enough
@@ -114,6 +117,8 @@ struct WindowPlayOptions {
   // play_frame_stats_to_json per frame shown, written under a temporary name and renamed when
   // the windows close (not when interrupted).
   std::optional<std::filesystem::path> stats;
+  // Frame-locked with a cluster: the master's frame states, its swap barrier.
+  FrameSync* sync = nullptr;
 };
 
 // A window per output on its monitor (or one spanning window), showing the content on the
