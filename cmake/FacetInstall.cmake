@@ -25,6 +25,10 @@ foreach(dir api/include driver/include interop/include projection/include projec
   install(DIRECTORY ${PROJECT_SOURCE_DIR}/${dir}/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
 endforeach()
 
+# The GLSL interface a material shader is written against (Display::set_material_shader).
+install(FILES ${PROJECT_SOURCE_DIR}/shaders/scene/material_interface.frag
+        DESTINATION ${CMAKE_INSTALL_DATADIR}/facet)
+
 set(FACET_CMAKE_DIR ${CMAKE_INSTALL_LIBDIR}/cmake/facet)
 install(EXPORT facetTargets NAMESPACE facet:: DESTINATION ${FACET_CMAKE_DIR})
 configure_package_config_file(${CMAKE_CURRENT_LIST_DIR}/facetConfig.cmake.in

@@ -14,6 +14,7 @@
 #include "facet/driver/content_pass.hpp"
 #include "facet/driver/gl_context.hpp"
 #include "facet/driver/gl_objects.hpp"
+#include "facet/driver/material_shader.hpp"
 #include "facet/driver/output_images.hpp"
 #include "facet/driver/scene.hpp"
 #include "facet/driver/scene_names.hpp"
@@ -124,6 +125,12 @@ void Display::set_tolerance_px(double tolerance_px) {
     throw InputError("API", "tolerance_px", "a positive number of output pixels");
   display_ = std::make_shared<driver::SessionDisplay>(*display_);
   display_->settings.facets.layout = FacetTolerance{tolerance_px};
+}
+
+void Display::set_material_shader(const std::string& name_or_file) {
+  driver::MaterialShader material = driver::load_material_shader(name_or_file);
+  display_ = std::make_shared<driver::SessionDisplay>(*display_);
+  display_->settings.material = std::move(material);
 }
 
 void Display::scale(double factor) {

@@ -178,6 +178,14 @@ TEST(Api, SceneFromArraysRendersTheSameIdsAsFromGltf) {
   EXPECT_EQ(differing, 0u);
   // And the colours: the same materials.
   EXPECT_EQ(from_arrays.read_output_rgba8(0), from_gltf.read_output_rgba8(0));
+  // Another material shader changes the colours, never the IDs.
+  Display wireframe = display;
+  wireframe.set_material_shader("solid-wireframe");
+  Renderer shaded(wireframe, built);
+  shaded.render(true);
+  EXPECT_EQ(shaded.read_output_ids(0), a);
+  EXPECT_NE(shaded.read_output_rgba8(0), from_arrays.read_output_rgba8(0));
+  EXPECT_THROW(wireframe.set_material_shader("chrome"), InputError);
   fs::remove_all(folder);
 }
 

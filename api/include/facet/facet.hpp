@@ -92,6 +92,16 @@ class Display {
   // facets methods: the largest error of the piecewise perspective pieces, in output pixels
   // (> 0; 0.25 by default).
   void set_tolerance_px(double tolerance_px);
+  // The fragment shading of every output (the CLI's --material): "lit" (the default),
+  // "solid-wireframe", "pen-and-ink", "procedural", or a GLSL file (".frag") defining
+  // `vec4 shade(MaterialInput m)` against facet's material interface (world position, normal,
+  // uv, barycentrics and edge distances in output pixels, eye distance, base colour and
+  // texture; shaders/scene/material_interface.frag, installed as
+  // share/facet/material_interface.frag). Triangle IDs and depth never depend on it, and the
+  // replication never sees it. InputError for an unknown name or a file that is missing, over
+  // 1 MiB, or uses discard or gl_FragDepth; a file that does not compile is an InputError from
+  // the Renderer's constructor, naming its line.
+  void set_material_shader(const std::string& name_or_file);
   // Every output's size and warp scaled by `factor` in (0, 1], for previews.
   void scale(double factor);
 
