@@ -319,6 +319,27 @@ TEST(Materials, WireframeStrokesKeepTheirWidthAcrossFacetSeams) {
   EXPECT_GT(c_hi, 0.0);  // the cube map drew the stroke (its width is reported, not asserted)
 }
 
+// The stroke's width depends on depth: 3 px at 8 m (capped), 1.5 px at 20 m, 1 px at 40 m (the
+// floor), the horizon of spheres of those radii through facets.
+TEST(Materials, WireframeWidthFallsWithDistance) {
+  test::shared_context();
+  const glm::ivec2 size(512, 384);
+  const auto outputs = load_display_outputs("builtin:cylinder360", size);
+  RenderSettings settings;
+  settings.facets.layout = FacetStrips{16};
+  settings.material = load_material_shader("solid-wireframe");
+  for (const auto& [radius, expected_px] :
+       {std::pair{8.0f, 3.0}, std::pair{20.0f, 1.5}, std::pair{40.0f, 1.0}}) {
+    const Rendered r =
+        render("facets", unlit_sphere(12, 6, radius), outputs, settings, glm::dmat4(1.0));
+    const auto [lo, hi] = range_of(horizon_stroke(r.colour[0], size).width_px);
+    std::printf("solid wireframe at %.0f m: %.3f to %.3f px (expected %.1f)\n", double(radius), lo,
+                hi, expected_px);
+    EXPECT_NEAR(lo, expected_px, 0.15) << radius << " m";
+    EXPECT_NEAR(hi, expected_px, 0.15) << radius << " m";
+  }
+}
+
 // facet render --material: a user's file that does not compile exits 2 naming the file and the
 // line; a built-in renders; --reference reports the same id_mismatch whatever the material;
 // facet run refuses the broken file too.
