@@ -54,6 +54,20 @@ void write_display_folder(const ImportedDisplay& display, const std::filesystem:
     entry.output = projector.output;
     config.projectors.push_back(entry);
   }
+  if (display.cluster) {
+    // The nodes name projectors as the importer did; the names written may differ.
+    config.cluster = *display.cluster;
+    for (projection_io::ClusterNode& node : config.cluster->nodes) {
+      for (std::string& name : node.projectors) {
+        for (std::size_t p = 0; p < display.projectors.size(); ++p) {
+          if (display.projectors[p].name == name) {
+            name = config.projectors[p].name;
+            break;
+          }
+        }
+      }
+    }
+  }
   projection_io::validate_display_config(config, folder.string() + "/display.json", false);
 
   write_folder_atomically(folder, [&](const fs::path& temporary) {

@@ -352,7 +352,13 @@ ImportedDisplay import_sgct_cluster(const std::filesystem::path& config,
   std::set<std::string> names;
   int desktop_x = 0;
   int node_index = 0;
+  // facet's own cluster: a node per SGCT node that drives a projector, at the node's address on
+  // ports 7400 + 2k and 7401 + 2k (SGCT's own ports belong to SGCT's protocol).
+  projection_io::DisplayCluster facet_cluster;
+  const std::string master_address = cluster.attribute("masterAddress").value();
   for (const pugi::xml_node& node : cluster.children("Node")) {
+    const int this_node = node_index;
+    const std::size_t projectors_before = display.projectors.size();
     const std::string node_path = "Node[" + std::to_string(node_index++) + "]";
     int node_right = desktop_x;
     int window_index = 0;
@@ -445,6 +451,42 @@ ImportedDisplay import_sgct_cluster(const std::filesystem::path& config,
       }
     }
     desktop_x = node_right;
+    if (display.projectors.size() > projectors_before) {
+      std::string address = node.attribute("address").value();
+      if (address.empty() || address == "localhost") address = "127.0.0.1";
+      projection_io::ClusterNode facet_node;
+      facet_node.name = "node" + std::to_string(this_node);
+      facet_node.address = "tcp://" + address + ":" + std::to_string(7400 + 2 * this_node);
+      for (std::size_t p = projectors_before; p < display.projectors.size(); ++p)
+        facet_node.projectors.push_back(display.projectors[p].name);
+      if (facet_cluster.master.empty() && node.attribute("address").value() == master_address)
+        facet_cluster.master = facet_node.name;
+      facet_cluster.nodes.push_back(std::move(facet_node));
+    }
+  }
+  if (facet_cluster.nodes.size() > 1) {
+    if (facet_cluster.master.empty()) {
+      facet_cluster.master = facet_cluster.nodes.front().name;
+      display.notes.push_back("the cluster's master (masterAddress \"" + master_address +
+                              "\") drives no projector: " + facet_cluster.master +
+                              " is facet's master");
+    }
+    // An address that is no node's own (a name SGCT resolves, a bad one) is left to the reader,
+    // which names it; here only what facet's cluster section can hold is kept.
+    bool addresses_ok = true;
+    for (const projection_io::ClusterNode& node : facet_cluster.nodes)
+      addresses_ok = addresses_ok && projection_io::cluster_address_problem(node.address).empty();
+    if (addresses_ok) {
+      display.notes.push_back("a cluster section maps the " +
+                              std::to_string(facet_cluster.nodes.size()) +
+                              " nodes with projectors to facet run --node node<k>, on ports "
+                              "7400 + 2k of their addresses");
+      display.cluster = std::move(facet_cluster);
+    } else {
+      display.notes.push_back(
+          "a node address is not a host name or IP address: no cluster "
+          "section written");
+    }
   }
   if (display.projectors.empty()) {
     throw InputError(source, "Node/Window/Viewport@mesh",

@@ -233,9 +233,15 @@ TEST(InteropCli, AnSgctDomeConfigurationAndBareSgcMeshesImport) {
               (scratch.path / "back").string(),
           scratch.path);
   ASSERT_EQ(r.status, 0) << r.output;
-  EXPECT_EQ(
-      projection_io::read_display_config(scratch.path / "back" / "display.json").projectors.size(),
-      4u);
+  const projection_io::DisplayConfig back =
+      projection_io::read_display_config(scratch.path / "back" / "display.json");
+  EXPECT_EQ(back.projectors.size(), 4u);
+  // One SGCT node per projector, all on 127.0.0.1: a cluster section facet run --node takes.
+  ASSERT_TRUE(back.cluster.has_value());
+  ASSERT_EQ(back.cluster->nodes.size(), 4u);
+  EXPECT_EQ(back.cluster->master, "node0");
+  EXPECT_EQ(back.cluster->nodes[3].address, "tcp://127.0.0.1:7406");
+  EXPECT_EQ(back.cluster->nodes[3].projectors, std::vector<std::string>{back.projectors[3].name});
 }
 
 // The first projector's warp of FOLDER/display.json.

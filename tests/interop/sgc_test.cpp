@@ -559,6 +559,18 @@ TEST(SgctCluster, TheRealDomeConfigurationImportsEveryChannelWithItsMask) {
   // The master's GUI viewport has no mesh.
   ASSERT_FALSE(display.notes.empty());
   EXPECT_NE(display.notes[0].find("no correction mesh"), std::string::npos) << display.notes[0];
+  // The six render nodes become facet's cluster; the SGCT master drives no projector, so the
+  // first node that does is facet's.
+  ASSERT_TRUE(display.cluster.has_value());
+  ASSERT_EQ(display.cluster->nodes.size(), 6u);
+  EXPECT_EQ(display.cluster->master, "node1");
+  for (int k = 0; k < 6; ++k) {
+    const projection_io::ClusterNode& node = display.cluster->nodes[std::size_t(k)];
+    EXPECT_EQ(node.name, "node" + std::to_string(k + 1));
+    EXPECT_EQ(node.address,
+              "tcp://172.19.1.1" + std::to_string(k + 1) + ":" + std::to_string(7402 + 2 * k));
+    EXPECT_EQ(node.projectors, std::vector<std::string>{"Channel_" + std::to_string(k + 1)});
+  }
 }
 
 TEST(SgctCluster, BadConfigurationsNameTheElement) {

@@ -30,6 +30,9 @@ struct ImportedDisplay {
   // What an importer wants the user to know (a guessed eye point, masked folds): one sentence
   // each, for the CLI to print.
   std::vector<std::string> notes;
+  // The render nodes the display came from (an SGCT cluster's), their projectors named as in
+  // `projectors`: written as display.json's cluster section.
+  std::optional<projection_io::DisplayCluster> cluster;
 };
 
 // Turns any text into a projector name display.json accepts ("" becomes "projector").
