@@ -344,6 +344,63 @@ nlohmann::json CalibrationReport::to_json() const {
           {"seconds", seconds}};
 }
 
+namespace {
+
+// InputError naming the display file unless its projectors are the capture's: the same names,
+// each with the size it was captured at.
+void check_display_matches_capture(const projection_io::DisplayConfig& display,
+                                   const Capture& capture) {
+  const std::string source = (display.folder / "display.json").string();
+  for (const CaptureProjector& projector : capture.projectors) {
+    const auto it = std::find_if(
+        display.projectors.begin(), display.projectors.end(),
+        [&](const projection_io::DisplayProjector& p) { return p.name == projector.name; });
+    if (it == display.projectors.end())
+      throw InputError(source, "projectors",
+                       "a projector named '" + projector.name + "', as in the capture");
+    if (it->size != projector.size)
+      throw InputError(source,
+                       "projectors[" + std::to_string(it - display.projectors.begin()) + "].size",
+                       std::to_string(projector.size.x) + "x" + std::to_string(projector.size.y) +
+                           ", the size '" + projector.name + "' was captured at");
+  }
+  if (display.projectors.size() != capture.projectors.size())
+    throw InputError(
+        source, "projectors",
+        "the capture's " + std::to_string(capture.projectors.size()) + " projectors and no others");
+}
+
+// The display facet calibrate writes (before its file names are set): `base` with its name
+// overridden by options.display_name, or a new one of windows side by side.
+projection_io::DisplayConfig written_display(
+    const Capture& capture, const std::optional<projection_io::DisplayConfig>& base,
+    const CalibrateOptions& options) {
+  projection_io::DisplayConfig display;
+  if (base) {
+    display = *base;
+    if (!display.screen) display.screen = capture.screen;
+  } else {
+    display.name = fs::absolute(capture.folder).filename().string();
+    display.screen = capture.screen;
+    int x = 0;
+    for (const CaptureProjector& projector : capture.projectors) {
+      projection_io::DisplayProjector item;
+      item.name = projector.name;
+      item.size = projector.size;
+      // Until the outputs are assigned, projectors sit side by side as windows on the desktop.
+      item.output.kind = projection_io::DisplayOutput::Kind::window;
+      item.output.window = {x, 0, projector.size.x, projector.size.y};
+      x += projector.size.x;
+      display.projectors.push_back(std::move(item));
+    }
+  }
+  if (!options.display_name.empty()) display.name = options.display_name;
+  if (display.name.empty()) display.name = "display";
+  return display;
+}
+
+}  // namespace
+
 CalibrationReport calibrate(const fs::path& capture_path, const fs::path& out,
                             const CalibrateOptions& options) {
   const auto started = std::chrono::steady_clock::now();
@@ -353,6 +410,11 @@ CalibrationReport calibrate(const fs::path& capture_path, const fs::path& out,
   // Polled between projectors and stages; the catch around the writing removes the temporary.
   const std::string stopped = "stopped before the end; nothing written to " + out.string();
   const CameraModel model = CameraModel::read(capture.resolve(capture.camera.model));
+  // The display to write back, checked against the capture before any heavy work.
+  std::optional<projection_io::DisplayConfig> base_display = options.display;
+  if (!base_display && capture.display)
+    base_display = projection_io::read_display_template(capture.resolve(*capture.display));
+  if (base_display) check_display_matches_capture(*base_display, capture);
 
   // Check every projector's frames and image headers before any heavy work.
   for (std::size_t p = 0; p < capture.projectors.size(); ++p) {
@@ -449,25 +511,12 @@ CalibrationReport calibrate(const fs::path& capture_path, const fs::path& out,
                          ")";
   }
 
-  projection_io::DisplayConfig display;
-  display.name = options.display_name.empty() ? fs::absolute(capture.folder).filename().string()
-                                              : options.display_name;
-  if (display.name.empty()) display.name = "display";
-  display.screen = capture.screen;
-  int x = 0;
-  for (std::size_t p = 0; p < warps.size(); ++p) {
-    const CaptureProjector& projector = capture.projectors[p];
-    projection_io::DisplayProjector item;
-    item.name = projector.name;
-    item.size = projector.size;
-    item.warp = projector.name + ".warp.exr";
-    item.blend = projector.name + ".blend.exr";
-    if (!blend.black.empty()) item.black = projector.name + ".black.exr";
-    // Until the outputs are assigned, projectors sit side by side as windows on the desktop.
-    item.output.kind = projection_io::DisplayOutput::Kind::window;
-    item.output.window = {x, 0, projector.size.x, projector.size.y};
-    x += projector.size.x;
-    display.projectors.push_back(std::move(item));
+  projection_io::DisplayConfig display = written_display(capture, base_display, options);
+  for (projection_io::DisplayProjector& item : display.projectors) {
+    item.warp = item.name + ".warp.exr";
+    item.blend = item.name + ".blend.exr";
+    item.black.reset();
+    if (!blend.black.empty()) item.black = item.name + ".black.exr";
   }
 
   try {

@@ -206,6 +206,7 @@ void validate_capture(const Capture& capture, const std::string& source) {
     }
   }
   if (capture.truth) check_relative_path(*capture.truth, root["truth"]);
+  if (capture.display) check_relative_path(*capture.display, root["display"]);
 }
 
 Capture read_capture(const std::filesystem::path& path) {
@@ -250,6 +251,9 @@ Capture read_capture(const std::filesystem::path& path) {
   if (const Json* truth = fields.optional("truth")) {
     capture.truth = to_string(*truth, at["truth"]);
   }
+  if (const Json* display = fields.optional("display")) {
+    capture.display = to_string(*display, at["display"]);
+  }
   fields.finish();
   validate_capture(capture, source);
   if (!std::filesystem::is_regular_file(capture.resolve(capture.camera.model), error)) {
@@ -293,6 +297,7 @@ nlohmann::json capture_to_json(const Capture& capture) {
   nlohmann::json root{{"format", kCaptureFormat}, {"camera", camera}, {"projectors", projectors}};
   if (capture.screen) root["screen"] = screen_to_json(*capture.screen);
   if (capture.truth) root["truth"] = capture.truth->generic_string();
+  if (capture.display) root["display"] = capture.display->generic_string();
   return root;
 }
 

@@ -367,6 +367,10 @@ LiveCaptureReport run_live_capture(PatternOutputs& outputs, LiveCamera& camera,
     report.complete = true;  // finished by an earlier run
   } else if (all_done) {
     if (setup.finish) capture.truth = setup.finish(out);
+    if (setup.display) {
+      projection_io::write_display_config(*setup.display, out / "display.json");
+      capture.display = "display.json";
+    }
     write_capture(capture, out / "capture.json");
     report.complete = true;
   }

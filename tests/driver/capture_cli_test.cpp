@@ -24,6 +24,8 @@
 #include "facet/calibration/capture.hpp"
 #include "facet/calibration/live_capture.hpp"
 #include "facet/calibration/simulate.hpp"
+#include "facet/projection/errors.hpp"
+#include "facet/projection_io/display_config.hpp"
 #include "facet/projection_io/rig_file.hpp"
 
 namespace facet::calibration {
@@ -57,6 +59,8 @@ struct RigFiles {
         {"format", "facet-display/1"},
         {"name", "capture-test"},
         {"eye", {0, 0, 0}},
+        {"render", {{"method", "naive"}, {"tolerance_px", 0.5}}},
+        {"missing_monitor", "window"},
         {"projectors",
          projectors}}.dump(1);
   }
@@ -195,6 +199,36 @@ TEST(CaptureCli, AResumedCaptureCalibratesLikeTheSimulatedOne) {
   ASSERT_EQ(run_cli(setup.command(live, "--stop-after 40")), 3);
   ASSERT_EQ(run_cli(setup.command(live)), 0);
   const CalibrationReport live_report = calibrate(live, setup.temp.path() / "live-display");
+  // The display the capture ran with comes back whole, its warps and blends filled in: name,
+  // eye, outputs, gammas, render settings and missing_monitor as in the file given to capture.
+  EXPECT_EQ(read_capture(live).display, fs::path("display.json"));
+  projection_io::DisplayConfig expected = projection_io::read_display_template(setup.display);
+  for (projection_io::DisplayProjector& projector : expected.projectors) {
+    projector.warp = projector.name + ".warp.exr";
+    projector.blend = projector.name + ".blend.exr";
+  }
+  projection_io::DisplayConfig written =
+      projection_io::read_display_config(setup.temp.path() / "live-display");
+  expected.folder = written.folder;
+  expected.screen = written.screen;  // the rig's screen, recorded by the capture
+  EXPECT_EQ(projection_io::format_display_config(written),
+            projection_io::format_display_config(expected));
+  EXPECT_EQ(written.name, "capture-test");
+  EXPECT_EQ(written.render.method, "naive");
+  // A display whose projectors are not the capture's is refused before any work, naming it.
+  CalibrateOptions renamed;
+  renamed.display = expected;
+  renamed.display->projectors[0].name = "elsewhere";
+  const fs::path refused = setup.temp.path() / "refused";
+  try {
+    calibrate(live, refused, renamed);
+    ADD_FAILURE() << "a display without the capture's projector was accepted";
+  } catch (const facet::InputError& error) {
+    EXPECT_EQ(error.field(), "projectors");
+    EXPECT_NE(std::string(error.what()).find(live_report.projectors[0].name), std::string::npos)
+        << error.what();
+  }
+  EXPECT_FALSE(fs::exists(refused));
   const fs::path simulated = setup.temp.path() / "simulated";
   simulate_capture(test::capture_test_rig(), simulated);
   const CalibrationReport simulated_report =

@@ -12,6 +12,7 @@
 #include "facet/projection/errors.hpp"
 #include "facet/projection/interrupt.hpp"
 #include "facet/projection/progress.hpp"
+#include "facet/projection_io/display_config.hpp"
 
 namespace {
 
@@ -24,6 +25,7 @@ struct CalibrateArgs {
   std::optional<double> black_level;
   double feather_deg = 20;
   std::string name;
+  std::string display;
 };
 
 glm::ivec2 parse_grid(const std::string& text) {
@@ -69,7 +71,12 @@ const facet::cli::Registration registration{
                       "of their white");
       cmd->add_option("--feather", args->feather_deg,
                       "blend feather: degrees from a projector's edge to its full weight");
-      cmd->add_option("--name", args->name, "display name (default: the capture folder's name)");
+      cmd->add_option("--display", args->display,
+                      "display.json (or its folder) to write back with its warps and blends filled "
+                      "in, keeping its name, outputs, gammas and render settings (default: the "
+                      "display the capture ran with, if it kept one)");
+      cmd->add_option("--name", args->name,
+                      "display name (default: the display's, else the capture folder's name)");
       cmd->callback([args] {
         facet::calibration::CalibrateOptions options;
         if (!args->grid.empty()) options.fit.grid = parse_grid(args->grid);
@@ -90,6 +97,8 @@ const facet::cli::Registration registration{
         }
         options.blend.feather_rad = args->feather_deg * M_PI / 180;
         options.display_name = args->name;
+        if (!args->display.empty())
+          options.display = facet::projection_io::read_display_template(args->display);
         // From here on SIGINT and SIGTERM stop the calibration cleanly (exit 128 + signal).
         facet::watch_interrupts();
         facet::TerminalProgress progress(stderr, "facet calibrate");

@@ -52,32 +52,6 @@ struct CaptureArgs {
   bool windowed = false, headless = false, json = false, quiet = false;
 };
 
-// display.json for capture: the warps do not exist yet, so `warp` may be left out (facet
-// calibrate writes <name>.warp.exr) and no referenced file is checked.
-projection_io::DisplayConfig read_capture_display(const std::string& path_text) {
-  fs::path path = path_text;
-  std::error_code error;
-  if (fs::is_directory(path, error)) path /= "display.json";
-  require_regular_file(path);
-  std::ifstream stream(path);
-  if (!stream) throw InputError(path.string(), "", "a readable display.json");
-  nlohmann::json root;
-  try {
-    root = nlohmann::json::parse(stream);
-  } catch (const nlohmann::json::parse_error& e) {
-    throw InputError(path.string(), "", std::string("valid JSON (") + e.what() + ")");
-  }
-  if (root.is_object() && root.contains("projectors") && root["projectors"].is_array()) {
-    for (auto& projector : root["projectors"]) {
-      if (projector.is_object() && !projector.contains("warp") && projector.contains("name") &&
-          projector["name"].is_string()) {
-        projector["warp"] = projector["name"].get<std::string>() + ".warp.exr";
-      }
-    }
-  }
-  return projection_io::parse_display_config(root.dump(), path.string(), path.parent_path(), false);
-}
-
 // The device node a --camera value names: /dev/videoN and indices as they are, usb: stable ids
 // through sysfs.
 std::string resolve_camera_device(const std::string& camera) {
@@ -130,7 +104,7 @@ class PresenterOutputs : public calibration::PatternOutputs {
 };
 
 int run_capture(const CaptureArgs& args) {
-  const projection_io::DisplayConfig display = read_capture_display(args.display);
+  const projection_io::DisplayConfig display = projection_io::read_display_template(args.display);
   const bool fake = args.camera.starts_with("fake:");
   if (args.windowed && args.headless) {
     throw InputError("--headless", "", "either --headless or --windowed, not both");
@@ -183,6 +157,7 @@ int run_capture(const CaptureArgs& args) {
     setup.projectors.push_back(std::move(projector));
   }
   setup.identity = {{"display", display.name}};
+  setup.display = display;
 
   std::vector<glm::ivec2> sizes;
   for (const auto& p : display.projectors) sizes.push_back(p.size);

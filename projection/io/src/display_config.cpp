@@ -491,6 +491,21 @@ DisplayConfig read_display_config(const std::filesystem::path& path, bool check_
                            check_files);
 }
 
+DisplayConfig read_display_template(const std::filesystem::path& path) {
+  std::error_code error;
+  const std::filesystem::path file =
+      std::filesystem::is_directory(path, error) ? path / "display.json" : path;
+  json_fields::Json root = json_fields::parse_file(file);
+  if (root.is_object() && root.contains("projectors") && root["projectors"].is_array()) {
+    for (auto& projector : root["projectors"]) {
+      if (projector.is_object() && !projector.contains("warp") && projector.contains("name") &&
+          projector["name"].is_string())
+        projector["warp"] = projector["name"].get<std::string>() + ".warp.exr";
+    }
+  }
+  return display_from_json(root, file.string(), file.parent_path(), false);
+}
+
 std::string format_display_config(const DisplayConfig& config) {
   return display_to_json(config).dump(2) + "\n";
 }

@@ -17,6 +17,7 @@
 #include "facet/calibration/fit.hpp"
 #include "facet/projection/progress.hpp"
 #include "facet/projection/warp.hpp"
+#include "facet/projection_io/display_config.hpp"
 
 namespace facet::calibration {
 
@@ -24,7 +25,12 @@ struct CalibrateOptions {
   DecodeOptions decode;
   FitOptions fit;
   BlendOptions blend;
-  std::string display_name;    // empty: the capture folder's name
+  // The display to write back, warps and blends filled in: its name, eye, screen, outputs,
+  // gammas, render settings and cluster are kept. Its projectors must be the capture's (names and
+  // sizes). nullopt: the display.json the capture ran with (capture.json's `display`), else a new
+  // display named after the capture folder, its projectors side by side as windows.
+  std::optional<projection_io::DisplayConfig> display;
+  std::string display_name;    // empty: the display's name, else the capture folder's
   double truth_border_px = 8;  // FORMATS.md §5
   // Steps as they finish: ("decoding", p, projectors), ("fitting warps", p, projectors), then
   // ("blending", 0 and 1, 1).

@@ -53,6 +53,9 @@ struct Capture {
   std::optional<Screen> screen;
   std::vector<CaptureProjector> projectors;
   std::optional<std::filesystem::path> truth;  // relative folder of the ground truth (§5)
+  // Relative path of the display.json the capture ran with (`facet capture --display` keeps a
+  // copy): facet calibrate writes that display back, its warps and blends filled in.
+  std::optional<std::filesystem::path> display;
 
   bool operator==(const Capture&) const = default;
 

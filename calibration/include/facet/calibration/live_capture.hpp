@@ -30,6 +30,7 @@
 
 #include "facet/calibration/camera_model.hpp"
 #include "facet/calibration/capture.hpp"
+#include "facet/projection_io/display_config.hpp"
 
 namespace facet::calibration {
 
@@ -76,6 +77,9 @@ struct LiveCaptureSetup {
   CaptureCamera camera;
   std::optional<CameraModel> model;  // the camera's lens model; required
   std::optional<Screen> screen;
+  // The display the capture runs with, kept as display.json in the capture folder (capture.json's
+  // `display`) so that facet calibrate writes it back with its warps and blends filled in.
+  std::optional<projection_io::DisplayConfig> display;
   // Added to the journal identity: what else the images depend on (the display, ...).
   nlohmann::json identity = nlohmann::json::object();
   // Called after the last frame and before capture.json is written, with the capture folder:

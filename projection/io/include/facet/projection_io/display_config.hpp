@@ -132,6 +132,11 @@ DisplayConfig parse_display_config(const std::string& text, const std::string& s
 // Reads display.json (`path` may also be its folder), checking that referenced files exist.
 DisplayConfig read_display_config(const std::filesystem::path& path, bool check_files = true);
 
+// Reads a display.json whose warps do not exist yet, as `facet capture` and `facet calibrate
+// --display` take it: a projector without `warp` gets "<name>.warp.exr", and no referenced file
+// is checked. `path` may also be its folder.
+DisplayConfig read_display_template(const std::filesystem::path& path);
+
 // Validates a value as the reader would (without touching files when check_files is false).
 void validate_display_config(const DisplayConfig& config, const std::string& source,
                              bool check_files);
