@@ -319,6 +319,76 @@ TEST(Materials, WireframeStrokesKeepTheirWidthAcrossFacetSeams) {
   EXPECT_GT(c_hi, 0.0);  // the cube map drew the stroke (its width is reported, not asserted)
 }
 
+// Direction of the hatching in a window of an image, degrees in [0, 180): the lines run across
+// the dominant gradient of the ink (structure tensor of central differences).
+double hatch_direction_deg(const std::vector<std::uint8_t>& rgba, glm::ivec2 size, int x0, int x1,
+                           int y0, int y1) {
+  auto value = [&](int x, int y) {
+    return double(rgba[4 * (std::size_t(y) * std::size_t(size.x) + std::size_t(x)) + 1]);
+  };
+  double jxx = 0, jyy = 0, jxy = 0;
+  for (int y = y0; y < y1; ++y)
+    for (int x = x0; x < x1; ++x) {
+      const double gx = value(x + 1, y) - value(x - 1, y), gy = value(x, y + 1) - value(x, y - 1);
+      jxx += gx * gx;
+      jyy += gy * gy;
+      jxy += gx * gy;
+    }
+  const double gradient = 0.5 * std::atan2(2 * jxy, jxx - jyy) * 180 / M_PI;
+  return std::fmod(gradient + 90 + 360, 180.0);
+}
+
+// Difference of two line directions, degrees in [0, 90].
+double direction_change_deg(double a, double b) {
+  const double d = std::fmod(std::abs(a - b), 180.0);
+  return std::min(d, 180 - d);
+}
+
+// Pen-and-ink on a grey sphere (one layer of diagonal hatching): facets lay the lines out in
+// output pixels on both sides of every seam; the cube map lays them out in each face's pixels,
+// so they take the faces' magnification (and turn where two faces do not mirror each other).
+// Direction in 24x24 windows either side of each cube seam at the horizon, cylinder 512x384;
+// asserted for facets (45 degrees on both sides, within 2), reported for the cube map.
+TEST(Materials, HatchingRunsOnAcrossSeams) {
+  test::shared_context();
+  Scene sphere = unlit_sphere(12, 6, 15.0f);
+  sphere.materials[0].base_colour = glm::vec4(0.1f, 0.1f, 0.1f, 1.0f);  // tone 0.68: one layer
+  const glm::ivec2 size(512, 384);
+  const auto outputs = load_display_outputs("builtin:cylinder360", size);
+  RenderSettings settings;
+  settings.facets.layout = FacetStrips{32};
+  settings.material = load_material_shader("pen-and-ink");
+  settings.cube_face_size = 384;
+  const Rendered facets = render("facets", sphere, outputs, settings, glm::dmat4(1.0));
+  const Rendered cube = render("cubemap", sphere, outputs, settings, glm::dmat4(1.0));
+  const int row = size.y / 2;
+  double worst[2] = {0, 0};
+  for (const glm::dvec3 v :
+       {glm::dvec3(1, 0, 1), glm::dvec3(1, 0, -1), glm::dvec3(-1, 0, 1), glm::dvec3(-1, 0, -1)}) {
+    const auto projected = outputs[0].warp.project(v);
+    ASSERT_TRUE(projected);
+    const int s = int(std::lround(projected->q.x));
+    if (s < 30 || s > size.x - 30) continue;
+    for (int k = 0; k < 2; ++k) {
+      const auto& image = (k == 0 ? facets : cube).colour[0];
+      const double left = hatch_direction_deg(image, size, s - 28, s - 4, row - 12, row + 12);
+      const double right = hatch_direction_deg(image, size, s + 4, s + 28, row - 12, row + 12);
+      worst[k] = std::max(worst[k], direction_change_deg(left, right));
+      // Facets: the material's 45 degrees in output pixels on both sides.
+      if (k == 0) {
+        EXPECT_LE(direction_change_deg(left, 45.0), 2.0) << s;
+      }
+      std::printf("%s, cube seam at column %d: hatching at %.1f and %.1f degrees\n",
+                  k == 0 ? "facets" : "cubemap", s, left, right);
+    }
+  }
+  std::printf(
+      "hatching turns across a cube seam by at most %.1f degrees with facets, %.1f with "
+      "the cube map\n",
+      worst[0], worst[1]);
+  EXPECT_LE(worst[0], 2.0);
+}
+
 // The stroke's width depends on depth: 3 px at 8 m (capped), 1.5 px at 20 m, 1 px at 40 m (the
 // floor), the horizon of spheres of those radii through facets.
 TEST(Materials, WireframeWidthFallsWithDistance) {
