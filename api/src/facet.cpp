@@ -491,10 +491,10 @@ void Renderer::warp_perspective(std::size_t output, unsigned int texture) {
   const std::string source = "warp_perspective(" + std::to_string(output) + ")";
   if (impl_->session)
     throw InputError("API", source, "a Renderer made without a scene (Renderer(display))");
-  driver::OutputTarget& target = impl_->targets.at(output < impl_->targets.size() ? output : 0);
   if (output >= impl_->targets.size())
     throw InputError("API", source,
                      "an output index below " + std::to_string(impl_->targets.size()));
+  driver::OutputTarget& target = impl_->targets[output];
   if (texture == 0 || !glIsTexture(texture))
     throw InputError("API", source, "the name of a 2D texture of the current context");
   GLint width = 0, height = 0, format = 0;
