@@ -245,7 +245,9 @@ TEST(ClusterCli, EightNodesLoseNoFrame) {
 TEST(ClusterCli, AKilledSecondaryIsReportedAndRejoinsWithTheSameFrames) {
   const Scratch scratch("rejoin");
   const fs::path display = write_display(scratch.path, "dome4", dome4_cluster(scratch.path));
-  constexpr int kFrames = 60;
+  // 10 s at the master's pace: time for the restarted node to start (its scene, its GL), even
+  // in a sanitizer build.
+  constexpr int kFrames = 100;
   // The master paces the run (10 frames a second), so that the restarted node finds it going.
   Node b = start_node(display, "b", scratch.path, "b");
   Node c = start_node(display, "c", scratch.path, "c");
