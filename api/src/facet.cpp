@@ -487,14 +487,10 @@ FrameReport Renderer::render(bool finish) {
   return report;
 }
 
-void Renderer::warp_perspective(std::size_t output, unsigned int texture) {
-  const std::string source = "warp_perspective(" + std::to_string(output) + ")";
-  if (impl_->session)
-    throw InputError("API", source, "a Renderer made without a scene (Renderer(display))");
-  if (output >= impl_->targets.size())
-    throw InputError("API", source,
-                     "an output index below " + std::to_string(impl_->targets.size()));
-  driver::OutputTarget& target = impl_->targets[output];
+namespace {
+
+// The application's texture `texture` (2D, RGBA8 or SRGB8_ALPHA8), checked; its size.
+glm::ivec2 application_texture_size(unsigned int texture, const std::string& source) {
   if (texture == 0 || !glIsTexture(texture))
     throw InputError("API", source, "the name of a 2D texture of the current context");
   GLint width = 0, height = 0, format = 0;
@@ -503,25 +499,32 @@ void Renderer::warp_perspective(std::size_t output, unsigned int texture) {
   glGetTextureLevelParameteriv(texture, 0, GL_TEXTURE_INTERNAL_FORMAT, &format);
   if (width < 1 || height < 1 || (format != GL_RGBA8 && format != GL_SRGB8_ALPHA8))
     throw InputError("API", source, "an RGBA8 or SRGB8_ALPHA8 2D texture with pixels");
+  return {width, height};
+}
+
+}  // namespace
+
+void Renderer::warp_content(const std::vector<std::size_t>& outputs, unsigned int texture,
+                            const ContentProjection& projection, std::size_t key,
+                            const std::string& source) {
+  if (impl_->session)
+    throw InputError("API", source, "a Renderer made without a scene (Renderer(display))");
+  const glm::ivec2 size = application_texture_size(texture, source);
   const KeepFramebuffers keep;
   if (!impl_->content_pass) {
     std::vector<driver::OutputSpec> specs;
-    for (const driver::SessionOutput& out : impl_->display->outputs) {
-      specs.push_back(out.spec);
-      const facet::Frustum covering = covering_frustum(out.spec.warp, out.spec.name);
-      impl_->frusta.push_back({covering.R_eye_frustum, covering.tan_extent});
-    }
+    for (const driver::SessionOutput& out : impl_->display->outputs) specs.push_back(out.spec);
     impl_->content_pass.emplace(specs);
     impl_->copy_source = driver::Framebuffer::create();
     impl_->copy_target = driver::Framebuffer::create();
   }
-  auto it = impl_->content.find(output);
-  if (it == impl_->content.end() || it->second.image_size() != glm::ivec2(width, height)) {
-    impl_->content.erase(output);
+  auto it = impl_->content.find(key);
+  if (it == impl_->content.end() || it->second.image_size() != size ||
+      it->second.format() != projection.format) {
+    impl_->content.erase(key);
     it = impl_->content
-             .emplace(output,
-                      driver::ContentTexture(ContentFormat::perspective, glm::ivec2(width, height),
-                                             driver::ContentImage::Pixels::srgb8, source))
+             .emplace(key, driver::ContentTexture(projection.format, size,
+                                                  driver::ContentImage::Pixels::srgb8, source))
              .first;
   }
   // The application's texture has GL's row order (row 0 at the bottom), content images row 0 at
@@ -531,18 +534,45 @@ void Renderer::warp_perspective(std::size_t output, unsigned int texture) {
   glNamedFramebufferTexture(impl_->copy_target.id(), GL_COLOR_ATTACHMENT0, content.id(), 0);
   const GLboolean srgb = glIsEnabled(GL_FRAMEBUFFER_SRGB);
   glDisable(GL_FRAMEBUFFER_SRGB);
-  glBlitNamedFramebuffer(impl_->copy_source.id(), impl_->copy_target.id(), 0, 0, width, height, 0,
-                         height, width, 0, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+  glBlitNamedFramebuffer(impl_->copy_source.id(), impl_->copy_target.id(), 0, 0, size.x, size.y, 0,
+                         size.y, size.x, 0, GL_COLOR_BUFFER_BIT, GL_NEAREST);
   if (srgb) glEnable(GL_FRAMEBUFFER_SRGB);
   glGenerateTextureMipmap(content.id());
+  for (const std::size_t output : outputs) {
+    driver::OutputTarget& target = impl_->targets[output];
+    target.clear();
+    target.bind();
+    impl_->content_pass->draw(output, it->second, projection);
+    impl_->blends[output].apply(target.colour());
+  }
+}
+
+void Renderer::warp_perspective(std::size_t output, unsigned int texture) {
+  const std::string source = "warp_perspective(" + std::to_string(output) + ")";
+  if (output >= impl_->display->outputs.size())
+    throw InputError("API", source,
+                     "an output index below " + std::to_string(impl_->display->outputs.size()));
+  if (impl_->frusta.empty()) {
+    for (const driver::SessionOutput& out : impl_->display->outputs) {
+      const facet::Frustum covering = covering_frustum(out.spec.warp, out.spec.name);
+      impl_->frusta.push_back({covering.R_eye_frustum, covering.tan_extent});
+    }
+  }
   ContentProjection projection;
   projection.format = ContentFormat::perspective;
   projection.R_eye_content = impl_->frusta[output].R_eye_view;
   projection.tan_extent = impl_->frusta[output].tan_extent;
-  target.clear();
-  target.bind();
-  impl_->content_pass->draw(output, it->second, projection);
-  impl_->blends[output].apply(target.colour());
+  warp_content({output}, texture, projection, output, source);
+}
+
+void Renderer::warp_image(unsigned int texture, ImageKind kind, double fisheye_fov_deg) {
+  const std::string source = "warp_image";
+  ContentProjection projection =
+      kind == ImageKind::fisheye ? fisheye_content(fisheye_fov_deg) : equirect_content();
+  projection.validate(source);
+  std::vector<std::size_t> outputs(impl_->display->outputs.size());
+  for (std::size_t i = 0; i < outputs.size(); ++i) outputs[i] = i;
+  warp_content(outputs, texture, projection, std::numeric_limits<std::size_t>::max(), source);
 }
 
 std::size_t Renderer::output_count() const { return impl_->display->outputs.size(); }

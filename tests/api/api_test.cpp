@@ -288,9 +288,58 @@ TEST(Api, WarpPerspectiveKeepsTheApplicationsImageUpright) {
     EXPECT_LT(first_blue, out.y) << o;
     EXPECT_LT(last_red, first_blue) << "output " << o;
   }
-  glDeleteTextures(1, &texture);
+  // The same halves as an equirectangular panorama (twice as wide): the sky red, the ground
+  // blue.
+  GLuint panorama = 0;
+  glCreateTextures(GL_TEXTURE_2D, 1, &panorama);
+  glTextureStorage2D(panorama, 1, GL_SRGB8_ALPHA8, size.x, size.y / 2);
+  glTextureSubImage2D(panorama, 0, 0, 0, size.x, size.y / 2, GL_RGBA, GL_UNSIGNED_BYTE,
+                      rgba.data() + std::size_t(size.x) * std::size_t(size.y / 4) * 4);
+  renderer.warp_image(panorama, Renderer::ImageKind::equirect);
+  for (std::size_t o = 0; o < 4; ++o) {
+    const auto image = renderer.read_output_rgba8(o);
+    const glm::ivec2 out = renderer.output_size(o);
+    int last_red = -1, first_blue = out.y;
+    for (int y = 0; y < out.y; ++y) {
+      const std::uint8_t* p = &image[(std::size_t(y) * out.x + out.x / 2) * 4];
+      if (p[0] > 200 && p[2] < 50) last_red = y;
+      if (p[2] > 200 && p[0] < 50) first_blue = std::min(first_blue, y);
+    }
+    // The horizon runs where the upper and lower projectors meet: the upper ones show sky, the
+    // lower ones ground, and no output shows ground above sky.
+    EXPECT_TRUE(o >= 2 || last_red >= 0) << "no sky in upper output " << o;
+    EXPECT_TRUE(o < 2 || first_blue < out.y) << "no ground in lower output " << o;
+    EXPECT_LT(last_red, first_blue) << "equirect, output " << o;
+  }
+  // A dome master on the 180° dome: its red zenith disc (a quarter of the radius) lands at the
+  // dome output's centre, its blue rest near the rim.
+  std::vector<std::uint8_t> master(64 * 64 * 4);
+  for (int y = 0; y < 64; ++y)
+    for (int x = 0; x < 64; ++x) {
+      const bool zenith = std::hypot(x + 0.5 - 32, y + 0.5 - 32) < 8;
+      std::uint8_t* p = &master[(std::size_t(y) * 64 + std::size_t(x)) * 4];
+      p[0] = zenith ? 255 : 0;
+      p[1] = 0;
+      p[2] = zenith ? 0 : 255;
+      p[3] = 255;
+    }
+  GLuint fisheye = 0;
+  glCreateTextures(GL_TEXTURE_2D, 1, &fisheye);
+  glTextureStorage2D(fisheye, 1, GL_RGBA8, 64, 64);
+  glTextureSubImage2D(fisheye, 0, 0, 0, 64, 64, GL_RGBA, GL_UNSIGNED_BYTE, master.data());
+  Renderer dome(Display::open("builtin:dome180", glm::ivec2(64, 64)));
+  dome.warp_image(fisheye, Renderer::ImageKind::fisheye, 180);
+  const auto shown = dome.read_output_rgba8(0);
+  const auto at = [&](int x, int y) { return &shown[(std::size_t(y) * 64 + std::size_t(x)) * 4]; };
+  EXPECT_GT(at(32, 32)[0], 200);
+  EXPECT_LT(at(32, 32)[2], 50);
+  EXPECT_GT(at(32, 4)[2], 200);
+  EXPECT_LT(at(32, 4)[0], 50);
+  EXPECT_THROW(dome.warp_image(fisheye, Renderer::ImageKind::fisheye, 400), InputError);
+  for (GLuint t : {texture, panorama, fisheye}) glDeleteTextures(1, &t);
   Renderer with_scene(display, Scene::load("builtin:city"));
   EXPECT_THROW(with_scene.warp_perspective(0, 1), InputError);
+  EXPECT_THROW(with_scene.warp_image(1, Renderer::ImageKind::equirect), InputError);
 }
 
 // The application's framebuffer stays bound through render(); present() then draws the

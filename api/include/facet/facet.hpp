@@ -52,6 +52,7 @@
 
 namespace facet {
 
+struct ContentProjection;
 namespace driver {
 struct Scene;
 struct SessionDisplay;
@@ -290,6 +291,12 @@ class Renderer {
   // context's share group); facet resamples it through the exact warp into the output (mip-
   // mapped, in linear light) and blends. The texture is copied, not kept.
   void warp_perspective(std::size_t output, unsigned int texture);
+  // Mode 2 for content of the whole view, into every output: a dome master (fisheye of
+  // `fisheye_fov_deg` in (0, 360], its centre the zenith and its bottom edge the front) or an
+  // equirectangular 360° x 180° panorama (its middle column straight ahead, -z), as a 2D texture
+  // like warp_perspective's. Not for a Renderer with a scene.
+  enum class ImageKind { fisheye, equirect };
+  void warp_image(unsigned int texture, ImageKind kind, double fisheye_fov_deg = 180);
 
   std::size_t output_count() const;
   glm::ivec2 output_size(std::size_t output) const;
@@ -311,6 +318,9 @@ class Renderer {
  private:
   struct Impl;
   std::unique_ptr<Impl> impl_;
+  void warp_content(const std::vector<std::size_t>& outputs, unsigned int texture,
+                    const ContentProjection& projection, std::size_t key,
+                    const std::string& source);
 };
 
 }  // namespace facet
