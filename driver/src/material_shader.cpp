@@ -56,6 +56,35 @@ void refuse_forbidden_words(const std::string& file, std::string_view text) {
                        "IDs and depth stay the renderer's");
 }
 
+// InputError when the material's bytes are not UTF-8 text: a NUL byte would cut the source short
+// where the GL reads it, and invalid UTF-8 has no meaning in GLSL (not even in a comment).
+void refuse_non_text(const std::string& file, std::string_view text) {
+  std::size_t line = 1;
+  for (std::size_t i = 0; i < text.size();) {
+    const auto byte = static_cast<unsigned char>(text[i]);
+    if (byte == '\n') ++line;
+    if (byte == 0) {
+      throw InputError(file, "--material",
+                       "line " + std::to_string(line) + " holds a NUL byte: expected GLSL text");
+    }
+    // The length of the UTF-8 sequence this byte starts (0: not a valid start byte).
+    const std::size_t length = byte < 0x80                   ? 1
+                               : byte >= 0xc2 && byte < 0xe0 ? 2
+                               : byte >= 0xe0 && byte < 0xf0 ? 3
+                               : byte >= 0xf0 && byte < 0xf5 ? 4
+                                                             : 0;
+    bool valid = length > 0 && i + length <= text.size();
+    for (std::size_t k = 1; valid && k < length; ++k) {
+      valid = (static_cast<unsigned char>(text[i + k]) & 0xc0) == 0x80;
+    }
+    if (!valid) {
+      throw InputError(file, "--material",
+                       "line " + std::to_string(line) + " is not valid UTF-8: expected GLSL text");
+    }
+    i += length;
+  }
+}
+
 // A minimal vertex stage that feeds scene/material.frag, for check_material_shader.
 constexpr std::string_view kCheckVertex = R"(
 out vec3 v_n_world;
@@ -117,6 +146,7 @@ MaterialShader load_material_shader(std::string_view name_or_file) {
   material.name = file;
   material.file = file;
   material.text = text.str();
+  refuse_non_text(file, material.text);
   refuse_forbidden_words(file, material.text);
   return material;
 }

@@ -31,6 +31,8 @@
 #include <iterator>
 #include <limits>
 #include <nlohmann/json.hpp>
+#include <opencv2/core.hpp>
+#include <opencv2/videoio.hpp>
 #include <string>
 #include <thread>
 #include <utility>
@@ -1331,6 +1333,303 @@ void add_gltf(std::vector<Variant>& out) {
                  {"x.gltf", "square.bin"}});
 }
 
+// ---- Content for facet play: stills and videos --------------------------------------------------
+
+// A valid still written with OpenImageIO: `width`×`height` RGB, a gradient.
+std::string still_image(const std::string& extension, int width, int height) {
+  const fs::path path =
+      fs::temp_directory_path() / ("facet_hostile_still_" + std::to_string(::getpid()) + extension);
+  std::vector<float> pixels(std::size_t(width) * height * 3);
+  for (std::size_t i = 0; i < pixels.size(); ++i) {
+    pixels[i] = float(i % 251) / 251.0f;
+  }
+  auto output = OIIO::ImageOutput::create(path.string());
+  const bool is_float = extension == ".exr";
+  output->open(
+      path.string(),
+      OIIO::ImageSpec(width, height, 3, is_float ? OIIO::TypeDesc::HALF : OIIO::TypeDesc::UINT8));
+  output->write_image(OIIO::TypeDesc::FLOAT, pixels.data());
+  output->close();
+  std::string bytes = slurp(path);
+  fs::remove(path);
+  return bytes;
+}
+
+// A valid short video (MJPEG in AVI, 10 frames of 64×64) written with OpenCV's VideoWriter.
+std::string short_video() {
+  static const std::string bytes = [] {
+    const fs::path path =
+        fs::temp_directory_path() / ("facet_hostile_video_" + std::to_string(::getpid()) + ".avi");
+    cv::VideoWriter writer(path.string(), cv::CAP_FFMPEG,
+                           cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), 30, cv::Size(64, 64));
+    for (int k = 0; k < 10; ++k)
+      writer.write(cv::Mat(64, 64, CV_8UC3, cv::Scalar(20 * k, 90, 200)));
+    writer.release();
+    std::string video = slurp(path);
+    fs::remove(path);
+    return video;
+  }();
+  return bytes;
+}
+
+std::uint32_t crc32_of(const std::string& bytes) {
+  std::uint32_t crc = 0xffffffffu;
+  for (const char c : bytes) {
+    crc ^= static_cast<unsigned char>(c);
+    for (int k = 0; k < 8; ++k) crc = (crc >> 1) ^ (0xedb88320u & (0u - (crc & 1u)));
+  }
+  return ~crc;
+}
+
+void put_be32(std::string& bytes, std::size_t offset, std::uint32_t value) {
+  for (int k = 0; k < 4; ++k) bytes[offset + k] = static_cast<char>(value >> (24 - 8 * k));
+}
+
+// A valid PNG whose IHDR (with a correct CRC) claims `width`×`height`.
+std::string png_claiming(std::uint32_t width, std::uint32_t height) {
+  std::string png = still_image(".png", 16, 16);
+  put_be32(png, 16, width);  // signature 8, length 4, "IHDR" 4
+  put_be32(png, 20, height);
+  put_be32(png, 29, crc32_of(png.substr(12, 17)));
+  return png;
+}
+
+// A valid JPEG whose first SOF marker claims `width`×`height`.
+std::string jpeg_claiming(std::uint16_t width, std::uint16_t height) {
+  std::string jpeg = still_image(".jpg", 16, 16);
+  for (std::size_t i = 2; i + 9 < jpeg.size(); ++i) {
+    if (static_cast<unsigned char>(jpeg[i]) == 0xff &&
+        (static_cast<unsigned char>(jpeg[i + 1]) & 0xf0) == 0xc0 &&
+        static_cast<unsigned char>(jpeg[i + 1]) != 0xc4) {
+      jpeg[i + 5] = static_cast<char>(height >> 8);
+      jpeg[i + 6] = static_cast<char>(height & 0xff);
+      jpeg[i + 7] = static_cast<char>(width >> 8);
+      jpeg[i + 8] = static_cast<char>(width & 0xff);
+      break;
+    }
+  }
+  return jpeg;
+}
+
+std::vector<std::string> play_args(const std::string& file, std::vector<std::string> extra = {}) {
+  std::vector<std::string> args{"play",   "@" + file, "--display",  "builtin:dome180",
+                                "--size", "32x32",    "--headless", "--frames",
+                                "1",      "--out",    "@out"};
+  args.insert(args.end(), extra.begin(), extra.end());
+  return args;
+}
+
+void add_play_content(std::vector<Variant>& out) {
+  add_byte_variants(out, "play_png", [] { return still_image(".png", 64, 64); }, "x.png", nullptr,
+                    play_args("x.png"), "out", {0.01, 0.5, 0.95});
+  add_byte_variants(out, "play_video", short_video, "x.avi", nullptr, play_args("x.avi"), "out",
+                    {0.01, 0.3, 0.6});
+  add_non_regular_variants(out, "play_video", "x.mp4", nullptr, play_args("x.mp4"), "out");
+  auto add = [&](const std::string& what, const std::string& file,
+                 std::function<std::string()> bytes, std::vector<std::string> extra = {}) {
+    out.push_back({"play_" + what,
+                   [file, bytes](const fs::path& dir) { spit(dir / file, bytes()); },
+                   play_args(file, std::move(extra)),
+                   "out",
+                   {file}});
+  };
+  add("png_claims_100000x100000", "x.png", [] { return png_claiming(100000, 100000); });
+  add("png_claims_2e9_wide", "x.png", [] { return png_claiming(2000000000, 1); });
+  add("jpeg_truncated", "x.jpg", [] { return truncated(still_image(".jpg", 64, 64), 300); });
+  add("jpeg_claims_65000x65000", "x.jpg", [] { return jpeg_claiming(65000, 65000); });
+  add("exr_truncated", "x.exr", [] {
+    const std::string exr = still_image(".exr", 64, 64);
+    return truncated(exr, exr.size() / 2);
+  });
+  add("exr_header_only", "x.exr", [] { return truncated(still_image(".exr", 64, 64), 200); });
+  add("exr_magic_flipped", "x.exr", [] { return flipped(still_image(".exr", 64, 64), 0); });
+  add("fisheye_not_square", "x.png", [] { return still_image(".png", 64, 32); },
+      {"--format", "fisheye"});
+  add("equirect_square", "x.png", [] { return still_image(".png", 64, 64); },
+      {"--format", "equirect"});
+  add("cubemap_square", "x.png", [] { return still_image(".png", 64, 64); },
+      {"--format", "cubemap"});
+  add("aspect_unknown", "x.png", [] { return still_image(".png", 64, 48); });
+  add("text_as_video", "x.mp4", [] { return std::string("this is not a video\n"); });
+  add("video_header_only", "x.avi", [] { return truncated(short_video(), 64); });
+  add("video_zero_bytes_after_header", "x.avi", [] {
+    std::string v = short_video();
+    std::fill(v.begin() + 512, v.end(), '\0');
+    return v;
+  });
+  add("video_named_png", "x.png", short_video);
+}
+
+// ---- Materials: a user's GLSL FILE.frag ---------------------------------------------------------
+
+std::string material_base() { return slurp(kSource / "shaders/scene/materials/procedural.frag"); }
+
+void add_material(std::vector<Variant>& out) {
+  const std::vector<std::string> args{"render",  "--display", "builtin:dome180",
+                                      "--size",  "32x32",     "--material",
+                                      "@m.frag", "--out",     "@out"};
+  add_byte_variants(out, "material", material_base, "m.frag", nullptr, args, "out", {0.3, 0.97},
+                    false);
+  add_non_regular_variants(out, "material", "m.frag", nullptr, args, "out");
+  auto add = [&](const std::string& what, std::function<std::string()> text,
+                 std::vector<std::string> command = {}) {
+    out.push_back({"material_" + what,
+                   [text](const fs::path& dir) { spit(dir / "m.frag", text()); },
+                   command.empty() ? args : command,
+                   "out",
+                   {"m.frag"}});
+  };
+  add("syntax_error", [] { return replace_first(material_base(), "vec4 shade(", "vec4 shade(("); });
+  add("undefined_name", [] { return material_base() + "\nfloat f() { return nowhere; }\n"; });
+  add("discard", [] {
+    return replace_first(material_base(), "vec4 shade(MaterialInput m) {",
+                         "vec4 shade(MaterialInput m) {\n  if (m.depth > 2.0) discard;");
+  });
+  add("frag_depth", [] {
+    return replace_first(material_base(), "vec4 shade(MaterialInput m) {",
+                         "vec4 shade(MaterialInput m) {\n  gl_FragDepth = 0.5;");
+  });
+  add("no_shade", [] { return replace_all(material_base(), "shade(", "shade_not("); });
+  add("shade_returns_vec3", [] { return "vec3 shade(MaterialInput m) { return vec3(1); }\n"; });
+  add("shade_wrong_parameter", [] { return "vec4 shade(vec3 m) { return vec4(1); }\n"; });
+  add("shade_twice",
+      [] { return material_base() + "\nvec4 shade(MaterialInput m) { return vec4(1); }\n"; });
+  add("defines_main", [] { return material_base() + "\nvoid main() {}\n"; });
+  add("redefines_sun_and_sky",
+      [] { return material_base() + "\nvec3 sun_and_sky(MaterialInput m) { return vec3(0); }\n"; });
+  add("version_directive", [] { return "#version 110\n" + material_base(); });
+  add("include_directive", [] { return "#include \"/etc/passwd\"\n" + material_base(); });
+  add("recursion", [] {
+    return "float r(float x) { return x > 0.0 ? r(x - 1.0) : 0.0; }\n"
+           "vec4 shade(MaterialInput m) { return vec4(r(3.0)); }\n";
+  });
+  add("invalid_utf8", [] { return replace_first(material_base(), "marble", "\xff\xfe\xfd"); });
+  add("nul_bytes", [] { return material_base() + std::string(64, '\0'); });
+  add("huge_40MiB", [] { return material_base() + "//" + std::string(40u << 20, 'x') + "\n"; });
+  add("huge_one_line",
+      [] { return "float f = " + std::string(2u << 20, '1') + ".0;\n" + material_base(); });
+  add("run_syntax_error",
+      [] { return replace_first(material_base(), "vec4 shade(", "vec4 shade(("); },
+      {"run", (kSource / "configs/displays/dome180/display.json").string(), "--headless",
+       "--frames", "1", "--scale", "0.125", "--material", "@m.frag", "--out", "@out"});
+  add("run_discard",
+      [] {
+        return replace_first(material_base(), "vec4 shade(MaterialInput m) {",
+                             "vec4 shade(MaterialInput m) {\n  discard;");
+      },
+      {"run", (kSource / "configs/displays/dome180/display.json").string(), "--headless",
+       "--frames", "1", "--scale", "0.125", "--material", "@m.frag", "--out", "@out"});
+}
+
+// ---- Clusters: display.json's cluster section and facet run --node ------------------------------
+
+// cylinder3 spread over three nodes listening on ipc:// addresses in the scratch folder.
+json cluster_base(const fs::path& dir) {
+  json display = display_base();
+  auto node = [&](const std::string& name, json projectors) {
+    return json{{"name", name},
+                {"address", "ipc://" + (dir / ("n-" + name)).string()},
+                {"projectors", std::move(projectors)}};
+  };
+  display["cluster"] = {
+      {"nodes", {node("left", {"p0"}), node("mid", {"p1"}), node("right", {"p2"})}},
+      {"master", "left"},
+      {"deadline_ms", 50}};
+  return display;
+}
+
+void add_cluster_section(std::vector<Variant>& out) {
+  // A secondary: it listens on its address, then waits for the master (which never comes).
+  const std::vector<std::string> args{"run", "@display.json", "--node",
+                                      "mid", "--headless",    "--join-timeout",
+                                      "2",   "--out",         "@out"};
+  const std::vector<FieldMutation> m = {
+      {"cluster_array", "/cluster", "[]", "cluster"},
+      {"nodes_empty", "/cluster/nodes", "[]", "nodes"},
+      {"nodes_object", "/cluster/nodes", "{}", "nodes"},
+      {"node_name_missing", "/cluster/nodes/1/name", "", "name"},
+      {"node_name_duplicate", "/cluster/nodes/2/name", "\"mid\"", "mid"},
+      {"node_name_invalid_utf8", "/cluster/nodes/2/name", "\"r\xff\xfe\"", "name"},
+      {"node_name_slash", "/cluster/nodes/2/name", "\"../x\"", "name"},
+      {"address_http", "/cluster/nodes/1/address", "\"http://localhost:80\"", "address"},
+      {"address_empty", "/cluster/nodes/1/address", "\"\"", "address"},
+      {"address_number", "/cluster/nodes/1/address", "7400", "address"},
+      {"address_port_huge", "/cluster/nodes/1/address", "\"tcp://127.0.0.1:99999\"", "address"},
+      {"address_port_last", "/cluster/nodes/1/address", "\"tcp://127.0.0.1:65535\"", "address"},
+      {"address_host_bogus", "/cluster/nodes/1/address", "\"tcp://no host:7400\"", "address"},
+      {"address_ipc_too_long", "/cluster/nodes/1/address",
+       "\"ipc:///tmp/" + std::string(200, 'a') + "\"", "address"},
+      {"address_ipc_missing_folder", "/cluster/nodes/1/address", "\"ipc:///nowhere/at/all/n\"",
+       "address"},
+      {"address_duplicate", "/cluster/nodes/1/address", "\"@ADDR0@\"", "address"},
+      {"projector_unknown", "/cluster/nodes/1/projectors", "[\"p9\"]", "p9"},
+      {"projector_on_two_nodes", "/cluster/nodes/1/projectors", "[\"p1\", \"p0\"]", "p0"},
+      {"projector_on_no_node", "/cluster/nodes/2/projectors", "[\"p1\"]", "p2"},
+      {"projectors_empty", "/cluster/nodes/1/projectors", "[]", "projectors"},
+      {"critical_string", "/cluster/nodes/1/critical", "\"yes\"", "critical"},
+      {"master_unknown", "/cluster/master", "\"nobody\"", "nobody"},
+      {"master_missing", "/cluster/master", "", "master"},
+      {"deadline_zero", "/cluster/deadline_ms", "0", "deadline_ms"},
+      {"deadline_negative", "/cluster/deadline_ms", "-50", "deadline_ms"},
+      {"deadline_huge", "/cluster/deadline_ms", "1e300", "deadline_ms"},
+      {"deadline_nan", "/cluster/deadline_ms", "NaN", "deadline_ms"},
+      {"deadline_string", "/cluster/deadline_ms", "\"50\"", "deadline_ms"},
+      {"unknown_key", "/cluster/surprise", "1", "surprise"},
+  };
+  for (const FieldMutation& f : m) {
+    out.push_back({"cluster_" + sanitize(f.what),
+                   [f](const fs::path& dir) {
+                     display_context(dir);
+                     const json base = cluster_base(dir);
+                     std::string raw = f.raw;
+                     if (raw == "\"@ADDR0@\"") raw = base["cluster"]["nodes"][0]["address"].dump();
+                     spit(dir / "display.json", json_with(base, f.pointer, raw));
+                   },
+                   args,
+                   "out",
+                   {"display.json", f.mention}});
+  }
+  auto add_flag = [&](const std::string& what, std::vector<std::string> command,
+                      const std::string& mention, bool with_cluster = true) {
+    out.push_back({"cluster_flag_" + what,
+                   [with_cluster](const fs::path& dir) {
+                     display_context(dir);
+                     spit(dir / "display.json",
+                          (with_cluster ? cluster_base(dir) : display_base()).dump(1));
+                   },
+                   std::move(command),
+                   "out",
+                   {mention}});
+  };
+  auto run = [](std::vector<std::string> flags) {
+    std::vector<std::string> command{"run", "@display.json", "--headless", "--frames",
+                                     "1",   "--out",         "@out"};
+    command.insert(command.end(), flags.begin(), flags.end());
+    return command;
+  };
+  add_flag("node_unknown", run({"--node", "nobody"}), "nobody");
+  add_flag("node_empty", run({"--node", ""}), "--node");
+  add_flag("node_invalid_utf8", run({"--node", "m\xff\xfe"}), "--node");
+  add_flag("node_without_cluster", run({"--node", "mid"}), "cluster", false);
+  add_flag("join_timeout_negative", run({"--node", "left", "--join-timeout", "-1"}),
+           "--join-timeout");
+  add_flag("join_timeout_nan", run({"--node", "left", "--join-timeout", "nan"}), "--join-timeout");
+  add_flag("join_timeout_huge", run({"--node", "left", "--join-timeout", "1e300"}),
+           "--join-timeout");
+  add_flag("rate_zero", run({"--node", "left", "--rate", "0"}), "--rate");
+  add_flag("rate_nan", run({"--node", "left", "--rate", "nan"}), "--rate");
+  out.push_back({"cluster_flag_play_node_unknown",
+                 [](const fs::path& dir) {
+                   display_context(dir);
+                   spit(dir / "display.json", cluster_base(dir).dump(1));
+                   spit(dir / "x.png", still_image(".png", 64, 64));
+                 },
+                 {"play", "@x.png", "--display", "@display.json", "--headless", "--frames", "1",
+                  "--node", "nobody", "--out", "@out"},
+                 "out",
+                 {"nobody"}});
+}
+
 // Flags: bad values of the CLI's own options, each command with a valid input.
 void add_flags(std::vector<Variant>& out) {
   const std::string dome = (kSource / "configs/displays/dome180/display.json").string();
@@ -1435,6 +1734,9 @@ const Kind kKinds[] = {
     {"sgc", add_sgc},
     {"cluster_xml_and_simcad", add_cluster},
     {"gltf", add_gltf},
+    {"play_content", add_play_content},
+    {"material_frag", add_material},
+    {"cluster_section_and_node", add_cluster_section},
 };
 
 // ---- Running one variant ------------------------------------------------------------------------

@@ -228,9 +228,11 @@ const Registration registration{
           ->capture_default_str();
       command->add_option("--stats", options->stats,
                           "Windowed: write per-frame statistics (stats.jsonl lines) to this file");
-      command->add_option("--node", options->node,
-                          "Play as this node of the display.json's cluster: its projectors only, "
-                          "frame-locked with the others (the master's show clock)");
+      command
+          ->add_option("--node", options->node,
+                       "Play as this node of the display.json's cluster: its projectors only, "
+                       "frame-locked with the others (the master's show clock)")
+          ->check(cluster_node_name());
       command
           ->add_option("--join-timeout", options->join_timeout_s,
                        "Cluster: seconds the master waits for the nodes to join, and a node "

@@ -260,9 +260,11 @@ const Registration registration{
       command->add_flag("--no-path", options->no_path, "Start still instead of on the path");
       command->add_option("--report", options->report,
                           "Windowed: write window placement and shown-pixel checks to this JSON");
-      command->add_option("--node", options->node,
-                          "Run as this node of the display.json's cluster: its projectors only, "
-                          "frame-locked with the others (see README: Clusters)");
+      command
+          ->add_option("--node", options->node,
+                       "Run as this node of the display.json's cluster: its projectors only, "
+                       "frame-locked with the others (see README: Clusters)")
+          ->check(cluster_node_name());
       command
           ->add_option("--join-timeout", options->join_timeout_s,
                        "Cluster: seconds the master waits for the nodes to join, and a node "

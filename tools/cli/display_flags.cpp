@@ -166,4 +166,14 @@ FacetLayout LayoutFlags::layout() const {
   return tolerance;
 }
 
+CLI::Validator cluster_node_name() {
+  return CLI::Validator(
+      [](const std::string& name) {
+        return name.empty()
+                   ? std::string("expected the name of a node of the display.json's cluster")
+                   : std::string();
+      },
+      "NAME");
+}
+
 }  // namespace facet::cli

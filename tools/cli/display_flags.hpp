@@ -61,4 +61,7 @@ std::optional<DomeOrientation> builtin_dome_orientation(const DomeOrientationFla
 // "WxH" → (W, H); InputError naming the flag otherwise.
 glm::ivec2 parse_size(const std::string& text, const std::string& flag);
 
+// --node's check (run, play): a name, not empty (an empty one would run every projector alone).
+CLI::Validator cluster_node_name();
+
 }  // namespace facet::cli

@@ -1,7 +1,8 @@
 #pragma once
 // Content files for playback: still images through OpenImageIO (PNG, JPEG, TIFF: 8-bit sRGB;
 // EXR, HDR: linear float) and videos through OpenCV's VideoCapture with its FFmpeg backend (any
-// container and codec that FFmpeg decodes), decoded into ContentImages.
+// container and codec that FFmpeg decodes), decoded into ContentImages. Non-finite float values
+// (NaN, Inf, as some renderers leave in an EXR) show as black.
 #include <cstdint>
 #include <filesystem>
 #include <memory>
