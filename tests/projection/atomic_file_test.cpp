@@ -4,11 +4,14 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
+#include "facet/projection/atomic_folder.hpp"
 #include "facet/projection/errors.hpp"
 
 namespace facet {
@@ -81,6 +84,110 @@ TEST(AtomicFile, RefusesAnOutputThatIsAnInput) {
         << out;
   }
   EXPECT_NO_THROW(refuse_output_over_inputs(folder / "new.exr", "--out", {input}));
+  fs::remove_all(folder);
+}
+
+std::string slurp(const fs::path& path) {
+  std::ifstream in(path);
+  std::string text;
+  std::getline(in, text);
+  return text;
+}
+
+// The names in `folder`, hidden ones included.
+std::vector<std::string> names_in(const fs::path& folder) {
+  std::vector<std::string> names;
+  for (const auto& entry : fs::directory_iterator(folder))
+    names.push_back(entry.path().filename().string());
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+// A command whose output is a folder holding run.txt, and nothing else.
+OutputFolderRules own_run_rules() {
+  OutputFolderRules rules;
+  rules.flag = "--out";
+  rules.is_own_output = [](const fs::path& folder) {
+    return names_in(folder) == std::vector<std::string>{"run.txt"};
+  };
+  return rules;
+}
+
+void write_run(const fs::path& out, const std::string& text) {
+  write_folder_atomically(
+      out, [&](const fs::path& temporary) { std::ofstream(temporary / "run.txt") << text; },
+      own_run_rules());
+}
+
+TEST(AtomicFolder, ReplacesItsOwnEarlierOutputAndAcceptsATrailingSlash) {
+  const fs::path folder = fresh_folder("folder_own");
+  const fs::path out = folder / "deeper" / "out";
+  write_run(out, "one");
+  EXPECT_EQ(slurp(out / "run.txt"), "one");
+  write_run(out.string() + "/", "two");
+  EXPECT_EQ(slurp(out / "run.txt"), "two");
+  EXPECT_EQ(names_in(folder / "deeper"), std::vector<std::string>{"out"});
+  // An empty folder is replaced without asking the command.
+  fs::create_directories(folder / "empty");
+  write_folder_atomically(folder / "empty/", [](const fs::path& temporary) {
+    std::ofstream(temporary / "a.txt") << "a";
+  });
+  EXPECT_EQ(names_in(folder / "empty"), std::vector<std::string>{"a.txt"});
+  fs::remove_all(folder);
+}
+
+TEST(AtomicFolder, RefusesAForeignFolderByNameBeforeWriting) {
+  const fs::path folder = fresh_folder("folder_foreign");
+  const fs::path out = folder / "out";
+  fs::create_directories(out);
+  std::ofstream(out / "keep.txt") << "mine";
+  std::ofstream(folder / "file") << "a file";
+  // The error names the folder (without its trailing slash) and the option.
+  for (const fs::path& target : {out, fs::path(out.string() + "/"), folder / "file"}) {
+    bool filled = false;
+    try {
+      write_folder_atomically(
+          target, [&](const fs::path&) { filled = true; }, own_run_rules());
+      ADD_FAILURE() << "no InputError for " << target;
+    } catch (const InputError& e) {
+      EXPECT_EQ(e.source(), (target == folder / "file" ? target : out).string());
+      EXPECT_EQ(e.field(), "--out");
+    }
+    EXPECT_FALSE(filled) << target;
+  }
+  EXPECT_EQ(slurp(out / "keep.txt"), "mine");
+  EXPECT_EQ(names_in(folder), (std::vector<std::string>{"file", "out"}));
+  // The current folder and its parents, an input and a folder holding one are refused too.
+  const fs::path before = fs::current_path();
+  fs::current_path(out);
+  for (const char* here : {".", "..", "../", "../out"})
+    EXPECT_THROW(check_output_folder(here, own_run_rules()), InputError) << here;
+  fs::current_path(before);
+  OutputFolderRules reading = own_run_rules();
+  reading.inputs = {out / "keep.txt"};
+  EXPECT_THROW(check_output_folder(folder / "out", reading), InputError);
+  EXPECT_THROW(check_output_folder(folder / "out" / "keep.txt", reading), InputError);
+  EXPECT_THROW(check_output_folder("", reading), InputError);
+  EXPECT_EQ(check_output_folder(folder / "new/", reading), folder / "new");
+  fs::remove_all(folder);
+}
+
+TEST(AtomicFolder, AFailureLeavesNoTemporaryAndTheEarlierOutputIntact) {
+  const fs::path folder = fresh_folder("folder_failure");
+  const fs::path out = folder / "out";
+  write_run(out, "one");
+  for (const fs::path& target : {out, folder / "new"}) {
+    EXPECT_THROW(write_folder_atomically(
+                     target,
+                     [](const fs::path& temporary) {
+                       std::ofstream(temporary / "run.txt") << "partial";
+                       throw std::runtime_error("stopped");
+                     },
+                     own_run_rules()),
+                 std::runtime_error);
+  }
+  EXPECT_EQ(slurp(out / "run.txt"), "one");
+  EXPECT_EQ(names_in(folder), std::vector<std::string>{"out"});
   fs::remove_all(folder);
 }
 
