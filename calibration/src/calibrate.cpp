@@ -7,13 +7,13 @@
 #include <cstdio>
 #include <iterator>
 #include <opencv2/imgproc.hpp>
-#include <random>
 #include <span>
 #include <tuple>
 
 #include "facet/calibration/camera_model.hpp"
 #include "facet/calibration/capture.hpp"
 #include "facet/calibration/image_io.hpp"
+#include "facet/projection/atomic_folder.hpp"
 #include "facet/projection/display_preview.hpp"
 #include "facet/projection/errors.hpp"
 #include "facet/projection/interrupt.hpp"
@@ -32,22 +32,6 @@ double percentile(std::vector<double>& values, double fraction) {
       std::min(values.size() - 1, std::size_t(std::ceil(fraction * double(values.size()))) - 1);
   std::nth_element(values.begin(), values.begin() + std::ptrdiff_t(k), values.end());
   return values[k];
-}
-
-// The output folder must be new or empty; returns the temporary sibling to write into.
-fs::path prepare_output(const fs::path& out) {
-  std::error_code error;
-  if (fs::exists(out, error)) {
-    if (!fs::is_directory(out, error) || !fs::is_empty(out, error)) {
-      throw InputError(out.string(), "", "an output folder that does not exist yet, or is empty");
-    }
-  }
-  const fs::path parent = out.parent_path().empty() ? fs::path(".") : out.parent_path();
-  if (!fs::is_directory(parent, error)) {
-    throw InputError(out.string(), "", "an output folder whose parent folder exists");
-  }
-  std::random_device random;
-  return parent / (out.filename().string() + ".tmp-" + std::to_string(random()));
 }
 
 // The pixels unlit_inside counts, row-major.
@@ -406,8 +390,11 @@ CalibrationReport calibrate(const fs::path& capture_path, const fs::path& out,
   const auto started = std::chrono::steady_clock::now();
   const Capture capture = read_capture(capture_path);
   const std::string capture_json = (capture.folder / "capture.json").string();
-  const fs::path temporary = prepare_output(out);
-  // Polled between projectors and stages; the catch around the writing removes the temporary.
+  // Checked before any heavy work, and again when written.
+  OutputFolderRules out_rules;
+  out_rules.inputs = {capture.folder};
+  check_output_folder(out, out_rules);
+  // Polled between projectors and stages; write_folder_atomically then removes the temporary.
   const std::string stopped = "stopped before the end; nothing written to " + out.string();
   const CameraModel model = CameraModel::read(capture.resolve(capture.camera.model));
   // The display to write back, checked against the capture before any heavy work.
@@ -519,39 +506,35 @@ CalibrationReport calibrate(const fs::path& capture_path, const fs::path& out,
     if (!blend.black.empty()) item.black = item.name + ".black.exr";
   }
 
-  try {
-    fs::create_directories(temporary);
-    for (std::size_t p = 0; p < warps.size(); ++p) {
-      const std::string& name = capture.projectors[p].name;
-      write_warp((temporary / (name + ".warp.exr")).string(), warps[p]);
-      projection_io::write_blend_map((temporary / (name + ".blend.exr")).string(), blend.alpha[p]);
-      if (!blend.black.empty()) {
-        projection_io::write_blend_map((temporary / (name + ".black.exr")).string(),
-                                       blend.black[p]);
-      }
-    }
-    projection_io::write_display_config(display, temporary / "display.json");
-    const fs::path pictures = temporary / "report";
-    fs::create_directories(pictures);
-    for (std::size_t p = 0; p < warps.size(); ++p) {
-      throw_if_interrupted(stopped);
-      const std::string& name = capture.projectors[p].name;
-      write_rgb_image(pictures / (name + ".residual.png"),
-                      residual_image(report.projectors[p].fit, warps[p].output_size));
-      write_rgb_image(pictures / (name + ".coverage.png"),
-                      coverage_image(warps[p], node_origins[p], blend.alpha[p]));
-    }
-    throw_if_interrupted(stopped);
-    write_rgb_image(pictures / "preview.png", residual_preview(warps, blend.alpha, report));
-    throw_if_interrupted(stopped);
-    std::error_code error;
-    if (fs::exists(out, error)) fs::remove(out);  // checked empty above
-    fs::rename(temporary, out);
-  } catch (...) {
-    std::error_code ignored;
-    fs::remove_all(temporary, ignored);
-    throw;
-  }
+  write_folder_atomically(
+      out,
+      [&](const fs::path& temporary) {
+        for (std::size_t p = 0; p < warps.size(); ++p) {
+          const std::string& name = capture.projectors[p].name;
+          write_warp((temporary / (name + ".warp.exr")).string(), warps[p]);
+          projection_io::write_blend_map((temporary / (name + ".blend.exr")).string(),
+                                         blend.alpha[p]);
+          if (!blend.black.empty()) {
+            projection_io::write_blend_map((temporary / (name + ".black.exr")).string(),
+                                           blend.black[p]);
+          }
+        }
+        projection_io::write_display_config(display, temporary / "display.json");
+        const fs::path pictures = temporary / "report";
+        fs::create_directories(pictures);
+        for (std::size_t p = 0; p < warps.size(); ++p) {
+          throw_if_interrupted(stopped);
+          const std::string& name = capture.projectors[p].name;
+          write_rgb_image(pictures / (name + ".residual.png"),
+                          residual_image(report.projectors[p].fit, warps[p].output_size));
+          write_rgb_image(pictures / (name + ".coverage.png"),
+                          coverage_image(warps[p], node_origins[p], blend.alpha[p]));
+        }
+        throw_if_interrupted(stopped);
+        write_rgb_image(pictures / "preview.png", residual_preview(warps, blend.alpha, report));
+        throw_if_interrupted(stopped);
+      },
+      out_rules);
   report.seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   return report;

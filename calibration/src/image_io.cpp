@@ -1,12 +1,9 @@
 #include "facet/calibration/image_io.hpp"
 
 #include <OpenImageIO/imageio.h>
-#include <unistd.h>
 
-#include <atomic>
 #include <cmath>
 #include <memory>
-#include <system_error>
 #include <vector>
 
 #include "facet/projection/atomic_file.hpp"
@@ -110,40 +107,6 @@ void write_rgb_image(const std::filesystem::path& path, const cv::Mat& rgb) {
       throw InputError(path.string(), "", "a writable image file (" + output->geterror() + ")");
     }
   });
-}
-
-void write_folder_atomically(const std::filesystem::path& folder,
-                             const std::function<void(const std::filesystem::path&)>& write) {
-  std::error_code error;
-  if (std::filesystem::exists(folder, error)) {
-    if (!std::filesystem::is_directory(folder, error) ||
-        !std::filesystem::is_empty(folder, error)) {
-      throw InputError(folder.string(), "", "an output folder that does not exist yet or is empty");
-    }
-  }
-  static std::atomic<unsigned> counter{0};
-  const std::filesystem::path absolute = std::filesystem::absolute(folder).lexically_normal();
-  std::filesystem::path parent =
-      absolute.has_filename() ? absolute.parent_path() : absolute.parent_path().parent_path();
-  const std::string name = absolute.has_filename() ? absolute.filename().string()
-                                                   : absolute.parent_path().filename().string();
-  std::filesystem::create_directories(parent, error);
-  if (error)
-    throw InputError(parent.string(), "", "a folder that can be created: " + error.message());
-  const std::filesystem::path temporary =
-      parent / ("." + name + ".tmp" + std::to_string(::getpid()) + "-" + std::to_string(counter++));
-  std::filesystem::create_directory(temporary, error);
-  if (error) {
-    throw InputError(temporary.string(), "", "a folder that can be created: " + error.message());
-  }
-  try {
-    write(temporary);
-    // rename() replaces an empty folder but not a full one, which the check above excluded.
-    std::filesystem::rename(temporary, parent / name);
-  } catch (...) {
-    std::filesystem::remove_all(temporary, error);
-    throw;
-  }
 }
 
 }  // namespace facet::calibration

@@ -6,6 +6,7 @@
 
 #include "facet/calibration/image_io.hpp"
 #include "facet/projection/atomic_file.hpp"
+#include "facet/projection/atomic_folder.hpp"
 #include "facet/projection/errors.hpp"
 #include "json_fields.hpp"
 

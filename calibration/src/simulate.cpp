@@ -17,6 +17,7 @@ extern "C" {
 
 #include "facet/calibration/capture.hpp"
 #include "facet/calibration/image_io.hpp"
+#include "facet/projection/atomic_folder.hpp"
 #include "facet/projection/errors.hpp"
 #include "facet/projection/interrupt.hpp"
 #include "facet/projection_io/rig_file.hpp"

@@ -11,13 +11,13 @@
 #include <cstdio>
 #include <fstream>
 #include <limits>
-#include <string_view>
 
 #include "facet/driver/cluster.hpp"
 #include "facet/driver/gl_context.hpp"
 #include "facet/driver/monitors.hpp"
 #include "facet/driver/output_images.hpp"
 #include "facet/driver/program.hpp"
+#include "facet/projection/atomic_folder.hpp"
 #include "facet/projection/errors.hpp"
 #include "facet/projection/interrupt.hpp"
 
@@ -146,141 +146,61 @@ PlayFrameStats ContentPlayer::render(const FrameState& state, bool finish) {
   return stats;
 }
 
-namespace {
-
-// A frame image's name: five or more digits, then ".png".
-bool is_frame_file_name(const std::string& name) {
-  constexpr std::string_view kSuffix = ".png";
-  if (name.size() < 5 + kSuffix.size() || !name.ends_with(kSuffix)) return false;
-  return std::all_of(name.begin(), name.end() - kSuffix.size(),
-                     [](char c) { return c >= '0' && c <= '9'; });
-}
-
-// Nothing there, an empty folder, or exactly a stats.jsonl and folders of frame images.
-bool holds_earlier_run_or_nothing(const fs::path& dir) {
-  const fs::file_status status = fs::symlink_status(dir);
-  if (!fs::exists(status)) return true;
-  if (!fs::is_directory(status)) return false;
-  bool has_stats = false, empty = true;
-  for (const fs::directory_entry& entry : fs::directory_iterator(dir)) {
-    empty = false;
-    const fs::file_status entry_status = entry.symlink_status();
-    if (entry.path().filename() == "stats.jsonl" && fs::is_regular_file(entry_status)) {
-      has_stats = true;
-      continue;
-    }
-    if (!fs::is_directory(entry_status)) return false;
-    for (const fs::directory_entry& frame : fs::directory_iterator(entry.path())) {
-      if (!fs::is_regular_file(frame.symlink_status()) ||
-          !is_frame_file_name(frame.path().filename().string()))
-        return false;
-    }
-  }
-  return empty || has_stats;
-}
-
-// `dir` is the current folder or one of its parents.
-bool holds_current_folder(const fs::path& dir) {
-  std::error_code error;
-  const fs::path target = fs::weakly_canonical(dir, error);
-  const fs::path current = fs::current_path(error);
-  if (error) return false;
-  auto t = target.begin(), c = current.begin();
-  for (; t != target.end() && c != current.end(); ++t, ++c) {
-    if (t->empty()) break;
-    if (*t != *c) return false;
-  }
-  return t == target.end() || t->empty();
-}
-
-std::string frame_file_name(std::uint64_t frame) {
-  char name[32];
-  std::snprintf(name, sizeof name, "%05llu.png", static_cast<unsigned long long>(frame));
-  return name;
-}
-
-}  // namespace
-
 HeadlessPlayResult run_headless_play(ContentPlayer& player, const HeadlessRunOptions& options) {
-  fs::path out_dir = options.out_dir.lexically_normal();
-  if (!out_dir.has_filename()) out_dir = out_dir.parent_path();
-  if (out_dir.empty()) throw InputError("command line", "--out", "expected an output folder");
   if (options.frames < 1 || options.frames > kMaxFrames)
     throw InputError("command line", "--frames",
                      "from 1 to " + std::to_string(kMaxFrames) + " frames");
-  if (holds_current_folder(out_dir))
-    throw InputError(out_dir.string(), "--out",
-                     "a folder other than the current folder and its parents");
-  if (!holds_earlier_run_or_nothing(out_dir))
-    throw InputError(out_dir.string(), "--out",
-                     "a new path, an empty folder, or a folder from an earlier 'facet play' or "
-                     "'facet run' (stats.jsonl and folders of NNNNN.png, nothing else)");
-  const fs::path parent = out_dir.has_parent_path() ? out_dir.parent_path() : fs::path(".");
-  fs::create_directories(parent);
-  const fs::path temporary =
-      parent / ("." + out_dir.filename().string() + ".tmp" + std::to_string(::getpid()));
-  fs::remove_all(temporary);
+  const OutputFolderRules rules = headless_out_rules("'facet play' or 'facet run'");
+  const fs::path out_dir = check_output_folder(options.out_dir, rules);
+  const bool replacing = fs::exists(fs::symlink_status(out_dir));
 
   HeadlessPlayResult result;
-  try {
-    fs::create_directories(temporary);
-    for (const SessionOutput& output : player.display().outputs)
-      fs::create_directories(temporary / output.spec.name);
-    std::ofstream stats_file(temporary / "stats.jsonl");
-    const bool replacing = fs::exists(fs::symlink_status(out_dir));
-    auto stop_if_interrupted = [&](std::uint64_t done) {
-      if (const int signal = interrupt_signal())
-        throw Interrupted(signal, "stopped after " + std::to_string(done) + " of " +
-                                      std::to_string(options.frames) +
-                                      " frames; nothing written to " + out_dir.string() +
-                                      (replacing ? " (what was there is kept)" : ""));
-    };
-    if (options.progress) options.progress({"frames", 0, options.frames});
-    for (std::uint64_t done = 0; done < options.frames; ++done) {
-      stop_if_interrupted(done);
-      FrameState state;
-      state.frame = done;
-      state.time_s = double(done) * kFramePeriod_s;
-      // In a cluster the master's frame state decides which video frame every node shows.
-      if (options.sync) {
-        std::optional<FrameState> next = options.sync->next_frame(state);
-        if (!next) break;
-        state = std::move(*next);
-      }
-      const std::uint64_t frame = state.frame;
-      PlayFrameStats stats = player.render(state, options.finish_each_frame || options.sync);
-      nlohmann::json line = play_frame_stats_to_json(stats);
-      const bool shown = !options.sync || options.sync->ready_to_swap(state, line);
-      stats_file << line.dump() << '\n' << std::flush;
-      for (std::size_t i = 0; shown && i < player.targets().size(); ++i) {
-        const OutputTarget& target = player.targets()[i];
-        const fs::path image =
-            fs::path(player.display().outputs[i].spec.name) / frame_file_name(frame);
-        write_png_rgba8(temporary / image, target.size(), target.read_colour_rgba8());
-        result.images.push_back(out_dir / image);
-      }
-      result.frames.push_back(std::move(stats));
-      if (options.progress) options.progress({"frames", done + 1, options.frames});
-    }
-    stats_file.close();
-    if (!stats_file)
-      throw std::runtime_error((out_dir / "stats.jsonl").string() + ": write failed");
-    stop_if_interrupted(options.frames);
-    const fs::path earlier =
-        parent / ("." + out_dir.filename().string() + ".old" + std::to_string(::getpid()));
-    if (replacing) fs::rename(out_dir, earlier);
-    try {
-      fs::rename(temporary, out_dir);
-    } catch (...) {
-      if (replacing) fs::rename(earlier, out_dir);
-      throw;
-    }
-    if (replacing) fs::remove_all(earlier);
-  } catch (...) {
-    std::error_code ignored;
-    fs::remove_all(temporary, ignored);
-    throw;
-  }
+  write_folder_atomically(
+      out_dir,
+      [&](const fs::path& temporary) {
+        for (const SessionOutput& output : player.display().outputs)
+          fs::create_directories(temporary / output.spec.name);
+        std::ofstream stats_file(temporary / "stats.jsonl");
+        auto stop_if_interrupted = [&](std::uint64_t done) {
+          if (const int signal = interrupt_signal())
+            throw Interrupted(signal, "stopped after " + std::to_string(done) + " of " +
+                                          std::to_string(options.frames) +
+                                          " frames; nothing written to " + out_dir.string() +
+                                          (replacing ? " (what was there is kept)" : ""));
+        };
+        if (options.progress) options.progress({"frames", 0, options.frames});
+        for (std::uint64_t done = 0; done < options.frames; ++done) {
+          stop_if_interrupted(done);
+          FrameState state;
+          state.frame = done;
+          state.time_s = double(done) * kFramePeriod_s;
+          // In a cluster the master's frame state decides which video frame every node shows.
+          if (options.sync) {
+            std::optional<FrameState> next = options.sync->next_frame(state);
+            if (!next) break;
+            state = std::move(*next);
+          }
+          const std::uint64_t frame = state.frame;
+          PlayFrameStats stats = player.render(state, options.finish_each_frame || options.sync);
+          nlohmann::json line = play_frame_stats_to_json(stats);
+          const bool shown = !options.sync || options.sync->ready_to_swap(state, line);
+          stats_file << line.dump() << '\n' << std::flush;
+          for (std::size_t i = 0; shown && i < player.targets().size(); ++i) {
+            const OutputTarget& target = player.targets()[i];
+            const fs::path image =
+                fs::path(player.display().outputs[i].spec.name) / frame_file_name(frame);
+            write_png_rgba8(temporary / image, target.size(), target.read_colour_rgba8());
+            result.images.push_back(out_dir / image);
+          }
+          result.frames.push_back(std::move(stats));
+          if (options.progress) options.progress({"frames", done + 1, options.frames});
+        }
+        stats_file.close();
+        if (!stats_file)
+          throw std::runtime_error((out_dir / "stats.jsonl").string() + ": write failed");
+        stop_if_interrupted(options.frames);
+      },
+      rules);
   return result;
 }
 

@@ -10,6 +10,7 @@
 #include <numbers>
 
 #include "facet/driver/display_outputs.hpp"
+#include "facet/projection/atomic_folder.hpp"
 #include "facet/projection/errors.hpp"
 #include "facet/projection_io/blend_file.hpp"
 #include "facet/projection_io/warp_file.hpp"
@@ -147,53 +148,46 @@ void scale_session_display(SessionDisplay& display, double factor) {
 void write_session_display(const SessionDisplay& display, const std::string& name,
                            const std::filesystem::path& folder) {
   namespace fs = std::filesystem;
-  if (fs::exists(folder))
-    throw InputError(folder.string(), "--out", "a folder that does not exist yet");
-  const fs::path parent = folder.has_parent_path() ? folder.parent_path() : fs::path(".");
-  fs::create_directories(parent);
-  const fs::path temporary = parent / ("." + folder.filename().string() + ".tmp");
-  fs::remove_all(temporary);
-  try {
-    fs::create_directories(temporary);
-    projection_io::DisplayConfig config;
-    config.name = name;
-    config.render.method = display.method;
-    if (const auto* tolerance = std::get_if<FacetTolerance>(&display.settings.facets.layout))
-      config.render.tolerance_px = tolerance->px;
-    config.render.z_near = display.settings.z_near;
-    config.missing_monitor = display.missing_monitor;
-    for (const SessionOutput& output : display.outputs) {
-      projection_io::DisplayProjector projector;
-      projector.name = output.spec.name;
-      projector.size = output.spec.warp.output_size;
-      projector.warp = output.spec.name + ".warp.exr";
-      write_warp((temporary / projector.warp).string(), output.spec.warp);
-      auto write_map = [&](const std::vector<float>& values, const std::string& file) {
-        projection_io::BlendMap map;
-        map.size = output.blend.size;
-        map.channels = output.blend.channels;
-        map.values = values;
-        projection_io::write_blend_map((temporary / file).string(), map);
-      };
-      if (!output.blend.alpha.empty()) {
-        projector.blend = output.spec.name + ".blend.exr";
-        write_map(output.blend.alpha, projector.blend->string());
-      }
-      if (!output.blend.black.empty()) {
-        projector.black = output.spec.name + ".black.exr";
-        write_map(output.blend.black, projector.black->string());
-      }
-      projector.gamma = output.encoding.gamma;
-      projector.output = output.placement;
-      config.projectors.push_back(std::move(projector));
-    }
-    projection_io::write_display_config(config, temporary / "display.json");
-    fs::rename(temporary, folder);
-  } catch (...) {
-    std::error_code ignored;
-    fs::remove_all(temporary, ignored);
-    throw;
-  }
+  OutputFolderRules rules;
+  rules.flag = "--out";
+  write_folder_atomically(
+      folder,
+      [&](const fs::path& temporary) {
+        projection_io::DisplayConfig config;
+        config.name = name;
+        config.render.method = display.method;
+        if (const auto* tolerance = std::get_if<FacetTolerance>(&display.settings.facets.layout))
+          config.render.tolerance_px = tolerance->px;
+        config.render.z_near = display.settings.z_near;
+        config.missing_monitor = display.missing_monitor;
+        for (const SessionOutput& output : display.outputs) {
+          projection_io::DisplayProjector projector;
+          projector.name = output.spec.name;
+          projector.size = output.spec.warp.output_size;
+          projector.warp = output.spec.name + ".warp.exr";
+          write_warp((temporary / projector.warp).string(), output.spec.warp);
+          auto write_map = [&](const std::vector<float>& values, const std::string& file) {
+            projection_io::BlendMap map;
+            map.size = output.blend.size;
+            map.channels = output.blend.channels;
+            map.values = values;
+            projection_io::write_blend_map((temporary / file).string(), map);
+          };
+          if (!output.blend.alpha.empty()) {
+            projector.blend = output.spec.name + ".blend.exr";
+            write_map(output.blend.alpha, projector.blend->string());
+          }
+          if (!output.blend.black.empty()) {
+            projector.black = output.spec.name + ".black.exr";
+            write_map(output.blend.black, projector.black->string());
+          }
+          projector.gamma = output.encoding.gamma;
+          projector.output = output.placement;
+          config.projectors.push_back(std::move(projector));
+        }
+        projection_io::write_display_config(config, temporary / "display.json");
+      },
+      rules);
 }
 
 namespace {

@@ -22,6 +22,7 @@
 #include "facet/driver/output_images.hpp"
 #include "facet/driver/program.hpp"
 #include "facet/projection/atomic_file.hpp"
+#include "facet/projection/atomic_folder.hpp"
 #include "facet/projection/errors.hpp"
 #include "facet/projection/interrupt.hpp"
 
@@ -65,15 +66,11 @@ bool is_frame_file_name(const std::string& name) {
                      [](char c) { return c >= '0' && c <= '9'; });
 }
 
-// True when `dir` holds nothing, or exactly what run_headless_session writes: a stats.jsonl and
-// folders of frame images, nothing else (no other file, no symbolic link).
-bool holds_earlier_run_or_nothing(const fs::path& dir) {
-  const fs::file_status status = fs::symlink_status(dir);
-  if (!fs::exists(status)) return true;
-  if (!fs::is_directory(status)) return false;
-  bool has_stats = false, empty = true;
+// True when the folder `dir` holds exactly what a headless run writes: a stats.jsonl and folders
+// of frame images, nothing else (no other file, no symbolic link).
+bool holds_earlier_run(const fs::path& dir) {
+  bool has_stats = false;
   for (const fs::directory_entry& entry : fs::directory_iterator(dir)) {
-    empty = false;
     const fs::file_status entry_status = entry.symlink_status();
     if (entry.path().filename() == "stats.jsonl" && fs::is_regular_file(entry_status)) {
       has_stats = true;
@@ -86,22 +83,7 @@ bool holds_earlier_run_or_nothing(const fs::path& dir) {
         return false;
     }
   }
-  return empty || has_stats;
-}
-
-// True when `dir` is the current folder or holds it: replacing it would remove the folder the
-// command runs in.
-bool holds_current_folder(const fs::path& dir) {
-  std::error_code error;
-  const fs::path target = fs::weakly_canonical(dir, error);
-  const fs::path current = fs::current_path(error);
-  if (error) return false;
-  auto t = target.begin(), c = current.begin();
-  for (; t != target.end() && c != current.end(); ++t, ++c) {
-    if (t->empty()) break;  // a trailing separator
-    if (*t != *c) return false;
-  }
-  return t == target.end() || t->empty();
+  return has_stats;
 }
 
 // The process's resident set in KiB, from /proc/self/statm; 0 where that cannot be read.
@@ -112,108 +94,91 @@ std::uint64_t resident_set_kib() {
   return resident_pages * static_cast<std::uint64_t>(::sysconf(_SC_PAGESIZE)) / 1024;
 }
 
+}  // namespace
+
 std::string frame_file_name(std::uint64_t frame) {
   char name[32];
   std::snprintf(name, sizeof name, "%05llu.png", static_cast<unsigned long long>(frame));
   return name;
 }
 
-}  // namespace
+OutputFolderRules headless_out_rules(const std::string& earlier) {
+  OutputFolderRules rules;
+  rules.flag = "--out";
+  rules.expected = "a new path, an empty folder, or a folder from an earlier " + earlier +
+                   " (stats.jsonl and folders of NNNNN.png, nothing else)";
+  rules.is_own_output = holds_earlier_run;
+  return rules;
+}
 
 HeadlessRunResult run_headless_session(Session& session, const CameraPath& path,
                                        const HeadlessRunOptions& options) {
-  // "run/" names the same folder as "run".
-  fs::path out_dir = options.out_dir.lexically_normal();
-  if (!out_dir.has_filename()) out_dir = out_dir.parent_path();
-  if (out_dir.empty()) throw InputError("command line", "--out", "expected an output folder");
   if (options.frames < 1 || options.frames > kMaxFrames)
     throw InputError("command line", "--frames",
                      "from 1 to " + std::to_string(kMaxFrames) + " frames");
   if (options.save_every < 1)
     throw InputError("command line", "--save-every", "a frame interval of at least 1");
-  if (holds_current_folder(out_dir))
-    throw InputError(out_dir.string(), "--out",
-                     "a folder other than the current folder and its parents");
-  if (!holds_earlier_run_or_nothing(out_dir))
-    throw InputError(out_dir.string(), "--out",
-                     "a new path, an empty folder, or a folder from an earlier 'facet run' "
-                     "(stats.jsonl and folders of NNNNN.png, nothing else)");
-  const fs::path parent = out_dir.has_parent_path() ? out_dir.parent_path() : fs::path(".");
-  fs::create_directories(parent);
-  const fs::path temporary =
-      parent / ("." + out_dir.filename().string() + ".tmp" + std::to_string(::getpid()));
-  fs::remove_all(temporary);
+  const OutputFolderRules rules = headless_out_rules("'facet run'");
+  const fs::path out_dir = check_output_folder(options.out_dir, rules);
+  const bool replacing = fs::exists(fs::symlink_status(out_dir));
 
   HeadlessRunResult result;
-  try {
-    fs::create_directories(temporary);
-    for (const SessionOutput& output : session.display().outputs)
-      fs::create_directories(temporary / output.spec.name);
-    std::ofstream stats_file(temporary / "stats.jsonl");
-    const bool replacing = fs::exists(fs::symlink_status(out_dir));
-    // Stops before a frame, and before the rename, once SIGINT or SIGTERM has arrived (after
-    // watch_interrupts); the catch below removes the temporary folder.
-    auto stop_if_interrupted = [&](std::uint64_t done) {
-      if (const int signal = interrupt_signal())
-        throw Interrupted(signal, "stopped after " + std::to_string(done) + " of " +
-                                      std::to_string(options.frames) +
-                                      " frames; nothing written to " + out_dir.string() +
-                                      (replacing ? " (what was there is kept)" : ""));
-    };
-    if (options.progress) options.progress({"frames", 0, options.frames});
-    for (std::uint64_t done = 0; done < options.frames; ++done) {
-      stop_if_interrupted(done);
-      FrameState state;
-      state.frame = done;
-      state.time_s = double(done) * kFramePeriod_s;
-      state.T_world_eye = path(state.time_s);
-      if (options.sync) {
-        std::optional<FrameState> next = options.sync->next_frame(state);
-        if (!next) break;
-        state = std::move(*next);
-      }
-      const std::uint64_t frame = state.frame;
-      FrameStats stats = session.render(state, options.finish_each_frame);
-      nlohmann::json line = frame_stats_to_json(stats);
-      const bool shown = !options.sync || options.sync->ready_to_swap(state, line);
-      const bool save = shown && (frame % options.save_every == 0 || frame + 1 == options.frames);
-      for (std::size_t i = 0; save && i < session.targets().size(); ++i) {
-        const OutputTarget& target = session.targets()[i];
-        const fs::path image =
-            fs::path(session.display().outputs[i].spec.name) / frame_file_name(frame);
-        write_png_rgba8(temporary / image, target.size(), target.read_colour_rgba8());
-        ++result.images_written;
-      }
-      const std::uint64_t rss_kib = resident_set_kib();
-      if (done == 0) result.rss_first_kib = rss_kib;
-      result.rss_peak_kib = std::max(result.rss_peak_kib, rss_kib);
-      line["rss_kib"] = rss_kib;
-      // Flushed per frame: whoever watches a long run (a cluster's tests) sees it progress.
-      stats_file << line.dump() << '\n' << std::flush;
-      result.frames = done + 1;
-      result.last = std::move(stats);
-      if (options.progress) options.progress({"frames", done + 1, options.frames});
-    }
-    stats_file.close();
-    if (!stats_file)
-      throw std::runtime_error((out_dir / "stats.jsonl").string() + ": write failed");
-    stop_if_interrupted(options.frames);
-    // The earlier run moves aside until the new one is in place.
-    const fs::path earlier =
-        parent / ("." + out_dir.filename().string() + ".old" + std::to_string(::getpid()));
-    if (replacing) fs::rename(out_dir, earlier);
-    try {
-      fs::rename(temporary, out_dir);
-    } catch (...) {
-      if (replacing) fs::rename(earlier, out_dir);
-      throw;
-    }
-    if (replacing) fs::remove_all(earlier);
-  } catch (...) {
-    std::error_code ignored;
-    fs::remove_all(temporary, ignored);
-    throw;
-  }
+  write_folder_atomically(
+      out_dir,
+      [&](const fs::path& temporary) {
+        for (const SessionOutput& output : session.display().outputs)
+          fs::create_directories(temporary / output.spec.name);
+        std::ofstream stats_file(temporary / "stats.jsonl");
+        // Stops before a frame, and before the rename, once SIGINT or SIGTERM has arrived (after
+        // watch_interrupts); write_folder_atomically then removes the temporary folder.
+        auto stop_if_interrupted = [&](std::uint64_t done) {
+          if (const int signal = interrupt_signal())
+            throw Interrupted(signal, "stopped after " + std::to_string(done) + " of " +
+                                          std::to_string(options.frames) +
+                                          " frames; nothing written to " + out_dir.string() +
+                                          (replacing ? " (what was there is kept)" : ""));
+        };
+        if (options.progress) options.progress({"frames", 0, options.frames});
+        for (std::uint64_t done = 0; done < options.frames; ++done) {
+          stop_if_interrupted(done);
+          FrameState state;
+          state.frame = done;
+          state.time_s = double(done) * kFramePeriod_s;
+          state.T_world_eye = path(state.time_s);
+          if (options.sync) {
+            std::optional<FrameState> next = options.sync->next_frame(state);
+            if (!next) break;
+            state = std::move(*next);
+          }
+          const std::uint64_t frame = state.frame;
+          FrameStats stats = session.render(state, options.finish_each_frame);
+          nlohmann::json line = frame_stats_to_json(stats);
+          const bool shown = !options.sync || options.sync->ready_to_swap(state, line);
+          const bool save =
+              shown && (frame % options.save_every == 0 || frame + 1 == options.frames);
+          for (std::size_t i = 0; save && i < session.targets().size(); ++i) {
+            const OutputTarget& target = session.targets()[i];
+            const fs::path image =
+                fs::path(session.display().outputs[i].spec.name) / frame_file_name(frame);
+            write_png_rgba8(temporary / image, target.size(), target.read_colour_rgba8());
+            ++result.images_written;
+          }
+          const std::uint64_t rss_kib = resident_set_kib();
+          if (done == 0) result.rss_first_kib = rss_kib;
+          result.rss_peak_kib = std::max(result.rss_peak_kib, rss_kib);
+          line["rss_kib"] = rss_kib;
+          // Flushed per frame: whoever watches a long run (a cluster's tests) sees it progress.
+          stats_file << line.dump() << '\n' << std::flush;
+          result.frames = done + 1;
+          result.last = std::move(stats);
+          if (options.progress) options.progress({"frames", done + 1, options.frames});
+        }
+        stats_file.close();
+        if (!stats_file)
+          throw std::runtime_error((out_dir / "stats.jsonl").string() + ": write failed");
+        stop_if_interrupted(options.frames);
+      },
+      rules);
   return result;
 }
 

@@ -1,24 +1,21 @@
 #include "facet/interop/display_folder.hpp"
 
-#include <unistd.h>
-
-#include <atomic>
 #include <fstream>
 #include <set>
-#include <system_error>
 
+#include "facet/projection/atomic_folder.hpp"
 #include "facet/projection/errors.hpp"
 #include "facet/projection_io/warp_file.hpp"
 
 namespace facet::interop {
 namespace {
 
-void check_new_folder(const std::filesystem::path& folder) {
-  std::error_code error;
-  if (std::filesystem::exists(folder, error) &&
-      !(std::filesystem::is_directory(folder) && std::filesystem::is_empty(folder))) {
-    throw InputError(folder.string(), "--out", "expected a folder that does not exist or is empty");
-  }
+// The imports and exports write a new or empty --out folder.
+OutputFolderRules out_folder_rules() {
+  OutputFolderRules rules;
+  rules.flag = "--out";
+  rules.expected = "expected a folder that does not exist or is empty";
+  return rules;
 }
 
 }  // namespace
@@ -70,53 +67,37 @@ void write_display_folder(const ImportedDisplay& display, const std::filesystem:
   }
   projection_io::validate_display_config(config, folder.string() + "/display.json", false);
 
-  write_folder_atomically(folder, [&](const fs::path& temporary) {
-    for (std::size_t p = 0; p < display.projectors.size(); ++p) {
-      const ImportedProjector& projector = display.projectors[p];
-      const projection_io::DisplayProjector& entry = config.projectors[p];
-      write_warp((temporary / entry.warp).string(), projector.warp);
-      if (projector.blend)
-        projection_io::write_blend_map((temporary / *entry.blend).string(), *projector.blend);
-      if (projector.black)
-        projection_io::write_blend_map((temporary / *entry.black).string(), *projector.black);
-    }
-    projection_io::write_display_config(config, temporary / "display.json");
-  });
-}
-
-void write_folder_atomically(const std::filesystem::path& folder,
-                             const std::function<void(const std::filesystem::path&)>& fill) {
-  namespace fs = std::filesystem;
-  check_new_folder(folder);
-  static std::atomic<unsigned> counter{0};
-  fs::path parent = folder.parent_path();
-  if (parent.empty()) parent = ".";
-  const fs::path temporary =
-      parent / ("." + folder.filename().string() + ".tmp" + std::to_string(::getpid()) + "-" +
-                std::to_string(counter++));
-  std::error_code error;
-  try {
-    fs::create_directories(temporary);
-    fill(temporary);
-    if (fs::exists(folder)) fs::remove(folder);  // empty, checked above
-    fs::rename(temporary, folder);
-  } catch (...) {
-    fs::remove_all(temporary, error);
-    throw;
-  }
+  write_folder_atomically(
+      folder,
+      [&](const fs::path& temporary) {
+        for (std::size_t p = 0; p < display.projectors.size(); ++p) {
+          const ImportedProjector& projector = display.projectors[p];
+          const projection_io::DisplayProjector& entry = config.projectors[p];
+          write_warp((temporary / entry.warp).string(), projector.warp);
+          if (projector.blend)
+            projection_io::write_blend_map((temporary / *entry.blend).string(), *projector.blend);
+          if (projector.black)
+            projection_io::write_blend_map((temporary / *entry.black).string(), *projector.black);
+        }
+        projection_io::write_display_config(config, temporary / "display.json");
+      },
+      out_folder_rules());
 }
 
 void write_files_folder(const std::map<std::string, std::string>& files,
                         const std::filesystem::path& folder) {
-  write_folder_atomically(folder, [&](const std::filesystem::path& temporary) {
-    for (const auto& [name, bytes] : files) {
-      std::ofstream out(temporary / name, std::ios::binary);
-      out << bytes;
-      if (!out.flush()) {
-        throw InputError((folder / name).string(), "", "cannot write the file");
-      }
-    }
-  });
+  write_folder_atomically(
+      folder,
+      [&](const std::filesystem::path& temporary) {
+        for (const auto& [name, bytes] : files) {
+          std::ofstream out(temporary / name, std::ios::binary);
+          out << bytes;
+          if (!out.flush()) {
+            throw InputError((folder / name).string(), "", "cannot write the file");
+          }
+        }
+      },
+      out_folder_rules());
 }
 
 }  // namespace facet::interop

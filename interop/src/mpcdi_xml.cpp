@@ -1,4 +1,5 @@
 // MPCDI XML: parsing and writing the container's description, and the frustum conventions.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <glm/gtc/matrix_transform.hpp>

@@ -198,7 +198,7 @@ void expect_input_error_naming(const fs::path& capture, const fs::path& out,
   EXPECT_EQ(run_cli("calibrate " + capture.string() + " --out " + out.string()), 2);
   EXPECT_FALSE(fs::exists(out));
   for (const auto& entry : fs::directory_iterator(out.parent_path())) {
-    EXPECT_EQ(entry.path().filename().string().find(".tmp-"), std::string::npos)
+    EXPECT_EQ(entry.path().filename().string().find(".tmp"), std::string::npos)
         << "left behind: " << entry.path();
   }
 }

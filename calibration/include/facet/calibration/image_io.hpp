@@ -1,8 +1,6 @@
 #pragma once
-// Image files for captures and patterns, through OpenImageIO, plus writing a whole folder
-// atomically.
+// Image files for captures and patterns, through OpenImageIO.
 #include <filesystem>
-#include <functional>
 #include <glm/glm.hpp>
 #include <opencv2/core.hpp>
 #include <string>
@@ -33,11 +31,5 @@ void write_grey_image(const std::filesystem::path& path, const cv::Mat& image, i
 // Writes a CV_8UC3 image, channels in R, G, B order, as an 8-bit RGB PNG (or any format the
 // extension names), through a temporary file renamed onto `path`. InputError when it cannot.
 void write_rgb_image(const std::filesystem::path& path, const cv::Mat& rgb);
-
-// Calls write(temporary_folder) with a new folder beside `folder`, then renames it onto `folder`.
-// `folder` must not exist or be an empty folder (InputError otherwise). If write throws, the
-// temporary folder is removed and the exception propagates.
-void write_folder_atomically(const std::filesystem::path& folder,
-                             const std::function<void(const std::filesystem::path&)>& write);
 
 }  // namespace facet::calibration

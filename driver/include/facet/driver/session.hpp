@@ -55,8 +55,8 @@ SessionDisplay load_session_display(std::string_view display,
 // nearest pixel. The geometry stays exact up to the rounding of the output size.
 void scale_session_display(SessionDisplay& display, double factor);
 
-// Writes `display` as a display.json folder (warps, blends, black levels, display.json) under a
-// temporary name, renamed to `folder` when complete; `folder` must not exist yet (InputError).
+// Writes `display` as a display.json folder (warps, blends, black levels, display.json) through
+// write_folder_atomically: `folder` must not exist yet or be empty (InputError naming --out).
 void write_session_display(const SessionDisplay& display, const std::string& name,
                            const std::filesystem::path& folder);
 

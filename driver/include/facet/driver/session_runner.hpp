@@ -12,6 +12,7 @@
 #include "facet/driver/scene.hpp"
 #include "facet/driver/scene_view.hpp"
 #include "facet/driver/session.hpp"
+#include "facet/projection/atomic_folder.hpp"
 #include "facet/projection/progress.hpp"
 
 namespace facet::driver {
@@ -55,6 +56,14 @@ struct HeadlessRunResult {
   std::uint64_t rss_first_kib = 0;   // resident set after the first frame
   std::uint64_t rss_peak_kib = 0;    // largest resident set after any frame
 };
+
+// A headless run's image of frame `frame`: its number in five or more digits, then ".png".
+std::string frame_file_name(std::uint64_t frame);
+
+// The rules for a headless run's --out (atomic_folder.hpp): a new path, an empty folder, or a
+// folder an earlier headless run wrote (stats.jsonl and folders of NNNNN.png, nothing else).
+// `earlier` names the commands that write such folders, for the error ("'facet run'").
+OutputFolderRules headless_out_rules(const std::string& earlier);
 
 // Renders frames 0..frames-1 at times k·kFramePeriod_s along `path` and writes
 // out_dir/<output>/<frame, 5 digits>.png (every save_every-th frame and the last) and

@@ -2,7 +2,6 @@
 // Writing an imported display: a folder holding display.json (FORMATS.md §4) with one
 // `.warp.exr` per projector and its optional blend and black-level maps.
 #include <filesystem>
-#include <functional>
 #include <map>
 #include <optional>
 #include <string>
@@ -44,13 +43,7 @@ std::string sanitize_name(const std::string& text);
 // exist or be empty (InputError naming it otherwise).
 void write_display_folder(const ImportedDisplay& display, const std::filesystem::path& folder);
 
-// Creates `folder` (it must not exist or be empty: InputError naming it otherwise) by letting
-// `fill` write into a temporary folder next to it, which is then renamed onto it; a failure leaves
-// nothing behind.
-void write_folder_atomically(const std::filesystem::path& folder,
-                             const std::function<void(const std::filesystem::path&)>& fill);
-
-// The same for files given as name → bytes.
+// Writes files given as name → bytes the same way into `folder`.
 void write_files_folder(const std::map<std::string, std::string>& files,
                         const std::filesystem::path& folder);
 
