@@ -154,6 +154,7 @@ void require_closed_quotes(std::string_view text, const std::string& source) {
 }  // namespace
 
 CameraModel CameraModel::read(const std::filesystem::path& path) {
+  const Activity activity("reading the camera model " + path.string());
   require_regular_file(path);
   std::ifstream stream(path);
   if (!stream) throw InputError(path.string(), "", "a readable mrcal .cameramodel file");

@@ -210,6 +210,7 @@ void validate_capture(const Capture& capture, const std::string& source) {
 }
 
 Capture read_capture(const std::filesystem::path& path) {
+  const Activity activity("reading the capture " + path.string());
   using namespace json_fields;
   std::error_code error;
   const std::filesystem::path file =

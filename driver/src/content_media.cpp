@@ -93,6 +93,7 @@ bool is_still_image_path(const fs::path& path) {
 ContentMedia::~ContentMedia() = default;
 
 std::unique_ptr<ContentMedia> ContentMedia::open(const fs::path& path) {
+  const Activity activity("opening the content " + path.string());
   require_regular_file(path);
   std::unique_ptr<ContentMedia> media(new ContentMedia());
   media->path_ = path;

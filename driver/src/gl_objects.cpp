@@ -153,6 +153,11 @@ void Framebuffer::check_complete() const {
     default:
       break;
   }
+  // An attachment the GL could not allocate (llvmpipe out of memory, a GPU out of video memory)
+  // leaves it incomplete: the size asked for is too large for this machine.
+  if (status == GL_FRAMEBUFFER_INCOMPLETE_ATTACHMENT || status == GL_FRAMEBUFFER_UNSUPPORTED) {
+    throw ResourceExhausted(std::string("the GL could not allocate a framebuffer (") + name + ")");
+  }
   throw std::runtime_error(std::string("Framebuffer::check_complete: ") + name);
 }
 

@@ -518,6 +518,7 @@ std::string lower(std::string s) {
 }  // namespace
 
 Scene load_gltf(const std::filesystem::path& path) {
+  const Activity activity("loading the glTF scene " + path.string());
   const std::string source = path.string();
   const std::string extension = lower(path.extension().string());
   if (extension != ".gltf" && extension != ".glb")

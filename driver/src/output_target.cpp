@@ -50,6 +50,8 @@ OutputTarget OutputTarget::create(glm::ivec2 size, int msaa_samples) {
                      "at most " + std::to_string(max_msaa) + " samples per pixel on this GL; got " +
                          std::to_string(msaa_samples));
   }
+  const Activity activity("allocating the framebuffers of a " + std::to_string(size.x) + "x" +
+                          std::to_string(size.y) + " output");
   OutputTarget target;
   target.size_ = size;
   target.msaa_samples_ = msaa_samples > 1 ? msaa_samples : 0;

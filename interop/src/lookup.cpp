@@ -7,11 +7,19 @@
 
 #include "facet/projection/atomic_file.hpp"
 #include "facet/projection/errors.hpp"
+#include "facet/projection/memory_budget.hpp"
 #include "facet/projection/warp_inverse.hpp"
 
 namespace facet::interop {
 
 void write_lookup(const Warp& warp, const std::filesystem::path& path) {
+  const Activity activity("writing the lookup " + path.string());
+  // Per output pixel: its st (two doubles), the image's 7 floats, and the inverse's own tables
+  // (about as much again as st).
+  const std::uint64_t pixels_count = std::uint64_t(warp.output_size.x) * warp.output_size.y;
+  require_memory(pixels_count * (2 * 16 + 7 * 4), path.string(), "output_size",
+                 "a lookup of " + std::to_string(warp.output_size.x) + "x" +
+                     std::to_string(warp.output_size.y) + " pixels");
   const WarpInverse inverse(warp);
   const std::vector<glm::dvec2> st = inverse.st_at_pixel_centres();
   const int w = warp.output_size.x, h = warp.output_size.y;

@@ -337,6 +337,7 @@ MpcdiFiles read_zip(std::string_view bytes, const std::string& source) {
 }
 
 MpcdiFiles read_zip_file(const std::filesystem::path& path) {
+  const Activity activity("reading the MPCDI container " + path.string());
   require_regular_file(path);
   std::ifstream stream(path, std::ios::binary);
   if (!stream) throw InputError(path.string(), "", "cannot open the file");

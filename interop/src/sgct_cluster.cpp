@@ -332,6 +332,7 @@ std::map<const void*, std::string> pair_sibling_simcad(const pugi::xml_node& clu
 ImportedDisplay import_sgct_cluster(const std::filesystem::path& config,
                                     const SgctImportOptions& options) {
   const std::string source = config.string();
+  const Activity activity("importing the SGCT cluster " + source);
   const std::string xml = read_file(config, source, "");
   pugi::xml_document document;
   load_xml(document, xml, source);

@@ -2,8 +2,35 @@
 
 #include <cstdio>
 #include <cstdlib>
+#include <mutex>
 
 namespace facet {
+
+namespace {
+
+std::mutex failed_mutex;
+std::string failed_activity;
+
+}  // namespace
+
+Activity::Activity(std::string what)
+    : what_(std::move(what)), exceptions_at_start_(std::uncaught_exceptions()) {
+  const std::lock_guard lock(failed_mutex);
+  failed_activity.clear();
+}
+
+Activity::~Activity() {
+  if (std::uncaught_exceptions() <= exceptions_at_start_) return;
+  // Unwinding: the innermost step is destroyed first and keeps its name; moving the string
+  // allocates nothing, which matters when the exception is std::bad_alloc.
+  const std::lock_guard lock(failed_mutex);
+  if (failed_activity.empty()) failed_activity = std::move(what_);
+}
+
+std::string Activity::failed() {
+  const std::lock_guard lock(failed_mutex);
+  return failed_activity;
+}
 
 void assertion_failed(const char* function, const char* condition, const char* file, int line) {
   std::fprintf(stderr, "%s: assertion '%s' failed (%s:%d)\n", function, condition, file, line);

@@ -33,6 +33,7 @@
 #include <nlohmann/json.hpp>
 #include <opencv2/core.hpp>
 #include <opencv2/videoio.hpp>
+#include <set>
 #include <string>
 #include <thread>
 #include <utility>
@@ -68,6 +69,13 @@ struct Variant {
   std::string output;
   std::vector<std::string> mentions;
 };
+
+// Variants that fail only under the suite's address-space limit (a size a machine with that much
+// memory cannot hold): the sanitizer build runs without the limit, so it skips them.
+std::set<std::string>& address_limited() {
+  static std::set<std::string> names;
+  return names;
+}
 
 // ---- Byte-level mutations of a valid file -------------------------------------------------------
 
@@ -562,6 +570,9 @@ void add_warp_exr(std::vector<Variant>& out) {
   add_exr("meta_output_size_zero", with_meta("/output_size", "[0, 0]"), "output_size");
   add_exr("meta_output_size_huge", with_meta("/output_size", "[1000000, 1000000]"), "output_size");
   add_exr("meta_output_size_short", with_meta("/output_size", "[2048]"), "output_size");
+  // Within the size limits, but the lookup's tables need about 4 GiB: refused up front.
+  add_exr("meta_output_size_over_memory", with_meta("/output_size", "[8192, 8192]"), "output_size");
+  address_limited().insert("warp_exr_meta_output_size_over_memory");
   add_exr("meta_rotation_zero", with_meta("/rotation", "[[0,0,0],[0,0,0],[0,0,0]]"), "rotation");
   add_exr("meta_rotation_shape", with_meta("/rotation", "[1, 2, 3]"), "rotation");
   add_exr("meta_invalid_utf8", with_meta("/base", "\"\xff\xfe\""), "base");
@@ -1814,6 +1825,9 @@ std::vector<std::string> leftover_temporaries(const fs::path& dir) {
 }
 
 void check_variant(const Variant& variant) {
+#ifdef __SANITIZE_ADDRESS__
+  if (address_limited().contains(variant.name)) return;
+#endif
   const fs::path root = fs::temp_directory_path() / ("facet_hostile_" + std::to_string(::getpid()));
   const fs::path scratch = root / variant.name;
   std::error_code ec;

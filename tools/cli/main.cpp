@@ -1,7 +1,20 @@
+#include <sys/resource.h>
+#include <unistd.h>
+
 #include <algorithm>
+#include <cstdint>
+#include <cstdio>
 #include <exception>
+#include <filesystem>
 #include <iostream>
+#include <new>
+#include <nlohmann/json.hpp>
+#include <stdexcept>
 #include <string>
+#if __has_include(<opencv2/core.hpp>)
+#include <opencv2/core.hpp>
+#define FACET_CLI_HAS_OPENCV 1
+#endif
 
 #include "command.hpp"
 #include "facet/projection/errors.hpp"
@@ -16,6 +29,104 @@ std::vector<std::pair<int, CommandSetup>>& CommandRegistry::commands() {
 
 Registration::Registration(int order, CommandSetup setup) {
   CommandRegistry::commands().emplace_back(order, std::move(setup));
+}
+
+namespace {
+
+// The arguments that name existing files or folders, outputs aside: the inputs a failure
+// without a source of its own is reported against.
+std::string inputs_of(int argc, char** argv) {
+  std::string inputs;
+  for (int i = 2; i < argc; ++i) {
+    std::error_code ec;
+    const std::string arg = argv[i];
+    const std::string before = argv[i - 1];
+    if (before == "--out" || before == "--stats") continue;
+    if (arg.empty() || arg.starts_with("-") || !std::filesystem::exists(arg, ec)) continue;
+    inputs += (inputs.empty() ? "" : ", ") + arg;
+  }
+  return inputs.empty() ? "the command line" : inputs;
+}
+
+// What the process may allocate: its address-space limit, else the machine's memory.
+std::string memory_limit() {
+  rlimit limit{};
+  double bytes = 0;
+  const char* kind = "physical memory";
+  if (::getrlimit(RLIMIT_AS, &limit) == 0 && limit.rlim_cur != RLIM_INFINITY) {
+    bytes = static_cast<double>(limit.rlim_cur);
+    kind = "address-space limit";
+  } else {
+    bytes = static_cast<double>(::sysconf(_SC_PHYS_PAGES)) *
+            static_cast<double>(::sysconf(_SC_PAGESIZE));
+  }
+  char text[64];
+  std::snprintf(text, sizeof text, "%.1f GiB %s", bytes / double(1 << 30), kind);
+  return text;
+}
+
+}  // namespace
+
+// Maps an exception that left a command to its message on stderr and the exit status: 2 for the
+// input's fault (InputError, exhausted memory or GL resources, a library's complaint about a file
+// being read), 3 for a lost peer, 1 for a bug (named by its function where it says so).
+int report_failure(std::exception_ptr failure, const std::string& command, int argc, char** argv) {
+  const std::string prefix = "facet" + (command.empty() ? "" : " " + command);
+  const std::string activity = facet::Activity::failed();
+  const std::string doing = activity.empty() ? "running " + prefix : activity;
+  auto input_error = [&](const std::string& what) {
+    std::cerr << prefix << ": error: " << what << "\n";
+    return 2;
+  };
+  auto out_of_memory = [&](const std::string& detail) {
+    return input_error("out of memory while " + doing + ", input " + inputs_of(argc, argv) +
+                       ": it asks for more than this process may use (" + memory_limit() + "); " +
+                       detail);
+  };
+  try {
+    std::rethrow_exception(failure);
+  } catch (const facet::Interrupted& e) {
+    // A long command stopped on SIGINT or SIGTERM after removing its temporary outputs; what()
+    // says what was done.
+    std::cerr << prefix << ": interrupted by " << facet::signal_name(e.signal()) << ": " << e.what()
+              << "\n";
+    return e.exit_status();
+  } catch (const facet::InputError& e) {
+    std::cerr << "facet: error: " << e.what() << "\n";
+    return 2;
+  } catch (const facet::PeerLost& e) {
+    std::cerr << "facet: stopped: " << e.what() << "\n";
+    return 3;
+  } catch (const std::bad_alloc&) {
+    return out_of_memory("ask for smaller sizes, grids or counts");
+  } catch (const std::length_error& e) {
+    return out_of_memory(std::string("a size too large to hold (") + e.what() + ")");
+  } catch (const facet::ResourceExhausted& e) {
+    return input_error(std::string(e.what()) + " while " + doing + ", input " +
+                       inputs_of(argc, argv) + " (" + memory_limit() + "); ask for smaller sizes");
+  } catch (const std::filesystem::filesystem_error& e) {
+    const std::string path = e.path1().empty() ? inputs_of(argc, argv) : e.path1().string();
+    return input_error(path + ": " + e.code().message() + " (while " + doing + ")");
+  } catch (const nlohmann::json::exception& e) {
+    return input_error("while " + doing + ", input " + inputs_of(argc, argv) +
+                       ": JSON that cannot be read (" + e.what() + ")");
+#ifdef FACET_CLI_HAS_OPENCV
+  } catch (const cv::Exception& e) {
+    if (e.code == cv::Error::StsNoMem) return out_of_memory("ask for smaller images");
+    // OpenCV's complaint while a step on an input was under way is about that input.
+    if (!activity.empty()) {
+      return input_error("while " + doing + ", input " + inputs_of(argc, argv) + ": " + e.err);
+    }
+    std::cerr << prefix << ": internal error: " << e.what() << "\n";
+    return 1;
+#endif
+  } catch (const std::exception& e) {
+    std::cerr << prefix << ": internal error: " << e.what() << "\n";
+    return 1;
+  } catch (...) {
+    std::cerr << prefix << ": internal error: an exception of unknown type\n";
+    return 1;
+  }
 }
 
 }  // namespace facet::cli
@@ -38,23 +149,15 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     app.exit(e);
     return 2;
-  } catch (const facet::Interrupted& e) {
-    // A long command stopped on SIGINT or SIGTERM after removing its temporary outputs; what()
-    // says what was done.
+  } catch (...) {
     const std::string command =
-        app.get_subcommands().empty() ? "" : " " + app.get_subcommands().front()->get_name();
-    std::cerr << "facet" << command << ": interrupted by " << facet::signal_name(e.signal()) << ": "
-              << e.what() << "\n";
-    return e.exit_status();
-  } catch (const facet::InputError& e) {
-    std::cerr << "facet: error: " << e.what() << "\n";
-    return 2;
-  } catch (const facet::PeerLost& e) {
-    std::cerr << "facet: stopped: " << e.what() << "\n";
-    return 3;
-  } catch (const std::exception& e) {
-    std::cerr << "facet: internal error: " << e.what() << "\n";
-    return 1;
+        app.get_subcommands().empty() ? "" : app.get_subcommands().front()->get_name();
+    try {
+      return facet::cli::report_failure(std::current_exception(), command, argc, argv);
+    } catch (...) {  // no memory left even for the message
+      std::fputs("facet: error: out of memory\n", stderr);
+      return 2;
+    }
   }
   return 0;
 }

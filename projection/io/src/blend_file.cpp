@@ -57,6 +57,7 @@ void BlendMap::validate(const std::string& source) const {
 }
 
 BlendMap read_blend_map(const std::string& path, std::optional<glm::ivec2> expected_size) {
+  const Activity activity("reading the blend map " + path);
   require_regular_file(path);
   auto input = OIIO::ImageInput::open(path);
   if (!input) throw InputError(path, "", "cannot open as an image: " + OIIO::geterror());

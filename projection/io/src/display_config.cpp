@@ -484,6 +484,7 @@ DisplayConfig parse_display_config(const std::string& text, const std::string& s
 }
 
 DisplayConfig read_display_config(const std::filesystem::path& path, bool check_files) {
+  const Activity activity("reading the display " + path.string());
   std::error_code error;
   const std::filesystem::path file =
       std::filesystem::is_directory(path, error) ? path / "display.json" : path;

@@ -251,6 +251,7 @@ Rig parse_rig(const std::string& text_in, const std::string& source) {
 }
 
 Rig read_rig(const std::filesystem::path& path) {
+  const Activity activity("reading the rig " + path.string());
   require_regular_file(path);
   std::ifstream stream(path);
   if (!stream) throw InputError(path.string(), "", "a readable rig JSON file");

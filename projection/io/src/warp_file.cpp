@@ -125,6 +125,7 @@ void base_from_json(const json& meta, const std::string& path, Warp& warp) {
 }  // namespace
 
 Warp read_warp(const std::string& path) {
+  const Activity activity("reading the warp " + path);
   require_regular_file(path);
   auto input = OIIO::ImageInput::open(path);
   if (!input) {

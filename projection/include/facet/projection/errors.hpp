@@ -4,6 +4,7 @@
 // InputError is the user's fault (a bad file, field or flag): it names the source, the field and
 // what was expected, and the CLI turns it into exit status 2. Programmer errors are assertions
 // (FACET_ASSERT) whose message starts with the function name.
+#include <exception>
 #include <stdexcept>
 #include <string>
 
@@ -36,6 +37,33 @@ class InputError : public std::runtime_error {
 class PeerLost : public std::runtime_error {
  public:
   using std::runtime_error::runtime_error;
+};
+
+// A resource an input asks for could not be had: memory, or a GL object (a framebuffer of the
+// requested size). Like InputError it is the input's fault: the CLI reports it with exit status 2,
+// naming what the command was doing (Activity).
+class ResourceExhausted : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+// What the command is doing, for errors that carry no context of their own: std::bad_alloc, a
+// ResourceExhausted, a library's exception. Declare one for the duration of a step, naming the
+// step and its input ("reading the warp p0.warp.exr"). When an exception leaves the step, the
+// innermost Activity it leaves is remembered until the next Activity starts; the CLI names it.
+class Activity {
+ public:
+  explicit Activity(std::string what);
+  ~Activity();
+  Activity(const Activity&) = delete;
+  Activity& operator=(const Activity&) = delete;
+
+  // The step the last exception left, or "" when it left none (or a step started since).
+  static std::string failed();
+
+ private:
+  std::string what_;
+  int exceptions_at_start_;
 };
 
 [[noreturn]] void assertion_failed(const char* function, const char* condition, const char* file,
