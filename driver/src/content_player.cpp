@@ -17,7 +17,6 @@
 #include "facet/driver/monitors.hpp"
 #include "facet/driver/output_images.hpp"
 #include "facet/driver/program.hpp"
-#include "facet/projection/atomic_folder.hpp"
 #include "facet/projection/errors.hpp"
 #include "facet/projection/interrupt.hpp"
 
@@ -147,60 +146,18 @@ PlayFrameStats ContentPlayer::render(const FrameState& state, bool finish) {
 }
 
 HeadlessPlayResult run_headless_play(ContentPlayer& player, const HeadlessRunOptions& options) {
-  if (options.frames < 1 || options.frames > kMaxFrames)
-    throw InputError("command line", "--frames",
-                     "from 1 to " + std::to_string(kMaxFrames) + " frames");
-  const OutputFolderRules rules = headless_out_rules("'facet play' or 'facet run'");
-  const fs::path out_dir = check_output_folder(options.out_dir, rules);
-  const bool replacing = fs::exists(fs::symlink_status(out_dir));
-
+  HeadlessRunOptions every_frame = options;
+  every_frame.save_every = 1;
   HeadlessPlayResult result;
-  write_folder_atomically(
-      out_dir,
-      [&](const fs::path& temporary) {
-        for (const SessionOutput& output : player.display().outputs)
-          fs::create_directories(temporary / output.spec.name);
-        std::ofstream stats_file(temporary / "stats.jsonl");
-        auto stop_if_interrupted = [&](std::uint64_t done) {
-          if (const int signal = interrupt_signal())
-            throw Interrupted(signal, "stopped after " + std::to_string(done) + " of " +
-                                          std::to_string(options.frames) +
-                                          " frames; nothing written to " + out_dir.string() +
-                                          (replacing ? " (what was there is kept)" : ""));
-        };
-        if (options.progress) options.progress({"frames", 0, options.frames});
-        for (std::uint64_t done = 0; done < options.frames; ++done) {
-          stop_if_interrupted(done);
-          FrameState state;
-          state.frame = done;
-          state.time_s = double(done) * kFramePeriod_s;
-          // In a cluster the master's frame state decides which video frame every node shows.
-          if (options.sync) {
-            std::optional<FrameState> next = options.sync->next_frame(state);
-            if (!next) break;
-            state = std::move(*next);
-          }
-          const std::uint64_t frame = state.frame;
-          PlayFrameStats stats = player.render(state, options.finish_each_frame || options.sync);
-          nlohmann::json line = play_frame_stats_to_json(stats);
-          const bool shown = !options.sync || options.sync->ready_to_swap(state, line);
-          stats_file << line.dump() << '\n' << std::flush;
-          for (std::size_t i = 0; shown && i < player.targets().size(); ++i) {
-            const OutputTarget& target = player.targets()[i];
-            const fs::path image =
-                fs::path(player.display().outputs[i].spec.name) / frame_file_name(frame);
-            write_png_rgba8(temporary / image, target.size(), target.read_colour_rgba8());
-            result.images.push_back(out_dir / image);
-          }
-          result.frames.push_back(std::move(stats));
-          if (options.progress) options.progress({"frames", done + 1, options.frames});
-        }
-        stats_file.close();
-        if (!stats_file)
-          throw std::runtime_error((out_dir / "stats.jsonl").string() + ": write failed");
-        stop_if_interrupted(options.frames);
+  write_headless_frames(
+      every_frame, "'facet play' or 'facet run'", player.display(), player.targets(), {},
+      [&](const FrameState& state) {
+        result.frames.push_back(player.render(state, options.finish_each_frame || options.sync));
+        return play_frame_stats_to_json(result.frames.back());
       },
-      rules);
+      [&](std::uint64_t, nlohmann::json&, std::span<const fs::path> images) {
+        result.images.insert(result.images.end(), images.begin(), images.end());
+      });
   return result;
 }
 

@@ -94,39 +94,35 @@ std::uint64_t resident_set_kib() {
   return resident_pages * static_cast<std::uint64_t>(::sysconf(_SC_PAGESIZE)) / 1024;
 }
 
-}  // namespace
-
 std::string frame_file_name(std::uint64_t frame) {
   char name[32];
   std::snprintf(name, sizeof name, "%05llu.png", static_cast<unsigned long long>(frame));
   return name;
 }
 
-OutputFolderRules headless_out_rules(const std::string& earlier) {
-  OutputFolderRules rules;
-  rules.flag = "--out";
-  rules.expected = "a new path, an empty folder, or a folder from an earlier " + earlier +
-                   " (stats.jsonl and folders of NNNNN.png, nothing else)";
-  rules.is_own_output = holds_earlier_run;
-  return rules;
-}
+}  // namespace
 
-HeadlessRunResult run_headless_session(Session& session, const CameraPath& path,
-                                       const HeadlessRunOptions& options) {
+void write_headless_frames(const HeadlessRunOptions& options, const std::string& earlier,
+                           const SessionDisplay& display, std::span<const OutputTarget> targets,
+                           const CameraPath& path, const RenderHeadlessFrame& render,
+                           const HeadlessFrameDone& done_frame) {
+  FACET_ASSERT(targets.size() == display.outputs.size());
   if (options.frames < 1 || options.frames > kMaxFrames)
     throw InputError("command line", "--frames",
                      "from 1 to " + std::to_string(kMaxFrames) + " frames");
   if (options.save_every < 1)
     throw InputError("command line", "--save-every", "a frame interval of at least 1");
-  const OutputFolderRules rules = headless_out_rules("'facet run'");
+  OutputFolderRules rules;
+  rules.flag = "--out";
+  rules.expected = "a new path, an empty folder, or a folder from an earlier " + earlier +
+                   " (stats.jsonl and folders of NNNNN.png, nothing else)";
+  rules.is_own_output = holds_earlier_run;
   const fs::path out_dir = check_output_folder(options.out_dir, rules);
   const bool replacing = fs::exists(fs::symlink_status(out_dir));
-
-  HeadlessRunResult result;
   write_folder_atomically(
       out_dir,
       [&](const fs::path& temporary) {
-        for (const SessionOutput& output : session.display().outputs)
+        for (const SessionOutput& output : display.outputs)
           fs::create_directories(temporary / output.spec.name);
         std::ofstream stats_file(temporary / "stats.jsonl");
         // Stops before a frame, and before the rename, once SIGINT or SIGTERM has arrived (after
@@ -139,38 +135,32 @@ HeadlessRunResult run_headless_session(Session& session, const CameraPath& path,
                                           (replacing ? " (what was there is kept)" : ""));
         };
         if (options.progress) options.progress({"frames", 0, options.frames});
+        std::vector<fs::path> images;
         for (std::uint64_t done = 0; done < options.frames; ++done) {
           stop_if_interrupted(done);
           FrameState state;
           state.frame = done;
           state.time_s = double(done) * kFramePeriod_s;
-          state.T_world_eye = path(state.time_s);
+          if (path) state.T_world_eye = path(state.time_s);
           if (options.sync) {
             std::optional<FrameState> next = options.sync->next_frame(state);
             if (!next) break;
             state = std::move(*next);
           }
           const std::uint64_t frame = state.frame;
-          FrameStats stats = session.render(state, options.finish_each_frame);
-          nlohmann::json line = frame_stats_to_json(stats);
+          nlohmann::json line = render(state);
           const bool shown = !options.sync || options.sync->ready_to_swap(state, line);
           const bool save =
               shown && (frame % options.save_every == 0 || frame + 1 == options.frames);
-          for (std::size_t i = 0; save && i < session.targets().size(); ++i) {
-            const OutputTarget& target = session.targets()[i];
-            const fs::path image =
-                fs::path(session.display().outputs[i].spec.name) / frame_file_name(frame);
-            write_png_rgba8(temporary / image, target.size(), target.read_colour_rgba8());
-            ++result.images_written;
+          images.clear();
+          for (std::size_t i = 0; save && i < targets.size(); ++i) {
+            const fs::path image = fs::path(display.outputs[i].spec.name) / frame_file_name(frame);
+            write_png_rgba8(temporary / image, targets[i].size(), targets[i].read_colour_rgba8());
+            images.push_back(out_dir / image);
           }
-          const std::uint64_t rss_kib = resident_set_kib();
-          if (done == 0) result.rss_first_kib = rss_kib;
-          result.rss_peak_kib = std::max(result.rss_peak_kib, rss_kib);
-          line["rss_kib"] = rss_kib;
+          if (done_frame) done_frame(done, line, images);
           // Flushed per frame: whoever watches a long run (a cluster's tests) sees it progress.
           stats_file << line.dump() << '\n' << std::flush;
-          result.frames = done + 1;
-          result.last = std::move(stats);
           if (options.progress) options.progress({"frames", done + 1, options.frames});
         }
         stats_file.close();
@@ -179,6 +169,25 @@ HeadlessRunResult run_headless_session(Session& session, const CameraPath& path,
         stop_if_interrupted(options.frames);
       },
       rules);
+}
+
+HeadlessRunResult run_headless_session(Session& session, const CameraPath& path,
+                                       const HeadlessRunOptions& options) {
+  HeadlessRunResult result;
+  write_headless_frames(
+      options, "'facet run'", session.display(), session.targets(), path,
+      [&](const FrameState& state) {
+        result.last = session.render(state, options.finish_each_frame);
+        return frame_stats_to_json(result.last);
+      },
+      [&](std::uint64_t done, nlohmann::json& line, std::span<const fs::path> images) {
+        result.images_written += images.size();
+        const std::uint64_t rss_kib = resident_set_kib();
+        if (done == 0) result.rss_first_kib = rss_kib;
+        result.rss_peak_kib = std::max(result.rss_peak_kib, rss_kib);
+        line["rss_kib"] = rss_kib;
+        result.frames = done + 1;
+      });
   return result;
 }
 

@@ -4,7 +4,9 @@
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <nlohmann/json.hpp>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -57,13 +59,28 @@ struct HeadlessRunResult {
   std::uint64_t rss_peak_kib = 0;    // largest resident set after any frame
 };
 
-// A headless run's image of frame `frame`: its number in five or more digits, then ".png".
-std::string frame_file_name(std::uint64_t frame);
+// What a headless run does per frame: render the frame `state` into the targets and return its
+// statistics line.
+using RenderHeadlessFrame = std::function<nlohmann::json(const FrameState& state)>;
+// Called per frame `done` (0, 1, ...) after its images were written (final paths, none when the
+// frame was not saved), before its line goes to stats.jsonl: may add to the line.
+using HeadlessFrameDone = std::function<void(std::uint64_t done, nlohmann::json& line,
+                                             std::span<const std::filesystem::path> images)>;
 
-// The rules for a headless run's --out (atomic_folder.hpp): a new path, an empty folder, or a
-// folder an earlier headless run wrote (stats.jsonl and folders of NNNNN.png, nothing else).
-// `earlier` names the commands that write such folders, for the error ("'facet run'").
-OutputFolderRules headless_out_rules(const std::string& earlier);
+// The frame loop of every headless run (run_headless_session, run_headless_play). Checks
+// options.frames (1 to kMaxFrames), options.save_every (>= 1) and options.out_dir, which may be
+// new, an empty folder or an earlier headless run's folder (stats.jsonl and folders of
+// NNNNN.png, nothing else; `earlier` names the commands that write one, for the error: "'facet
+// run'"); then through write_folder_atomically: for done = 0..frames-1 the state of time
+// done·kFramePeriod_s and eye path(time) (`path` may be empty), or what options.sync makes of it,
+// goes to render; the images of `targets` (one per display output) of every shown frame that
+// save_every selects (and of the last) go to out_dir/<output>/<frame, 5 digits>.png, and the
+// line to out_dir/stats.jsonl. SIGINT or SIGTERM (after watch_interrupts) stops it before the
+// next frame or before the rename with Interrupted, leaving out_dir as it was.
+void write_headless_frames(const HeadlessRunOptions& options, const std::string& earlier,
+                           const SessionDisplay& display, std::span<const OutputTarget> targets,
+                           const CameraPath& path, const RenderHeadlessFrame& render,
+                           const HeadlessFrameDone& done_frame);
 
 // Renders frames 0..frames-1 at times k·kFramePeriod_s along `path` and writes
 // out_dir/<output>/<frame, 5 digits>.png (every save_every-th frame and the last) and
