@@ -3,6 +3,7 @@
 #include <charconv>
 #include <glm/gtc/matrix_transform.hpp>
 
+#include "facet/driver/depth_image.hpp"
 #include "facet/driver/gltf_loader.hpp"
 #include "facet/projection/errors.hpp"
 
@@ -11,7 +12,8 @@ namespace {
 
 constexpr const char* kExpected =
     "builtin:city, builtin:city:K (K x K tiles, K in 1..64), builtin:city-fine:N (every "
-    "triangle cut into N², N in 1..64) or a .gltf/.glb file";
+    "triangle cut into N², N in 1..64) or a .gltf/.glb file, optionally followed by "
+    "+depth:FILE.exr depth images, or depth:FILE.exr alone";
 
 [[noreturn]] void refuse(std::string_view text, const std::string& why) {
   throw InputError("command line", "--scene",
@@ -36,6 +38,29 @@ std::uint64_t city_triangles() {
 }  // namespace
 
 SceneName parse_scene_name(std::string_view text) {
+  // Depth images: "depth:A.exr", "depth:A.exr+depth:B.exr", "SCENE+depth:A.exr".
+  constexpr std::string_view kDepth = "depth:", kMoreDepth = "+depth:";
+  const bool only_depth = text.starts_with(kDepth);
+  const std::size_t first_depth = only_depth ? 0 : text.find(kMoreDepth);
+  if (first_depth != std::string_view::npos) {
+    std::vector<std::filesystem::path> files;
+    std::string_view rest = text.substr(first_depth + (only_depth ? kDepth : kMoreDepth).size());
+    while (true) {
+      const std::size_t next = rest.find(kMoreDepth);
+      const std::string_view file = rest.substr(0, next);
+      if (!file.ends_with(".exr") || file.size() <= 4)
+        refuse(text, "a depth image is a .exr file: depth:FILE.exr");
+      files.emplace_back(file);
+      if (next == std::string_view::npos) break;
+      rest = rest.substr(next + kMoreDepth.size());
+    }
+    SceneName name;
+    if (!only_depth) name = parse_scene_name(text.substr(0, first_depth));
+    if (only_depth) name.kind = SceneName::Kind::depth_images;
+    name.text = std::string(text);
+    name.depth_images = std::move(files);
+    return name;
+  }
   SceneName name;
   name.text = std::string(text);
   if (text.starts_with("builtin:")) {
@@ -75,12 +100,15 @@ std::uint64_t builtin_scene_triangles(const SceneName& name) {
     case SceneName::Kind::city_fine:
       return city_triangles() * std::uint64_t(name.count) * std::uint64_t(name.count);
     case SceneName::Kind::file:
+    case SceneName::Kind::depth_images:
       break;
   }
   return 0;
 }
 
-Scene load_scene(const SceneName& name) {
+namespace {
+
+Scene load_polygons(const SceneName& name) {
   switch (name.kind) {
     case SceneName::Kind::city:
       return build_city();
@@ -90,8 +118,24 @@ Scene load_scene(const SceneName& name) {
       return name.count == 1 ? build_city() : subdivide_triangles(build_city(), name.count);
     case SceneName::Kind::file:
       break;
+    case SceneName::Kind::depth_images:
+      return Scene{};
   }
   return load_gltf(name.file);
+}
+
+}  // namespace
+
+Scene load_scene(const SceneName& name) {
+  Scene scene = load_polygons(name);
+  for (std::size_t k = 0; k < name.depth_images.size(); ++k) {
+    Scene mesh = depth_image_mesh(read_depth_image(name.depth_images[k])).scene;
+    mesh.name = name.depth_images[k].filename().string();
+    scene = (k == 0 && name.kind == SceneName::Kind::depth_images)
+                ? std::move(mesh)
+                : merge_scenes(std::move(scene), mesh);
+  }
+  return scene;
 }
 
 FrameViews::FrameViews(const SceneView& view, double city_step_s, bool static_view)

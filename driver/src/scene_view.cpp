@@ -179,6 +179,14 @@ SceneView choose_scene_view(const Scene& scene, const ViewRequest& request, bool
   if (request.look_at_world)
     throw InputError("command line", "--look-at", "expected --eye as well: the point to look from");
 
+  const auto depth_eye =
+      std::find_if(scene.cameras.begin(), scene.cameras.end(),
+                   [](const SceneCamera& c) { return c.name == kDepthImageEyeCamera; });
+  if (depth_eye != scene.cameras.end()) {
+    view.T_world_eye = depth_eye->T_world_camera;
+    view.pivot_world = glm::dvec3(view.T_world_eye[3]);
+    return view;
+  }
   if (builtin_city) {
     view.follows_city_path = true;
     return view;

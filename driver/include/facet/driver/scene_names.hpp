@@ -9,6 +9,10 @@
 //                         [1, 64]: 34,642 N² triangles; :4 has 554,272, :8 2,217,088,
 //                         :17 10,011,538
 //   FILE.gltf, FILE.glb   a glTF 2.0 file (load_gltf)
+//   depth:FILE.exr        a depth image (depth_image.hpp) drawn as its grid mesh; several as
+//                         depth:A.exr+depth:B.exr
+//   SCENE+depth:FILE.exr  hybrid: any scene above and depth images, in one z-buffer (the depth
+//                         images' triangles numbered after the scene's)
 // Names that would give more than kMaxSceneTriangles triangles are refused before anything is
 // built.
 #include <cstdint>
@@ -16,6 +20,7 @@
 #include <glm/mat4x4.hpp>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "facet/driver/city.hpp"
 #include "facet/driver/scene.hpp"
@@ -27,27 +32,32 @@ inline constexpr std::uint64_t kMaxSceneTriangles = 64'000'000;
 // The --scene values, for command-line help.
 inline constexpr const char* kSceneNameSyntax =
     "builtin:city | builtin:city:K (KxK tiles) | builtin:city-fine:N (each triangle in N^2) | "
-    "FILE.gltf";
+    "FILE.gltf | depth:FILE.exr (a depth image) | SCENE+depth:FILE.exr (hybrid)";
 
 struct SceneName {
-  enum class Kind { city, city_tiles, city_fine, file };
+  // depth_images: no polygon scene, only the depth images.
+  enum class Kind { city, city_tiles, city_fine, file, depth_images };
   Kind kind = Kind::city;
   int count = 1;               // K of builtin:city:K, N of builtin:city-fine:N, else 1
   std::filesystem::path file;  // Kind::file only
   std::string text;            // as given
-  // The built-in city in any form: its camera path applies.
-  bool builtin_city() const { return kind != Kind::file; }
+  // The depth images drawn with (or, for Kind::depth_images, instead of) the scene.
+  std::vector<std::filesystem::path> depth_images;
+  // The built-in city in any form: its camera path applies (a depth image's eye comes first:
+  // choose_scene_view).
+  bool builtin_city() const { return kind != Kind::file && kind != Kind::depth_images; }
 };
 
 // Parses a --scene value. InputError("command line", "--scene", what was expected) for an unknown
-// builtin: name, a count that is not a whole number in range, a file that is not .gltf/.glb, or a
-// built-in scene of more than kMaxSceneTriangles triangles.
+// builtin: name, a count that is not a whole number in range, a file that is not .gltf/.glb, a
+// depth image that is not .exr, or a built-in scene of more than kMaxSceneTriangles triangles.
 SceneName parse_scene_name(std::string_view text);
 
 // Triangles of a built-in scene, counted without building it (0 for files).
 std::uint64_t builtin_scene_triangles(const SceneName& name);
 
-// Builds or loads the scene (load_gltf's InputError for a bad file).
+// Builds or loads the scene (load_gltf's and read_depth_image's InputError for a bad file), the
+// depth images' grid meshes (depth_image_mesh, default options) appended.
 Scene load_scene(const SceneName& name);
 inline Scene load_scene(std::string_view text) { return load_scene(parse_scene_name(text)); }
 

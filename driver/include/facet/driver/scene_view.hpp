@@ -50,6 +50,8 @@ struct SceneView {
 // - eye_world: the eye there, looking at look_at_world (default: the bounds' centre), circling
 //   the point looked at. InputError naming --eye / --look-at when the two coincide, and naming
 //   --look-at when it comes without --eye.
+// - neither, a scene holding a SceneCamera named kDepthImageEyeCamera (a depth image's mesh,
+//   depth_image.hpp): the eye at that camera, turning on the spot.
 // - neither, built-in city: its camera path.
 // - neither, other scenes: the eye at the bounds' centre, turning on the spot; but when that
 //   centre is inside closed geometry (eye_inside_geometry) the eye goes outside and above the
@@ -57,6 +59,9 @@ struct SceneView {
 //   and circling it; `message` says so.
 // An explicit eye or camera inside geometry is kept, with a warning in `message`.
 SceneView choose_scene_view(const Scene& scene, const ViewRequest& request, bool builtin_city);
+
+// The camera a depth image's mesh carries at the image's eye point (depth_image_mesh).
+inline constexpr const char* kDepthImageEyeCamera = "depth-image-eye";
 
 // The number of rays cast by eye_inside_geometry.
 inline constexpr int kInsideTestRays = 26;
