@@ -9,6 +9,7 @@
 #include <thread>
 
 #include "facet/projection/errors.hpp"
+#include "facet/projection/memory_budget.hpp"
 #include "raster.hpp"
 
 namespace facet {
@@ -233,6 +234,11 @@ DisplayPreview preview_display(std::span<const PreviewProjector> projectors,
   const int height = options.height_px;
   preview.size = {view.format == ContentFormat::fisheye ? height : 2 * height, height};
   const std::size_t pixels = std::size_t(preview.size.x) * preview.size.y;
+  // The maps below take 32 bytes a pixel; the image drawn from them and its encoding about as
+  // much again.
+  require_memory(
+      std::uint64_t(pixels) * 64, source, "--preview-size",
+      "a " + std::to_string(preview.size.x) + "x" + std::to_string(preview.size.y) + " preview");
   for (const PreviewProjector& projector : projectors) preview.names.push_back(projector.name);
   preview.in_view.assign(pixels, 0);
   preview.count.assign(pixels, 0);

@@ -1654,6 +1654,11 @@ void add_flags(std::vector<Variant>& out) {
   add("render_size_huge",
       {"render", "--display", "builtin:dome180", "--size", "100000x100000", "--out", "@out"},
       "--size");
+  // Within --preview-size's range, but its maps need about 2.1 GiB: refused up front (it ended in
+  // std::bad_alloc).
+  add("preview_size_over_memory", {"preview", dome, "--preview-size", "6000", "--out", "@out"},
+      "--preview-size");
+  address_limited().insert("flag_preview_size_over_memory");
   add("render_size_text",
       {"render", "--display", "builtin:dome180", "--size", "big", "--out", "@out"}, "--size");
   add("render_frames_zero",
