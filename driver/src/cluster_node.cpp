@@ -19,6 +19,7 @@
 #include <thread>
 
 #include "facet/driver/cluster.hpp"
+#include "facet/driver/session_runner.hpp"
 #include "facet/projection/errors.hpp"
 #include "facet/projection/interrupt.hpp"
 
@@ -721,6 +722,45 @@ ClusterNodeShare keep_cluster_node_outputs(SessionDisplay& display,
   }
   display.outputs = std::move(kept);
   return share;
+}
+
+NodeDisplay load_node_display(const std::string& display, std::optional<glm::ivec2> size,
+                              std::optional<double> scale, const ClusterRequest& request) {
+  NodeDisplay loaded{load_session_display(display, size), std::nullopt};
+  if (scale) scale_session_display(loaded.display, *scale);
+  if (!request.node.empty()) {
+    if (!display.ends_with(".json"))
+      throw InputError("command line", "--node", "a display.json with a cluster section");
+    loaded.cluster = keep_cluster_node_outputs(loaded.display, display, request.node);
+    if (!loaded.cluster->master && request.frames_given)
+      throw InputError("command line", "--frames",
+                       "no --frames on a secondary node: the master's --frames ends the run on "
+                       "every node");
+    if (!loaded.cluster->master && request.rate_hz)
+      throw InputError("command line", "--rate", "no --rate on a secondary: the master paces");
+    if (!(request.join_timeout_s > 0 && request.join_timeout_s <= 86400))
+      throw InputError("command line", "--join-timeout", "seconds in (0, 86400]");
+  } else if (request.rate_hz) {
+    throw InputError("command line", "--rate", "--node: --rate paces a cluster's master");
+  }
+  if (request.rate_hz && !(*request.rate_hz > 0 && *request.rate_hz <= 10000))
+    throw InputError("command line", "--rate", "frames per second in (0, 10000]");
+  return loaded;
+}
+
+std::unique_ptr<FrameSync> join_cluster(const ClusterNodeShare& share, const std::string& display,
+                                        const ClusterRequest& request,
+                                        std::uint64_t content_digest) {
+  FACET_ASSERT(share.config.cluster);
+  ClusterNodeOptions options;
+  options.cluster = *share.config.cluster;
+  options.source = display;
+  options.node = share.node;
+  options.frame_period_s = kFramePeriod_s;
+  options.join_timeout = std::chrono::milliseconds(std::int64_t(request.join_timeout_s * 1000));
+  options.rate_hz = request.rate_hz;
+  options.content_digest = content_digest;
+  return share.master ? make_cluster_master(options) : make_cluster_secondary(options);
 }
 
 std::unique_ptr<FrameSync> make_cluster_secondary(const ClusterNodeOptions& options) {

@@ -122,6 +122,61 @@ TEST(ClusterWire, DigestsTellContentsApart) {
   EXPECT_EQ(digest_hex(0x1234), "0000000000001234");
 }
 
+// ---- The display of one node --------------------------------------------------------------
+
+// load_node_display: a node keeps its own projectors at the asked scale; the flags that make no
+// sense for its role, or for no cluster, are refused by name.
+TEST(NodeDisplay, ANodeKeepsItsProjectorsAndItsRoleIsChecked) {
+  const fs::path folder =
+      fs::temp_directory_path() / ("facet-node-display-" + std::to_string(::getpid()));
+  fs::remove_all(folder);
+  write_session_display(load_session_display("builtin:wall2x2", glm::ivec2(64, 40)), "wall",
+                        folder / "wall");
+  const fs::path json = folder / "wall" / "display.json";
+  pio::DisplayConfig config = pio::read_display_config(json);
+  ASSERT_EQ(config.projectors.size(), 4u);
+  pio::DisplayCluster cluster;
+  cluster.nodes.push_back(
+      {"a", "tcp://127.0.0.1:7400", {config.projectors[0].name, config.projectors[1].name}, true});
+  cluster.nodes.push_back(
+      {"b", "tcp://127.0.0.1:7410", {config.projectors[2].name, config.projectors[3].name}, false});
+  cluster.master = "a";
+  config.cluster = cluster;
+  fs::remove(json);
+  pio::write_display_config(config, json);
+
+  auto field_of = [&](const std::string& display, const ClusterRequest& request) {
+    try {
+      load_node_display(display, std::nullopt, std::nullopt, request);
+    } catch (const InputError& e) {
+      return e.field();
+    }
+    return std::string("no error");
+  };
+  EXPECT_EQ(field_of("builtin:wall2x2", {"a", false, std::nullopt, 60}), "--node");
+  EXPECT_EQ(field_of("builtin:wall2x2", {"", false, 30.0, 60}), "--rate");
+  EXPECT_EQ(field_of(json.string(), {"b", true, std::nullopt, 60}), "--frames");
+  EXPECT_EQ(field_of(json.string(), {"b", false, 30.0, 60}), "--rate");
+  EXPECT_EQ(field_of(json.string(), {"a", false, 0.0, 60}), "--rate");
+  EXPECT_EQ(field_of(json.string(), {"a", false, std::nullopt, 0}), "--join-timeout");
+
+  const NodeDisplay secondary =
+      load_node_display(json.string(), std::nullopt, 0.5, {"b", false, std::nullopt, 5});
+  ASSERT_TRUE(secondary.cluster);
+  EXPECT_FALSE(secondary.cluster->master);
+  ASSERT_EQ(secondary.display.outputs.size(), 2u);
+  EXPECT_EQ(secondary.display.outputs[0].spec.name, config.projectors[2].name);
+  EXPECT_EQ(secondary.display.outputs[1].spec.warp.output_size, glm::ivec2(32, 20));
+  const NodeDisplay master =
+      load_node_display(json.string(), std::nullopt, std::nullopt, {"a", true, 30.0, 60});
+  ASSERT_TRUE(master.cluster);
+  EXPECT_TRUE(master.cluster->master);
+  EXPECT_EQ(master.display.outputs.size(), 2u);
+  EXPECT_EQ(load_node_display(json.string(), std::nullopt, std::nullopt, {}).display.outputs.size(),
+            4u);
+  fs::remove_all(folder);
+}
+
 // ---- The protocol, on threads -----------------------------------------------------------------
 
 struct Scratch {

@@ -106,30 +106,16 @@ void run(const RunOptions& options) {
   std::optional<glm::ivec2> size;
   if (!options.size.empty()) size = parse_size(options.size, "--size");
   const auto orientation = builtin_dome_orientation(options.orientation, options.display);
-  driver::SessionDisplay display = driver::load_session_display(options.display, size);
+  // A cluster node renders its own projectors only.
+  const driver::ClusterRequest cluster_request{options.node, options.frames.has_value(),
+                                               options.rate_hz, options.join_timeout_s};
+  driver::NodeDisplay node_display =
+      driver::load_node_display(options.display, size, options.scale, cluster_request);
+  driver::SessionDisplay& display = node_display.display;
+  const std::optional<driver::ClusterNodeShare>& cluster_share = node_display.cluster;
   for (auto& output : display.outputs) {
     if (orientation) orient_warp(output.spec.warp, *orientation);
   }
-  // A cluster node renders its own projectors only.
-  std::optional<driver::ClusterNodeShare> cluster_share;
-  if (!options.node.empty()) {
-    if (!options.display.ends_with(".json"))
-      throw InputError("command line", "--node", "a display.json with a cluster section");
-    cluster_share = driver::keep_cluster_node_outputs(display, options.display, options.node);
-    if (!cluster_share->master && options.frames)
-      throw InputError("command line", "--frames",
-                       "no --frames on a secondary node: the master's --frames ends the run on "
-                       "every node");
-    if (!cluster_share->master && options.rate_hz)
-      throw InputError("command line", "--rate", "no --rate on a secondary: the master paces");
-    if (!(options.join_timeout_s > 0 && options.join_timeout_s <= 86400))
-      throw InputError("command line", "--join-timeout", "seconds in (0, 86400]");
-  } else if (options.rate_hz) {
-    throw InputError("command line", "--rate", "--node: --rate paces a cluster's master");
-  }
-  if (options.rate_hz && !(*options.rate_hz > 0 && *options.rate_hz <= 10000))
-    throw InputError("command line", "--rate", "frames per second in (0, 10000]");
-  if (options.scale) driver::scale_session_display(display, *options.scale);
   if (!options.method.empty()) display.method = options.method;
   if (options.tolerance) {
     if (!(*options.tolerance > 0))
@@ -157,22 +143,13 @@ void run(const RunOptions& options) {
   // found before any GL work.
   std::unique_ptr<driver::FrameSync> sync;
   if (cluster_share) {
-    driver::ClusterNodeOptions node_options;
-    node_options.cluster = *cluster_share->config.cluster;
-    node_options.source = options.display;
-    node_options.node = cluster_share->node;
-    node_options.frame_period_s = driver::kFramePeriod_s;
-    node_options.join_timeout =
-        std::chrono::milliseconds(std::int64_t(options.join_timeout_s * 1000));
-    node_options.rate_hz = options.rate_hz;
-    node_options.content_digest =
+    sync = driver::join_cluster(
+        *cluster_share, options.display, cluster_request,
         driver::content_digest(cluster_share->config, options.display, scene_name.text,
                                scene_name.kind == driver::SceneName::Kind::file
                                    ? std::optional<std::filesystem::path>(scene_name.file)
                                    : std::nullopt,
-                               picture_settings(options, display));
-    sync = cluster_share->master ? driver::make_cluster_master(node_options)
-                                 : driver::make_cluster_secondary(node_options);
+                               picture_settings(options, display)));
   }
 
   // From here on SIGINT and SIGTERM stop the run cleanly (Interrupted, exit 128 + signal).

@@ -163,4 +163,34 @@ ClusterNodeShare keep_cluster_node_outputs(SessionDisplay& display,
                                            const std::filesystem::path& display_file,
                                            const std::string& node);
 
+// ---- The display a session or playback runs on, as one node or alone ------------------------
+
+// What `facet run` and `facet play` ask of a cluster.
+struct ClusterRequest {
+  std::string node;               // this process's node; "" when not part of a cluster
+  bool frames_given = false;      // a frame count was asked for (only the master's ends a run)
+  std::optional<double> rate_hz;  // the master's pace, frames per second in (0, 10000]
+  double join_timeout_s = 60;     // in (0, 86400]
+};
+
+struct NodeDisplay {
+  SessionDisplay display;
+  std::optional<ClusterNodeShare> cluster;  // set when the request names a node
+};
+
+// load_session_display(display, size), then scale_session_display(scale) when a scale is given,
+// then, for a cluster node, its own outputs only (keep_cluster_node_outputs). InputError naming
+// the flag for a node of a display that is not a display.json (--node), a frame count (--frames)
+// or a rate (--rate) on a secondary node, a rate without a node or out of range, and a join
+// timeout out of range (--join-timeout).
+NodeDisplay load_node_display(const std::string& display, std::optional<glm::ivec2> size,
+                              std::optional<double> scale, const ClusterRequest& request);
+
+// Joins `share`'s cluster as its master or a secondary (make_cluster_master,
+// make_cluster_secondary) at kFramePeriod_s, with the request's timeout and pace and the
+// content_digest of what this node shows.
+std::unique_ptr<FrameSync> join_cluster(const ClusterNodeShare& share, const std::string& display,
+                                        const ClusterRequest& request,
+                                        std::uint64_t content_digest);
+
 }  // namespace facet::driver
