@@ -231,6 +231,14 @@ std::uint64_t FacetMethodBase::buffer_bytes(const OutputState& out) const {
   return bytes;
 }
 
+bool FacetMethodBase::add_output_stats(const OutputState& out, RenderStats& stats) const {
+  stats.facets += out.facets.mesh.facets.size();
+  stats.triangles_in += out.triangles;
+  stats.triangles_sole_piece += out.triangles_sole_piece;
+  stats.gpu_buffer_bytes += buffer_bytes(out);
+  return out.triangles != 0 && !out.facets.mesh.facets.empty();
+}
+
 void FacetMethodBase::set_material(const Program& program, std::uint32_t m) const {
   if (m >= scene_->materials.size()) {
     const glm::vec4 white(1.0f);

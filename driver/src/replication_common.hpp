@@ -131,6 +131,9 @@ class FacetMethodBase : public RenderMethod {
   // GPU bytes of output state `out`: facet tables, coverage grid and hierarchy, triangle list,
   // scan, staging, pairs, statistics and draw arguments.
   std::uint64_t buffer_bytes(const OutputState& out) const;
+  // Adds output `out`'s fixed figures to `stats` (facets, list triangles, those on one facet,
+  // buffer_bytes); returns whether it has anything to draw (list triangles and facets).
+  bool add_output_stats(const OutputState& out, RenderStats& stats) const;
   // Program uniforms of replication_lib.comp for output i.
   void set_list_uniforms(const Program& program, std::size_t i) const;
 

@@ -61,11 +61,7 @@ class TessellatedPipeline final : public FacetMethodBase {
     for (std::size_t i = 0; i < outputs_.size(); ++i) {
       OutputState& out = outputs_[i];
       targets[i].clear();
-      stats.facets += out.facets.mesh.facets.size();
-      stats.triangles_in += out.triangles;
-      stats.triangles_sole_piece += out.triangles_sole_piece;
-      stats.gpu_buffer_bytes += buffer_bytes(out);
-      if (out.triangles == 0 || out.facets.mesh.facets.empty()) {
+      if (!add_output_stats(out, stats)) {
         targets[i].resolve();
         continue;
       }
