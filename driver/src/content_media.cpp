@@ -12,6 +12,7 @@
 #include "facet/projection/errors.hpp"
 #include "facet/projection/input_file.hpp"
 #include "facet/projection/warp.hpp"
+#include "facet/projection_io/exr_header.hpp"
 
 namespace facet::driver {
 
@@ -46,6 +47,7 @@ void check_content_size(glm::ivec2 size, const std::string& source) {
 
 ContentImage read_still_image(const fs::path& path) {
   const std::string source = path.string();
+  projection_io::check_exr_header(source);
   auto input = OIIO::ImageInput::open(source);
   if (!input)
     throw InputError(

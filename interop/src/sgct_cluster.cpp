@@ -54,12 +54,17 @@ std::string attribute_of(const pugi::xml_node& node, std::initializer_list<const
 std::filesystem::path resolve(const std::string& written, const std::filesystem::path& folder,
                               const std::string& source, const std::string& field,
                               std::vector<std::string>& notes) {
+  // A name the system cannot look up (too long, a loop of links) is no file either.
+  auto is_file = [](const std::filesystem::path& path) {
+    std::error_code ec;
+    return std::filesystem::is_regular_file(path, ec);
+  };
   const std::filesystem::path as_written(written);
-  if (as_written.is_absolute() && std::filesystem::is_regular_file(as_written)) return as_written;
-  if (std::filesystem::is_regular_file(folder / as_written)) return folder / as_written;
+  if (as_written.is_absolute() && is_file(as_written)) return as_written;
+  if (is_file(folder / as_written)) return folder / as_written;
   const std::size_t slash = written.find_last_of("/\\");
   const std::string name = slash == std::string::npos ? written : written.substr(slash + 1);
-  if (!name.empty() && std::filesystem::is_regular_file(folder / name)) {
+  if (!name.empty() && is_file(folder / name)) {
     notes.push_back(field + " \"" + written + "\" not found; took \"" + name +
                     "\" next to the configuration");
     return folder / name;
@@ -254,7 +259,8 @@ std::map<const void*, std::string> pair_sibling_simcad(const pugi::xml_node& clu
   for (const std::string& mesh : meshes) {
     const std::filesystem::path table =
         folder / (std::filesystem::path(mesh).stem().string() + "_frustum.csv");
-    tables.push_back(std::filesystem::is_regular_file(table)
+    std::error_code error_table;
+    tables.push_back(std::filesystem::is_regular_file(table, error_table)
                          ? std::optional(read_frustum_table(table))
                          : std::nullopt);
     every_table = every_table && tables.back().has_value();

@@ -9,6 +9,7 @@
 #include "facet/projection/atomic_file.hpp"
 #include "facet/projection/errors.hpp"
 #include "facet/projection/input_file.hpp"
+#include "facet/projection_io/exr_header.hpp"
 
 namespace facet::projection_io {
 namespace {
@@ -59,6 +60,7 @@ void BlendMap::validate(const std::string& source) const {
 BlendMap read_blend_map(const std::string& path, std::optional<glm::ivec2> expected_size) {
   const Activity activity("reading the blend map " + path);
   require_regular_file(path);
+  check_exr_header(path);
   auto input = OIIO::ImageInput::open(path);
   if (!input) throw InputError(path, "", "cannot open as an image: " + OIIO::geterror());
   const OIIO::ImageSpec& spec = input->spec();

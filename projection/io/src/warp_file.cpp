@@ -8,6 +8,7 @@
 #include "facet/projection/atomic_file.hpp"
 #include "facet/projection/errors.hpp"
 #include "facet/projection/input_file.hpp"
+#include "facet/projection_io/exr_header.hpp"
 
 namespace facet {
 namespace {
@@ -127,6 +128,7 @@ void base_from_json(const json& meta, const std::string& path, Warp& warp) {
 Warp read_warp(const std::string& path) {
   const Activity activity("reading the warp " + path);
   require_regular_file(path);
+  projection_io::check_exr_header(path);
   auto input = OIIO::ImageInput::open(path);
   if (!input) {
     throw InputError(path, "", "cannot open as an image: " + OIIO::geterror());
