@@ -28,6 +28,7 @@ glm::vec3 sample_texture(const Image& image, glm::vec2 uv, bool repeat,
                          const std::array<float, 256>& decode) {
   if (image.width < 1 || image.height < 1) return glm::vec3(1);
   const float x = uv.x * float(image.width) - 0.5f, y = uv.y * float(image.height) - 0.5f;
+  if (!(std::abs(x) < 1e9f && std::abs(y) < 1e9f)) return glm::vec3(1);  // no texel to name
   const float fx = std::floor(x), fy = std::floor(y);
   const auto wrap = [&](long k, int n) {
     if (repeat) return int(((k % n) + n) % n);
@@ -36,7 +37,6 @@ glm::vec3 sample_texture(const Image& image, glm::vec2 uv, bool repeat,
   glm::vec3 sum(0);
   for (int dy = 0; dy < 2; ++dy) {
     for (int dx = 0; dx < 2; ++dx) {
-      if (!std::isfinite(fx) || !std::isfinite(fy)) return glm::vec3(1);
       const int i = wrap(long(fx) + dx, image.width), j = wrap(long(fy) + dy, image.height);
       const float w = (dx ? x - fx : 1 - (x - fx)) * (dy ? y - fy : 1 - (y - fy));
       const std::uint8_t* texel = &image.rgba[(std::size_t(j) * image.width + i) * 4];
@@ -185,7 +185,8 @@ DepthImage run_depth_image_command(const DepthImageCommand& command) {
   check_image_size(request.size, "command line", "--size");
   const SceneName name = parse_scene_name(command.scene);
   {
-    std::vector<std::filesystem::path> inputs = name.depth_images;
+    std::vector<std::filesystem::path> inputs;
+    for (const DepthImageName& image : name.depth_images) inputs.push_back(image.file);
     if (name.kind == SceneName::Kind::file) inputs.push_back(name.file);
     for (const std::filesystem::path& input : inputs)
       refuse_output_over_inputs(command.out, "--out", {input});

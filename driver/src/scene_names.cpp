@@ -43,14 +43,21 @@ SceneName parse_scene_name(std::string_view text) {
   const bool only_depth = text.starts_with(kDepth);
   const std::size_t first_depth = only_depth ? 0 : text.find(kMoreDepth);
   if (first_depth != std::string_view::npos) {
-    std::vector<std::filesystem::path> files;
+    std::vector<DepthImageName> files;
     std::string_view rest = text.substr(first_depth + (only_depth ? kDepth : kMoreDepth).size());
     while (true) {
       const std::size_t next = rest.find(kMoreDepth);
-      const std::string_view file = rest.substr(0, next);
+      std::string_view file = rest.substr(0, next);
+      DepthImageName image;
+      const std::size_t at = file.rfind(".exr@");
+      if (at != std::string_view::npos) {
+        image.step = parse_count(text, file.substr(at + 5));
+        file = file.substr(0, at + 4);
+      }
       if (!file.ends_with(".exr") || file.size() <= 4)
-        refuse(text, "a depth image is a .exr file: depth:FILE.exr");
-      files.emplace_back(file);
+        refuse(text, "a depth image is a .exr file: depth:FILE.exr or depth:FILE.exr@STEP");
+      image.file = std::filesystem::path(file);
+      files.push_back(image);
       if (next == std::string_view::npos) break;
       rest = rest.substr(next + kMoreDepth.size());
     }
@@ -129,8 +136,9 @@ Scene load_polygons(const SceneName& name) {
 Scene load_scene(const SceneName& name) {
   Scene scene = load_polygons(name);
   for (std::size_t k = 0; k < name.depth_images.size(); ++k) {
-    Scene mesh = depth_image_mesh(read_depth_image(name.depth_images[k])).scene;
-    mesh.name = name.depth_images[k].filename().string();
+    const DepthImageName& image = name.depth_images[k];
+    Scene mesh = depth_image_mesh(read_depth_image(image.file), {.step = image.step}).scene;
+    mesh.name = image.file.filename().string();
     scene = (k == 0 && name.kind == SceneName::Kind::depth_images)
                 ? std::move(mesh)
                 : merge_scenes(std::move(scene), mesh);

@@ -175,16 +175,37 @@ TEST(DepthImage, BadInputIsRefusedNamingTheField) {
   EXPECT_NE(wide_error.find("wide.exr"), std::string::npos) << wide_error;
   EXPECT_NE(wide_error.find("size"), std::string::npos) << wide_error;
 
-  // The CLI: exit 2, the file named, nothing written.
+  // Every channel there, one distance NaN.
+  const fs::path nan_depth = scratch.dir / "nan_depth.exr";
+  {
+    OIIO::ImageSpec full(6, 4, 7, OIIO::TypeDesc::FLOAT);
+    full.channelnames = {"R", "G", "B", "Z", "N.x", "N.y", "N.z"};
+    full.attribute("facet:depth_image", spec.get_string_attribute("facet:depth_image"));
+    std::vector<float> pixels;
+    for (int k = 0; k < 24; ++k)
+      pixels.insert(pixels.end(), {0.5f, 0.5f, 0.5f, k == 13 ? NAN : 4.0f, 0.0f, 0.0f, 1.0f});
+    auto output = OIIO::ImageOutput::create("openexr");
+    ASSERT_TRUE(output->open(nan_depth.string(), full));
+    ASSERT_TRUE(output->write_image(OIIO::TypeDesc::FLOAT, pixels.data()));
+    ASSERT_TRUE(output->close());
+  }
+  EXPECT_NE(error_of([&] { read_depth_image(nan_depth); }).find("pixel (1, 2)"), std::string::npos);
+
+  // The CLI: exit 2, the file and field named, nothing written.
   const fs::path log = scratch.dir / "log.txt";
-  EXPECT_EQ(
-      facet::test::run_facet("render --display builtin:dome180 --size 32x32 --scene depth:" +
-                                 no_normals.string() + " --out " + (scratch.dir / "out").string(),
-                             log),
-      2);
-  EXPECT_NE(facet::test::slurp(log).find("missing N.x"), std::string::npos)
-      << facet::test::slurp(log);
-  EXPECT_FALSE(fs::exists(scratch.dir / "out"));
+  for (const auto& [file, expected] : {std::pair{no_normals, "missing N.x"},
+                                       std::pair{nan_depth, "'Z'"}, std::pair{wide, "size"}}) {
+    EXPECT_EQ(facet::test::run_facet(
+                  "render --display builtin:dome180 --size 32x32 --scene depth:" + file.string() +
+                      " --out " + (scratch.dir / "out").string(),
+                  log),
+              2)
+        << file;
+    const std::string said = facet::test::slurp(log);
+    EXPECT_NE(said.find(expected), std::string::npos) << said;
+    EXPECT_NE(said.find(file.filename().string()), std::string::npos) << said;
+    EXPECT_FALSE(fs::exists(scratch.dir / "out"));
+  }
   const fs::path out = scratch.dir / "city.exr";
   EXPECT_EQ(facet::test::run_facet(
                 "depth-image --scene builtin:city --size 0x64 --out " + out.string(), log),
@@ -351,7 +372,13 @@ TEST(DepthImage, SceneNamesTakeDepthImagesAloneAndHybrid) {
   const SceneName alone = parse_scene_name("depth:a.exr+depth:b.exr");
   EXPECT_EQ(alone.kind, SceneName::Kind::depth_images);
   ASSERT_EQ(alone.depth_images.size(), 2u);
-  EXPECT_EQ(alone.depth_images[1], fs::path("b.exr"));
+  EXPECT_EQ(alone.depth_images[1].file, fs::path("b.exr"));
+  EXPECT_EQ(alone.depth_images[1].step, 1);
+  const SceneName coarse = parse_scene_name("depth:a.exr@4");
+  EXPECT_EQ(coarse.depth_images[0].file, fs::path("a.exr"));
+  EXPECT_EQ(coarse.depth_images[0].step, 4);
+  EXPECT_THROW(parse_scene_name("depth:a.exr@0"), InputError);
+  EXPECT_THROW(parse_scene_name("depth:a.exr@x"), InputError);
   EXPECT_FALSE(alone.builtin_city());
   const SceneName hybrid = parse_scene_name("builtin:city+depth:a.exr");
   EXPECT_EQ(hybrid.kind, SceneName::Kind::city);
@@ -373,6 +400,8 @@ TEST(DepthImage, SceneNamesTakeDepthImagesAloneAndHybrid) {
   const Scene city = build_city(small);
   const Scene mesh = depth_image_mesh(image).scene;
   EXPECT_EQ(mesh.triangle_count(), 12u);  // 3 × 2 cells, two triangles each
+  // Every second pixel and the last: columns 0, 2, 3 and rows 0, 2.
+  EXPECT_EQ(depth_image_mesh(image, {.step = 2}).scene.triangle_count(), 4u);
   const Scene merged = merge_scenes(city, mesh);
   EXPECT_EQ(merged.triangle_count(), city.triangle_count() + 12);
   const SceneView view = choose_scene_view(merged, {}, true);

@@ -1642,6 +1642,117 @@ void add_cluster_section(std::vector<Variant>& out) {
 }
 
 // Flags: bad values of the CLI's own options, each command with a valid input.
+// ---- Depth images (--scene depth:FILE.exr) --------------------------------------------------
+
+// A valid planar depth image, 8 × 6, every pixel 5 m away facing the eye.
+Exr depth_exr_base() {
+  Exr exr;
+  exr.width = 8;
+  exr.height = 6;
+  exr.channels = {"R", "G", "B", "Z", "N.x", "N.y", "N.z"};
+  for (int k = 0; k < 48; ++k)
+    exr.pixels.insert(exr.pixels.end(), {0.5f, 0.5f, 0.5f, 5.0f, 0.0f, 0.0f, 1.0f});
+  const json meta = {{"format", "facet-depth-image/1"},
+                     {"kind", "planar"},
+                     {"part", "planar"},
+                     {"base", "perspective"},
+                     {"tan_extent", {-1.0, 1.0, 0.75, -0.75}},
+                     {"rotation", {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}},
+                     {"T_world_image", {{1, 0, 0, 0}, {0, 1, 0, 1.7}, {0, 0, 1, 0}, {0, 0, 0, 1}}}};
+  exr.attributes = {{"facet:depth_image", meta.dump()}};
+  return exr;
+}
+
+std::string depth_exr_bytes() {
+  const fs::path file =
+      fs::temp_directory_path() / ("facet_hostile_depth_" + std::to_string(::getpid()) + ".exr");
+  write_exr(file, depth_exr_base());
+  std::string bytes = slurp(file);
+  std::error_code ec;
+  fs::remove(file, ec);
+  return bytes;
+}
+
+void add_depth_image(std::vector<Variant>& out) {
+  const std::vector<std::string> render{"render",      "--display", "builtin:dome180",
+                                        "--size",      "16x16",     "--scene",
+                                        "depth:x.exr", "--out",     "@out"};
+  add_byte_variants(out, "depth_exr", depth_exr_bytes, "x.exr", nullptr, render, "out");
+  add_non_regular_variants(out, "depth_exr", "x.exr", nullptr, render, "out");
+  for (const auto& [what, x_max, y_max] :
+       {std::tuple{"huge", 1 << 30, 1 << 30}, std::tuple{"inverted", -5, -5}}) {
+    const std::int32_t x = x_max, y = y_max;
+    out.push_back({std::string("depth_exr_data_window_") + what,
+                   [x, y](const fs::path& dir) {
+                     spit(dir / "x.exr", exr_with_data_window(depth_exr_bytes(), x, y));
+                   },
+                   render,
+                   "out",
+                   {"x.exr"}});
+  }
+  auto add_exr = [&](const std::string& what, std::function<void(Exr&)> mutate,
+                     const std::string& mention) {
+    out.push_back({"depth_exr_" + what,
+                   [mutate](const fs::path& dir) {
+                     Exr exr = depth_exr_base();
+                     mutate(exr);
+                     write_exr(dir / "x.exr", exr);
+                   },
+                   render,
+                   "out",
+                   {"x.exr", mention}});
+  };
+  // Channel c of pixel k set to v.
+  auto set = [](int k, int c, float v) {
+    return [k, c, v](Exr& exr) { exr.pixels[std::size_t(k * 7 + c)] = v; };
+  };
+  auto without = [](const std::string& channel) {
+    return [channel](Exr& exr) {
+      for (std::size_t c = 0; c < exr.channels.size(); ++c) {
+        if (exr.channels[c] == channel) exr.channels[c] = "unused";
+      }
+    };
+  };
+  auto with_meta = [](const std::string& pointer, const std::string& raw) {
+    return [pointer, raw](Exr& exr) {
+      for (auto& [key, value] : exr.attributes) value = json_with(json::parse(value), pointer, raw);
+    };
+  };
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  const float inf = std::numeric_limits<float>::infinity();
+  add_exr("no_normal_x", without("N.x"), "N.x");
+  add_exr("no_depth", without("Z"), "Z");
+  add_exr("no_green", without("G"), "G");
+  add_exr("depth_nan", set(9, 3, nan), "Z");
+  add_exr("depth_minus_inf", set(9, 3, -inf), "Z");
+  add_exr("depth_zero", set(9, 3, 0.0f), "Z");
+  add_exr("depth_negative", set(9, 3, -2.0f), "Z");
+  add_exr("normal_zero", set(9, 6, 0.0f), "N.x");
+  add_exr("normal_nan", set(9, 4, nan), "N.x");
+  add_exr("normal_long", set(9, 6, 1.5f), "N.x");
+  add_exr("colour_inf", set(9, 0, inf), "R,G,B");
+  add_exr(
+      "meta_missing", [](Exr& exr) { exr.attributes.clear(); }, "facet:depth_image");
+  add_exr(
+      "meta_not_json",
+      [](Exr& exr) {
+        exr.attributes = {{"facet:depth_image", "{"}};
+      },
+      "facet:depth_image");
+  add_exr("meta_format_unknown", with_meta("/format", "\"facet-depth-image/9\""), "format");
+  add_exr("meta_kind_bogus", with_meta("/kind", "\"sphere\""), "kind");
+  add_exr("meta_kind_dpci_one_part", with_meta("/kind", "\"dpci\""), "parts");
+  add_exr("meta_part_renamed", with_meta("/part", "\"cap\""), "parts");
+  add_exr("meta_base_fisheye", with_meta("/base", "\"fisheye\""), "base");
+  add_exr("meta_tan_extent_short", with_meta("/tan_extent", "[1, 2]"), "tan_extent");
+  add_exr("meta_tan_extent_flat", with_meta("/tan_extent", "[1, 1, 1, 1]"), "tan_extent");
+  add_exr("meta_rotation_scaled", with_meta("/rotation", "[[2,0,0],[0,2,0],[0,0,2]]"), "rotation");
+  add_exr("meta_pose_scaled",
+          with_meta("/T_world_image", "[[3,0,0,0],[0,3,0,0],[0,0,3,0],[0,0,0,1]]"),
+          "T_world_image");
+  add_exr("meta_pose_not_numbers", with_meta("/T_world_image", "\"identity\""), "T_world_image");
+}
+
 void add_flags(std::vector<Variant>& out) {
   const std::string dome = (kSource / "configs/displays/dome180/display.json").string();
   const std::string warp = (kSource / "configs/displays/dome180/dome180.warp.exr").string();
@@ -1753,6 +1864,7 @@ const Kind kKinds[] = {
     {"play_content", add_play_content},
     {"material_frag", add_material},
     {"cluster_section_and_node", add_cluster_section},
+    {"depth_image", add_depth_image},
 };
 
 // ---- Running one variant ------------------------------------------------------------------------

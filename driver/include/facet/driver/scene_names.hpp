@@ -10,7 +10,8 @@
 //                         :17 10,011,538
 //   FILE.gltf, FILE.glb   a glTF 2.0 file (load_gltf)
 //   depth:FILE.exr        a depth image (depth_image.hpp) drawn as its grid mesh; several as
-//                         depth:A.exr+depth:B.exr
+//                         depth:A.exr+depth:B.exr; FILE.exr@N takes every N-th pixel (N in
+//                         1..64, DepthMeshOptions::step)
 //   SCENE+depth:FILE.exr  hybrid: any scene above and depth images, in one z-buffer (the depth
 //                         images' triangles numbered after the scene's)
 // Names that would give more than kMaxSceneTriangles triangles are refused before anything is
@@ -32,7 +33,13 @@ inline constexpr std::uint64_t kMaxSceneTriangles = 64'000'000;
 // The --scene values, for command-line help.
 inline constexpr const char* kSceneNameSyntax =
     "builtin:city | builtin:city:K (KxK tiles) | builtin:city-fine:N (each triangle in N^2) | "
-    "FILE.gltf | depth:FILE.exr (a depth image) | SCENE+depth:FILE.exr (hybrid)";
+    "FILE.gltf | depth:FILE.exr[@STEP] (a depth image) | SCENE+depth:FILE.exr (hybrid)";
+
+// A depth image of a scene name, and the grid step its mesh takes.
+struct DepthImageName {
+  std::filesystem::path file;
+  int step = 1;
+};
 
 struct SceneName {
   // depth_images: no polygon scene, only the depth images.
@@ -42,7 +49,7 @@ struct SceneName {
   std::filesystem::path file;  // Kind::file only
   std::string text;            // as given
   // The depth images drawn with (or, for Kind::depth_images, instead of) the scene.
-  std::vector<std::filesystem::path> depth_images;
+  std::vector<DepthImageName> depth_images;
   // The built-in city in any form: its camera path applies (a depth image's eye comes first:
   // choose_scene_view).
   bool builtin_city() const { return kind != Kind::file && kind != Kind::depth_images; }
