@@ -159,6 +159,11 @@ class FacetPipeline final : public FacetMethodBase {
     scan_.run(out.scan, n + 1);
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
     bind_output(i);
+    out.scan_texels.view(out.scan, GL_R32UI, 4).bind_unit(texture_unit::scan);
+    out.staged_texels.view(out.staged, GL_R32UI, 4).bind_unit(texture_unit::staged);
+    out.stage_offset_texels.view(out.stage_offsets, GL_R32UI, 4)
+        .bind_unit(texture_unit::stage_offsets);
+    glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT);
     set_list_uniforms(scatter_, i);
     scatter_.use();
     glDispatchCompute((n + kLocalSize - 1) / kLocalSize, 1, 1);
@@ -177,12 +182,17 @@ class FacetPipeline final : public FacetMethodBase {
     out.replicas = values[1];
     if (values[2] == 0) return true;
     const std::uint64_t wanted = std::uint64_t(values[1]) + values[1] / 4 + 4096;
-    if (staged_words(wanted) > std::uint64_t(std::numeric_limits<std::int32_t>::max()))
-      throw InputError(
-          "scene", "pairs",
-          "fewer than 2^30 (triangle, facet) pairs per output and frame (pass 1 stages up to two "
-          "words a pair); this view needs " +
-              std::to_string(values[1]));
+    // The scatter reads the staged words through a buffer texture.
+    GLint max_texels = 0;
+    glGetIntegerv(GL_MAX_TEXTURE_BUFFER_SIZE, &max_texels);
+    const std::uint64_t max_words = std::min<std::uint64_t>(
+        std::numeric_limits<std::int32_t>::max(), std::uint64_t(max_texels));
+    if (staged_words(wanted) > max_words)
+      throw InputError("scene", "pairs",
+                       "at most " + std::to_string(max_words / 2) +
+                           " (triangle, facet) pairs per output and frame (pass 1 stages up to "
+                           "two words a pair, read as a buffer texture); this view needs " +
+                           std::to_string(values[1]));
     out.pair_capacity = std::uint32_t(wanted);
     out.replication_valid = false;
     return false;

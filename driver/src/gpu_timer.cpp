@@ -1,6 +1,9 @@
 #include "facet/driver/gpu_timer.hpp"
 
 #include <chrono>
+#include <cstdlib>
+#include <ctime>
+#include <string_view>
 
 #include "facet/driver/gpu_scene.hpp"
 #include "facet/projection/errors.hpp"
@@ -14,11 +17,27 @@ std::int64_t steady_ns() {
       .count();
 }
 
+std::int64_t process_cpu_ns() {
+  timespec now{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &now);
+  return std::int64_t(now.tv_sec) * 1'000'000'000 + now.tv_nsec;
+}
+
+bool cpu_clock_wanted() {
+  const char* value = std::getenv("FACET_PASS_CLOCK");
+  return value && std::string_view(value) == "cpu";
+}
+
+std::int64_t now_ns(bool cpu_time) { return cpu_time ? process_cpu_ns() : steady_ns(); }
+
 }  // namespace
 
-GpuTimer::GpuTimer(Clock clock)
-    : wall_clock_(clock == Clock::wall_clock ||
-                  (clock == Clock::automatic && is_software_renderer())) {}
+GpuTimer::GpuTimer(Clock clock) {
+  if (clock == Clock::automatic && is_software_renderer())
+    clock = cpu_clock_wanted() ? Clock::process_cpu_time : Clock::wall_clock;
+  wall_clock_ = clock == Clock::wall_clock || clock == Clock::process_cpu_time;
+  cpu_time_ = clock == Clock::process_cpu_time;
+}
 
 void GpuTimer::begin(std::string_view pass) {
   FACET_ASSERT(!in_pass_);
@@ -26,7 +45,7 @@ void GpuTimer::begin(std::string_view pass) {
   if (wall_clock_) {
     glFinish();
     open_frame_.push_back({std::string(pass), Query{}, 0});
-    wall_begin_ns_ = steady_ns();
+    wall_begin_ns_ = now_ns(cpu_time_);
     return;
   }
   Query query;
@@ -45,7 +64,7 @@ void GpuTimer::end() {
   in_pass_ = false;
   if (wall_clock_) {
     glFinish();
-    open_frame_.back().milliseconds = double(steady_ns() - wall_begin_ns_) * 1e-6;
+    open_frame_.back().milliseconds = double(now_ns(cpu_time_) - wall_begin_ns_) * 1e-6;
     return;
   }
   glEndQuery(GL_TIME_ELAPSED);

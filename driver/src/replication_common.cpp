@@ -31,6 +31,32 @@ Program link_replication_program(std::initializer_list<std::string_view> shaders
   return link_with_material(builder, *material);
 }
 
+std::vector<std::uint32_t> list_block_table(std::span<const ListEntry> list,
+                                            std::uint32_t triangles) {
+  FACET_ASSERT(!list.empty());
+  const std::uint32_t blocks = (triangles + kListBlockTriangles - 1) / kListBlockTriangles;
+  std::vector<std::uint32_t> values;
+  values.reserve(blocks + 4);
+  std::uint32_t entry = 0;
+  for (std::uint32_t b = 0; b < blocks; ++b) {
+    const std::uint32_t first = b * kListBlockTriangles;
+    while (entry + 1 < list.size() && list[entry + 1].first_triangle <= first) ++entry;
+    values.push_back(entry);
+  }
+  values.push_back(std::uint32_t(list.size() - 1));
+  values.resize((values.size() + 3) / 4 * 4, 0);  // whole RGBA32UI texels
+  return values;
+}
+
+const Texture& BufferView::view(const Buffer& buffer, GLenum internal_format,
+                                std::size_t texel_bytes) {
+  if (!texture_ || buffer_id_ != buffer.id()) {
+    texture_ = Texture::create_buffer_view(buffer, internal_format, texel_bytes);
+    buffer_id_ = buffer.id();
+  }
+  return texture_;
+}
+
 void ensure_capacity(Buffer& buffer, std::size_t bytes) {
   if (buffer && buffer.size() >= bytes) return;
   std::size_t size = buffer ? buffer.size() : 256;
@@ -170,9 +196,13 @@ bool FacetMethodBase::update_view(const glm::dmat4& T_eye_world) {
     }
     out.triangles = triangles;
     if (out.list.empty()) out.list.push_back({0, 0});  // keeps the binding valid; never read
+    const std::vector<std::uint32_t> block_table = list_block_table(out.list, triangles);
+    const std::size_t list_bytes = out.list.size() * sizeof(ListEntry);
+    const std::size_t table_bytes = block_table.size() * sizeof(std::uint32_t);
     const GLuint list_buffer_before = out.list_buffer.id();
-    ensure_capacity(out.list_buffer, out.list.size() * sizeof(ListEntry));
-    out.list_buffer.sub_data(0, out.list.size() * sizeof(ListEntry), out.list.data());
+    ensure_capacity(out.list_buffer, list_bytes + table_bytes);
+    out.list_buffer.sub_data(0, list_bytes, out.list.data());
+    out.list_buffer.sub_data(list_bytes, table_bytes, block_table.data());
     if (!out.list_texels || out.list_buffer.id() != list_buffer_before)
       out.list_texels =
           Texture::create_buffer_view(out.list_buffer, GL_RGBA32UI, sizeof(ListEntry));

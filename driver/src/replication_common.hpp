@@ -4,6 +4,7 @@
 // grouped by material; plus the GPU prefix scan of both pipelines.
 #include <cstdint>
 #include <initializer_list>
+#include <span>
 #include <string_view>
 #include <vector>
 
@@ -41,6 +42,17 @@ Program link_replication_program(std::initializer_list<std::string_view> shaders
                                  const std::vector<ShaderDefine>& defines = {},
                                  const MaterialShader* material = nullptr);
 
+// A buffer texture over a Buffer that ensure_capacity may replace: view() makes it anew when the
+// buffer is not the one it was made for.
+class BufferView {
+ public:
+  const Texture& view(const Buffer& buffer, GLenum internal_format, std::size_t texel_bytes);
+
+ private:
+  Texture texture_;
+  GLuint buffer_id_ = 0;
+};
+
 // Grows `buffer` (contents lost) to hold at least `bytes`, doubling to keep reallocations rare.
 void ensure_capacity(Buffer& buffer, std::size_t bytes);
 
@@ -76,6 +88,14 @@ struct ListEntry {  // std430 ListEntry of replication_lib.comp's List
 };
 static_assert(sizeof(ListEntry) == 16);
 
+// The block table that follows a frame's list in its buffer: value b is the last entry whose
+// first_triangle is at most kListBlockTriangles·b, for b < ceil(triangles / kListBlockTriangles),
+// then the last entry; packed four values to a texel (ListEntry-sized, RGBA32UI). The entry
+// holding list triangle t lies between the values of t's block and the next. Padded with zeros
+// to whole texels.
+std::vector<std::uint32_t> list_block_table(std::span<const ListEntry> list,
+                                            std::uint32_t triangles);
+
 class FacetMethodBase : public RenderMethod {
  public:
   void prepare(const Scene& scene, const GpuScene& gpu_scene, std::span<const OutputSpec> outputs,
@@ -103,6 +123,8 @@ class FacetMethodBase : public RenderMethod {
     // triangles the cull pass leaves to the grid pass, and those the grid pass leaves to the walk
     // pass (each queue: its pass's indirect dispatch and count, then the list triangles).
     Buffer staged, stage_offsets, grid_queue, walk_queue;
+    // scan, staged and stage_offsets as R32UI buffer textures for the scatter (facets only).
+    BufferView scan_texels, staged_texels, stage_offset_texels;
     std::uint32_t pair_capacity = 0;  // pairs that pairs and staged hold
     bool replication_valid = false;
     std::uint64_t replicas = 0, visible = 0;

@@ -189,7 +189,7 @@ void main() {
     overflow = 1u;
     return;
   }
-  for (uint k = 0u; k < kKept; ++k) {
-    if (k < count) staged[base + k] = kept[k];
-  }
+  // To the run's length, not kKept: llvmpipe runs a loop until its last lane is done, and a
+  // masked store still visits all eight lanes.
+  for (uint k = 0u; k < count; ++k) staged[base + k] = kept[k];
 }

@@ -55,9 +55,18 @@ const float kCoverageSlack = 2e-6;
 const uint kNone = 0xffffffffu;
 const uint kCoverageLeafSize = 4u;  // CoverageIndex's leaf size, checked by pack_coverage_nodes
 
-// The list entry holding list triangle t (binary search on first_triangle).
+// After the list_entries entries, the list's block table: entry k of the table, packed four to a
+// texel, is the entry holding list triangle kListBlockTriangles·k; one more ends it with the last
+// entry (FacetMethodBase::update_view). A lookup then searches only the entries of one block.
+const uint kListBlockTriangles = 64u;
+uint list_block_entry(uint block) {
+  return texelFetch(list_texels, int(list_entries + block / 4u))[block % 4u];
+}
+
+// The list entry holding list triangle t (binary search on first_triangle within its block).
 uint entry_of_triangle(uint t) {
-  uint lo = 0u, hi = list_entries - 1u;
+  uint block = t / kListBlockTriangles;
+  uint lo = list_block_entry(block), hi = list_block_entry(block + 1u);
   while (lo < hi) {
     uint mid = (lo + hi + 1u) / 2u;
     if (list_entry(mid).y <= t) lo = mid; else hi = mid - 1u;

@@ -8,7 +8,6 @@
 #endif
 layout(local_size_x = LOCAL_SIZE) in;
 
-layout(std430, binding = 10) readonly buffer Scan { uint scan[]; };
 layout(std430, binding = 11) writeonly buffer Pairs { uvec4 replicas[]; };
 layout(std430, binding = 12) readonly buffer Stats {
   uint visible_triangles;
@@ -16,8 +15,13 @@ layout(std430, binding = 12) readonly buffer Stats {
   uint overflow;
   uint staged_total;
 };
-layout(std430, binding = 17) readonly buffer Staged { uint staged[]; };
-layout(std430, binding = 18) readonly buffer StageOffsets { uint stage_offset[]; };
+// Pass 1's and the scan's results, read as buffer textures (R32UI): llvmpipe fetches a texel for
+// every SIMD lane at once, where it loads shader storage one lane at a time.
+layout(binding = 16) uniform usamplerBuffer scan_texels;
+layout(binding = 17) uniform usamplerBuffer staged_texels;
+layout(binding = 18) uniform usamplerBuffer stage_offset_texels;
+uint scan(uint t) { return texelFetch(scan_texels, int(t)).x; }
+uint staged(uint at) { return texelFetch(staged_texels, int(at)).x; }
 layout(location = 42) uniform uint triangle_count;
 
 const uint kKept = 8u;              // kStagedChunkFacets
@@ -31,22 +35,31 @@ uint triangle_id(uint e, uint t);
 void main() {
   uint t = gl_GlobalInvocationID.x;
   if (t >= triangle_count || overflow != 0u) return;
-  uint first = scan[t], count = scan[t + 1u] - first;
+  uint first = scan(t), count = scan(t + 1u) - first;
   if (count == 0u) return;
   uint e = entry_of_triangle(t);
   uvec4 replica = uvec4(vertex_index_of(e, t), 0u, object_of(e), triangle_id(e, t));
-  uint source = stage_offset[t];
+  uint source = texelFetch(stage_offset_texels, int(t)).x;
   bool chained = (source & kChained) != 0u;
   source &= ~kChained;
-  // Eight pairs per iteration: a triangle over thousands of facets stays within llvmpipe's loop
-  // budget per invocation.
+  if (!chained) {
+    // A run: as many iterations as pairs (llvmpipe runs a loop until its last lane is done, and a
+    // masked store still visits all eight lanes).
+    for (uint m = 0u; m < count; ++m) {
+      replica.y = staged(source + m);
+      replicas[first + m] = replica;
+    }
+    return;
+  }
+  // A chain, eight pairs per iteration of an unrolled inner loop: a triangle over thousands of
+  // facets stays within llvmpipe's loop budget per invocation.
   for (uint k = 0u; k < count; k += kKept) {
     for (uint m = 0u; m < kKept; ++m) {
       if (k + m < count) {
-        replica.y = staged[source + m];
+        replica.y = staged(source + m);
         replicas[first + k + m] = replica;
       }
     }
-    source = chained ? staged[source + kKept] : source + kKept;
+    source = staged(source + kKept);
   }
 }

@@ -64,6 +64,25 @@ TEST(Shaders, StagingConstantsMatchTheCpp) {
   }
 }
 
+// The list's block size and the scatter's texture units exist twice: facet_gpu.hpp and the GLSL.
+TEST(Shaders, ListAndScatterConstantsMatchTheCpp) {
+  std::smatch match;
+  const std::string library(embedded_shader("replication/replication_lib.comp").text);
+  ASSERT_TRUE(std::regex_search(library, match, std::regex(R"(kListBlockTriangles = (\d+)u)")));
+  EXPECT_EQ(std::stoul(match[1]), kListBlockTriangles);
+  const std::string scatter(embedded_shader("replication/scatter.comp").text);
+  for (const auto& [name, unit] :
+       {std::pair<const char*, GLuint>{"scan_texels", texture_unit::scan},
+        {"staged_texels", texture_unit::staged},
+        {"stage_offset_texels", texture_unit::stage_offsets}}) {
+    ASSERT_TRUE(std::regex_search(
+        scatter, match,
+        std::regex(R"(binding = (\d+)\) uniform usamplerBuffer )" + std::string(name))))
+        << name;
+    EXPECT_EQ(std::stoul(match[1]), unit) << name;
+  }
+}
+
 // The material shading block's binding exists twice, in gpu_scene.hpp and material.frag.
 TEST(Shaders, MaterialShadingBindingMatchesTheCpp) {
   const std::string text(embedded_shader("scene/material.frag").text);

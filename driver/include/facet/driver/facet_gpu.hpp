@@ -36,6 +36,8 @@ namespace facet::driver {
 // Read-only tables are buffer textures (texelFetch), as the scene is (gpu_scene.hpp, pulling::).
 namespace texture_unit {
 inline constexpr GLuint object_frames = 11, facets = 12, records = 13, list = 14, grid = 15;
+// The scatter's reads of pass 1's results (R32UI views of binding::scan, staged, stage_offsets).
+inline constexpr GLuint scan = 16, staged = 17, stage_offsets = 18;
 }  // namespace texture_unit
 
 namespace binding {
@@ -146,6 +148,9 @@ std::vector<std::uint32_t> pack_coverage_grid(const CoverageGrid& grid, const Fa
 // with kStagedChained set for a chain.
 inline constexpr std::uint32_t kStagedChunkFacets = 8;
 inline constexpr std::uint32_t kStagedChained = 0x80000000u;
+// Triangles per block of a frame list's block table (replication_lib.comp's entry_of_triangle;
+// the table is made by FacetMethodBase::update_view).
+inline constexpr std::uint32_t kListBlockTriangles = 64;
 // Staging words that hold the facets of `pairs` pairs: one word per facet in runs, and for a chain
 // of c > kStagedChunkFacets facets ceil(c / 8) chunks of 9 words, at most 2c.
 constexpr std::uint64_t staged_words(std::uint64_t pairs) { return 2 * pairs + 16; }

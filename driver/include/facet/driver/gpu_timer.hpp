@@ -34,6 +34,10 @@ class GpuTimer {
     automatic,   // queries on a GPU, the wall clock on a software rasterizer
     queries,     // GL_TIME_ELAPSED
     wall_clock,  // glFinish, then the wall clock, at each begin and end
+    // glFinish, then the CPU time of every thread of the process: on a software rasterizer the
+    // work a pass costs, whatever else the machine runs. `automatic` takes it on a software
+    // rasterizer when the environment sets FACET_PASS_CLOCK=cpu.
+    process_cpu_time,
   };
   explicit GpuTimer(Clock clock = Clock::automatic);
   GpuTimer(GpuTimer&&) noexcept = default;
@@ -76,7 +80,8 @@ class GpuTimer {
     Query query;              // queries only
     double milliseconds = 0;  // wall clock only, set by end()
   };
-  bool wall_clock_ = false;
+  bool wall_clock_ = false;  // wall_clock or process_cpu_time
+  bool cpu_time_ = false;    // process_cpu_time
   std::int64_t wall_begin_ns_ = 0;
   std::vector<Pending> open_frame_;
   std::deque<std::vector<Pending>> frames_;
