@@ -133,15 +133,21 @@ Scene load_polygons(const SceneName& name) {
 
 }  // namespace
 
-Scene load_scene(const SceneName& name) {
+Scene load_scene(const SceneName& name, std::vector<std::uint32_t>* source_ids) {
   Scene scene = load_polygons(name);
+  if (source_ids) {
+    source_ids->resize(scene.triangle_count() + 1);
+    for (std::size_t id = 0; id < source_ids->size(); ++id) (*source_ids)[id] = std::uint32_t(id);
+  }
   for (std::size_t k = 0; k < name.depth_images.size(); ++k) {
     const DepthImageName& image = name.depth_images[k];
-    Scene mesh = depth_image_mesh(read_depth_image(image.file), {.step = image.step}).scene;
-    mesh.name = image.file.filename().string();
+    DepthMesh mesh = depth_image_mesh(read_depth_image(image.file), {.step = image.step});
+    mesh.scene.name = image.file.filename().string();
+    if (source_ids)
+      source_ids->insert(source_ids->end(), mesh.source_id.begin(), mesh.source_id.end());
     scene = (k == 0 && name.kind == SceneName::Kind::depth_images)
-                ? std::move(mesh)
-                : merge_scenes(std::move(scene), mesh);
+                ? std::move(mesh.scene)
+                : merge_scenes(std::move(scene), mesh.scene);
   }
   return scene;
 }

@@ -13,6 +13,7 @@
 #include <functional>
 #include <glm/gtc/matrix_transform.hpp>
 #include <limits>
+#include <nlohmann/json.hpp>
 #include <random>
 
 #include "cli_process.hpp"
@@ -407,6 +408,35 @@ TEST(DepthImage, SceneNamesTakeDepthImagesAloneAndHybrid) {
   const SceneView view = choose_scene_view(merged, {}, true);
   EXPECT_FALSE(view.follows_city_path);
   EXPECT_EQ(glm::dvec3(view.T_world_eye[3]), glm::dvec3(0, 2, 0));
+}
+
+// The command line end to end: facet depth-image of the city, then facet render of the depth image
+// with the reference ray cast into the polygon city (--reference-scene).
+TEST(DepthImage, CliRendersTheCityDpciAgainstThePolygonCity) {
+  const Scratch scratch("cli");
+  const fs::path image = scratch.dir / "city.exr", log = scratch.dir / "log.txt";
+  ASSERT_EQ(facet::test::run_facet(
+                "depth-image --scene builtin:city --size 256x128 --out " + image.string(), log),
+            0)
+      << facet::test::slurp(log);
+  ASSERT_TRUE(fs::is_regular_file(image));
+  ASSERT_EQ(facet::test::run_facet(
+                "render --display builtin:dome180 --size 96x96 --scene depth:" + image.string() +
+                    " --reference --reference-scene builtin:city --json",
+                log),
+            0)
+      << facet::test::slurp(log);
+  const std::string text = facet::test::slurp(log);
+  const nlohmann::json report = nlohmann::json::parse(text.substr(text.find('{')));
+  const nlohmann::json& reference = report["reference"];
+  std::printf("facet render --scene depth: against builtin:city: id_mismatch %.5f, p99 %.2f px\n",
+              reference["id_mismatch"].get<double>(), reference["p99_edge_px"].get<double>());
+  EXPECT_LE(reference["id_mismatch"].get<double>(), 0.005);
+  EXPECT_LE(reference["p99_edge_px"].get<double>(), 2.0);
+  EXPECT_EQ(facet::test::run_facet("render --display builtin:dome180 --size 16x16 --scene depth:" +
+                                       image.string() + " --reference-scene builtin:city",
+                                   log),
+            2);
 }
 
 }  // namespace

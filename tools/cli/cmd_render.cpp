@@ -39,7 +39,7 @@ using namespace facet::driver;
 constexpr double kFrameStepS = 1.0 / 30.0;
 
 struct RenderOptions {
-  std::string display, scene = "builtin:city", method = "facets", size, out;
+  std::string display, scene = "builtin:city", method = "facets", size, out, reference_scene;
   LayoutFlags layout;
   ViewFlags view;
   std::optional<int> face_size;
@@ -61,12 +61,15 @@ double median(std::vector<double> values) {
 
 // The last frame's IDs against the Embree ray cast of the same view, pooled over the outputs:
 // id_mismatch from compare_ids (ratio of pooled pixel counts), edge distances from the exact
-// geometry (ReferenceRaycaster::edge_displacement; the worst output's).
+// geometry (ReferenceRaycaster::edge_displacement; the worst output's). With --reference-scene the
+// ray cast sees that scene and the rendered IDs are mapped to it through `source_ids`
+// (load_scene: a depth image's triangles to the triangles they were rendered from).
 nlohmann::json compare_with_reference(const Scene& scene, const std::vector<OutputSpec>& outputs,
                                       const std::vector<OutputTarget>& targets,
                                       const glm::dmat4& T_eye_world,
                                       const std::filesystem::path& ids_folder,
-                                      const std::string& stopped) {
+                                      const std::string& stopped,
+                                      const std::vector<std::uint32_t>* source_ids) {
   const ReferenceRaycaster raycaster(scene);
   IdComparison pooled;
   EdgeDisplacement edges;
@@ -80,7 +83,10 @@ nlohmann::json compare_with_reference(const Scene& scene, const std::vector<Outp
       write_ids_exr(ids_folder / (outputs[i].name + ".reference.ids.exr"), targets[i].size(),
                     reference);
     }
-    const std::vector<std::uint32_t> tested = targets[i].read_ids();
+    std::vector<std::uint32_t> tested = targets[i].read_ids();
+    if (source_ids) {
+      for (std::uint32_t& id : tested) id = id < source_ids->size() ? (*source_ids)[id] : 0;
+    }
     const IdComparison c = compare_ids(reference, tested, targets[i].size(), {.wrap_x = wrap_x});
     const EdgeDisplacement e =
         raycaster.edge_displacement(inverse, T_eye_world, reference, tested, {.wrap_x = wrap_x});
@@ -186,7 +192,14 @@ void run(const RenderOptions& options) {
   settings.material = load_material_shader(options.material);
   const ViewRequest view_request = options.view.request();  // malformed flags before the scene
   const SceneName scene_name = parse_scene_name(options.scene);
-  const Scene scene = load_scene(scene_name);
+  std::vector<std::uint32_t> source_ids;
+  const Scene scene = load_scene(scene_name, &source_ids);
+  std::optional<Scene> reference_scene;
+  if (!options.reference_scene.empty()) {
+    if (!options.reference)
+      throw InputError("command line", "--reference-scene", "expected --reference as well");
+    reference_scene = load_scene(parse_scene_name(options.reference_scene));
+  }
   const SceneView view = choose_view(scene, view_request, scene_name.builtin_city(), "render");
 
   auto context = create_headless_context();
@@ -235,8 +248,9 @@ void run(const RenderOptions& options) {
   std::optional<nlohmann::json> reference;
   auto compare = [&](const std::filesystem::path& ids_folder) {
     if (options.reference)
-      reference = compare_with_reference(scene, outputs, targets, T_eye_world,
-                                         options.ids ? ids_folder : "", stopped);
+      reference = compare_with_reference(reference_scene ? *reference_scene : scene, outputs,
+                                         targets, T_eye_world, options.ids ? ids_folder : "",
+                                         stopped, reference_scene ? &source_ids : nullptr);
   };
   if (options.out.empty()) {
     compare("");
@@ -363,6 +377,9 @@ const Registration registration{
       command->add_flag(
           "--reference", options->reference,
           "Compare the IDs with the CPU ray-cast reference (with --ids: also write it)");
+      command->add_option("--reference-scene", options->reference_scene,
+                          "With --reference: cast the rays into this scene (the polygon model a "
+                          "depth:FILE.exr was rendered from), IDs mapped through its id channel");
       command->add_option("--anisotropy", options->anisotropy,
                           "Texture anisotropy level (0: automatic, 8 on GPUs, off on llvmpipe)");
       command->add_option("--coverage", options->coverage,

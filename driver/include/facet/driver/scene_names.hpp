@@ -65,7 +65,11 @@ std::uint64_t builtin_scene_triangles(const SceneName& name);
 
 // Builds or loads the scene (load_gltf's and read_depth_image's InputError for a bad file), the
 // depth images' grid meshes (depth_image_mesh, default options) appended.
-Scene load_scene(const SceneName& name);
+// With `source_ids`, also the table that maps every triangle ID of the result to the triangle ID
+// of the scene the pictures came from: the identity for the polygon scene's own triangles, and for
+// a depth image's triangles the source ID its id channel stored (DepthMesh::source_id; 0 when it
+// has none). Entry 0 is 0; the table has triangle_count() + 1 entries.
+Scene load_scene(const SceneName& name, std::vector<std::uint32_t>* source_ids = nullptr);
 inline Scene load_scene(std::string_view text) { return load_scene(parse_scene_name(text)); }
 
 // The eye pose of frame k of `facet render` and `facet bench`, turning about world up (y) by 360°
