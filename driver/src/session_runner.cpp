@@ -117,6 +117,7 @@ void write_headless_frames(const HeadlessRunOptions& options, const std::string&
   rules.expected = "a new path, an empty folder, or a folder from an earlier " + earlier +
                    " (stats.jsonl and folders of NNNNN.png, nothing else)";
   rules.is_own_output = holds_earlier_run;
+  rules.inputs = options.inputs;
   const fs::path out_dir = check_output_folder(options.out_dir, rules);
   const bool replacing = fs::exists(fs::symlink_status(out_dir));
   write_folder_atomically(

@@ -392,6 +392,12 @@ TEST(HeadlessRun, WritesFramesPerOutputAndStatistics) {
   }
   fs::current_path(before);
   EXPECT_TRUE(fs::exists(out / "front" / "00000.png"));
+  // Nor may it replace a folder holding a file the run reads, such as a frame shown as content.
+  options.out_dir = out;
+  options.inputs = {out / "front" / "00000.png"};
+  EXPECT_THROW(run_headless_session(session, still, options), InputError);
+  EXPECT_TRUE(fs::exists(out / "front" / "00000.png"));
+  options.inputs.clear();
   options.out_dir = folder / "counted";
   for (const std::uint64_t frames : {std::uint64_t(0), kMaxFrames + 1}) {
     options.frames = frames;

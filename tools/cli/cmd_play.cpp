@@ -83,10 +83,8 @@ void play(const PlayOptions& options) {
   // A cluster node shows its own projectors only.
   const driver::ClusterRequest cluster_request{options.node, options.frames.has_value(),
                                                options.rate_hz, options.join_timeout_s};
-  driver::NodeDisplay node_display =
+  auto [display, cluster_share] =
       driver::load_node_display(options.display, size, options.scale, cluster_request);
-  driver::SessionDisplay& display = node_display.display;
-  const std::optional<driver::ClusterNodeShare>& cluster_share = node_display.cluster;
 
   auto media = driver::ContentMedia::open(options.file);
   const ContentFormat chosen = driver::check_content_format(media->size(), format, options.file);
@@ -152,6 +150,9 @@ void play(const PlayOptions& options) {
   headless_options.frames = frames.value_or(driver::frames_for_one_pass(player.clock()));
   headless_options.out_dir = options.out;
   headless_options.sync = sync.get();
+  // An earlier run's folder may be replaced, but not with the files this playback reads.
+  headless_options.inputs = {options.file};
+  if (!options.display.starts_with("builtin:")) headless_options.inputs.push_back(options.display);
   // A secondary plays until the master ends the run.
   if (cluster_share && !cluster_share->master) headless_options.frames = driver::kMaxFrames;
   facet::TerminalProgress progress(stderr, "facet play");

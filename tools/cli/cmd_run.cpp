@@ -109,10 +109,8 @@ void run(const RunOptions& options) {
   // A cluster node renders its own projectors only.
   const driver::ClusterRequest cluster_request{options.node, options.frames.has_value(),
                                                options.rate_hz, options.join_timeout_s};
-  driver::NodeDisplay node_display =
+  auto [display, cluster_share] =
       driver::load_node_display(options.display, size, options.scale, cluster_request);
-  driver::SessionDisplay& display = node_display.display;
-  const std::optional<driver::ClusterNodeShare>& cluster_share = node_display.cluster;
   for (auto& output : display.outputs) {
     if (orientation) orient_warp(output.spec.warp, *orientation);
   }
@@ -176,6 +174,10 @@ void run(const RunOptions& options) {
   headless_options.out_dir = options.out;
   headless_options.save_every = std::uint64_t(options.save_every);
   headless_options.sync = sync.get();
+  // An earlier run's folder may be replaced, but not with the files this run reads.
+  if (!options.display.starts_with("builtin:")) headless_options.inputs.push_back(options.display);
+  if (scene_name.kind == driver::SceneName::Kind::file)
+    headless_options.inputs.push_back(scene_name.file);
   // A secondary runs until the master ends the run: no count to show progress against.
   if (cluster_share && !cluster_share->master) headless_options.frames = driver::kMaxFrames;
   facet::TerminalProgress progress(stderr, "facet run");

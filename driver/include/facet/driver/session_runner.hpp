@@ -47,6 +47,8 @@ struct HeadlessRunOptions {
   // the last frame for save_every, and a frame the sync does not let swap is not written.
   FrameSync* sync = nullptr;
   ProgressSink progress;  // ("frames", done, frames) before the first and after each frame
+  // What the run reads (display, scene, content files): out_dir may neither be one nor hold one.
+  std::vector<std::filesystem::path> inputs;
 };
 
 // What a run leaves in memory stays the same size whatever the frame count: the per-frame
