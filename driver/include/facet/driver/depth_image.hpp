@@ -11,12 +11,13 @@
 // base frame is turned into the image frame by R_image_part. Pixel (i, j), row 0 at the top,
 // looks along R_image_part · base.direction(((i + 0.5) / W, (j + 0.5) / H)).
 //
-// The file (FILE.exr, OpenEXR, one subimage per part; README "Depth images"):
-//   channels R, G, B (half): linear albedo, what the material's base colour times its texture
+// The file (FILE.exr, multi-part OpenEXR, one part per image part, sharing the largest part's
+// display window; driver/README.md "Depth images"). Channels are float unless said:
+//   R, G, B: linear albedo, what the material's base colour times its texture
 //            gives, before lighting;
-//   Z (float): distance in metres from the eye point along the pixel centre's ray; +inf where the
+//   Z: distance in metres from the eye point along the pixel centre's ray; +inf where the
 //            ray meets nothing;
-//   N.x, N.y, N.z (half): unit normal in the image frame, turned towards the eye; 0 where Z is inf;
+//   N.x, N.y, N.z: unit normal in the image frame, turned towards the eye; 0 where Z is inf;
 //   id (uint, optional): the source scene's triangle ID (render_method.hpp numbering), 0 for none;
 //   attribute facet:depth_image: JSON {"format": "facet-depth-image/1", "kind": "planar"|"dpci",
 //            "part": name, "base": "perspective"|"cylindrical", base parameters as in
@@ -124,8 +125,8 @@ struct DepthMesh {
 // InputError naming "--scene" for a step outside [1, 64].
 DepthMesh depth_image_mesh(const DepthImage& image, const DepthMeshOptions& options = {});
 
-// Several scenes in one: objects, primitives, materials and images appended in order (triangle
-// IDs of `b` follow those of `a`).
+// Several scenes in one: objects, primitives, materials, images and cameras appended in order
+// (triangle IDs of `b` follow those of `a`). `a`'s animation is kept, `b`'s is not taken.
 Scene merge_scenes(Scene a, const Scene& b);
 
 // What `facet depth-image` renders.
