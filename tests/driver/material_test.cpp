@@ -21,6 +21,7 @@
 #include "facet/driver/render_method.hpp"
 #include "facet/projection/errors.hpp"
 #include "gl_test_context.hpp"
+#include "test_scenes.hpp"
 
 namespace facet::driver {
 namespace {
@@ -80,37 +81,10 @@ glm::dmat4 city_view(double t) {
   return glm::inverse(CityCameraPath(options).T_world_eye(t));
 }
 
-// An inward-facing UV sphere of `radius` metres about the eye in one unlit white material: the
-// edges between its stacks are circles of latitude, the middle one the horizon (y = 0).
 Scene unlit_sphere(int slices, int stacks, float radius) {
-  Scene scene;
   Material white;
   white.unlit = true;
-  scene.materials.push_back(white);
-  for (int j = 0; j <= stacks; ++j) {
-    const double theta = M_PI * j / stacks;
-    for (int i = 0; i <= slices; ++i) {
-      const double phi = 2 * M_PI * i / slices;
-      const glm::vec3 d(float(std::sin(theta) * std::cos(phi)), float(std::cos(theta)),
-                        float(std::sin(theta) * std::sin(phi)));
-      scene.positions.push_back(radius * d);
-      scene.normals.push_back(-d);
-      scene.uvs.push_back({float(i) / float(slices), float(j) / float(stacks)});
-    }
-  }
-  for (int j = 0; j < stacks; ++j) {
-    for (int i = 0; i < slices; ++i) {
-      const std::uint32_t a = std::uint32_t(j * (slices + 1) + i), b = a + 1,
-                          c = a + std::uint32_t(slices + 1), d = c + 1;
-      for (std::uint32_t v : {a, c, b, b, c, d}) scene.indices.push_back(v);
-    }
-  }
-  scene.primitives.push_back({0, std::uint32_t(scene.indices.size()), 0});
-  Object object;
-  object.primitive_count = 1;
-  scene.objects.push_back(object);
-  scene.update_bounds();
-  return scene;
+  return facet::test::background_sphere(slices, stacks, radius, white);
 }
 
 TEST(Materials, BuiltinsLoadAndUnknownNamesAreInputErrors) {
