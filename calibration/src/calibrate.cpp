@@ -91,12 +91,28 @@ cv::Mat residual_image(const FitReport& fit, glm::ivec2 size) {
   return image;
 }
 
-// What the audience sees from the eye, every projector composited on fitted_preview_view, each
-// direction coloured by the fit residual of the projector with the largest blend weight there:
-// CV_8UC3, RGB, 768 rows.
-cv::Mat residual_preview(const std::vector<Warp>& warps,
-                         const std::vector<projection_io::BlendMap>& alpha,
-                         const CalibrationReport& report) {
+// An RGBA8 image of render_preview as CV_8UC3, RGB.
+cv::Mat rgb_of(const std::vector<std::uint8_t>& rgba, glm::ivec2 size) {
+  cv::Mat rgb(size.y, size.x, CV_8UC3);
+  for (int y = 0; y < size.y; ++y)
+    for (int x = 0; x < size.x; ++x) {
+      const std::uint8_t* pixel = &rgba[(std::size_t(y) * size.x + x) * 4];
+      rgb.at<cv::Vec3b>(y, x) = {pixel[0], pixel[1], pixel[2]};
+    }
+  return rgb;
+}
+
+// What the audience sees from the eye, every projector composited on fitted_preview_view (768
+// rows), as facet preview computes and draws it (preview_display, render_preview): `composite`
+// each projector in its colour weighted by its blend (facet preview's default, --show
+// projectors), `residual` each direction coloured by the fit residual of the projector with the
+// largest blend weight there. CV_8UC3, RGB.
+struct EyeViews {
+  cv::Mat composite, residual;
+};
+EyeViews eye_views(const std::vector<Warp>& warps,
+                   const std::vector<projection_io::BlendMap>& alpha,
+                   const CalibrationReport& report) {
   std::vector<cv::Mat> residuals(warps.size());
   std::vector<PreviewProjector> projectors;
   for (std::size_t p = 0; p < warps.size(); ++p) {
@@ -119,15 +135,8 @@ cv::Mat residual_preview(const std::vector<Warp>& warps,
   options.view = fitted_preview_view(projectors);
   options.height_px = 768;
   const DisplayPreview preview = preview_display(projectors, options, "calibration");
-  const std::vector<std::uint8_t> rgba =
-      render_preview(preview, PreviewShow::residual, options.view);
-  cv::Mat rgb(preview.size.y, preview.size.x, CV_8UC3);
-  for (int y = 0; y < preview.size.y; ++y)
-    for (int x = 0; x < preview.size.x; ++x) {
-      const std::uint8_t* pixel = &rgba[(std::size_t(y) * preview.size.x + x) * 4];
-      rgb.at<cv::Vec3b>(y, x) = {pixel[0], pixel[1], pixel[2]};
-    }
-  return rgb;
+  return {rgb_of(render_preview(preview, PreviewShow::projectors, options.view), preview.size),
+          rgb_of(render_preview(preview, PreviewShow::residual, options.view), preview.size)};
 }
 
 // Lit pixels grey, unlit black; over them, at each node's output position, a disc half a node
@@ -531,7 +540,9 @@ CalibrationReport calibrate(const fs::path& capture_path, const fs::path& out,
                           coverage_image(warps[p], node_origins[p], blend.alpha[p]));
         }
         throw_if_interrupted(stopped);
-        write_rgb_image(pictures / "preview.png", residual_preview(warps, blend.alpha, report));
+        const EyeViews views = eye_views(warps, blend.alpha, report);
+        write_rgb_image(pictures / "composite.png", views.composite);
+        write_rgb_image(pictures / "preview.png", views.residual);
         throw_if_interrupted(stopped);
       },
       out_rules);

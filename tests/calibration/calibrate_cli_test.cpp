@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "facet/calibration/calibrate.hpp"
 #include "facet/calibration/image_io.hpp"
@@ -277,10 +278,25 @@ std::array<int, 3> rgb_at(const fs::path& path, int x, int y) {
   return {pixel[0], pixel[1], pixel[2]};
 }
 
+// The RGB pixels of an image file (its first three channels), row-major.
+std::vector<std::uint8_t> rgb_pixels(const fs::path& path, glm::ivec2& size) {
+  auto input = OIIO::ImageInput::open(path.string());
+  EXPECT_TRUE(input) << path;
+  if (!input) return {};
+  const OIIO::ImageSpec& spec = input->spec();
+  size = {spec.width, spec.height};
+  std::vector<std::uint8_t> all(std::size_t(spec.width) * spec.height * spec.nchannels);
+  input->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::UINT8, all.data());
+  std::vector<std::uint8_t> rgb(std::size_t(spec.width) * spec.height * 3);
+  for (std::size_t i = 0; i < std::size_t(spec.width) * spec.height; ++i)
+    for (int c = 0; c < 3; ++c) rgb[3 * i + c] = all[i * spec.nchannels + std::size_t(c)];
+  return rgb;
+}
+
 }  // namespace
 
 // report/: per projector a residual heat map and a coverage map at the output's size, and the
-// residual seen from the eye. On
+// display seen from the eye, by projector (composite.png) and by residual (preview.png). On
 // procam-board the black square whose undecoded middle sits near output pixel (280, 328) is a
 // filled hole (blue 0, 110, 255), the wall left of the board is covered and plain (grey 160), the
 // wall above it unlit (black); the residual map is black where no sample falls and, on the plain
@@ -314,4 +330,48 @@ TEST(CliCalibrate, RealBoardReportHasResidualAndCoverageMaps) {
   EXPECT_EQ(info.channels, 3);
   EXPECT_NE(rgb_at(preview, 384, 384), (std::array<int, 3>{0, 0, 0}));
   EXPECT_EQ(rgb_at(preview, 767, 767), (std::array<int, 3>{0, 0, 0}));
+
+  // report/composite.png: the same view coloured by projector, blended, as facet preview draws
+  // it: pixel for pixel what `facet preview` draws of the display.json calibrate wrote.
+  const fs::path composite = board.out / "report/composite.png";
+  const auto composite_info = facet::calibration::read_image_info(composite);
+  EXPECT_EQ(composite_info.size, glm::ivec2(768, 768));
+  EXPECT_EQ(composite_info.channels, 3);
+  const facet::test::TempFolder temp;
+  const fs::path drawn = temp.path() / "preview.png";
+  const fs::path figures = temp.path() / "figures.json";
+  const std::string command = std::string(FACET_CLI) + " preview " +
+                              (board.out / "display.json").string() +
+                              " --preview-size 768 --json --out " + drawn.string() + " > " +
+                              figures.string();
+  ASSERT_EQ(std::system(command.c_str()), 0) << command;
+  glm::ivec2 size{0}, drawn_size{0};
+  const std::vector<std::uint8_t> pixels = rgb_pixels(composite, size);
+  const std::vector<std::uint8_t> expected = rgb_pixels(drawn, drawn_size);
+  ASSERT_EQ(size, drawn_size);
+  std::size_t differing = 0;
+  for (std::size_t i = 0; i < pixels.size(); ++i) differing += pixels[i] != expected[i] ? 1 : 0;
+  EXPECT_EQ(differing, 0u);
+  // Its covered region: inside the fisheye's disc, the pixels in colour (a projector's) rather
+  // than grey (uncovered, with or without a grid line). On the fitted view of this one narrow
+  // projector (a fisheye about 30° wide, where every pixel's solid angle is within 2% of the
+  // others'), their share of the disc is preview's covered_sr / view_sr within 0.01.
+  std::size_t disc = 0, covered = 0;
+  for (int y = 0; y < size.y; ++y)
+    for (int x = 0; x < size.x; ++x) {
+      const double dx = x + 0.5 - size.x / 2.0, dy = y + 0.5 - size.y / 2.0;
+      if (dx * dx + dy * dy >= size.y * size.y / 4.0) continue;
+      const std::uint8_t* p = &pixels[(std::size_t(y) * size.x + x) * 3];
+      ++disc;
+      covered += p[0] != p[1] || p[1] != p[2] ? 1 : 0;
+    }
+  std::ifstream figures_stream(figures);
+  const nlohmann::json json = nlohmann::json::parse(figures_stream);
+  const double expected_share = json["covered_sr"].get<double>() / json["view_sr"].get<double>();
+  const double share = double(covered) / double(disc);
+  std::printf("composite.png: %zu of %zu disc pixels covered (%.4f); preview covers %.4f of the "
+              "view's solid angle (fov %.0f deg)\n",
+              covered, disc, share, expected_share, json["fov_deg"].get<double>());
+  EXPECT_GT(covered, 0u);
+  EXPECT_NEAR(share, expected_share, 0.01);
 }

@@ -47,7 +47,9 @@ const facet::cli::Registration registration{
           "calibrate",
           "Fit every projector's warp and blend from a recorded capture (capture.json and its "
           "images) and write display.json, <p>.warp.exr and <p>.blend.exr, and report/ with "
-          "<p>.residual.png and <p>.coverage.png; ends with a verdict per projector");
+          "<p>.residual.png, <p>.coverage.png, and composite.png and preview.png (the display "
+          "from the eye, as facet preview draws it, by projector and by residual); ends with a "
+          "verdict per projector");
       cmd->add_option("capture", args->capture, "capture folder, or its capture.json")->required();
       cmd->add_option("--out", args->out, "output folder (must not exist, or be empty)")
           ->required();

@@ -2,7 +2,9 @@
 // The whole calibration: a recorded capture (FORMATS.md §1) → an output folder holding
 // display.json (§4), `<p>.warp.exr` (§2) and `<p>.blend.exr` (§3) for every projector, plus
 // `<p>.black.exr` when black-level maps are asked for, and report/ with `<p>.residual.png` (the fit
-// residual as a heat map) and `<p>.coverage.png` (covered, filled holes, refilled and cut folds)
+// residual as a heat map) and `<p>.coverage.png` (covered, filled holes, refilled and cut folds),
+// and for the whole display seen from the eye `composite.png` (every projector blended, in its
+// colour) and `preview.png` (the residual), drawn as facet preview draws them
 // (calibration/README.md); with an accuracy report against the capture's `truth/` (§5) when it
 // has one, and a verdict per projector (judge).
 #include <cstddef>
