@@ -3,12 +3,17 @@
 #include <OpenImageIO/imageio.h>
 
 #include <cmath>
+#include <cstdint>
 #include <memory>
+#include <string>
+#include <system_error>
 #include <vector>
 
 #include "facet/projection/atomic_file.hpp"
 #include "facet/projection/errors.hpp"
 #include "facet/projection/input_file.hpp"
+#include "facet/projection/warp.hpp"
+#include "facet/projection_io/exr_header.hpp"
 
 namespace facet::calibration {
 namespace {
@@ -21,12 +26,33 @@ OIIO::ImageSpec unassociated_config() {
   return config;
 }
 
+// The most pixels one byte of a file can stand for: a 1-bit PNG (8 pixels a byte) at deflate's
+// largest ratio, 1032:1. OpenEXR's compressions reach less.
+constexpr std::uintmax_t kMaxPixelsPerByte = 8 * 1032;
+
+// Opens `path` once its header is known to ask for no more than the file can hold: OpenEXR
+// allocates every header attribute at the size the file gives (check_exr_header walks it first,
+// as for warps and blend maps), and the image size is within kMaxImageSide and kMaxImagePixels
+// and what the file's bytes can encode, before any pixel is allocated.
 std::unique_ptr<OIIO::ImageInput> open_image(const std::filesystem::path& path) {
   require_regular_file(path);
+  projection_io::check_exr_header(path.string());
   const OIIO::ImageSpec config = unassociated_config();
   auto input = OIIO::ImageInput::open(path.string(), &config);
   if (!input) {
     throw InputError(path.string(), "", "a readable PNG or EXR image (" + OIIO::geterror() + ")");
+  }
+  const OIIO::ImageSpec& spec = input->spec();
+  const glm::ivec2 size{spec.width, spec.height};
+  check_image_size(size, path.string(), "image size");
+  std::error_code ec;
+  const std::uintmax_t bytes = std::filesystem::file_size(path, ec);
+  if (!ec && std::uintmax_t(size.x) * std::uintmax_t(size.y) > bytes * kMaxPixelsPerByte) {
+    throw InputError(path.string(), "image size",
+                     std::to_string(size.x) + "x" + std::to_string(size.y) +
+                         " pixels, more than its " + std::to_string(bytes) +
+                         " bytes can encode (at most " + std::to_string(kMaxPixelsPerByte) +
+                         " pixels a byte)");
   }
   return input;
 }
@@ -45,14 +71,15 @@ cv::Mat read_luminance(const std::filesystem::path& path) {
   if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0 || spec.depth != 1) {
     throw InputError(path.string(), "", "a 2D image with at least one channel");
   }
-  const int channels = spec.nchannels;
+  // Only the channels luminance needs are read: R, G, B, or the first (grey + alpha has two).
+  const bool rgb = spec.nchannels >= 3;
+  const int channels = rgb ? 3 : 1;
   std::vector<float> pixels(std::size_t(spec.width) * spec.height * channels);
   // Integer pixels are converted to float in [0,1] by OpenImageIO (value / max of the type).
   if (!input->read_image(0, 0, 0, channels, OIIO::TypeDesc::FLOAT, pixels.data())) {
     throw InputError(path.string(), "", "a readable image (" + input->geterror() + ")");
   }
   cv::Mat luminance(spec.height, spec.width, CV_32F);
-  const bool rgb = channels >= 3;  // grey + alpha has 2 channels
   for (int y = 0; y < spec.height; ++y) {
     auto* row = luminance.ptr<float>(y);
     const float* in = pixels.data() + std::size_t(y) * spec.width * channels;

@@ -798,6 +798,29 @@ void add_capture(std::vector<Variant>& out) {
                  args,
                  "out",
                  {"graycode_00.png"}});
+  // Frame images whose header asks for more than the file holds (the fuzz corpus's seeds): an
+  // OpenEXR attribute of 2 GB in 1 KB, a channel list whose size disagrees with its content (both
+  // allocated by OpenEXR unless the header is checked first), an EXR data window of 2^30 x 2^30
+  // and a PNG of 100000 x 100000.
+  for (const auto& [variant, seed] : std::vector<std::pair<std::string, std::string>>{
+           {"capture_exr_attribute_2gb", "attribute_of_2gb.warp.exr"},
+           {"capture_exr_chlist_size_disagrees", "chlist_size_disagrees.warp.exr"},
+           {"capture_exr_data_window_huge", "data_window_huge.warp.exr"},
+           {"capture_png_huge_header", "huge_header.png"}}) {
+    const std::string frame = seed.ends_with(".png") ? "graycode_00.png" : "graycode_00.exr";
+    out.push_back({variant,
+                   [seed, frame](const fs::path& dir) {
+                     capture_context(dir);
+                     fs::remove(dir / "cap/graycode_00.png");
+                     fs::copy_file(kSource / "tests/fuzz/corpus" / seed, dir / "cap" / frame);
+                     json capture = capture_base();
+                     capture["projectors"][0]["frames"][0]["file"] = frame;
+                     spit(dir / "cap/capture.json", capture.dump(1));
+                   },
+                   args,
+                   "out",
+                   {frame}});
+  }
 
   // The camera model (mrcal's Python-literal format) inside the capture.
   const std::string model = slurp(kCapture / "camera.cameramodel");

@@ -13,7 +13,10 @@ struct ImageInfo {
   std::string format;  // OpenImageIO's name for the file format, e.g. "png", "openexr"
 };
 
-// Reads only the header. Throws InputError(path, "", ...) when the file is missing or unreadable.
+// Reads only the header. Throws InputError naming `path` when the file is missing, not a regular
+// file or unreadable, when its OpenEXR header asks for more than the file holds
+// (projection_io::check_exr_header), or when its size is beyond kMaxImageSide / kMaxImagePixels or
+// more pixels than its bytes can encode; read_luminance checks the same before allocating.
 ImageInfo read_image_info(const std::filesystem::path& path);
 
 // Reads an 8- or 16-bit PNG or an EXR (any format OpenImageIO reads) as CV_32F luminance:
