@@ -50,10 +50,12 @@ WarpInverse::WarpInverse(Warp warp) : warp_(std::move(warp)) {
           lo = glm::min(lo, corner);
           hi = glm::max(hi, corner);
         }
-        const int x0 = std::max(0, int(std::ceil(lo.x - 0.5)));
-        const int x1 = std::min(size.x - 1, int(std::floor(hi.x - 0.5)));
-        const int y0 = std::max(0, int(std::ceil(lo.y - 0.5)));
-        const int y1 = std::min(size.y - 1, int(std::floor(hi.y - 0.5)));
+        // Pixel centres within the bounds, clamped while still doubles: any finite offset is a
+        // valid warp, and a corner 1e13 pixels away must not overflow an int.
+        const int x0 = int(std::clamp(std::ceil(lo.x - 0.5), 0.0, double(size.x)));
+        const int x1 = int(std::clamp(std::floor(hi.x - 0.5), -1.0, double(size.x - 1)));
+        const int y0 = int(std::clamp(std::ceil(lo.y - 0.5), 0.0, double(size.y)));
+        const int y1 = int(std::clamp(std::floor(hi.y - 0.5), -1.0, double(size.y - 1)));
         for (int y = y0; y <= y1; ++y) {
           for (int x = x0; x <= x1; ++x) {
             const glm::dvec2 p(x + 0.5, y + 0.5);
