@@ -1,6 +1,11 @@
 // facet bench --scenario cluster: the cluster protocol's cost per frame and its loss detection,
 // with nodes on threads that render nothing.
 #include <netinet/in.h>
+#include <nng/nng.h>
+#include <nng/protocol/pubsub0/pub.h>
+#include <nng/protocol/pubsub0/sub.h>
+#include <nng/protocol/survey0/respond.h>
+#include <nng/protocol/survey0/survey.h>
 #include <sys/socket.h>
 #include <unistd.h>
 
@@ -8,6 +13,10 @@
 #include <atomic>
 #include <chrono>
 #include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <optional>
+#include <stdexcept>
 #include <thread>
 
 #include "facet/driver/cluster.hpp"
@@ -67,6 +76,105 @@ double percentile(std::vector<double> values, double p) {
   return values[index];
 }
 
+// The floor under the protocol: NNG's own exchange, on the same transport between the same number
+// of nodes. Per frame the master publishes a message of `state_bytes` and surveys; every other
+// node, on a thread of its own, receives both and answers at once. None of facet's protocol: no
+// heartbeat, no hand-off between threads, no swap message, no digests. Sets row.floor_*.
+void bench_bare_nng(const projection_io::DisplayCluster& cluster, int frames,
+                    std::size_t state_bytes, double deadline_ms, ClusterBenchRow& row) {
+  auto check = [](int error, const char* what) {
+    if (error != 0)
+      throw std::runtime_error(std::string("bare NNG bench: ") + what + ": " + nng_strerror(error));
+  };
+  const std::size_t nodes = cluster.nodes.size();
+  // Every socket is closed on the way out, thrown or not; the threads start once all listen.
+  std::vector<nng_socket> sockets;
+  struct Closer {
+    std::vector<nng_socket>& sockets;
+    ~Closer() {
+      for (nng_socket socket : sockets) nng_close(socket);
+    }
+  } closer{sockets};
+  auto open = [&](int (*opener)(nng_socket*), const char* what) {
+    nng_socket socket = NNG_SOCKET_INITIALIZER;
+    check(opener(&socket), what);
+    sockets.push_back(socket);
+    return socket;
+  };
+  const nng_socket publisher = open(nng_pub0_open, "pub");
+  const nng_socket surveyor = open(nng_surveyor0_open, "surveyor");
+  check(nng_socket_set_ms(surveyor, NNG_OPT_SURVEYOR_SURVEYTIME, nng_duration(deadline_ms)),
+        "survey time");
+  check(nng_socket_set_ms(surveyor, NNG_OPT_RECVTIMEO, nng_duration(deadline_ms)), "timeout");
+  std::vector<std::pair<nng_socket, nng_socket>> node_sockets;  // subscriber, respondent
+  for (std::size_t k = 1; k < nodes; ++k) {
+    const std::string& address = cluster.nodes[k].address;
+    const std::string barrier = projection_io::cluster_barrier_address(address);
+    const nng_socket subscriber = open(nng_sub0_open, "sub");
+    const nng_socket respondent = open(nng_respondent0_open, "respondent");
+    node_sockets.emplace_back(subscriber, respondent);
+    check(nng_socket_set(subscriber, NNG_OPT_SUB_SUBSCRIBE, "", 0), "subscribe");
+    for (nng_socket socket : {subscriber, respondent})
+      check(nng_socket_set_ms(socket, NNG_OPT_RECVTIMEO, 20), "timeout");
+    check(nng_listen(subscriber, address.c_str(), nullptr, 0), address.c_str());
+    check(nng_listen(respondent, barrier.c_str(), nullptr, 0), barrier.c_str());
+    check(nng_dial(publisher, address.c_str(), nullptr, NNG_FLAG_NONBLOCK), address.c_str());
+    check(nng_dial(surveyor, barrier.c_str(), nullptr, NNG_FLAG_NONBLOCK), barrier.c_str());
+  }
+  std::atomic<bool> stop{false};
+  std::vector<std::thread> threads;
+  for (const auto& [subscriber, respondent] : node_sockets) {
+    threads.emplace_back([subscriber = subscriber, respondent = respondent, &stop] {
+      while (!stop.load()) {
+        void* state = nullptr;
+        std::size_t size = 0;
+        if (nng_recv(subscriber, &state, &size, NNG_FLAG_ALLOC) != 0) continue;
+        nng_free(state, size);
+        void* survey = nullptr;
+        if (nng_recv(respondent, &survey, &size, NNG_FLAG_ALLOC) != 0) continue;
+        nng_send(respondent, survey, size, NNG_FLAG_ALLOC);  // the answer; NNG frees it
+      }
+    });
+  }
+  std::vector<std::uint8_t> state(state_bytes, 0);
+  // One exchange: the time until every node answered, or nullopt when the survey expired first.
+  auto exchange = [&](std::uint64_t frame) -> std::optional<double> {
+    const Clock::time_point start = Clock::now();
+    nng_send(publisher, state.data(), state.size(), 0);
+    nng_send(surveyor, &frame, sizeof frame, 0);
+    for (std::size_t answered = 0; answered + 1 < nodes;) {
+      void* answer = nullptr;
+      std::size_t size = 0;
+      if (nng_recv(surveyor, &answer, &size, NNG_FLAG_ALLOC) != 0) return std::nullopt;
+      std::uint64_t answered_frame = 0;
+      if (size == sizeof answered_frame) std::memcpy(&answered_frame, answer, size);
+      nng_free(answer, size);
+      if (answered_frame == frame) ++answered;
+    }
+    return ms_between(start, Clock::now());
+  };
+  // Until every node is connected and answers (at most 30 s), then the frames timed.
+  std::uint64_t frame = 1;
+  const Clock::time_point joining = Clock::now();
+  int in_a_row = 0;
+  while (in_a_row < 10 && Clock::now() - joining < std::chrono::seconds(30))
+    in_a_row = exchange(frame++) ? in_a_row + 1 : 0;
+  std::vector<double> frame_ms;
+  int expired = 0;
+  for (int i = 0; i < frames && in_a_row == 10; ++i) {
+    if (const std::optional<double> ms = exchange(frame++))
+      frame_ms.push_back(*ms);
+    else
+      ++expired;
+  }
+  stop = true;
+  for (std::thread& thread : threads) thread.join();
+  if (in_a_row < 10) throw std::runtime_error("bare NNG bench: the nodes did not connect in 30 s");
+  row.floor_median_ms = percentile(frame_ms, 0.5);
+  row.floor_p99_ms = percentile(frame_ms, 0.99);
+  row.floor_expired = expired;
+}
+
 }  // namespace
 
 std::vector<ClusterBenchRow> bench_cluster(
@@ -111,6 +219,24 @@ std::vector<ClusterBenchRow> bench_cluster(
       ClusterBenchRow row;
       row.nodes = nodes;
       row.transport = transport;
+      if (nodes >= 2) {
+        if (transport == "ipc") std::filesystem::create_directories(options.folder / "bare");
+        FrameState typical;
+        typical.frame = 1000;
+        // A port the kernel offered may be taken by the time it is listened on (and the barrier
+        // listens on the next one): then again with other ports, three times at most.
+        for (int attempt = 1;; ++attempt) {
+          try {
+            bench_bare_nng(bench_cluster_config(nodes, transport, options.folder / "bare",
+                                                options.deadline_ms),
+                           options.frames, encode_frame_state(typical).size() + 9,
+                           options.deadline_ms, row);
+            break;
+          } catch (const std::runtime_error&) {
+            if (attempt == 3) throw;
+          }
+        }
+      }
       std::vector<double> frame_ms;
       {
         const std::unique_ptr<FrameSync> master = make_cluster_master(node_options(0));
@@ -140,12 +266,14 @@ std::vector<ClusterBenchRow> bench_cluster(
       row.median_ms = percentile(frame_ms, 0.5);
       row.p99_ms = percentile(frame_ms, 0.99);
       row.worst_ms = percentile(frame_ms, 1.0);
-      char line[200];
+      char line[400];
       std::snprintf(line, sizeof line,
                     "cluster %s %d nodes: %.3f ms median, %.3f ms p99, %.3f ms worst per frame; "
-                    "lost secondary dropped after %.1f ms, lost master seen after %.1f ms",
+                    "lost secondary dropped after %.1f ms, lost master seen after %.1f ms; "
+                    "bare NNG publish+survey %.3f ms median, %.3f ms p99",
                     transport.c_str(), nodes, row.median_ms, row.p99_ms, row.worst_ms,
-                    row.secondary_loss_ms, row.master_loss_ms);
+                    row.secondary_loss_ms, row.master_loss_ms, row.floor_median_ms,
+                    row.floor_p99_ms);
       if (progress) progress(line);
       rows.push_back(row);
     }

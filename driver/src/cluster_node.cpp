@@ -362,6 +362,7 @@ class Master final : public FrameSync {
  private:
   void publish(Published kind, const std::vector<std::uint8_t>& body) {
     publisher_.send(Bytes().put(kind).put(options_.content_digest).put_bytes(body).data);
+    last_published_.store(Clock::now().time_since_epoch().count(), std::memory_order_relaxed);
   }
 
   void stop(const std::string& reason) {
@@ -450,12 +451,22 @@ class Master final : public FrameSync {
                       ms_text(ms_since(start)) + "; deadline " + ms_text(deadline_ms_));
   }
 
+  // A heartbeat when nothing else was published for a quarter deadline: while frames follow
+  // each other faster than that, they are the sign of life, and a heartbeat would only wake every
+  // node in the middle of a barrier.
   void beat() {
     const Clock::duration every = period(std::max(1.0, deadline_ms_ / 4) / 1000);
     std::unique_lock lock(mutex_);
     while (!stopping_) {
-      publish(Published::heartbeat, {});
-      wake_.wait_for(lock, every, [this] { return stopping_; });
+      const Clock::time_point last{
+          Clock::duration(last_published_.load(std::memory_order_relaxed))};
+      const Clock::time_point now = Clock::now();
+      if (now - last >= every) {
+        publish(Published::heartbeat, {});
+        wake_.wait_for(lock, every, [this] { return stopping_; });
+      } else {
+        wake_.wait_until(lock, last + every, [this] { return stopping_; });
+      }
     }
   }
 
@@ -469,6 +480,7 @@ class Master final : public FrameSync {
   std::uint64_t frames_sent_ = 0, last_frame_ = 0;
   double last_broadcast_ms_ = 0;
   Clock::time_point last_start_;
+  std::atomic<Clock::rep> last_published_{0};  // when anything was last published
   std::mutex mutex_;
   std::condition_variable wake_;
   bool stopping_ = false;
@@ -507,7 +519,8 @@ class Secondary final : public FrameSync {
       std::lock_guard lock(mutex_);
       stopping_ = true;
     }
-    changed_.notify_all();
+    inbox_changed_.notify_all();
+    rendered_changed_.notify_all();
     subscriber_.close();
     respondent_.close();
     listener_.join();
@@ -540,7 +553,7 @@ class Secondary final : public FrameSync {
   bool ready_to_swap(const FrameState& state, nlohmann::json& stats) override {
     std::unique_lock lock(mutex_);
     rendered_ = state.frame;
-    changed_.notify_all();
+    rendered_changed_.notify_all();
     for (;;) {
       check();
       while (!inbox_.empty()) {
@@ -621,7 +634,7 @@ class Secondary final : public FrameSync {
     if (last_heard_)
       until = std::min(until,
                        *last_heard_ + period(deadline_ms_ / 1000) + std::chrono::microseconds(100));
-    changed_.wait_until(lock, until);
+    inbox_changed_.wait_until(lock, until);
   }
 
   void listen() {
@@ -640,9 +653,14 @@ class Secondary final : public FrameSync {
       last_heard_ = Clock::now();
       if (digest != options_.content_digest) foreign_digest_ = digest;
       if (kind == Published::stop) stop_reason_ = in.rest_text();
-      if (kind != Published::heartbeat)
+      if (kind != Published::heartbeat) {
         inbox_.emplace_back(kind, std::vector<std::uint8_t>(in.rest().begin(), in.rest().end()));
-      changed_.notify_all();
+        inbox_changed_.notify_one();
+      } else if (foreign_digest_) {
+        inbox_changed_.notify_one();
+      }
+      // A plain heartbeat wakes nobody: it moves last_heard_, which check() reads when the main
+      // thread wakes, at the latest when the old silence would have passed the deadline.
     }
   }
 
@@ -665,7 +683,8 @@ class Secondary final : public FrameSync {
         hears = last_heard_.has_value();
         if (kind == Survey::ready) {
           // Answered once this node's outputs of `frame` are rendered; not when it skipped it.
-          changed_.wait(lock, [&] { return stopping_ || (rendered_ && *rendered_ >= frame); });
+          rendered_changed_.wait(lock,
+                                 [&] { return stopping_ || (rendered_ && *rendered_ >= frame); });
           answer = !stopping_ && rendered_ && *rendered_ == frame;
         }
       }
@@ -686,7 +705,8 @@ class Secondary final : public FrameSync {
   std::string master_;
   Socket subscriber_, respondent_;
   std::mutex mutex_;
-  std::condition_variable changed_;
+  // The main thread waits for the inbox (and the master's silence), the responder for rendered_.
+  std::condition_variable inbox_changed_, rendered_changed_;
   std::deque<std::pair<Published, std::vector<std::uint8_t>>> inbox_;
   std::optional<Clock::time_point> last_heard_;
   Clock::time_point started_ = Clock::now();

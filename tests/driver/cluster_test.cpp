@@ -466,6 +466,9 @@ TEST(ClusterBench, ReportsEveryNodeCountAndBothLosses) {
   for (const ClusterBenchRow& row : rows) {
     EXPECT_GT(row.median_ms, 0) << row.transport << " " << row.nodes;
     EXPECT_LE(row.median_ms, row.p99_ms);
+    // NNG's own exchange on the same transport, measured before the protocol.
+    EXPECT_GT(row.floor_median_ms, 0) << row.transport << " " << row.nodes;
+    EXPECT_LE(row.floor_median_ms, row.floor_p99_ms);
     // Nobody is declared lost before the deadline has passed (the survey's own timer allows a
     // little rounding); the 2-node row has no secondary to lose besides the one the master needs.
     if (row.nodes == 3) {

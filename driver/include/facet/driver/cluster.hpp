@@ -9,8 +9,9 @@
 //      answers when its outputs are rendered and about to swap;
 //   3. publishes "swap N" with the nodes that missed the deadline, which are dropped from the
 //      barrier, and the nodes that answered again, which rejoin it. Then every node swaps.
-// Between frames the master publishes a heartbeat every quarter deadline, so that a secondary
-// that hears nothing for a deadline knows the master is gone, whatever the frames cost to render.
+// Whenever it has published nothing for a quarter deadline, the master publishes a heartbeat, so
+// that a secondary that hears nothing for a deadline knows the master is gone, whatever the
+// frames cost to render.
 //
 // Addresses: every node listens on its address (frame states) and on
 // cluster_barrier_address(address) (the barrier); the master dials every other node, so nodes
@@ -146,6 +147,11 @@ struct ClusterBenchRow {
   double median_ms = 0, p99_ms = 0, worst_ms = 0;
   double secondary_loss_ms = 0;  // a secondary falls silent: the master's wait until it drops it
   double master_loss_ms = 0;     // the master falls silent: until the last secondary gives up
+  // The floor under the protocol, measured before it on the same transport and node count:
+  // NNG's publish and survey alone, each node answering at once from a thread of its own, per
+  // frame; floor_expired frames whose survey expired before every node answered (not timed).
+  double floor_median_ms = 0, floor_p99_ms = 0;
+  int floor_expired = 0;
 };
 // One row per node count and transport; `progress` gets a line per row.
 std::vector<ClusterBenchRow> bench_cluster(const ClusterBenchOptions& options,
