@@ -125,6 +125,8 @@ void Display::set_tolerance_px(double tolerance_px) {
     throw InputError("API", "tolerance_px", "a positive number of output pixels");
   display_ = std::make_shared<driver::SessionDisplay>(*display_);
   display_->settings.facets.layout = FacetTolerance{tolerance_px};
+  display_->settings.facets.origin.source = "API";
+  display_->settings.facets.origin.field = "tolerance_px";
 }
 
 void Display::set_material_shader(const std::string& name_or_file) {

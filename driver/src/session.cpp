@@ -76,11 +76,16 @@ BlendMaps wall2x2_blend(const Warp& warp, int row, int column) {
 SessionDisplay load_session_display(std::string_view display, std::optional<glm::ivec2> size) {
   SessionDisplay result;
   result.source = std::string(display);
+  // A show goes on when its facets miss the tolerance by a near miss (with a warning, when the
+  // caller gives facets.warn); the tolerance is the display's own, or --tolerance's default.
+  result.settings.facets.near_miss = kRunNearMiss;
+  result.settings.facets.origin = {"command line", "--tolerance", {}};
   std::vector<OutputSpec> specs = load_display_outputs(display, size);
   if (display.ends_with(".json")) {
     const auto config = projection_io::read_display_config(std::filesystem::path(display));
     result.method = config.render.method;
     result.settings.facets.layout = FacetTolerance{config.render.tolerance_px};
+    result.settings.facets.origin = {std::string(display), "render.tolerance_px", {}};
     result.settings.z_near = config.render.z_near;
     result.missing_monitor = config.missing_monitor;
     for (std::size_t i = 0; i < config.projectors.size(); ++i) {
@@ -332,7 +337,9 @@ Session::Session(SessionDisplay display, Scene scene)
   for (const SessionOutput& output : display_.outputs) {
     const Warp& warp = output.spec.warp;
     std::unique_ptr<RenderMethod> method = make_render_method(display_.method);
-    method->prepare(scene_, gpu_scene_, std::span(&output.spec, 1), display_.settings);
+    RenderSettings settings = display_.settings;  // its facets' messages name the projector
+    settings.facets.origin.output = output.spec.name;
+    method->prepare(scene_, gpu_scene_, std::span(&output.spec, 1), settings);
     methods_.push_back(std::move(method));
     targets_.push_back(OutputTarget::create(warp.output_size, display_.settings.msaa_samples));
     blends_.emplace_back(warp.output_size, output.blend, output.encoding);

@@ -152,6 +152,13 @@ using detail::kPi;
 using detail::max_coverage;
 using detail::vertex_at;
 
+// A pixel figure for messages: 0.25, 1e-09 (std::to_string would say 0.250000, 0.000000).
+std::string px_figure(double px) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%g", px);
+  return text;
+}
+
 struct Cell {
   std::array<FacetVertex, 4> corner;  // (s0,t0) (s1,t0) (s0,t1) (s1,t1)
   std::array<Facet, 2> facet;
@@ -339,15 +346,15 @@ class GridFitter {
         throw InputError({}, "tolerance",
                          "the warp changes too fast near " + std::string(axis == 0 ? "s" : "t") +
                              " = " + std::to_string(start) + " for facets to meet " +
-                             std::to_string(tolerance_px_) + " px");
+                             px_figure(tolerance_px_) + " px");
       }
       breaks.push_back(lo);
       previous_width = lo - start;
       start = lo;
       if (breaks.size() * other.size() > std::size_t(max_cells_)) {
         throw InputError({}, "tolerance",
-                         "meeting " + std::to_string(tolerance_px_) + " px needs more than " +
-                             std::to_string(max_cells_) + " cells");
+                         "meeting " + px_figure(tolerance_px_) + " px needs more than " +
+                             std::to_string(max_cells_) + " cells; a larger tolerance needs fewer");
       }
     }
     // A uniform spacing with the same count spreads the slack evenly; keep it when it fits.
@@ -384,8 +391,8 @@ class GridFitter {
       const auto [s_breaks, t_breaks] = grid(hi);
       if ((s_breaks.size() - 1) * (t_breaks.size() - 1) > std::size_t(max_cells_)) {
         throw InputError({}, "tolerance",
-                         "meeting " + std::to_string(tolerance_px_) + " px needs more than " +
-                             std::to_string(max_cells_) + " cells");
+                         "meeting " + px_figure(tolerance_px_) + " px needs more than " +
+                             std::to_string(max_cells_) + " cells; a larger tolerance needs fewer");
       }
     }
     while (hi - lo > 1) {
@@ -462,8 +469,8 @@ FacetMesh build_tolerance_layout(const Warp& warp, double tolerance, int max_cel
   }
   if (cells(s_breaks, t_breaks) > std::size_t(max_cells)) {
     throw InputError({}, "tolerance",
-                     "meeting " + std::to_string(tolerance) + " px needs more than " +
-                         std::to_string(max_cells) + " cells");
+                     "meeting " + px_figure(tolerance) + " px needs more than " +
+                         std::to_string(max_cells) + " cells; a larger tolerance needs fewer");
   }
   return assemble(warp, std::move(s_breaks), std::move(t_breaks), kBuildSubdivisions);
 }
@@ -492,34 +499,21 @@ FacetMesh build_fewest_facets(const Warp& warp, double target, int max_cells) {
   return std::move(*adaptive);
 }
 
-}  // namespace
+// A figure rounded up to two significant digits, for "set it to at least ...".
+double round_up_2(double x) {
+  const double unit = std::pow(10.0, std::floor(std::log10(x)) - 1);
+  return std::ceil(x / unit * (1 - 1e-12)) * unit;
+}
 
-FacetMesh build_facets(const Warp& warp, const FacetBuildOptions& options) {
-  warp.validate();
-  if (const auto* strips = std::get_if<FacetStrips>(&options.layout)) {
-    if (strips->count < 1) throw InputError({}, "pieces", "expected at least 1 strip");
-    if (strips->count > options.max_cells)
-      throw InputError({}, "pieces",
-                       "at most " + std::to_string(options.max_cells) + " strips; got " +
-                           std::to_string(strips->count));
-    return assemble(warp, uniform_breaks(strips->count), uniform_breaks(1), kBuildSubdivisions);
-  }
-  if (const auto* grid = std::get_if<FacetGrid>(&options.layout)) {
-    if (grid->columns < 1 || grid->rows < 1) {
-      throw InputError({}, "grid", "expected at least 1×1 cells");
-    }
-    if (std::int64_t(grid->columns) * grid->rows > options.max_cells) {
-      throw InputError({}, "grid",
-                       "at most " + std::to_string(options.max_cells) + " cells; got " +
-                           std::to_string(grid->columns) + "x" + std::to_string(grid->rows));
-    }
-    return assemble(warp, uniform_breaks(grid->columns), uniform_breaks(grid->rows),
-                    kBuildSubdivisions);
-  }
+// The tolerance layout of build_facets; InputErrors say field "tolerance" and no source.
+FacetMesh build_to_tolerance(const Warp& warp, const FacetBuildOptions& options) {
   const FacetTolerance& layout = std::get<FacetTolerance>(options.layout);
   const double tolerance = layout.px;
   if (!(tolerance > 0) || !std::isfinite(tolerance)) {
     throw InputError({}, "tolerance", "expected a positive number of pixels");
+  }
+  if (!(options.near_miss >= 0) || !std::isfinite(options.near_miss)) {
+    throw InputError({}, "near_miss", "expected a fraction >= 0");
   }
   // Below kProbePx / 10 a tolerance is first checked against an estimate of the cells it needs,
   // from a tensor build at kProbePx: a cell's error grows as the square of its size where the
@@ -551,27 +545,94 @@ FacetMesh build_facets(const Warp& warp, const FacetBuildOptions& options) {
   // evaluate_facet_error measures it (every covered direction against the facet that holds it,
   // which near a cell's edge may be its neighbour's). Where that exceeds the tolerance (a warp
   // with a kink, such as a folded node masked by an import), the build is repeated with the
-  // cells' target scaled down by the overshoot, twice at most, and gives up rather than return
-  // facets that break the tolerance.
+  // cells' target scaled down by the overshoot, twice at most (a retry whose finer target cannot
+  // be built ends the tries). The try with the smallest worst error is then kept when it misses
+  // by at most near_miss; beyond, the build gives up rather than return facets that break the
+  // tolerance.
   double target = tolerance;
-  FacetError measured;
+  std::optional<FacetMesh> best;
+  FacetError best_error;
   for (int attempt = 0; attempt < 3; ++attempt) {
-    FacetMesh mesh = layout.builder == FacetTolerance::Builder::tensor
-                         ? build_tolerance_layout(warp, target, options.max_cells)
-                     : layout.builder == FacetTolerance::Builder::bisection
-                         ? detail::build_adaptive_layout(warp, target, options.max_cells)
-                         : build_fewest_facets(warp, target, options.max_cells);
-    measured = evaluate_facet_error(warp, mesh);
+    FacetMesh mesh;
+    try {
+      mesh = layout.builder == FacetTolerance::Builder::tensor
+                 ? build_tolerance_layout(warp, target, options.max_cells)
+             : layout.builder == FacetTolerance::Builder::bisection
+                 ? detail::build_adaptive_layout(warp, target, options.max_cells)
+                 : build_fewest_facets(warp, target, options.max_cells);
+    } catch (const InputError&) {
+      if (!best) throw;
+      break;  // a retry's finer target cannot be built: judge the tries so far
+    }
+    const FacetError measured = evaluate_facet_error(warp, mesh);
     if (measured.max_px <= tolerance) return mesh;
+    if (!best || measured.max_px < best_error.max_px) {
+      best = std::move(mesh);
+      best_error = measured;
+    }
     target *= 0.9 * tolerance / measured.max_px;
   }
-  throw InputError({}, "tolerance",
-                   "the facets built for " + std::to_string(tolerance) + " px still reach " +
-                       std::to_string(measured.max_px) + " px at output pixel (" +
-                       std::to_string(measured.worst_q.x) + ", " +
-                       std::to_string(measured.worst_q.y) +
-                       "): the warp is not smooth enough there; a larger tolerance or a grid "
-                       "layout renders it");
+  const double reached = best_error.max_px;
+  const std::string where = "(" + std::to_string(int(std::floor(best_error.worst_q.x))) + ", " +
+                            std::to_string(int(std::floor(best_error.worst_q.y))) + ")";
+  char text[400];
+  if (reached <= tolerance * (1 + options.near_miss)) {
+    best->tolerance_miss = FacetToleranceMiss{tolerance, reached, best_error.worst_q};
+    if (options.warn) {
+      const FacetToleranceOrigin& origin = options.origin;
+      std::snprintf(text, sizeof text,
+                    "%s: field '%s': %s%g px not met: the facets reach %.3g px (%.1f%% over, "
+                    "within the %g%% accepted) at output pixel %s; rendering with them (they meet "
+                    "%g px)",
+                    origin.source.empty() ? "input" : origin.source.c_str(), origin.field.c_str(),
+                    origin.output.empty() ? "" : ("output '" + origin.output + "': ").c_str(),
+                    tolerance, reached, 100 * (reached / tolerance - 1), 100 * options.near_miss,
+                    where.c_str(), round_up_2(reached));
+      options.warn(text);
+    }
+    return std::move(*best);
+  }
+  std::snprintf(text, sizeof text,
+                "the facets built for %g px still reach %.3g px (%.1f%% over) at output pixel "
+                "%s: the warp is not smooth enough there; set it to %g px or more",
+                tolerance, reached, 100 * (reached / tolerance - 1), where.c_str(),
+                round_up_2(reached));
+  throw InputError({}, "tolerance", text);
+}
+
+}  // namespace
+
+FacetMesh build_facets(const Warp& warp, const FacetBuildOptions& options) {
+  warp.validate();
+  if (const auto* strips = std::get_if<FacetStrips>(&options.layout)) {
+    if (strips->count < 1) throw InputError({}, "pieces", "expected at least 1 strip");
+    if (strips->count > options.max_cells)
+      throw InputError({}, "pieces",
+                       "at most " + std::to_string(options.max_cells) + " strips; got " +
+                           std::to_string(strips->count));
+    return assemble(warp, uniform_breaks(strips->count), uniform_breaks(1), kBuildSubdivisions);
+  }
+  if (const auto* grid = std::get_if<FacetGrid>(&options.layout)) {
+    if (grid->columns < 1 || grid->rows < 1) {
+      throw InputError({}, "grid", "expected at least 1×1 cells");
+    }
+    if (std::int64_t(grid->columns) * grid->rows > options.max_cells) {
+      throw InputError({}, "grid",
+                       "at most " + std::to_string(options.max_cells) + " cells; got " +
+                           std::to_string(grid->columns) + "x" + std::to_string(grid->rows));
+    }
+    return assemble(warp, uniform_breaks(grid->columns), uniform_breaks(grid->rows),
+                    kBuildSubdivisions);
+  }
+  // The tolerance layout's own errors say "tolerance"; they are the field the tolerance came from.
+  try {
+    return build_to_tolerance(warp, options);
+  } catch (const InputError& error) {
+    if (error.field() != "tolerance" || !error.source().empty()) throw;
+    const std::string& output = options.origin.output;
+    throw InputError(options.origin.source, options.origin.field,
+                     (output.empty() ? "" : "for output '" + output + "', ") + error.expected());
+  }
 }
 
 }  // namespace facet

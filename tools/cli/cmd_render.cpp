@@ -173,6 +173,12 @@ void run(const RenderOptions& options) {
   check_render_method(options.method);
   RenderSettings settings;
   settings.facets.layout = options.layout.layout();
+  // As facet run: facets that miss the tolerance by a near miss render, with a warning.
+  settings.facets.near_miss = kRunNearMiss;
+  settings.facets.origin = {"command line", "--tolerance", {}};
+  settings.facets.warn = [](const std::string& line) {
+    std::cerr << "facet render: warning: " << line << "\n";
+  };
   if (options.face_size) {
     if (*options.face_size < 1) {
       throw InputError("command line", "--face-size", "expected a cube face size >= 1 pixel");

@@ -119,7 +119,12 @@ void run(const RunOptions& options) {
     if (!(*options.tolerance > 0))
       throw InputError("command line", "--tolerance", "a positive number of output pixels");
     display.settings.facets.layout = FacetTolerance{*options.tolerance};
+    display.settings.facets.origin.source = "command line";
+    display.settings.facets.origin.field = "--tolerance";
   }
+  display.settings.facets.warn = [](const std::string& line) {
+    std::cerr << "facet run: warning: " << line << "\n";
+  };
   display.settings.material = driver::load_material_shader(options.material);
   // Check the method name before any scene work; one from display.json is reported there.
   try {

@@ -8,7 +8,9 @@
 // w = n·X. Neighbours share corners, so shared edges map identically: no cracks, no T-junctions.
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <glm/glm.hpp>
+#include <optional>
 #include <string>
 #include <variant>
 #include <vector>
@@ -43,8 +45,18 @@ struct Facet {
   glm::dmat4 clip_from_eye(glm::ivec2 output_size, double z_near) const;
 };
 
+// A tolerance build that kept facets whose worst error exceeds the tolerance by at most
+// FacetBuildOptions::near_miss (see build_facets).
+struct FacetToleranceMiss {
+  double tolerance_px = 0;  // the tolerance asked for
+  double max_px = 0;        // the worst error of the facets kept (evaluate_facet_error)
+  glm::dvec2 worst_q{0.0};  // the output pixel where it is reached
+};
+
 struct FacetMesh {
   glm::ivec2 output_size{0, 0};
+  // Set when a tolerance build kept facets that miss the tolerance by a near miss.
+  std::optional<FacetToleranceMiss> tolerance_miss;
   std::vector<FacetVertex> vertices;
   std::vector<Facet> facets;
   // The tensor-product layout the facets came from (empty for any other layout): cell (c, r) spans
@@ -80,16 +92,37 @@ struct FacetTolerance {  // as few facets as the builder can find with max error
 };
 using FacetLayout = std::variant<FacetStrips, FacetGrid, FacetTolerance>;
 
+// The near miss a running show accepts (facet run, facet render): facets whose worst error is at
+// most 10% above the tolerance render with a warning instead of stopping the show.
+inline constexpr double kRunNearMiss = 0.10;
+
+// Where a tolerance was set and what the facets are for, so that the errors and warnings of a
+// tolerance build name them: InputError(source, field, ...) and "<source>: field '<field>': ...".
+struct FacetToleranceOrigin {
+  std::string source;               // a display.json's path, "command line"; empty: "input"
+  std::string field = "tolerance";  // "render.tolerance_px", "--tolerance"
+  std::string output;               // the projector the facets are for; empty: not named
+};
+
 struct FacetBuildOptions {
   FacetLayout layout = FacetTolerance{};
   // Upper bound on cells a tolerance build may use before it gives up with InputError.
   int max_cells = 1 << 20;
+  // A tolerance build whose best try still misses the tolerance is kept when its worst error is
+  // at most (1 + near_miss) × the tolerance: FacetMesh::tolerance_miss records it and `warn`, when
+  // set, gets one line naming origin's field and the figure reached. Beyond it, or at 0 (the
+  // default), the build throws InputError.
+  double near_miss = 0;
+  FacetToleranceOrigin origin{};
+  std::function<void(const std::string& line)> warn{};
 };
 
 // Builds facets over the covered part of the warp. A tolerance layout is checked as a whole with
-// evaluate_facet_error before it is returned: its max_px is at most the tolerance. Throws
-// InputError for a layout that cannot be met (a facet spanning 180° or more, a tolerance that
-// needs more than max_cells, or one the builder misses three times, naming the worst pixel).
+// evaluate_facet_error before it is returned: its max_px is at most the tolerance, or at most
+// (1 + near_miss) × the tolerance with tolerance_miss set. Throws InputError for a layout that
+// cannot be met (a facet spanning 180° or more, a tolerance that needs more than max_cells, or one
+// the builder misses three times by more than near_miss, naming the worst pixel and the tolerance
+// that would be met); the errors of a tolerance layout name options.origin's source and field.
 FacetMesh build_facets(const Warp& warp, const FacetBuildOptions& options);
 
 }  // namespace facet
