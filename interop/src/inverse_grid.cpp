@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string>
 
 #include "facet/projection/errors.hpp"
 #include "facet/projection/warp_inverse.hpp"
@@ -15,6 +16,11 @@ bool finite(glm::dvec2 v) { return std::isfinite(v.x) && std::isfinite(v.y); }
 // base-image positions times this. WarpInverse's per-pixel table then has this many pixels per
 // side; queries are solved exactly by Newton whatever the table's resolution.
 constexpr int kAuxiliaryScale = 1024;
+
+// The largest magnitude of a node's value (a base-image position normalised to [0,1]) that an
+// inverse grid may hold: a million base images away is no map, and the bound keeps the auxiliary
+// warp's offsets, its extrapolated nodes included, finite as floats.
+constexpr double kMaxInverseGridValue = 1e6;
 
 // Nodes found only among filled-in nodes of the inverse grid may come from a fold of that
 // extrapolation rather than from the map. A suspect node is kept when it continues its trusted
@@ -193,6 +199,16 @@ Warp warp_from_inverse_grid(const InverseGrid& grid, const BaseProjection& base,
   FACET_ASSERT(grid.grid_size.x >= 2 && grid.grid_size.y >= 2);
   FACET_ASSERT(grid.st.size() == std::size_t(grid.grid_size.x) * grid.grid_size.y);
   FACET_ASSERT(warp_grid.x >= 2 && warp_grid.y >= 2);
+  for (int j = 0; j < grid.grid_size.y; ++j) {
+    for (int i = 0; i < grid.grid_size.x; ++i) {
+      const glm::dvec2 value = grid.st[std::size_t(j) * grid.grid_size.x + i];
+      if (std::abs(value.x) > kMaxInverseGridValue || std::abs(value.y) > kMaxInverseGridValue) {
+        throw InputError(source, "node (" + std::to_string(i) + ", " + std::to_string(j) + ")",
+                         "a normalised position within ±1e6 (or NaN for none); got (" +
+                             std::to_string(value.x) + ", " + std::to_string(value.y) + ")");
+      }
+    }
+  }
   // The inverse grid as a Warp of its own: its base image is the output (normalised), its
   // "output" the base image of the result scaled by kAuxiliaryScale. Inverting that warp answers
   // "which output position shows st". The grid is padded by extrapolated nodes on every side, so

@@ -39,7 +39,8 @@ std::vector<bool> fill_missing(std::vector<glm::dvec2>& values, glm::ivec2 grid_
 // output position shows get coverage 0 and extrapolated offsets. The inverse grid is inverted
 // cell by cell in double precision (WarpInverse), so the forward warp reproduces the inverse
 // grid to about 1e-9 px at its nodes. Throws InputError naming `source` when the grid has no
-// valid node or the result folds.
+// valid node, a node whose value lies beyond ±1e6 (a million base images away), or the result
+// folds.
 Warp warp_from_inverse_grid(const InverseGrid& grid, const BaseProjection& base,
                             const glm::dmat3& R_eye_base, glm::ivec2 output_size,
                             glm::ivec2 warp_grid, const std::string& source);
