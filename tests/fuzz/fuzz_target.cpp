@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cstdio>
 #include <cstdlib>
 #include <fstream>
 
@@ -35,8 +36,11 @@ const Target* find_target(std::string_view name) {
 const std::filesystem::path& scratch_folder() {
   // Never destroyed, so that the exit handler can still name it.
   static const std::filesystem::path* folder = [] {
-    auto* path = new std::filesystem::path(std::filesystem::temp_directory_path() /
-                                           ("facet_fuzz_" + std::to_string(::getpid())));
+    // The process id at a fixed width: paths (and the messages naming them) keep one length in
+    // every run, so that a libFuzzer run with a fixed -seed follows the same sequence each time.
+    char name[32];
+    std::snprintf(name, sizeof name, "facet_fuzz_%010ld", long(::getpid()));
+    auto* path = new std::filesystem::path(std::filesystem::temp_directory_path() / name);
     std::filesystem::create_directories(*path);
     return path;
   }();
