@@ -63,7 +63,8 @@ void run_cluster(const BenchCommandOptions& command) {
                     {"master_loss_detected_ms", row.master_loss_ms},
                     {"bare_nng_median_ms", row.floor_median_ms},
                     {"bare_nng_p99_ms", row.floor_p99_ms},
-                    {"bare_nng_expired_frames", row.floor_expired}});
+                    {"bare_nng_expired_frames", row.floor_expired},
+                    {"frames_without_every_node", row.frames_short}});
   const std::filesystem::path file = std::filesystem::path(command.out) / "cluster.json";
   write_atomically(file, [&](const std::filesystem::path& temporary) {
     std::ofstream(temporary) << json.dump(2) << '\n';

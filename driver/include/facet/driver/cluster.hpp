@@ -152,6 +152,9 @@ struct ClusterBenchRow {
   // frame; floor_expired frames whose survey expired before every node answered (not timed).
   double floor_median_ms = 0, floor_p99_ms = 0;
   int floor_expired = 0;
+  // Timed frames the master swapped without every secondary in the barrier (one that did not
+  // join, or was dropped): a row with any is not the protocol's cost at `nodes` nodes.
+  int frames_short = 0;
 };
 // One row per node count and transport; `progress` gets a line per row.
 std::vector<ClusterBenchRow> bench_cluster(const ClusterBenchOptions& options,
