@@ -28,6 +28,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <iostream>
 #include <iterator>
 #include <limits>
 #include <nlohmann/json.hpp>
@@ -2009,6 +2010,7 @@ TEST_P(Hostile, EveryVariantExitsTwoNamingTheInputAndLeavesNothing) {
   std::vector<Variant> variants;
   GetParam().add(variants);
   EXPECT_GE(variants.size(), 20u);
+  std::cout << GetParam().name << ": " << variants.size() << " variants\n";
   for (const Variant& variant : variants) {
     SCOPED_TRACE("variant " + variant.name);
     check_variant(variant);
