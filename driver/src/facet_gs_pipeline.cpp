@@ -2,8 +2,10 @@
 // shader counts each triangle's facets into transform feedback, the counts are scanned and
 // expanded into a replicated index of (triangle, replica) entries, and a geometry shader renders
 // each replica through its facet. Same triangle list, walk order and arithmetic as "facets", so
-// both give the same image.
-#include <optional>
+// both give the same image; the pair buffer, its overflow rerun and the indirect draws without a
+// read-back are PairPipelineBase's, as for "facets".
+#include <algorithm>
+#include <cstdint>
 
 #include "facet/projection/errors.hpp"
 #include "render_methods_internal.hpp"
@@ -12,7 +14,7 @@
 namespace facet::driver::detail {
 namespace {
 
-class FacetGsPipeline final : public FacetMethodBase {
+class FacetGsPipeline final : public PairPipelineBase {
  public:
   std::string_view name() const override { return "facets-gs"; }
 
@@ -34,46 +36,27 @@ class FacetGsPipeline final : public FacetMethodBase {
     }
   }
 
-  RenderStats render(const glm::dmat4& T_eye_world, std::span<OutputTarget> targets,
-                     GpuTimer* timer) override {
-    FACET_ASSERT(targets.size() == outputs_.size());
-    const bool changed = update_view(T_eye_world);
-    RenderStats stats;
-    stats.reused_replication = !outputs_.empty();
-    for (std::size_t i = 0; i < outputs_.size(); ++i) {
-      OutputState& out = outputs_[i];
-      targets[i].clear();
-      if (!add_output_stats(out, stats)) {
-        targets[i].resolve();
-        continue;
-      }
-      if (changed || !out.replication_valid) {
-        stats.reused_replication = false;
-        // Pass 1 draws (with rasterizer discard), which needs a complete framebuffer bound.
-        targets[i].bind();
-        replicate(i, timer);
-      }
-      stats.replicas += out.replicas;
-      stats.triangles_visible += out.visible;
-
-      TimedPass scope(timer, "pass3 draw");
-      draw_replicas(i, targets[i], draw_, GL_POINTS);
-      targets[i].resolve();
-    }
-    if (timer) timer->end_frame();
-    return stats;
+  void draw(std::size_t i, OutputTarget& target, GpuTimer* timer) override {
+    TimedPass scope(timer, "pass3 draw");
+    draw_replicas(i, target, draw_, GL_POINTS);
   }
 
- private:
-  void replicate(std::size_t i, GpuTimer* timer) {
+  // Passes 1 and 2 of output i without reading anything back: replicate.comp writes the pair
+  // count and, beyond the pair capacity, the overflow flag that makes draw_args.comp draw nothing.
+  void replicate(std::size_t i, OutputTarget& target, GpuTimer* timer) override {
     OutputState& out = outputs_[i];
     const std::uint32_t n = out.triangles;
     ensure_capacity(out.scan, (std::size_t(n) + 1) * sizeof(std::uint32_t));
+    const std::uint32_t capacity = pair_capacity(i);
+    ensure_capacity(out.pairs, std::size_t(capacity) * 2 * sizeof(std::uint32_t));
+    size_draw_commands(out, capacity);
     {
       TimedPass scope(timer, "pass1 coverage");
-      const std::uint32_t zero = 0;
-      out.stats.sub_data(0, sizeof zero, &zero);
-      out.scan.sub_data(std::size_t(n) * sizeof zero, sizeof zero, &zero);
+      const std::uint32_t zero[4] = {0, 0, 0, 0};
+      out.stats.sub_data(0, sizeof zero, zero);
+      out.scan.sub_data(std::size_t(n) * sizeof(std::uint32_t), sizeof(std::uint32_t), zero);
+      // Pass 1 draws (with rasterizer discard), which needs a complete framebuffer bound.
+      target.bind();
       bind_output(i);
       set_list_uniforms(count_, i);
       count_.use();
@@ -91,21 +74,25 @@ class FacetGsPipeline final : public FacetMethodBase {
     TimedPass scope(timer, "pass2 replicate");
     glMemoryBarrier(GL_ALL_BARRIER_BITS);
     scan_.run(out.scan, n + 1);
-    glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
-    std::uint32_t total = 0, visible = 0;
-    out.scan.get_sub_data(std::size_t(n) * sizeof(std::uint32_t), sizeof total, &total);
-    out.stats.get_sub_data(0, sizeof visible, &visible);
-    out.replicas = total;
-    out.visible = visible;
-    ensure_capacity(out.pairs, std::max<std::size_t>(total, 1) * 2 * sizeof(std::uint32_t));
-    size_draw_commands(out, total);
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
     bind_output(i);
     set_list_uniforms(replicate_, i);
     replicate_.use();
     glDispatchCompute((n + 63) / 64, 1, 1);
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
     write_draw_commands(i, args_);
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_COMMAND_BARRIER_BIT);
     out.replication_valid = true;
+  }
+
+  // The replicated index, 8 bytes a pair, is one shader storage block.
+  std::uint64_t max_pairs() const override {
+    GLint64 block_bytes = 0;
+    glGetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &block_bytes);
+    return std::uint64_t(std::max<GLint64>(block_bytes, 0)) / 8;
+  }
+  std::string_view max_pairs_reason() const override {
+    return "the replicated index is one shader storage block of 8 bytes a pair";
   }
 
   Program count_, replicate_, args_, draw_;

@@ -27,7 +27,7 @@ constexpr GLuint kLocalSize = 64;
 // (replication/count.comp).
 constexpr std::size_t kQueueHeaderWords = 4;
 
-class FacetPipeline final : public FacetMethodBase {
+class FacetPipeline final : public PairPipelineBase {
  public:
   std::string_view name() const override { return "facets"; }
 
@@ -64,72 +64,25 @@ class FacetPipeline final : public FacetMethodBase {
     }
   }
 
-  RenderStats render(const glm::dmat4& T_eye_world, std::span<OutputTarget> targets,
-                     GpuTimer* timer) override {
-    FACET_ASSERT(targets.size() == outputs_.size());
-    const bool changed = update_view(T_eye_world);
-    RenderStats stats;
-    stats.reused_replication = !outputs_.empty();
-    std::vector<std::size_t> replicated;
-    for (std::size_t i = 0; i < outputs_.size(); ++i) {
-      OutputState& out = outputs_[i];
-      targets[i].clear();
-      if (out.triangles == 0 || out.facets.mesh.facets.empty()) continue;
-      if (changed || !out.replication_valid) {
-        stats.reused_replication = false;
-        replicate(i, timer);
-        replicated.push_back(i);
-      }
-      draw(i, targets[i], timer);
-    }
-    // One read of each replicated output's statistics, after every output's passes are queued:
-    // pair count, visible triangles, and whether the pairs overflowed their buffers. An output
-    // that overflowed is replicated and drawn again with room for its pairs (sized from this
-    // frame, so the next frames do not overflow unless the view covers more).
-    for (std::size_t i : replicated) {
-      if (!read_replication(i)) {
-        ++stats.overflow_reruns;
-        targets[i].clear();
-        replicate(i, timer);
-        draw(i, targets[i], timer);
-        const bool fits = read_replication(i);
-        FACET_ASSERT(fits);
-      }
-    }
-    for (std::size_t i = 0; i < outputs_.size(); ++i) {
-      const OutputState& out = outputs_[i];
-      stats.facets += out.facets.mesh.facets.size();
-      stats.triangles_in += out.triangles;
-      stats.triangles_sole_piece += out.triangles_sole_piece;
-      stats.gpu_buffer_bytes += buffer_bytes(out);
-      targets[i].resolve();
-      if (out.triangles == 0 || out.facets.mesh.facets.empty()) continue;
-      stats.replicas += out.replicas;
-      stats.triangles_visible += out.visible;
-    }
-    if (timer) timer->end_frame();
-    return stats;
-  }
-
  private:
-  void draw(std::size_t i, OutputTarget& target, GpuTimer* timer) {
+  void draw(std::size_t i, OutputTarget& target, GpuTimer* timer) override {
     TimedPass scope(timer, "pass3 draw");
     draw_replicas(i, target, draw_, GL_TRIANGLES);
   }
 
   // Passes 1 and 2 for output i: coverage with every facet staged, scan, the pairs' copy and the
   // indirect arguments, all without reading anything back.
-  void replicate(std::size_t i, GpuTimer* timer) {
+  void replicate(std::size_t i, OutputTarget&, GpuTimer* timer) override {
     OutputState& out = outputs_[i];
     const std::uint32_t n = out.triangles;
     ensure_capacity(out.scan, (std::size_t(n) + 1) * sizeof(std::uint32_t));
     ensure_capacity(out.stage_offsets, std::max<std::size_t>(n, 1) * sizeof(std::uint32_t));
     for (Buffer* queue : {&out.grid_queue, &out.walk_queue})
       ensure_capacity(*queue, (kQueueHeaderWords + std::size_t(n)) * sizeof(std::uint32_t));
-    if (out.pair_capacity == 0) out.pair_capacity = std::max<std::uint32_t>(n, 4096);
-    ensure_capacity(out.staged, staged_words(out.pair_capacity) * sizeof(std::uint32_t));
-    ensure_capacity(out.pairs, std::size_t(out.pair_capacity) * sizeof(GpuReplica));
-    size_draw_commands(out, out.pair_capacity);
+    const std::uint32_t capacity = pair_capacity(i);
+    ensure_capacity(out.staged, staged_words(capacity) * sizeof(std::uint32_t));
+    ensure_capacity(out.pairs, std::size_t(capacity) * sizeof(GpuReplica));
+    size_draw_commands(out, capacity);
     {
       TimedPass scope(timer, "pass1 coverage");
       const std::uint32_t zero[4] = {0, 0, 0, 0};
@@ -172,30 +125,16 @@ class FacetPipeline final : public FacetMethodBase {
     out.replication_valid = true;
   }
 
-  // Reads output i's statistics after its passes; false when its pairs overflowed, after making
-  // room for them (the caller replicates again).
-  bool read_replication(std::size_t i) {
-    OutputState& out = outputs_[i];
-    std::uint32_t values[3] = {0, 0, 0};
-    out.stats.get_sub_data(0, sizeof values, values);
-    out.visible = values[0];
-    out.replicas = values[1];
-    if (values[2] == 0) return true;
-    const std::uint64_t wanted = std::uint64_t(values[1]) + values[1] / 4 + 4096;
-    // The scatter reads the staged words through a buffer texture.
+  // The scatter reads the staged words, two a pair and 16 more at most, as a buffer texture.
+  std::uint64_t max_pairs() const override {
     GLint max_texels = 0;
     glGetIntegerv(GL_MAX_TEXTURE_BUFFER_SIZE, &max_texels);
     const std::uint64_t max_words = std::min<std::uint64_t>(
-        std::numeric_limits<std::int32_t>::max(), std::uint64_t(max_texels));
-    if (staged_words(wanted) > max_words)
-      throw InputError("scene", "pairs",
-                       "at most " + std::to_string(max_words / 2) +
-                           " (triangle, facet) pairs per output and frame (pass 1 stages up to "
-                           "two words a pair, read as a buffer texture); this view needs " +
-                           std::to_string(values[1]));
-    out.pair_capacity = std::uint32_t(wanted);
-    out.replication_valid = false;
-    return false;
+        std::numeric_limits<std::int32_t>::max(), std::uint64_t(std::max(max_texels, 16)));
+    return (max_words - 16) / 2;
+  }
+  std::string_view max_pairs_reason() const override {
+    return "pass 1 stages up to two words a pair, read as a buffer texture";
   }
 
   friend std::vector<std::vector<std::uint32_t>> facet::driver::gpu_triangle_coverage(
@@ -247,9 +186,10 @@ std::vector<std::vector<std::uint32_t>> gpu_triangle_coverage(
   pipeline.update_view(glm::dmat4(1.0));
   auto& out = pipeline.outputs_[0];
   if (out.triangles == 0 || out.facets.mesh.facets.empty()) return result;
-  pipeline.replicate(0, nullptr);
+  OutputTarget unused_target;
+  pipeline.replicate(0, unused_target, nullptr);
   if (!pipeline.read_replication(0)) {
-    pipeline.replicate(0, nullptr);
+    pipeline.replicate(0, unused_target, nullptr);
     const bool fits = pipeline.read_replication(0);
     FACET_ASSERT(fits);
   }

@@ -1,6 +1,8 @@
 #include "replication_common.hpp"
 
 #include <algorithm>
+#include <cstdint>
+#include <string>
 #include <glm/gtc/type_ptr.hpp>
 
 #include "facet/driver/gpu_scene.hpp"
@@ -359,6 +361,78 @@ void FacetMethodBase::end_facet_drawing() {
   glDisable(GL_DEPTH_TEST);
   glClipControl(GL_LOWER_LEFT, GL_NEGATIVE_ONE_TO_ONE);
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
+}
+
+}  // namespace facet::driver::detail
+
+namespace facet::driver::detail {
+
+RenderStats PairPipelineBase::render(const glm::dmat4& T_eye_world,
+                                     std::span<OutputTarget> targets, GpuTimer* timer) {
+  FACET_ASSERT(targets.size() == outputs_.size());
+  const bool changed = update_view(T_eye_world);
+  RenderStats stats;
+  stats.reused_replication = !outputs_.empty();
+  const auto has_work = [](const OutputState& out) {
+    return out.triangles != 0 && !out.facets.mesh.facets.empty();
+  };
+  std::vector<std::size_t> replicated;
+  for (std::size_t i = 0; i < outputs_.size(); ++i) {
+    OutputState& out = outputs_[i];
+    targets[i].clear();
+    if (!has_work(out)) continue;
+    if (changed || !out.replication_valid) {
+      stats.reused_replication = false;
+      replicate(i, targets[i], timer);
+      replicated.push_back(i);
+    }
+    draw(i, targets[i], timer);
+  }
+  // One read of each replicated output's statistics, after every output's passes are queued.
+  for (std::size_t i : replicated) {
+    if (read_replication(i)) continue;
+    ++stats.overflow_reruns;
+    targets[i].clear();
+    replicate(i, targets[i], timer);
+    draw(i, targets[i], timer);
+    const bool fits = read_replication(i);
+    FACET_ASSERT(fits);
+  }
+  for (std::size_t i = 0; i < outputs_.size(); ++i) {
+    const OutputState& out = outputs_[i];
+    targets[i].resolve();
+    if (!add_output_stats(out, stats)) continue;
+    stats.replicas += out.replicas;
+    stats.triangles_visible += out.visible;
+  }
+  if (timer) timer->end_frame();
+  return stats;
+}
+
+std::uint32_t PairPipelineBase::pair_capacity(std::size_t i) {
+  OutputState& out = outputs_[i];
+  if (out.pair_capacity == 0) out.pair_capacity = std::max(out.triangles, kFirstPairCapacity);
+  return out.pair_capacity;
+}
+
+bool PairPipelineBase::read_replication(std::size_t i) {
+  OutputState& out = outputs_[i];
+  std::uint32_t values[3] = {0, 0, 0};  // visible triangles, pairs, overflow
+  out.stats.get_sub_data(0, sizeof values, values);
+  out.visible = values[0];
+  out.replicas = values[1];
+  if (values[2] == 0) return true;
+  const std::uint64_t wanted = std::uint64_t(values[1]) + values[1] / 4 + kFirstPairCapacity;
+  const std::uint64_t most = std::min<std::uint64_t>(max_pairs(), UINT32_MAX);
+  if (values[1] > most)
+    throw InputError("scene", "pairs",
+                     "at most " + std::to_string(most) +
+                         " (triangle, facet) pairs per output and frame (" +
+                         std::string(max_pairs_reason()) + "); this view needs " +
+                         std::to_string(values[1]));
+  out.pair_capacity = std::uint32_t(std::min(wanted, most));
+  out.replication_valid = false;
+  return false;
 }
 
 }  // namespace facet::driver::detail

@@ -176,4 +176,31 @@ class FacetMethodBase : public RenderMethod {
   std::vector<glm::mat4> last_T_world_object_;  // the transforms of the last update_view
 };
 
+// The pipelines that replicate into a pair buffer (facets, facets-gs). A frame queues every
+// output's passes 1 and 2 (`replicate`) and pass 3 (`draw`) without reading anything back, then
+// reads each replicated output's statistics once (visible triangles, pairs, overflow). The pair
+// buffers are sized from the last frame (the first: one pair per list triangle, at least
+// kFirstPairCapacity); an output whose pairs overflowed them draws nothing, and is replicated and
+// drawn again with room for 1.25x its pairs (RenderStats::overflow_reruns).
+class PairPipelineBase : public FacetMethodBase {
+ public:
+  RenderStats render(const glm::dmat4& T_eye_world, std::span<OutputTarget> targets,
+                     GpuTimer* timer) override;
+
+ protected:
+  static constexpr std::uint32_t kFirstPairCapacity = 4096;
+  // Passes 1 and 2 of output i, with `target` bound where a pass needs a framebuffer.
+  virtual void replicate(std::size_t i, OutputTarget& target, GpuTimer* timer) = 0;
+  // Pass 3 of output i into `target`.
+  virtual void draw(std::size_t i, OutputTarget& target, GpuTimer* timer) = 0;
+  // The most (triangle, facet) pairs one output may take in a frame, and why (for the error).
+  virtual std::uint64_t max_pairs() const = 0;
+  virtual std::string_view max_pairs_reason() const = 0;
+  // Output i's pair capacity for this frame: the last frame's, or the first frame's.
+  std::uint32_t pair_capacity(std::size_t i);
+  // Reads output i's statistics after its passes; false when its pairs overflowed, after making
+  // room for them (the caller replicates again). Pairs beyond max_pairs() are an InputError.
+  bool read_replication(std::size_t i);
+};
+
 }  // namespace facet::driver::detail
