@@ -288,18 +288,17 @@ std::vector<ClusterBenchRow> bench_cluster(
       row.p99_ms = percentile(frame_ms, 0.99);
       row.worst_ms = percentile(frame_ms, 1.0);
       char line[400];
-      std::snprintf(line, sizeof line,
-                    "cluster %s %d nodes: %.3f ms median, %.3f ms p99, %.3f ms worst per frame; "
-                    "lost secondary dropped after %.1f ms, lost master seen after %.1f ms; "
-                    "bare NNG publish+survey %.3f ms median, %.3f ms p99%s",
-                    transport.c_str(), nodes, row.median_ms, row.p99_ms, row.worst_ms,
-                    row.secondary_loss_ms, row.master_loss_ms, row.floor_median_ms,
-                    row.floor_p99_ms,
-                    row.frames_short > 0
-                        ? ("; NOT COMPARABLE: " + std::to_string(row.frames_short) +
-                           " timed frames without every node in the barrier")
-                              .c_str()
-                        : "");
+      std::snprintf(
+          line, sizeof line,
+          "cluster %s %d nodes: %.3f ms median, %.3f ms p99, %.3f ms worst per frame; "
+          "lost secondary dropped after %.1f ms, lost master seen after %.1f ms; "
+          "bare NNG publish+survey %.3f ms median, %.3f ms p99%s",
+          transport.c_str(), nodes, row.median_ms, row.p99_ms, row.worst_ms, row.secondary_loss_ms,
+          row.master_loss_ms, row.floor_median_ms, row.floor_p99_ms,
+          row.frames_short > 0 ? ("; NOT COMPARABLE: " + std::to_string(row.frames_short) +
+                                  " timed frames without every node in the barrier")
+                                     .c_str()
+                               : "");
       if (progress) progress(line);
       rows.push_back(row);
     }

@@ -2,8 +2,8 @@
 
 #include <algorithm>
 #include <cstdint>
-#include <string>
 #include <glm/gtc/type_ptr.hpp>
+#include <string>
 
 #include "facet/driver/gpu_scene.hpp"
 #include "facet/driver/shader_library.hpp"
@@ -367,8 +367,8 @@ void FacetMethodBase::end_facet_drawing() {
 
 namespace facet::driver::detail {
 
-RenderStats PairPipelineBase::render(const glm::dmat4& T_eye_world,
-                                     std::span<OutputTarget> targets, GpuTimer* timer) {
+RenderStats PairPipelineBase::render(const glm::dmat4& T_eye_world, std::span<OutputTarget> targets,
+                                     GpuTimer* timer) {
   FACET_ASSERT(targets.size() == outputs_.size());
   const bool changed = update_view(T_eye_world);
   RenderStats stats;
@@ -425,11 +425,10 @@ bool PairPipelineBase::read_replication(std::size_t i) {
   const std::uint64_t wanted = std::uint64_t(values[1]) + values[1] / 4 + kFirstPairCapacity;
   const std::uint64_t most = std::min<std::uint64_t>(max_pairs(), UINT32_MAX);
   if (values[1] > most)
-    throw InputError("scene", "pairs",
-                     "at most " + std::to_string(most) +
-                         " (triangle, facet) pairs per output and frame (" +
-                         std::string(max_pairs_reason()) + "); this view needs " +
-                         std::to_string(values[1]));
+    throw InputError(
+        "scene", "pairs",
+        "at most " + std::to_string(most) + " (triangle, facet) pairs per output and frame (" +
+            std::string(max_pairs_reason()) + "); this view needs " + std::to_string(values[1]));
   out.pair_capacity = std::uint32_t(std::min(wanted, most));
   out.replication_valid = false;
   return false;

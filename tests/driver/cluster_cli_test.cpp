@@ -287,8 +287,8 @@ TEST(ClusterCli, ALongRunKeepsEveryNodesResidentSetFlat) {
     }
     EXPECT_GT(rss_kib[kFrom], 0u);
     EXPECT_LE(rss_kib.back(), rss_kib[kFrom] + kGrowth_kib)
-        << node->out << ": resident set " << rss_kib[kFrom] << " KiB after frame " << kFrom
-        << ", " << rss_kib.back() << " KiB after frame " << kFrames - 1;
+        << node->out << ": resident set " << rss_kib[kFrom] << " KiB after frame " << kFrom << ", "
+        << rss_kib.back() << " KiB after frame " << kFrames - 1;
   }
 }
 
