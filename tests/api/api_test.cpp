@@ -139,7 +139,7 @@ fs::path write_gltf(const fs::path& folder, const Cube& big, const Cube& small) 
 }
 
 fs::path fresh_folder(const std::string& name) {
-  const fs::path folder = fs::temp_directory_path() / ("facet_api_test_" + name);
+  const fs::path folder = facet::test_paths::scratch_path("facet_api_test_" + name);
   fs::remove_all(folder);
   fs::create_directories(folder);
   return folder;

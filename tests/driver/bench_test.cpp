@@ -31,7 +31,7 @@ int run(const std::string& arguments, const fs::path& log) {
 }
 
 fs::path fresh_folder(const std::string& name) {
-  const fs::path folder = fs::temp_directory_path() / ("facet_bench_cli_" + name);
+  const fs::path folder = facet::test_paths::scratch_path("facet_bench_cli_" + name);
   fs::remove_all(folder);
   fs::create_directories(folder);
   return folder;

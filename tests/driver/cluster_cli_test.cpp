@@ -41,7 +41,7 @@ const std::string kScale = "0.125";
 struct Scratch {
   fs::path path;
   explicit Scratch(const std::string& name)
-      : path(fs::temp_directory_path() / ("facet_cluster_cli_" + name)) {
+      : path(facet::test_paths::scratch_path("facet_cluster_cli_" + name)) {
     fs::remove_all(path);
     fs::create_directories(path);
   }

@@ -51,10 +51,9 @@ void append(std::vector<unsigned char>& out, const T& value) {
 class TempDir {
  public:
   TempDir() {
-    path_ =
-        fs::temp_directory_path() /
-        ("facet_gltf_test_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) +
-         "_" + ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    path_ = facet::test_paths::scratch_path(
+        std::string("facet_gltf_test_") +
+        ::testing::UnitTest::GetInstance()->current_test_info()->name());
     fs::create_directories(path_);
   }
   ~TempDir() {

@@ -56,7 +56,7 @@ double lit_fraction(const Png& png) {
 }
 
 fs::path fresh_folder(const std::string& name) {
-  const fs::path folder = fs::temp_directory_path() / ("facet_run_cli_" + name);
+  const fs::path folder = facet::test_paths::scratch_path("facet_run_cli_" + name);
   fs::remove_all(folder);
   fs::create_directories(folder);
   return folder;

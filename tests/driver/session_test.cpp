@@ -25,7 +25,7 @@ namespace {
 namespace fs = std::filesystem;
 
 fs::path fresh_folder(const std::string& name) {
-  const fs::path folder = fs::temp_directory_path() / ("facet_session_test_" + name);
+  const fs::path folder = facet::test_paths::scratch_path("facet_session_test_" + name);
   fs::remove_all(folder);
   fs::create_directories(folder);
   return folder;
