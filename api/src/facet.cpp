@@ -491,17 +491,27 @@ FrameReport Renderer::render(bool finish) {
 
 namespace {
 
-// The application's texture `texture` (2D, RGBA8 or SRGB8_ALPHA8), checked; its size.
-glm::ivec2 application_texture_size(unsigned int texture, const std::string& source) {
+// The application's texture `texture` (2D, or a cube map with `cube`; RGBA8 or SRGB8_ALPHA8),
+// checked; the size of its content image (a cube map's: its six faces side by side).
+glm::ivec2 application_texture_size(unsigned int texture, bool cube, const std::string& source) {
+  const std::string kind = cube ? "cube-map" : "2D";
   if (texture == 0 || !glIsTexture(texture))
-    throw InputError("API", source, "the name of a 2D texture of the current context");
-  GLint width = 0, height = 0, format = 0;
+    throw InputError("API", source, "the name of a " + kind + " texture of the current context");
+  GLint target = 0, width = 0, height = 0, format = 0;
+  glGetTextureParameteriv(texture, GL_TEXTURE_TARGET, &target);
+  if (target != GLint(cube ? GL_TEXTURE_CUBE_MAP : GL_TEXTURE_2D))
+    throw InputError("API", source, "a " + kind + " texture; this one has another target");
   glGetTextureLevelParameteriv(texture, 0, GL_TEXTURE_WIDTH, &width);
   glGetTextureLevelParameteriv(texture, 0, GL_TEXTURE_HEIGHT, &height);
   glGetTextureLevelParameteriv(texture, 0, GL_TEXTURE_INTERNAL_FORMAT, &format);
   if (width < 1 || height < 1 || (format != GL_RGBA8 && format != GL_SRGB8_ALPHA8))
-    throw InputError("API", source, "an RGBA8 or SRGB8_ALPHA8 2D texture with pixels");
-  return {width, height};
+    throw InputError("API", source, "an RGBA8 or SRGB8_ALPHA8 " + kind + " texture with pixels");
+  if (!cube) return {width, height};
+  if (width != height)
+    throw InputError(
+        "API", source,
+        "a cube map of square faces; got " + std::to_string(width) + "x" + std::to_string(height));
+  return {6 * width, height};
 }
 
 }  // namespace
@@ -511,7 +521,8 @@ void Renderer::warp_content(const std::vector<std::size_t>& outputs, unsigned in
                             const std::string& source) {
   if (impl_->session)
     throw InputError("API", source, "a Renderer made without a scene (Renderer(display))");
-  const glm::ivec2 size = application_texture_size(texture, source);
+  const bool cube = projection.format == ContentFormat::cubemap;
+  const glm::ivec2 size = application_texture_size(texture, cube, source);
   const KeepFramebuffers keep;
   if (!impl_->content_pass) {
     std::vector<driver::OutputSpec> specs;
@@ -529,16 +540,23 @@ void Renderer::warp_content(const std::vector<std::size_t>& outputs, unsigned in
                                                   driver::ContentImage::Pixels::srgb8, source))
              .first;
   }
-  // The application's texture has GL's row order (row 0 at the bottom), content images row 0 at
-  // the top: copy the bytes upside down (a blit with FRAMEBUFFER_SRGB off converts nothing).
   const driver::Texture& content = it->second.texture();
-  glNamedFramebufferTexture(impl_->copy_source.id(), GL_COLOR_ATTACHMENT0, texture, 0);
-  glNamedFramebufferTexture(impl_->copy_target.id(), GL_COLOR_ATTACHMENT0, content.id(), 0);
-  const GLboolean srgb = glIsEnabled(GL_FRAMEBUFFER_SRGB);
-  glDisable(GL_FRAMEBUFFER_SRGB);
-  glBlitNamedFramebuffer(impl_->copy_source.id(), impl_->copy_target.id(), 0, 0, size.x, size.y, 0,
-                         size.y, size.x, 0, GL_COLOR_BUFFER_BIT, GL_NEAREST);
-  if (srgb) glEnable(GL_FRAMEBUFFER_SRGB);
+  if (cube) {
+    // Both are GL cube maps with the same face layout: the bytes of all six faces as they are
+    // (RGBA8 and SRGB8_ALPHA8 copy into each other unconverted).
+    glCopyImageSubData(texture, GL_TEXTURE_CUBE_MAP, 0, 0, 0, 0, content.id(), GL_TEXTURE_CUBE_MAP,
+                       0, 0, 0, 0, size.y, size.y, 6);
+  } else {
+    // The application's texture has GL's row order (row 0 at the bottom), content images row 0
+    // at the top: copy the bytes upside down (a blit with FRAMEBUFFER_SRGB off converts nothing).
+    glNamedFramebufferTexture(impl_->copy_source.id(), GL_COLOR_ATTACHMENT0, texture, 0);
+    glNamedFramebufferTexture(impl_->copy_target.id(), GL_COLOR_ATTACHMENT0, content.id(), 0);
+    const GLboolean srgb = glIsEnabled(GL_FRAMEBUFFER_SRGB);
+    glDisable(GL_FRAMEBUFFER_SRGB);
+    glBlitNamedFramebuffer(impl_->copy_source.id(), impl_->copy_target.id(), 0, 0, size.x, size.y,
+                           0, size.y, size.x, 0, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+    if (srgb) glEnable(GL_FRAMEBUFFER_SRGB);
+  }
   glGenerateTextureMipmap(content.id());
   for (const std::size_t output : outputs) {
     driver::OutputTarget& target = impl_->targets[output];
@@ -571,6 +589,15 @@ void Renderer::warp_image(unsigned int texture, ImageKind kind, double fisheye_f
   const std::string source = "warp_image";
   ContentProjection projection =
       kind == ImageKind::fisheye ? fisheye_content(fisheye_fov_deg) : equirect_content();
+  projection.validate(source);
+  std::vector<std::size_t> outputs(impl_->display->outputs.size());
+  for (std::size_t i = 0; i < outputs.size(); ++i) outputs[i] = i;
+  warp_content(outputs, texture, projection, std::numeric_limits<std::size_t>::max(), source);
+}
+
+void Renderer::warp_cubemap(unsigned int texture) {
+  const std::string source = "warp_cubemap";
+  const ContentProjection projection = cubemap_content();
   projection.validate(source);
   std::vector<std::size_t> outputs(impl_->display->outputs.size());
   for (std::size_t i = 0; i < outputs.size(); ++i) outputs[i] = i;

@@ -1,9 +1,11 @@
 // facet::facet, the application API: a scene built from the application's arrays renders the
 // same triangle IDs as the same scene loaded from glTF; objects move through the API; mode 2
-// warps an application's perspective image into the outputs the right way up; bad input throws.
+// warps an application's perspective image into the outputs the right way up, and its cube map as
+// the same panorama would; bad input throws.
 #include <epoxy/gl.h>
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -249,6 +251,105 @@ TEST(Api, MovedObjectsAndTheirErrors) {
 // Mode 2: on builtin:wall2x2, each projector's frustum rendered by the "application" as a
 // texture whose top half is red and bottom half blue comes out with red above blue in every
 // output, where the frustum's middle row maps.
+// A smooth colour of an eye direction: each channel 0.5 + 0.5 of one component, as bytes.
+std::array<std::uint8_t, 4> direction_colour(glm::dvec3 v) {
+  v = glm::normalize(v);
+  const auto byte = [](double x) { return std::uint8_t(std::lround(255 * (0.5 + 0.5 * x))); };
+  return {byte(v.x), byte(v.y), byte(v.z), 255};
+}
+
+TEST(Api, WarpCubemapShowsWhatTheSamePanoramaShows) {
+  context();
+  // The cube map's faces as GL samples them (OpenGL 4.5 table 8.19), written out here on their
+  // own: face f's texel (i, j) at sc = 2s - 1, tc = 2t - 1 looks along these eye directions.
+  const auto face_direction = [](int f, double sc, double tc) -> glm::dvec3 {
+    switch (f) {
+      case 0:
+        return {1, -tc, -sc};  // +x
+      case 1:
+        return {-1, -tc, sc};  // -x
+      case 2:
+        return {sc, 1, tc};  // +y
+      case 3:
+        return {sc, -1, -tc};  // -y
+      case 4:
+        return {sc, -tc, 1};  // +z
+      default:
+        return {-sc, -tc, -1};  // -z
+    }
+  };
+  constexpr int kFace = 256;
+  GLuint cube = 0;
+  glCreateTextures(GL_TEXTURE_CUBE_MAP, 1, &cube);
+  glTextureStorage2D(cube, 1, GL_SRGB8_ALPHA8, kFace, kFace);
+  std::vector<std::uint8_t> face(std::size_t(kFace) * kFace * 4);
+  for (int f = 0; f < 6; ++f) {
+    for (int j = 0; j < kFace; ++j)
+      for (int i = 0; i < kFace; ++i) {
+        const auto c = direction_colour(
+            face_direction(f, 2 * (i + 0.5) / kFace - 1, 2 * (j + 0.5) / kFace - 1));
+        std::copy(c.begin(), c.end(), &face[(std::size_t(j) * kFace + i) * 4]);
+      }
+    glTextureSubImage3D(cube, 0, 0, 0, f, kFace, kFace, 1, GL_RGBA, GL_UNSIGNED_BYTE, face.data());
+  }
+  // The same colours as an equirectangular panorama (the middle column ahead, -z; azimuth to the
+  // right; GL row 0 at the bottom, the nadir).
+  constexpr int kWidth = 2048, kHeight = 1024;
+  std::vector<std::uint8_t> rgba(std::size_t(kWidth) * kHeight * 4);
+  for (int y = 0; y < kHeight; ++y)
+    for (int x = 0; x < kWidth; ++x) {
+      const double azimuth = ((x + 0.5) / kWidth - 0.5) * 2 * M_PI;
+      const double elevation = ((y + 0.5) / kHeight - 0.5) * M_PI;
+      const auto c = direction_colour({std::cos(elevation) * std::sin(azimuth), std::sin(elevation),
+                                       -std::cos(elevation) * std::cos(azimuth)});
+      std::copy(c.begin(), c.end(), &rgba[(std::size_t(y) * kWidth + x) * 4]);
+    }
+  GLuint panorama = 0;
+  glCreateTextures(GL_TEXTURE_2D, 1, &panorama);
+  glTextureStorage2D(panorama, 1, GL_SRGB8_ALPHA8, kWidth, kHeight);
+  glTextureSubImage2D(panorama, 0, 0, 0, kWidth, kHeight, GL_RGBA, GL_UNSIGNED_BYTE, rgba.data());
+
+  for (const char* name : {"builtin:dome180", "builtin:wall2x2"}) {
+    Renderer renderer(Display::open(name, glm::ivec2(128, 96)));
+    std::vector<std::vector<std::uint8_t>> from_cube, from_panorama;
+    renderer.warp_cubemap(cube);
+    for (std::size_t o = 0; o < renderer.output_count(); ++o)
+      from_cube.push_back(renderer.read_output_rgba8(o));
+    renderer.warp_image(panorama, Renderer::ImageKind::equirect);
+    for (std::size_t o = 0; o < renderer.output_count(); ++o)
+      from_panorama.push_back(renderer.read_output_rgba8(o));
+    // Both resample the same smooth colours through the same warp: they differ by the filtering
+    // of two samplings of them only, a few levels; a face turned or flipped differs by up to 255.
+    // Compared within 70° of the horizon: toward its poles the panorama's rows bunch up and a
+    // pixel's footprint spans every azimuth, so there the panorama, not the cube map, blurs.
+    // (Where the colour says the direction: green is 0.5 + 0.5 of its y.)
+    int worst = 0;
+    std::size_t compared = 0;
+    for (std::size_t o = 0; o < from_cube.size(); ++o)
+      for (std::size_t k = 0; k < from_cube[o].size(); k += 4) {
+        const std::uint8_t* cube_pixel = &from_cube[o][k];
+        const std::uint8_t* panorama_pixel = &from_panorama[o][k];
+        const bool lit = (cube_pixel[0] | cube_pixel[1] | cube_pixel[2]) != 0;
+        const double y = cube_pixel[1] / 127.5 - 1;
+        if (!lit || std::abs(y) > std::sin(70 * M_PI / 180)) continue;
+        ++compared;
+        for (std::size_t c = 0; c < 3; ++c)
+          worst = std::max(worst, std::abs(int(cube_pixel[c]) - int(panorama_pixel[c])));
+      }
+    std::printf("%s: cube map against panorama, worst %d levels over %zu pixels\n", name, worst,
+                compared);
+    EXPECT_GT(compared, std::size_t(128 * 96 / 3)) << name;
+    EXPECT_LE(worst, 4) << name << ": worst difference in levels of 255, any channel";
+  }
+  // A 2D texture is not a cube map, and a cube map no 2D image.
+  Renderer renderer(Display::open("builtin:dome180", glm::ivec2(32, 32)));
+  EXPECT_THROW(renderer.warp_cubemap(panorama), InputError);
+  EXPECT_THROW(renderer.warp_image(cube, Renderer::ImageKind::fisheye), InputError);
+  EXPECT_THROW(renderer.warp_cubemap(0), InputError);
+  glDeleteTextures(1, &cube);
+  glDeleteTextures(1, &panorama);
+}
+
 TEST(Api, WarpPerspectiveKeepsTheApplicationsImageUpright) {
   context();
   const Display display = Display::open("builtin:wall2x2", glm::ivec2(96, 72));

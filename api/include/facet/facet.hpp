@@ -297,6 +297,12 @@ class Renderer {
   // like warp_perspective's. Not for a Renderer with a scene.
   enum class ImageKind { fisheye, equirect };
   void warp_image(unsigned int texture, ImageKind kind, double fisheye_fov_deg = 180);
+  // Mode 2 for a cube map of the whole view, into every output: `texture` is a GL cube-map
+  // texture (RGBA8 or SRGB8_ALPHA8, sRGB-encoded, square faces) in the eye frame (x right, y up,
+  // -z ahead), its faces as GL samples them (OpenGL 4.5 §8.13, table 8.19): what the
+  // application's own texture(samplerCube, v_eye) returns for an eye direction v_eye is what that
+  // direction shows. Copied, not kept. Not for a Renderer with a scene.
+  void warp_cubemap(unsigned int texture);
 
   std::size_t output_count() const;
   glm::ivec2 output_size(std::size_t output) const;
