@@ -166,6 +166,8 @@ TEST_F(XorgDummy, SurvivesAMonitorUnpluggedDuringTheSession) {
   EXPECT_NE(report["monitor_events"].dump().find("DUMMY2 disconnected"), std::string::npos)
       << report["monitor_events"].dump() << "\n"
       << output;
+  // And the operator was told, through the CLI's log sink.
+  EXPECT_NE(output.find("facet run: monitor DUMMY2 disconnected"), std::string::npos) << output;
 }
 
 TEST_F(XorgDummy, AMissingMonitorIsAClearError) {

@@ -10,6 +10,7 @@
 #include <string>
 
 #include "command.hpp"
+#include "console_log.hpp"
 #include "display_flags.hpp"
 #include "facet/driver/cluster.hpp"
 #include "facet/driver/content_media.hpp"
@@ -139,6 +140,7 @@ void play(const PlayOptions& options) {
     window_options.span = options.span;
     if (!options.stats.empty()) window_options.stats = options.stats;
     window_options.sync = sync.get();
+    window_options.log = console_log("facet play: ");
     driver::run_windowed_play(display, std::move(media), playback, window_options);
     return;
   }

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "command.hpp"
+#include "console_log.hpp"
 #include "display_flags.hpp"
 #include "facet/driver/cluster.hpp"
 #include "facet/driver/gl_context.hpp"
@@ -166,6 +167,7 @@ void run(const RunOptions& options) {
     window_options.pattern = pattern;
     if (!options.report.empty()) window_options.report = options.report;
     window_options.sync = sync.get();
+    window_options.log = console_log("facet run: ");
     driver::run_windowed_session(display, scene, path, window_options);
     return;
   }

@@ -292,11 +292,14 @@ void run_windowed_play(const SessionDisplay& display, std::unique_ptr<ContentMed
     const PlayFrameStats stats = player.render(state, window_options.sync != nullptr);
     nlohmann::json line = play_frame_stats_to_json(stats);
     const bool show = !window_options.sync || window_options.sync->ready_to_swap(state, line);
-    if (frame == 0)
-      std::printf(
-          "facet play: first frame after %.0f ms\n",
+    if (frame == 0 && window_options.log) {
+      char said[64];
+      std::snprintf(
+          said, sizeof said, "first frame after %.0f ms",
           std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - entered)
               .count());
+      window_options.log(LogLevel::info, said);
+    }
     dropped_total = stats.dropped_total;
     if (stats_file.is_open()) stats_file << line.dump() << '\n';
     GLsync rendered = glFenceSync(GL_SYNC_GPU_COMMANDS_COMPLETE, 0);
@@ -334,8 +337,10 @@ void run_windowed_play(const SessionDisplay& display, std::unique_ptr<ContentMed
   }
   windows.front().context->make_current();
   raw_views.clear();
-  std::printf("facet play: %llu frames shown, %lld source frames dropped\n",
-              static_cast<unsigned long long>(frames_shown), static_cast<long long>(dropped_total));
+  if (window_options.log)
+    window_options.log(LogLevel::info, std::to_string(frames_shown) + " frames shown, " +
+                                           std::to_string(dropped_total) +
+                                           " source frames dropped");
   if (stats_file.is_open()) {
     stats_file.close();
     // Interrupted: no statistics file, as nothing is written then.

@@ -243,13 +243,14 @@ void on_mouse_button(GLFWwindow* window, int button, int action, int) {
 }
 
 Navigation* monitor_messages = nullptr;
+const LogSink* monitor_log = nullptr;
 
 void on_monitor(GLFWmonitor* monitor, int event) {
   const char* name = glfwGetMonitorName(monitor);
   const std::string message = std::string("monitor ") + (name ? name : "?") +
                               (event == GLFW_CONNECTED ? " connected" : " disconnected") +
                               "; windows stay where they are";
-  std::fprintf(stderr, "facet run: %s\n", message.c_str());
+  if (monitor_log && *monitor_log) (*monitor_log)(LogLevel::warning, message);
   if (monitor_messages) monitor_messages->messages.push_back(message);
 }
 
@@ -328,9 +329,18 @@ void run_windowed_session(const SessionDisplay& display, const Scene& scene, con
   Navigation nav;
   nav.play_path = options.play_path;
   nav.overlay = options.overlay;
-  monitor_messages = &nav;
 
   std::vector<Window> windows;
+  // Until the windows close, also when the run ends by an exception (a lost cluster master).
+  monitor_messages = &nav;
+  monitor_log = &options.log;
+  struct StopMonitorMessages {
+    ~StopMonitorMessages() {
+      glfwSetMonitorCallback(nullptr);
+      monitor_messages = nullptr;
+      monitor_log = nullptr;
+    }
+  } stop_monitor_messages;
   auto open_window = [&](WindowOptions window_options) {
     Window window;
     window_options.share = windows.empty() ? nullptr : windows.front().context.get();
@@ -376,13 +386,16 @@ void run_windowed_session(const SessionDisplay& display, const Scene& scene, con
     }
   }
   glfwSetMonitorCallback(on_monitor);
-  std::printf("facet run: %zu windows open:", windows.size());
-  for (std::size_t i = 0; i < placements.size(); ++i)
-    std::printf(" %s at %d,%d %dx%d (%s)", display.outputs[i].spec.name.c_str(),
-                placements[i].rect.x, placements[i].rect.y, placements[i].rect.z,
-                placements[i].rect.w, placements[i].how.c_str());
-  std::printf("\n");
-  std::fflush(stdout);
+  if (options.log) {
+    std::string line = std::to_string(windows.size()) + " windows open:";
+    for (std::size_t i = 0; i < placements.size(); ++i) {
+      const glm::ivec4& r = placements[i].rect;
+      line += " " + display.outputs[i].spec.name + " at " + std::to_string(r.x) + "," +
+              std::to_string(r.y) + " " + std::to_string(r.z) + "x" + std::to_string(r.w) + " (" +
+              placements[i].how + ")";
+    }
+    options.log(LogLevel::info, line);
+  }
 
   windows.front().context->make_current();
   Session session(display, scene);
@@ -438,9 +451,9 @@ void run_windowed_session(const SessionDisplay& display, const Scene& scene, con
       const auto next = at == patterns.end() ? patterns.begin() : at + 1;
       session.set_pattern(next == patterns.end() ? std::nullopt
                                                  : std::optional<TestPattern>(*next));
-      std::printf("facet run: showing %s\n",
-                  session.pattern() ? to_string(*session.pattern()).c_str() : "the scene");
-      std::fflush(stdout);
+      if (options.log)
+        options.log(LogLevel::info,
+                    "showing " + (session.pattern() ? to_string(*session.pattern()) : "the scene"));
     }
     FrameState state{frame, time_s, nav.play_path ? T_path : nav.T_world_eye(), {}};
     bool show = true;
@@ -569,8 +582,6 @@ void run_windowed_session(const SessionDisplay& display, const Scene& scene, con
       std::ofstream(temporary) << report.dump(2) << '\n';
     });
   }
-  monitor_messages = nullptr;
-  glfwSetMonitorCallback(nullptr);
   // Vertex arrays belong to their own context: delete each with its context current.
   for (Window& window : windows) {
     window.context->make_current();

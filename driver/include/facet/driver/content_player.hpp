@@ -17,6 +17,7 @@
 #include "facet/driver/blend_pass.hpp"
 #include "facet/driver/content_media.hpp"
 #include "facet/driver/content_pass.hpp"
+#include "facet/driver/log.hpp"
 #include "facet/driver/session.hpp"
 #include "facet/driver/session_runner.hpp"
 
@@ -119,6 +120,8 @@ struct WindowPlayOptions {
   std::optional<std::filesystem::path> stats;
   // Frame-locked with a cluster: the master's frame states, its swap barrier.
   FrameSync* sync = nullptr;
+  // How long the first frame took, and at the end the frames shown and dropped (info).
+  LogSink log;
 };
 
 // A window per output on its monitor (or one spanning window), showing the content on the

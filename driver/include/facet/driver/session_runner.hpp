@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "facet/driver/log.hpp"
 #include "facet/driver/monitors.hpp"
 #include "facet/driver/scene.hpp"
 #include "facet/driver/scene_view.hpp"
@@ -109,6 +110,8 @@ struct WindowRunOptions {
   FrameSync* sync = nullptr;
   // Start on this test pattern instead of the scene (T cycles: the scene, then every pattern).
   std::optional<TestPattern> pattern;
+  // The windows opened (info), the pattern shown (info), monitors that come or go (warning).
+  LogSink log;
 };
 
 // Opens the windows (one per output on its monitor, or one spanning window), renders until the
@@ -116,7 +119,7 @@ struct WindowRunOptions {
 // and up, arrows or dragging with the left mouse button turn, P toggles the camera path,
 // O toggles the overlay (fps, replication, ms per pass), T steps from the scene through the test
 // patterns (all_test_patterns) and back, Escape quits. Monitors that disappear
-// during the session are reported on stderr and their windows kept. After watch_interrupts(),
+// during the session are reported to options.log and their windows kept. After watch_interrupts(),
 // SIGINT or SIGTERM closes the windows and throws Interrupted, writing no report. Needs a display
 // server: GlContextError without one. InputError when a monitor the display needs is missing and
 // the display says "missing_monitor": "error".
