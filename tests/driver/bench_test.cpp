@@ -244,9 +244,10 @@ TEST(BenchScenarios, MatchedToleranceFollowsTheCubeMapsError) {
   options.quick = true;
   const auto quick = driver::make_bench_scenarios(options);
   EXPECT_EQ(driver::with_matched_tolerance(quick[0], 0.41378).size(), quick[0].settings.size());
-  // The scale rows match their one cube map: 512 scaled to 128.
+  // The scene-size rows match their one cube map: 512 scaled to 128. (The facet-count and width
+  // rows keep fixed strips.)
   options.quick = false;
-  options.scenarios = {"scale"};
+  options.scenarios = {"scale-scenes"};
   for (const auto& scenario : driver::make_bench_scenarios(options)) {
     EXPECT_EQ(scenario.matched_cube_face, 128) << scenario.name;
     const auto scaled = driver::with_matched_tolerance(scenario, 1.6654);
@@ -264,10 +265,11 @@ TEST(BenchScenarios, ScaleBuildsItsRowsOverTheSceneSizes) {
   options.scenarios = {"scale"};
   options.dome_rig = std::string(FACET_SOURCE_DIR) + "/configs/rigs/dome4.json";
   const auto quick = driver::make_bench_scenarios(options);
-  ASSERT_EQ(quick.size(), 4u);  // builtin:city and builtin:city:2, each on both displays
+  // builtin:city and builtin:city:2, each on both displays; the strip counts; two widths.
+  ASSERT_EQ(quick.size(), 7u);
   const std::vector<std::string> scenes = {"builtin:city", "builtin:city", "builtin:city:2",
                                            "builtin:city:2"};
-  for (std::size_t k = 0; k < quick.size(); ++k) {
+  for (std::size_t k = 0; k < scenes.size(); ++k) {
     EXPECT_EQ(quick[k].scene, scenes[k]);
     EXPECT_EQ(quick[k].scale_group, k % 2 ? "scale-dome" : "scale-cylinder");
     EXPECT_EQ(quick[k].name, quick[k].scale_group + ":" + scenes[k].substr(8));
@@ -283,10 +285,32 @@ TEST(BenchScenarios, ScaleBuildsItsRowsOverTheSceneSizes) {
   }
   EXPECT_EQ(quick[0].outputs.at(0).warp.output_size, glm::ivec2(200, 150));
   EXPECT_EQ(quick[1].outputs.at(0).warp.output_size, glm::ivec2(256, 256));
+  // The facet count: three facet methods over two strip counts, each method's rows under one
+  // fit label.
+  EXPECT_EQ(quick[4].scale_group, "scale-facets-cylinder");
+  ASSERT_EQ(quick[4].settings.size(), 6u);
+  for (const auto& setting : quick[4].settings) {
+    EXPECT_EQ(setting.fit_label, "pieces=N") << setting.label;
+    EXPECT_TRUE(setting.method != "facets-gs" || setting.same_ids_as == setting.label);
+  }
+  EXPECT_EQ(quick[4].settings[1].label, "pieces=40");
+  // The output width: the same settings at two sizes of one aspect.
+  EXPECT_EQ(quick[5].scale_group, "scale-width-cylinder");
+  EXPECT_EQ(quick[5].outputs.at(0).warp.output_size, glm::ivec2(100, 75));
+  EXPECT_EQ(quick[6].outputs.at(0).warp.output_size, glm::ivec2(200, 150));
+  EXPECT_EQ(quick[5].settings.size(), quick[6].settings.size());
+  // Each part alone.
+  options.scenarios = {"scale-width"};
+  EXPECT_EQ(driver::make_bench_scenarios(options).size(), 2u);
+  options.scenarios = {"scale-facets"};
+  EXPECT_EQ(driver::make_bench_scenarios(options).size(), 1u);
+  options.scenarios = {"scale-scenes"};
+  EXPECT_EQ(driver::make_bench_scenarios(options).size(), 4u);
+  options.scenarios = {"scale"};
   options.quick = false;
   options.size_scale = 0.125;
   const auto full = driver::make_bench_scenarios(options);
-  ASSERT_EQ(full.size(), 6u);
+  ASSERT_EQ(full.size(), 10u);
   EXPECT_EQ(full[4].scene, "builtin:city:8");
   EXPECT_NE(full[4].description.find("2175976 triangles"), std::string::npos)
       << full[4].description;
@@ -353,12 +377,61 @@ TEST(BenchScaleFit, FitsEachGroupAndMethodAndSaysWhatDoesNotVary) {
   for (const std::string& note : driver::bench_notes(rows, "test")) {
     if (note.starts_with("scale-cylinder: exponent")) {
       noted = true;
-      EXPECT_NE(note.find("facets s 0.800"), std::string::npos) << note;
-      EXPECT_NE(note.find("cubemap s 1.100"), std::string::npos) << note;
-      EXPECT_NE(note.find("no exponent against them"), std::string::npos) << note;
+      EXPECT_NE(note.find("facets s: triangles 0.800 (34642 to 2175976);"), std::string::npos)
+          << note;
+      EXPECT_NE(note.find("cubemap s: triangles 1.100"), std::string::npos) << note;
+      EXPECT_EQ(note.find("facets 0."), std::string::npos) << note;  // 400 in every row
     }
   }
   EXPECT_TRUE(noted);
+}
+
+// The facet-count rows of one method fit together under their fit label; the width rows of one
+// setting over their output sizes.
+TEST(BenchScaleFit, FitsFacetCountsUnderOneLabelAndWidthsOverSizes) {
+  std::vector<driver::BenchRow> rows;
+  for (const int pieces : {40, 80, 160, 320}) {
+    driver::BenchRow row;
+    row.scenario = row.scale_group = "scale-facets-cylinder";
+    row.method = "facets";
+    row.setting = "pieces=" + std::to_string(pieces);
+    row.fit_label = "pieces=N";
+    row.output_size = "400x300";
+    row.triangles_scene = 34642;
+    row.facets = std::uint64_t(2 * pieces);
+    row.frames = 3;
+    row.frame_ms = 5 * std::pow(double(row.facets), 0.3);
+    rows.push_back(row);
+  }
+  for (const int width : {200, 283, 400}) {
+    driver::BenchRow row;
+    row.scale_group = "scale-width-cylinder";
+    row.scenario = row.scale_group + ":" + std::to_string(width);
+    row.method = "naive";
+    row.setting = row.fit_label = "pieces=80";
+    row.output_size = std::to_string(width) + "x" + std::to_string(width * 3 / 4);
+    row.triangles_scene = 34642;
+    row.facets = 160;
+    row.frames = 3;
+    row.frame_ms = 0.01 * std::pow(double(width), 1.7);
+    rows.push_back(row);
+  }
+  const auto fits = driver::bench_scale_fits(rows);
+  ASSERT_EQ(fits.size(), 2u);
+  EXPECT_EQ(fits[0].setting, "pieces=N");
+  EXPECT_EQ(fits[0].rows, 4u);
+  ASSERT_TRUE(fits[0].facets_exponent);
+  EXPECT_NEAR(*fits[0].facets_exponent, 0.3, 1e-9);
+  EXPECT_FALSE(fits[0].triangles_exponent);  // one scene
+  EXPECT_FALSE(fits[0].width_exponent);      // one size
+  EXPECT_EQ(fits[1].rows, 3u);
+  ASSERT_TRUE(fits[1].width_exponent);
+  EXPECT_NEAR(*fits[1].width_exponent, 1.7, 0.01);  // 283 stands in for 200·√2
+  EXPECT_FALSE(fits[1].facets_exponent);
+  std::string notes;
+  for (const std::string& note : driver::bench_notes(rows, "test")) notes += note + "\n";
+  EXPECT_NE(notes.find("facets pieces=N: facets 0.300 (80 to 640);"), std::string::npos) << notes;
+  EXPECT_NE(notes.find("naive pieces=80: width 1.70"), std::string::npos) << notes;
 }
 
 // Each scenario's notes name the fastest row on the machine the bench ran on, at any error and

@@ -104,29 +104,29 @@ std::vector<BenchSetting> sweep(const std::vector<FacetLayout>& layouts,
                                 const std::vector<int>& tessellation) {
   std::vector<BenchSetting> settings;
   for (const FacetLayout& layout : layouts) {
-    BenchSetting s{"facets", layout_label(layout), {}, {}};
+    BenchSetting s{"facets", layout_label(layout), {}, {}, {}};
     s.settings.facets.layout = layout;
     settings.push_back(s);
   }
   // The tessellator form takes the geometry-shader form's layout: it walks the same way.
   for (const char* method : {"facets-gs", "tessellated"}) {
     const std::string label = layout_label(gs_layout);
-    BenchSetting s{method, label, {}, label};
+    BenchSetting s{method, label, {}, label, {}};
     s.settings.facets.layout = gs_layout;
     settings.push_back(s);
   }
   for (const FacetLayout& layout : naive_layouts) {
-    BenchSetting s{"naive", layout_label(layout), {}, {}};
+    BenchSetting s{"naive", layout_label(layout), {}, {}, {}};
     s.settings.facets.layout = layout;
     settings.push_back(s);
   }
   for (int face : faces) {
-    BenchSetting s{"cubemap", format("face=%d", face), {}, {}};
+    BenchSetting s{"cubemap", format("face=%d", face), {}, {}, {}};
     s.settings.cube_face_size = face;
     settings.push_back(s);
   }
   for (int cap : tessellation) {
-    BenchSetting s{"vertex", format("tess=%d", cap), {}, {}};
+    BenchSetting s{"vertex", format("tess=%d", cap), {}, {}, {}};
     s.settings.max_tessellation = cap;
     settings.push_back(s);
   }
@@ -202,7 +202,7 @@ std::vector<BenchSetting> with_matched_tolerance(const BenchScenario& scenario,
   if (face <= 0 || !cube || !tolerance || !(px > 0)) return settings;
   const auto last_facets = std::find_if(settings.rbegin(), settings.rend(),
                                         [](const BenchSetting& s) { return s.method == "facets"; });
-  BenchSetting matched{"facets", format("tol=%gpx (cube %d)", px, face), {}, {}};
+  BenchSetting matched{"facets", format("tol=%gpx (cube %d)", px, face), {}, {}, {}};
   matched.settings.facets.layout = FacetTolerance{px};
   settings.insert(last_facets.base(), matched);
   return settings;
@@ -217,16 +217,25 @@ double median(std::vector<double> values) {
 
 std::vector<BenchScenario> make_bench_scenarios(const BenchOptions& options) {
   // "deformation" and "dome" are groups; their parts can be run alone.
-  static const std::set<std::string> known = {
-      "cylinder", "deformation", "deformation-80x60", "deformation-128x128", "dome", "dome-master",
-      "dome4",    "scale"};
+  static const std::set<std::string> known = {"cylinder",
+                                              "deformation",
+                                              "deformation-80x60",
+                                              "deformation-128x128",
+                                              "dome",
+                                              "dome-master",
+                                              "dome4",
+                                              "scale",
+                                              "scale-scenes",
+                                              "scale-facets",
+                                              "scale-width"};
   std::vector<std::string> names = options.scenarios;
   if (names.empty()) names = {"cylinder", "deformation", "dome"};
   for (const std::string& name : names) {
     if (!known.contains(name)) {
       throw InputError("command line", "--scenario",
                        "expected cylinder, deformation, deformation-80x60, deformation-128x128, "
-                       "dome, dome-master, dome4, scale or all; got '" +
+                       "dome, dome-master, dome4, scale (scale-scenes, scale-facets, scale-width) "
+                       "or all; got '" +
                            name + "'");
     }
   }
@@ -268,14 +277,17 @@ std::vector<BenchScenario> make_bench_scenarios(const BenchOptions& options) {
       }
       s.matched_cube_face = matched_face;
       scenarios.push_back(std::move(s));
-    } else if (name == "scale") {
-      // Frame cost against scene size: every method at one setting each, on the cylinder and the
-      // dome master, over growing tiled cities (scene names and counts: scene_names.hpp). Ordered
-      // by scene, so run_bench builds each scene once.
+    } else if (name.starts_with("scale")) {
+      // Frame cost against what grows, each in a scale group of its own (bench_scale_fits).
+      const bool all_parts = name == "scale";
+      // Scene size: every method at one setting each, on the cylinder and the dome master, over
+      // growing tiled cities (scene names and counts: scene_names.hpp). Ordered by scene, so
+      // run_bench builds each scene once.
       const std::vector<std::string> scenes =
           quick ? std::vector<std::string>{"builtin:city", "builtin:city:2"}
                 : std::vector<std::string>{"builtin:city", "builtin:city:4", "builtin:city:8"};
       for (const std::string& scene : scenes) {
+        if (!all_parts && name != "scale-scenes") break;
         const std::uint64_t triangles = builtin_scene_triangles(parse_scene_name(scene));
         for (const bool cylinder : {true, false}) {
           BenchScenario s;
@@ -293,6 +305,46 @@ std::vector<BenchScenario> make_bench_scenarios(const BenchOptions& options) {
           s.matched_cube_face = quick ? 0 : faces({512})[0];
           scenarios.push_back(std::move(s));
         }
+      }
+      // Facet count: the facet methods over the seed's strips on the cylinder, the city, one
+      // output size; each method's rows fitted together.
+      if (all_parts || name == "scale-facets") {
+        BenchScenario s;
+        s.scale_group = "scale-facets-cylinder";
+        s.name = s.scale_group;
+        s.scene = "builtin:city";
+        s.outputs = load_display_outputs("builtin:cylinder360", scaled({1600, 1200}, scale));
+        s.description = "the 360x90 cylinder at " + size_text(s.outputs[0].warp.output_size) +
+                        ", builtin:city, the facet methods over strip counts";
+        const std::vector<int> counts =
+            quick ? std::vector<int>{20, 40} : std::vector<int>{40, 80, 160, 320};
+        for (const char* method : {"facets", "facets-gs", "naive"}) {
+          for (const int count : counts) {
+            BenchSetting setting{method, layout_label(FacetStrips{count}), {}, {}, "pieces=N"};
+            setting.settings.facets.layout = FacetStrips{count};
+            if (std::string(method) == "facets-gs") setting.same_ids_as = setting.label;
+            s.settings.push_back(setting);
+          }
+        }
+        scenarios.push_back(std::move(s));
+      }
+      // Output width: every method at one setting (fixed strips, so the facet count stays) on
+      // the cylinder at three sizes of one aspect, the city.
+      const std::vector<double> widths =
+          quick ? std::vector<double>{0.5, 1.0} : std::vector<double>{0.5, 0.7071, 1.0};
+      for (const double width : widths) {
+        if (!all_parts && name != "scale-width") break;
+        BenchScenario s;
+        s.scale_group = "scale-width-cylinder";
+        s.scene = "builtin:city";
+        s.outputs =
+            load_display_outputs("builtin:cylinder360", scaled({1600, 1200}, scale * width));
+        s.name = s.scale_group + ":" + size_text(s.outputs[0].warp.output_size);
+        s.description = "the 360x90 cylinder at " + size_text(s.outputs[0].warp.output_size) +
+                        ", builtin:city, every method at one setting";
+        s.settings =
+            sweep({FacetStrips{80}}, FacetStrips{80}, {FacetStrips{80}}, faces({512}), {1});
+        scenarios.push_back(std::move(s));
       }
     } else if (name.starts_with("deformation")) {
       for (const glm::ivec2 cells : {glm::ivec2(80, 60), glm::ivec2(128, 128)}) {
@@ -457,6 +509,7 @@ BenchReport run_bench(const BenchOptions& options, const std::string& renderer,
       row.triangles_scene = scene.triangle_count();
       row.method = setting.method;
       row.setting = setting.label;
+      row.fit_label = setting.fit_label.empty() ? setting.label : setting.fit_label;
       row.outputs = int(scenario.outputs.size());
       row.output_size = size_text(scenario.outputs[0].warp.output_size);
       row.frames = options.frames;

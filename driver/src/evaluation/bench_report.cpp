@@ -76,7 +76,10 @@ nlohmann::json row_json(const BenchRow& row) {
                       {"triangles_scene", row.triangles_scene},
                       {"outputs", row.outputs},
                       {"output_size", row.output_size}};
-  if (!row.scale_group.empty()) j["scale_group"] = row.scale_group;
+  if (!row.scale_group.empty()) {
+    j["scale_group"] = row.scale_group;
+    j["fit_label"] = row.fit_label;
+  }
   if (!row.error.empty()) {
     j["error"] = row.error;
     return j;
@@ -403,12 +406,13 @@ std::vector<BenchScaleFit> bench_scale_fits(const std::vector<BenchRow>& rows) {
   for (const BenchRow& row : rows) {
     if (row.scale_group.empty() || !row.error.empty()) continue;
     std::size_t k = 0;
+    const std::string& label = row.fit_label.empty() ? row.setting : row.fit_label;
     while (k < fits.size() && !(fits[k].scale_group == row.scale_group &&
-                                fits[k].method == row.method && fits[k].setting == row.setting)) {
+                                fits[k].method == row.method && fits[k].setting == label)) {
       ++k;
     }
     if (k == fits.size()) {
-      fits.push_back({row.scale_group, row.method, row.setting, 0, {}, {}, {}, 0, 0, 0, 0, 0, 0});
+      fits.push_back({row.scale_group, row.method, label, 0, {}, {}, {}, 0, 0, 0, 0, 0, 0});
       members.emplace_back();
     }
     members[k].push_back(&row);
@@ -561,24 +565,24 @@ std::vector<std::string> bench_notes(const std::vector<BenchRow>& rows,
     if (fit.scale_group != group) {
       flush();
       group = fit.scale_group;
-      line = format(
-          "%s: exponent b of median frame ms ~ triangles^b (least squares over %zu scene sizes, "
-          "%llu to %llu triangles, view moving):",
-          group.c_str(), fit.rows, static_cast<unsigned long long>(fit.triangles_min),
-          static_cast<unsigned long long>(fit.triangles_max));
+      line = group +
+             ": exponent b of median frame ms ~ x^b, least squares over the group's rows, view "
+             "moving, for each x its rows vary:";
     }
-    line += fit.triangles_exponent ? format(" %s %s %.3f;", fit.method.c_str(), fit.setting.c_str(),
-                                            *fit.triangles_exponent)
-                                   : format(" %s %s n/a;", fit.method.c_str(), fit.setting.c_str());
-    if (fit.method == "facets") {
-      line += fit.facets_exponent
-                  ? format(" (facets exponent %.3f)", *fit.facets_exponent)
-                  : format(
-                        " (facet count fixed at %llu and output width at %d px in these rows: "
-                        "no exponent against them)",
-                        static_cast<unsigned long long>(fit.facets_max), fit.width_max);
-      if (fit.width_exponent) line += format(" (width exponent %.3f)", *fit.width_exponent);
-    }
+    line += format(" %s %s:", fit.method.c_str(), fit.setting.c_str());
+    if (fit.triangles_exponent)
+      line += format(" triangles %.3f (%llu to %llu)", *fit.triangles_exponent,
+                     static_cast<unsigned long long>(fit.triangles_min),
+                     static_cast<unsigned long long>(fit.triangles_max));
+    if (fit.facets_exponent)
+      line += format(" facets %.3f (%llu to %llu)", *fit.facets_exponent,
+                     static_cast<unsigned long long>(fit.facets_min),
+                     static_cast<unsigned long long>(fit.facets_max));
+    if (fit.width_exponent)
+      line +=
+          format(" width %.3f (%d to %d px)", *fit.width_exponent, fit.width_min, fit.width_max);
+    if (!fit.triangles_exponent && !fit.facets_exponent && !fit.width_exponent) line += " n/a";
+    line += ";";
   }
   flush();
   for (const char* scenario : {"deformation-80x60", "deformation-128x128"}) {

@@ -49,14 +49,18 @@ struct BenchSetting {
   RenderSettings settings;
   // facets-gs: the label of the facets setting whose IDs it must reproduce exactly.
   std::string same_ids_as;
+  // Scale fits (bench_scale_fits): the rows of one method with this fit label are fitted together
+  // (a facet-count sweep: "pieces=N" for pieces=40, 80, ...); empty: the label.
+  std::string fit_label;
 };
 
 struct BenchScenario {
   std::string name;         // "cylinder", "deformation-80x60", "dome", "dome4", ...
   std::string description;  // one line
   std::string scene;        // parse_scene_name name; BenchOptions::scene when empty
-  // Scale scenarios: the display they share ("scale-cylinder", "scale-dome"); the exponent fits
-  // (bench_scale_fits) run over the rows of one group, method and setting.
+  // Scale scenarios: the rows fitted together ("scale-cylinder" and "scale-dome" over scene
+  // sizes, "scale-facets-cylinder" over facet counts, "scale-width-cylinder" over output widths);
+  // the exponent fits (bench_scale_fits) run over the rows of one group, method and fit label.
   std::string scale_group;
   std::vector<OutputSpec> outputs;
   std::vector<BenchSetting> settings;
@@ -69,6 +73,7 @@ struct BenchRow {
   std::string scenario, method, setting;
   std::string scene;                   // its --scene name
   std::string scale_group;             // BenchScenario::scale_group
+  std::string fit_label;               // BenchSetting::fit_label, else the setting's label
   std::uint64_t triangles_scene = 0;   // Scene::triangle_count()
   std::uint64_t gpu_buffer_bytes = 0;  // RenderStats::gpu_buffer_bytes of the last timed frame
   std::string error;  // non-empty when the setting could not be prepared (then nothing else)
@@ -120,9 +125,9 @@ struct BenchRow {
 std::optional<double> fit_power_exponent(const std::vector<double>& x,
                                          const std::vector<double>& y);
 
-// How the frame time of one method and setting grows over a scale group's rows.
+// How the frame time of one method and setting (or fit label) grows over a scale group's rows.
 struct BenchScaleFit {
-  std::string scale_group, method, setting;
+  std::string scale_group, method, setting;  // setting: the rows' fit label
   std::size_t rows = 0;
   // Exponents of median frame ms against the scene's triangles, the facet count and the output
   // width; nullopt where the rows do not vary that quantity (or too few rows ran).
