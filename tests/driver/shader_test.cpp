@@ -2,6 +2,7 @@
 // file and the line of the original file, whatever preamble the builder added.
 #include <gtest/gtest.h>
 
+#include <map>
 #include <regex>
 #include <string>
 
@@ -81,6 +82,44 @@ TEST(Shaders, ListAndScatterConstantsMatchTheCpp) {
         << name;
     EXPECT_EQ(std::stoul(match[1]), unit) << name;
   }
+}
+
+// The replication passes' storage-buffer bindings exist twice: binding:: (facet_gpu.hpp) and the
+// layout of every shader that declares the block. Each block is found somewhere, and wherever it
+// is declared its binding is the C++ one.
+TEST(Shaders, StorageBufferBindingsMatchTheCpp) {
+  const std::map<std::string, GLuint> bindings = {{"Indices", binding::indices},
+                                                  {"Nodes", binding::nodes},
+                                                  {"Order", binding::order},
+                                                  {"Scan", binding::scan},
+                                                  {"Pairs", binding::pairs},
+                                                  {"Stats", binding::stats},
+                                                  {"MaterialRanges", binding::material_ranges},
+                                                  {"DrawArgs", binding::draw_args},
+                                                  {"BlockSums", binding::block_sums},
+                                                  {"Staged", binding::staged},
+                                                  {"StageOffsets", binding::stage_offsets},
+                                                  {"DrawCounts", binding::draw_counts},
+                                                  {"WalkQueue", binding::walk_queue},
+                                                  {"GridQueue", binding::grid_queue}};
+  std::map<std::string, int> found;
+  const std::regex block(R"(layout\(std430, binding = (\d+)\) (?:[a-z]+ )*buffer (\w+))");
+  for (const EmbeddedShader& shader : embedded_shaders()) {
+    const std::string text(shader.text);
+    std::string block_name;
+    for (auto it = std::sregex_iterator(text.begin(), text.end(), block);
+         it != std::sregex_iterator(); ++it) {
+      block_name = (*it)[2];
+      // The prefix scan's data is whichever buffer is bound at binding::scan.
+      if (shader.name == "replication/scan.comp" && block_name == "Data") block_name = "Scan";
+      const auto expected = bindings.find(block_name);
+      if (expected == bindings.end()) continue;
+      ++found[block_name];
+      EXPECT_EQ(std::stoul((*it)[1]), expected->second) << shader.name << ": " << block_name;
+    }
+  }
+  for (const auto& [name, value] : bindings)
+    EXPECT_GT(found[name], 0) << name << " is declared nowhere";
 }
 
 // The material shading block's binding exists twice, in gpu_scene.hpp and material.frag.
