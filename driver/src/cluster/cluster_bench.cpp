@@ -4,14 +4,13 @@
 #include <nng/nng.h>
 #include <nng/protocol/pubsub0/pub.h>
 #include <nng/protocol/pubsub0/sub.h>
-#include <nng/protocol/survey0/respond.h>
-#include <nng/protocol/survey0/survey.h>
 #include <sys/socket.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -76,10 +75,13 @@ double percentile(std::vector<double> values, double p) {
   return values[index];
 }
 
-// The floor under the protocol: NNG's own exchange, on the same transport between the same number
-// of nodes. Per frame the master publishes a message of `state_bytes` and surveys; every other
-// node, on a thread of its own, receives both and answers at once. None of facet's protocol: no
-// heartbeat, no hand-off between threads, no swap message, no digests. Sets row.floor_*.
+// The floor under the protocol: NNG's own exchange, the one the protocol makes, on the same
+// transport between the same number of nodes. Per frame the master publishes a message of
+// `state_bytes` and then a question on the same pub socket; every other node, on a thread of its
+// own, receives both from its sub socket and answers at once on a pub socket of its own, which
+// the master's one sub socket dials; the master waits for every answer, until the deadline by its
+// own clock. None of facet's protocol: no heartbeat, no hand-off between threads, no swap message,
+// no digests. Sets row.floor_*.
 void bench_bare_nng(const projection_io::DisplayCluster& cluster, int frames,
                     std::size_t state_bytes, double deadline_ms, ClusterBenchRow& row) {
   auto check = [](int error, const char* what) {
@@ -87,7 +89,8 @@ void bench_bare_nng(const projection_io::DisplayCluster& cluster, int frames,
       throw std::runtime_error(std::string("bare NNG bench: ") + what + ": " + nng_strerror(error));
   };
   const std::size_t nodes = cluster.nodes.size();
-  // Every socket is closed on the way out, thrown or not; the threads start once all listen.
+  // Every socket is closed on the way out, thrown or not, after the threads that use them have
+  // ended; the threads start once all listen.
   std::vector<nng_socket> sockets;
   struct Closer {
     std::vector<nng_socket>& sockets;
@@ -102,69 +105,80 @@ void bench_bare_nng(const projection_io::DisplayCluster& cluster, int frames,
     return socket;
   };
   const nng_socket publisher = open(nng_pub0_open, "pub");
-  const nng_socket surveyor = open(nng_surveyor0_open, "surveyor");
-  check(nng_socket_set_ms(surveyor, NNG_OPT_SURVEYOR_SURVEYTIME, nng_duration(deadline_ms)),
-        "survey time");
-  check(nng_socket_set_ms(surveyor, NNG_OPT_RECVTIMEO, nng_duration(deadline_ms)), "timeout");
-  std::vector<std::pair<nng_socket, nng_socket>> node_sockets;  // subscriber, respondent
+  const nng_socket answers = open(nng_sub0_open, "sub");
+  check(nng_socket_set(answers, NNG_OPT_SUB_SUBSCRIBE, "", 0), "subscribe");
+  std::vector<std::pair<nng_socket, nng_socket>> node_sockets;  // subscriber, answering publisher
   for (std::size_t k = 1; k < nodes; ++k) {
     const std::string& address = cluster.nodes[k].address;
     const std::string barrier = projection_io::cluster_barrier_address(address);
     const nng_socket subscriber = open(nng_sub0_open, "sub");
-    const nng_socket respondent = open(nng_respondent0_open, "respondent");
-    node_sockets.emplace_back(subscriber, respondent);
+    const nng_socket answerer = open(nng_pub0_open, "pub");
+    node_sockets.emplace_back(subscriber, answerer);
     check(nng_socket_set(subscriber, NNG_OPT_SUB_SUBSCRIBE, "", 0), "subscribe");
-    for (nng_socket socket : {subscriber, respondent})
-      check(nng_socket_set_ms(socket, NNG_OPT_RECVTIMEO, 20), "timeout");
+    check(nng_socket_set_ms(subscriber, NNG_OPT_RECVTIMEO, 20), "timeout");
     check(nng_listen(subscriber, address.c_str(), nullptr, 0), address.c_str());
-    check(nng_listen(respondent, barrier.c_str(), nullptr, 0), barrier.c_str());
+    check(nng_listen(answerer, barrier.c_str(), nullptr, 0), barrier.c_str());
     check(nng_dial(publisher, address.c_str(), nullptr, NNG_FLAG_NONBLOCK), address.c_str());
-    check(nng_dial(surveyor, barrier.c_str(), nullptr, NNG_FLAG_NONBLOCK), barrier.c_str());
+    check(nng_dial(answers, barrier.c_str(), nullptr, NNG_FLAG_NONBLOCK), barrier.c_str());
   }
+  // A message is a kind byte (1: frame state, 2: question, answer) and a frame number, then the
+  // frame state's bytes.
+  constexpr std::uint8_t kState = 1, kQuestion = 2;
+  constexpr std::size_t kHeader = 1 + sizeof(std::uint64_t);
   std::atomic<bool> stop{false};
   std::vector<std::thread> threads;
-  for (const auto& [subscriber, respondent] : node_sockets) {
-    // Each survey is answered once the frame state of its frame has come; surveys older than
-    // the newest state (sent before this node was connected) are passed over unanswered.
-    threads.emplace_back([subscriber = subscriber, respondent = respondent, &stop] {
-      auto frame_of = [](void* message, std::size_t size) {
-        std::uint64_t frame = 0;
-        if (size >= sizeof frame) std::memcpy(&frame, message, sizeof frame);
-        return frame;
-      };
+  for (const auto& [subscriber, answerer] : node_sockets) {
+    // Each question is answered when the frame state of its frame came before it; questions
+    // heard without their state (this node connected between the two) are passed over.
+    threads.emplace_back([subscriber = subscriber, answerer = answerer, &stop] {
       std::uint64_t newest_state = 0;
       while (!stop.load()) {
-        void* survey = nullptr;
-        std::size_t survey_size = 0;
-        if (nng_recv(respondent, &survey, &survey_size, NNG_FLAG_ALLOC) != 0) continue;
-        const std::uint64_t frame = frame_of(survey, survey_size);
-        while (newest_state < frame && !stop.load()) {
-          void* state = nullptr;
-          std::size_t size = 0;
-          if (nng_recv(subscriber, &state, &size, NNG_FLAG_ALLOC) != 0) break;
-          newest_state = frame_of(state, size);
-          nng_free(state, size);
+        void* message = nullptr;
+        std::size_t size = 0;
+        if (nng_recv(subscriber, &message, &size, NNG_FLAG_ALLOC) != 0) continue;
+        if (size < kHeader) {
+          nng_free(message, size);
+          continue;
         }
-        if (newest_state == frame)
-          nng_send(respondent, survey, survey_size, NNG_FLAG_ALLOC);  // NNG frees it
-        else
-          nng_free(survey, survey_size);
+        const std::uint8_t kind = *static_cast<const std::uint8_t*>(message);
+        std::uint64_t frame = 0;
+        std::memcpy(&frame, static_cast<const std::uint8_t*>(message) + 1, sizeof frame);
+        if (kind == kState) {
+          newest_state = frame;
+          nng_free(message, size);
+        } else if (kind == kQuestion && newest_state == frame) {
+          nng_send(answerer, message, size, NNG_FLAG_ALLOC);  // NNG frees it
+        } else {
+          nng_free(message, size);
+        }
       }
     });
   }
-  std::vector<std::uint8_t> state(std::max(state_bytes, sizeof(std::uint64_t)), 0);
-  // One exchange: the time until every node answered, or nullopt when the survey expired first.
+  std::vector<std::uint8_t> state(std::max(state_bytes, kHeader), 0);
+  std::uint8_t question[kHeader] = {kQuestion};
+  // One exchange: the time until every node answered, or nullopt when the deadline passed first.
   auto exchange = [&](std::uint64_t frame) -> std::optional<double> {
     const Clock::time_point start = Clock::now();
-    std::memcpy(state.data(), &frame, sizeof frame);
+    const Clock::time_point deadline =
+        start + std::chrono::duration_cast<Clock::duration>(
+                    std::chrono::duration<double, std::milli>(deadline_ms));
+    state[0] = kState;
+    std::memcpy(state.data() + 1, &frame, sizeof frame);
+    std::memcpy(question + 1, &frame, sizeof frame);
     nng_send(publisher, state.data(), state.size(), 0);
-    nng_send(surveyor, &frame, sizeof frame, 0);
+    nng_send(publisher, question, sizeof question, 0);
     for (std::size_t answered = 0; answered + 1 < nodes;) {
+      const double left =
+          std::chrono::duration<double, std::milli>(deadline - Clock::now()).count();
+      if (left <= 0) return std::nullopt;
+      nng_socket_set_ms(answers, NNG_OPT_RECVTIMEO, nng_duration(std::ceil(left)));
       void* answer = nullptr;
       std::size_t size = 0;
-      if (nng_recv(surveyor, &answer, &size, NNG_FLAG_ALLOC) != 0) return std::nullopt;
+      const int error = nng_recv(answers, &answer, &size, NNG_FLAG_ALLOC);
+      if (error == NNG_ETIMEDOUT) continue;
+      if (error != 0) return std::nullopt;
       std::uint64_t answered_frame = 0;
-      if (size == sizeof answered_frame) std::memcpy(&answered_frame, answer, size);
+      if (size == kHeader) std::memcpy(&answered_frame, static_cast<std::uint8_t*>(answer) + 1, 8);
       nng_free(answer, size);
       if (answered_frame == frame) ++answered;
     }
@@ -292,7 +306,7 @@ std::vector<ClusterBenchRow> bench_cluster(
           line, sizeof line,
           "cluster %s %d nodes: %.3f ms median, %.3f ms p99, %.3f ms worst per frame; "
           "lost secondary dropped after %.1f ms, lost master seen after %.1f ms; "
-          "bare NNG publish+survey %.3f ms median, %.3f ms p99%s",
+          "bare NNG publish+answers %.3f ms median, %.3f ms p99%s",
           transport.c_str(), nodes, row.median_ms, row.p99_ms, row.worst_ms, row.secondary_loss_ms,
           row.master_loss_ms, row.floor_median_ms, row.floor_p99_ms,
           row.frames_short > 0 ? ("; NOT COMPARABLE: " + std::to_string(row.frames_short) +

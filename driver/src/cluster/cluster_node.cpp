@@ -1,10 +1,15 @@
-// The cluster protocol over NNG: the master's frame-state broadcast (pub/sub) and swap barrier
-// (surveyor/respondent), and the secondaries' side of both. See cluster.hpp.
+// The cluster protocol over NNG: the master's frame-state broadcast and swap barrier, and the
+// secondaries' side of both, all over pub/sub. The master publishes frame states and the barrier's
+// questions ("joined?", "frame N rendered?") on one pub socket; every secondary answers on a pub
+// socket of its own, at its barrier address, which the master's one sub socket dials. The
+// master's deadline is its own timer. See cluster.hpp.
+//
+// No surveyor/respondent: NNG 1.5.2's respondent keeps a closed surveyor pipe in its list of pipes
+// to receive from and later uses it freed (nanomsg/nng#1959, fixed in NNG 1.10), which aborted a
+// secondary whose master was killed ("panic: pthread_mutex_unlock: Invalid argument").
 #include <nng/nng.h>
 #include <nng/protocol/pubsub0/pub.h>
 #include <nng/protocol/pubsub0/sub.h>
-#include <nng/protocol/survey0/respond.h>
-#include <nng/protocol/survey0/survey.h>
 
 #include <algorithm>
 #include <atomic>
@@ -17,6 +22,7 @@
 #include <mutex>
 #include <set>
 #include <thread>
+#include <tuple>
 
 #include "facet/driver/cluster.hpp"
 #include "facet/driver/session_runner.hpp"
@@ -46,9 +52,19 @@ const ClusterNode& find_cluster_node(const projection_io::DisplayCluster& cluste
 
 namespace {
 
-// Message kinds. Every published message starts with its kind and the master's content digest.
-enum class Published : std::uint8_t { heartbeat = 1, frame = 2, swap = 3, end = 4, stop = 5 };
-enum class Survey : std::uint8_t { join = 1, ready = 2 };
+// Message kinds. Every message the master publishes starts with its kind and its content digest.
+// join and ready are the barrier's questions, followed by a frame number (0 for join); a
+// secondary answers one on its own pub socket with the question's kind and frame, its content
+// digest and its name.
+enum class Published : std::uint8_t {
+  heartbeat = 1,
+  frame = 2,
+  swap = 3,
+  end = 4,
+  stop = 5,
+  join = 6,
+  ready = 7
+};
 
 constexpr auto kPoll = std::chrono::milliseconds(20);  // how often blocked threads look up
 
@@ -174,7 +190,8 @@ class Socket {
     nng_socket_set_ms(socket_, option, nng_duration(std::max(1.0, std::ceil(ms))));
   }
   void send(const std::vector<std::uint8_t>& bytes) {
-    // A pub socket never blocks; a respondent's answer to an expired survey is dropped by NNG.
+    // A pub socket never blocks: a message for no subscriber, or for one whose queue is full, is
+    // dropped by NNG.
     nng_send(socket_, const_cast<std::uint8_t*>(bytes.data()), bytes.size(), 0);
   }
   // A message, or nullopt after the receive timeout (or any other error).
@@ -234,21 +251,23 @@ class Master final : public FrameSync {
     if (!options_.report) options_.report = default_report;
     const ClusterNode& self = find_cluster_node(options_.cluster, options_.node, options_.source);
     publisher_.open(nng_pub0_open, "pub");
-    surveyor_.open(nng_surveyor0_open, "surveyor");
+    answers_.open(nng_sub0_open, "sub");
+    nng_socket_set(answers_.get(), NNG_OPT_SUB_SUBSCRIBE, "", 0);
+    nng_socket_set_int(answers_.get(), NNG_OPT_RECVBUF, 1024);
     const std::string field = address_field(options_.cluster, self.name);
     publisher_.listen(self.address, options_.source, field, self.name, nng_sub0_open);
-    surveyor_.listen(projection_io::cluster_barrier_address(self.address), options_.source, field,
-                     self.name, nng_respondent0_open);
-    for (Socket* socket : {&publisher_, &surveyor_}) {
+    // Nothing dials the master's barrier address; it is held all the same, as every node holds
+    // its own, so that every node's two addresses are in use while it runs.
+    answers_.listen(projection_io::cluster_barrier_address(self.address), options_.source, field,
+                    self.name, nng_pub0_open);
+    for (Socket* socket : {&publisher_, &answers_}) {
       socket->set_ms(NNG_OPT_RECONNMINT, 10);
       socket->set_ms(NNG_OPT_RECONNMAXT, 100);
     }
-    surveyor_.set_ms(NNG_OPT_SURVEYOR_SURVEYTIME, deadline_ms_);
-    surveyor_.set_ms(NNG_OPT_RECVTIMEO, deadline_ms_);
     for (const ClusterNode& node : options_.cluster.nodes) {
       if (node.name == self.name) continue;
       publisher_.dial(node.address);
-      surveyor_.dial(projection_io::cluster_barrier_address(node.address));
+      answers_.dial(projection_io::cluster_barrier_address(node.address));
       secondaries_.push_back(&node);
     }
     say_no_swap_group_once(options_.report);
@@ -304,13 +323,18 @@ class Master final : public FrameSync {
 
   bool ready_to_swap(const FrameState& state, nlohmann::json& stats) override {
     const Clock::time_point start = Clock::now();
-    surveyor_.send(Bytes().put(Survey::ready).put(state.frame).data);
+    // Rounded up: waited_ms, reported for a dropped node, is never below the deadline.
+    const Clock::time_point deadline =
+        start +
+        std::chrono::ceil<Clock::duration>(std::chrono::duration<double, std::milli>(deadline_ms_));
+    // After the frame state on the same socket: a node that hears the question heard the state.
+    publish(Published::ready, Bytes().put(state.frame).data);
     std::set<std::string> answered;
     std::vector<std::string> rejoined;
     while (answered.size() < active_.size() + rejoined.size()) {
-      const auto reply = surveyor_.receive();
-      if (!reply) break;  // the survey expired: the deadline has passed
-      const auto answer = parse_answer(*reply, Survey::ready, state.frame);
+      const auto reply = receive_answer(deadline);
+      if (!reply) break;  // the deadline has passed
+      const auto answer = parse_answer(*reply, Published::ready, state.frame);
       if (!answer) continue;
       if (active_.contains(*answer) ||
           std::find(rejoined.begin(), rejoined.end(), *answer) != rejoined.end()) {
@@ -377,15 +401,31 @@ class Master final : public FrameSync {
     return find_cluster_node(options_.cluster, name, options_.source);
   }
 
-  // The node that answered survey `kind` for `frame`, when it runs our display and scene (and,
-  // when joining, hears our broadcast); the others are reported once each and ignored.
-  std::optional<std::string> parse_answer(const std::vector<std::uint8_t>& reply, Survey kind,
+  // The next answer a secondary published, or nullopt once `deadline` has passed. NNG's timeout
+  // is whole milliseconds on a clock of its own: one that ends a little early is waited again,
+  // so that nobody is declared lost before the deadline.
+  std::optional<std::vector<std::uint8_t>> receive_answer(Clock::time_point deadline) {
+    for (;;) {
+      const double left =
+          std::chrono::duration<double, std::milli>(deadline - Clock::now()).count();
+      if (left <= 0) return std::nullopt;
+      answers_.set_ms(NNG_OPT_RECVTIMEO, left);
+      int error = 0;
+      std::optional<std::vector<std::uint8_t>> answer = answers_.receive(&error);
+      if (answer || error != NNG_ETIMEDOUT) return answer;
+    }
+  }
+
+  // The node that answered question `kind` for `frame`, when it runs our display and scene; the
+  // others are reported once each and ignored. Answers to other questions (an earlier frame's,
+  // given after its deadline) are ignored. A node that answers heard the question, and so every
+  // message published before it: it needs no more to join.
+  std::optional<std::string> parse_answer(const std::vector<std::uint8_t>& reply, Published kind,
                                           std::uint64_t frame) {
     Parse in(reply);
-    const auto answer_kind = in.get<Survey>();
+    const auto answer_kind = in.get<Published>();
     const auto answer_frame = in.get<std::uint64_t>();
     const auto digest = in.get<std::uint64_t>();
-    const auto hears = in.get<std::uint8_t>();
     const std::string name = in.rest_text();
     if (!in.ok || answer_kind != kind || answer_frame != frame) return std::nullopt;
     const bool known = std::any_of(secondaries_.begin(), secondaries_.end(),
@@ -403,7 +443,6 @@ class Master final : public FrameSync {
                         digest_hex(options_.content_digest) + "): refused");
       return std::nullopt;
     }
-    if (kind == Survey::join && !hears) return std::nullopt;  // not subscribed yet
     return name;
   }
 
@@ -418,17 +457,16 @@ class Master final : public FrameSync {
     while (active_.size() < secondaries_.size() && Clock::now() - start < options_.join_timeout) {
       if (const int signal = interrupt_signal())
         throw Interrupted(signal, "stopped while waiting for the cluster's nodes");
-      surveyor_.set_ms(NNG_OPT_SURVEYOR_SURVEYTIME, 100);
-      publish(Published::heartbeat, {});  // so that a node that has just come hears us at once
-      surveyor_.send(Bytes().put(Survey::join).put(std::uint64_t(0)).data);
-      const Clock::time_point survey_start = Clock::now();
-      while (ms_since(survey_start) < 100) {
-        const auto reply = surveyor_.receive();
+      // Asked again every 100 ms: a node that has just come, or whose answer socket the master
+      // has not reached yet, answers the next one. The question is also the sign of life.
+      publish(Published::join, Bytes().put(std::uint64_t(0)).data);
+      const Clock::time_point next_ask = Clock::now() + std::chrono::milliseconds(100);
+      while (active_.size() < secondaries_.size()) {
+        const auto reply = receive_answer(next_ask);
         if (!reply) break;
-        if (const auto name = parse_answer(*reply, Survey::join, 0)) active_.insert(*name);
+        if (const auto name = parse_answer(*reply, Published::join, 0)) active_.insert(*name);
       }
     }
-    surveyor_.set_ms(NNG_OPT_SURVEYOR_SURVEYTIME, deadline_ms_);
     std::string missing;
     const ClusterNode* missing_critical = nullptr;
     for (const ClusterNode* node : secondaries_) {
@@ -472,7 +510,8 @@ class Master final : public FrameSync {
 
   ClusterNodeOptions options_;
   double deadline_ms_;
-  Socket publisher_, surveyor_;
+  // Main thread: both; heartbeat thread: publisher_, until the destructor has joined it.
+  Socket publisher_, answers_;
   std::vector<const ClusterNode*> secondaries_;
   std::set<std::string> active_;  // secondaries in the barrier
   std::set<std::string> complained_;
@@ -498,15 +537,14 @@ class Secondary final : public FrameSync {
         master_(options_.cluster.master) {
     if (!options_.report) options_.report = default_report;
     subscriber_.open(nng_sub0_open, "sub");
-    respondent_.open(nng_respondent0_open, "respondent");
+    answers_.open(nng_pub0_open, "pub");
     nng_socket_set(subscriber_.get(), NNG_OPT_SUB_SUBSCRIBE, "", 0);
     nng_socket_set_int(subscriber_.get(), NNG_OPT_RECVBUF, 1024);
     subscriber_.set_ms(NNG_OPT_RECVTIMEO, double(kPoll.count()));
-    respondent_.set_ms(NNG_OPT_RECVTIMEO, double(kPoll.count()));
     const std::string field = address_field(options_.cluster, self_.name);
     subscriber_.listen(self_.address, options_.source, field, self_.name, nng_pub0_open);
-    respondent_.listen(projection_io::cluster_barrier_address(self_.address), options_.source,
-                       field, self_.name, nng_surveyor0_open);
+    answers_.listen(projection_io::cluster_barrier_address(self_.address), options_.source, field,
+                    self_.name, nng_sub0_open);
     say_no_swap_group_once(options_.report);
     options_.report("node " + self_.name + ": listening on " + self_.address + " for master " +
                     master_);
@@ -514,6 +552,8 @@ class Secondary final : public FrameSync {
     responder_ = std::thread([this] { respond(); });
   }
 
+  // The threads end first, then the sockets close: no thread uses a socket after its close.
+  // The listener sees stopping_ within a receive timeout (kPoll), the responder at once.
   ~Secondary() override {
     {
       std::lock_guard lock(mutex_);
@@ -521,10 +561,11 @@ class Secondary final : public FrameSync {
     }
     inbox_changed_.notify_all();
     rendered_changed_.notify_all();
-    subscriber_.close();
-    respondent_.close();
+    question_asked_.notify_all();
     listener_.join();
     responder_.join();
+    subscriber_.close();
+    answers_.close();
   }
 
   std::optional<FrameState> next_frame(const FrameState&) override {
@@ -653,7 +694,15 @@ class Secondary final : public FrameSync {
       last_heard_ = Clock::now();
       if (digest != options_.content_digest) foreign_digest_ = digest;
       if (kind == Published::stop) stop_reason_ = in.rest_text();
-      if (kind != Published::heartbeat) {
+      if (kind == Published::join || kind == Published::ready) {
+        // For the responder; the main thread waits for frame states and swaps only.
+        const auto frame = in.get<std::uint64_t>();
+        if (in.ok) {
+          questions_.emplace_back(kind, frame);
+          question_asked_.notify_one();
+        }
+        if (foreign_digest_) inbox_changed_.notify_one();
+      } else if (kind != Published::heartbeat) {
         inbox_.emplace_back(kind, std::vector<std::uint8_t>(in.rest().begin(), in.rest().end()));
         inbox_changed_.notify_one();
       } else if (foreign_digest_) {
@@ -664,38 +713,31 @@ class Secondary final : public FrameSync {
     }
   }
 
+  // Answers the master's questions in the order the listener heard them, on this node's own
+  // pub socket (which only this thread uses).
   void respond() {
     for (;;) {
-      {
-        std::lock_guard lock(mutex_);
-        if (stopping_) return;
-      }
-      const auto survey = respondent_.receive();
-      if (!survey) continue;
-      Parse in(*survey);
-      const auto kind = in.get<Survey>();
-      const auto frame = in.get<std::uint64_t>();
-      if (!in.ok) continue;
-      bool answer = kind == Survey::join;
-      bool hears = false;
+      Published kind{};
+      std::uint64_t frame = 0;
+      bool answer = false;
       {
         std::unique_lock lock(mutex_);
-        hears = last_heard_.has_value();
-        if (kind == Survey::ready) {
+        question_asked_.wait(lock, [&] { return stopping_ || !questions_.empty(); });
+        if (stopping_) return;
+        std::tie(kind, frame) = questions_.front();
+        questions_.pop_front();
+        answer = kind == Published::join;
+        if (kind == Published::ready) {
           // Answered once this node's outputs of `frame` are rendered; not when it skipped it.
           rendered_changed_.wait(lock,
                                  [&] { return stopping_ || (rendered_ && *rendered_ >= frame); });
-          answer = !stopping_ && rendered_ && *rendered_ == frame;
+          if (stopping_) return;
+          answer = rendered_ && *rendered_ == frame;
         }
       }
       if (answer)
-        respondent_.send(Bytes()
-                             .put(kind)
-                             .put(frame)
-                             .put(options_.content_digest)
-                             .put(std::uint8_t(hears))
-                             .put_text(self_.name)
-                             .data);
+        answers_.send(
+            Bytes().put(kind).put(frame).put(options_.content_digest).put_text(self_.name).data);
     }
   }
 
@@ -703,11 +745,15 @@ class Secondary final : public FrameSync {
   double deadline_ms_;
   const ClusterNode& self_;
   std::string master_;
-  Socket subscriber_, respondent_;
+  // The listener receives on subscriber_, the responder sends on answers_; both close after the
+  // threads have ended.
+  Socket subscriber_, answers_;
   std::mutex mutex_;
-  // The main thread waits for the inbox (and the master's silence), the responder for rendered_.
-  std::condition_variable inbox_changed_, rendered_changed_;
+  // The main thread waits for the inbox (and the master's silence), the responder for a question
+  // and for rendered_.
+  std::condition_variable inbox_changed_, rendered_changed_, question_asked_;
   std::deque<std::pair<Published, std::vector<std::uint8_t>>> inbox_;
+  std::deque<std::pair<Published, std::uint64_t>> questions_;  // join or ready, and the frame
   std::optional<Clock::time_point> last_heard_;
   Clock::time_point started_ = Clock::now();
   std::optional<std::uint64_t> rendered_;
