@@ -17,6 +17,7 @@
 #include <optional>
 #include <stdexcept>
 #include <thread>
+#include <vector>
 
 #include "facet/driver/cluster.hpp"
 #include "facet/projection/errors.hpp"
@@ -30,34 +31,62 @@ double ms_between(Clock::time_point from, Clock::time_point to) {
   return std::chrono::duration<double, std::milli>(to - from).count();
 }
 
-// A loopback TCP port nobody listens on now (the kernel's choice for port 0).
-int free_loopback_port() {
+// A socket bound to loopback TCP port `port` (0: the kernel's choice), or -1 when it cannot be.
+int bind_loopback(int port) {
   const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
   sockaddr_in address{};
   address.sin_family = AF_INET;
   address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  address.sin_port = htons(std::uint16_t(port));
+  if (fd >= 0 && ::bind(fd, reinterpret_cast<sockaddr*>(&address), sizeof address) == 0) return fd;
+  if (fd >= 0) ::close(fd);
+  return -1;
+}
+
+int bound_port(int fd) {
+  sockaddr_in address{};
   socklen_t size = sizeof address;
-  int port = 0;
-  if (::bind(fd, reinterpret_cast<sockaddr*>(&address), size) == 0 &&
-      ::getsockname(fd, reinterpret_cast<sockaddr*>(&address), &size) == 0)
-    port = ntohs(address.sin_port);
-  ::close(fd);
-  return port;
+  if (::getsockname(fd, reinterpret_cast<sockaddr*>(&address), &size) != 0) return 0;
+  return ntohs(address.sin_port);
+}
+
+// Loopback TCP ports P and P + 1 (a node's address and its barrier) that nobody holds now, held
+// in `held` (closed by the caller once every node has its pair, so that no two nodes share a
+// port). Both are checked: Linux hands out odd ports to bind() and even ones to connect(), so the
+// port after the kernel's choice is one that outgoing connections use.
+int free_loopback_port_pair(std::vector<int>& held) {
+  for (int attempt = 0; attempt < 100; ++attempt) {
+    const int first = bind_loopback(0);
+    if (first < 0) continue;
+    const int port = bound_port(first);
+    const int second = port > 0 && port < 65534 ? bind_loopback(port + 1) : -1;
+    if (second >= 0) {
+      held.push_back(first);
+      held.push_back(second);
+      return port;
+    }
+    ::close(first);
+  }
+  throw std::runtime_error("cluster bench: no two free loopback TCP ports in a row");
 }
 
 projection_io::DisplayCluster bench_cluster_config(int nodes, const std::string& transport,
                                                    const std::filesystem::path& folder,
                                                    double deadline_ms) {
   projection_io::DisplayCluster cluster;
+  std::vector<int> held;  // the ports chosen so far, until every node has its pair
+  struct Closer {
+    std::vector<int>& fds;
+    ~Closer() {
+      for (const int fd : fds) ::close(fd);
+    }
+  } closer{held};
   for (int k = 0; k < nodes; ++k) {
     const std::string name = "n" + std::to_string(k);
     std::string address;
     if (transport == "tcp") {
       // Two ports each: the barrier listens on the next one.
-      int port = 0;
-      do port = free_loopback_port();
-      while (port == 0 || port >= 65534);
-      address = "tcp://127.0.0.1:" + std::to_string(port);
+      address = "tcp://127.0.0.1:" + std::to_string(free_loopback_port_pair(held));
     } else {
       address = "ipc://" + (folder / name).string();
     }
