@@ -11,6 +11,7 @@
 #include "facet/projection/errors.hpp"
 #include "facet/projection/input_file.hpp"
 #include "facet/projection/progress.hpp"
+#include "facet/projection/rig.hpp"
 
 namespace facet::calibration {
 namespace {
@@ -167,8 +168,8 @@ LiveCaptureReport run_live_capture(PatternOutputs& outputs, LiveCamera& camera,
   };
   if (options.average < 1) throw InputError("--average", "", "a number of exposures >= 1");
   if (options.bits != 8 && options.bits != 16) throw InputError("--bits", "", "8 or 16");
-  if (!(options.camera_gamma > 0) || !std::isfinite(options.camera_gamma)) {
-    throw InputError("--camera-gamma", "", "a positive number");
+  if (!(options.camera_gamma > 0 && options.camera_gamma <= kMaxGamma)) {
+    throw InputError("--camera-gamma", "", "a gamma in (0, 10]");
   }
   if (!(options.max_clipped_fraction >= 0 && options.max_clipped_fraction <= 1)) {
     throw InputError("--max-clipped", "", "a fraction of camera pixels from 0 to 1");

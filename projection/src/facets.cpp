@@ -10,6 +10,7 @@
 
 #include "facet/projection/errors.hpp"
 #include "facet/projection/facet_error.hpp"
+#include "facet/projection/warp.hpp"
 #include "facets_internal.hpp"
 #include "parallel.hpp"
 
@@ -509,8 +510,9 @@ double round_up_2(double x) {
 FacetMesh build_to_tolerance(const Warp& warp, const FacetBuildOptions& options) {
   const FacetTolerance& layout = std::get<FacetTolerance>(options.layout);
   const double tolerance = layout.px;
-  if (!(tolerance > 0) || !std::isfinite(tolerance)) {
-    throw InputError({}, "tolerance", "expected a positive number of pixels");
+  // Past the largest image side a tolerance bounds nothing (1e308 px built the coarsest layout).
+  if (!(tolerance > 0 && tolerance <= kMaxImageSide)) {
+    throw InputError({}, "tolerance", "expected a number of pixels in (0, 16384]");
   }
   if (!(options.near_miss >= 0) || !std::isfinite(options.near_miss)) {
     throw InputError({}, "near_miss", "expected a fraction >= 0");

@@ -185,7 +185,7 @@ void Rig::validate(const std::string& source) const {
       fail(at + "R_eye_projector", "a rotation matrix (orthonormal within 1e-6, determinant +1)");
     }
     if (!finite(p.t_eye_projector)) fail(at + "t_eye_projector", "a list of 3 finite numbers");
-    if (!(p.gamma > 0) || !std::isfinite(p.gamma)) fail(at + "gamma", "a positive number");
+    if (!(p.gamma > 0 && p.gamma <= kMaxGamma)) fail(at + "gamma", "a gamma in (0, 10]");
   }
   if (camera.lensmodel.empty()) fail("camera.lensmodel", "an mrcal lens model name");
   if (camera.size.x < 1 || camera.size.y < 1 || camera.size.x > 32768 || camera.size.y > 32768) {
@@ -202,8 +202,8 @@ void Rig::validate(const std::string& source) const {
   }
   if (!finite(camera.t_eye_camera)) fail("camera.t_eye_camera", "a list of 3 finite numbers");
   const SimulationSettings& s = simulation;
-  if (!(s.phase_period > 0) || !std::isfinite(s.phase_period)) {
-    fail("simulation.phase_period", "a positive number of projector pixels");
+  if (!(s.phase_period >= kMinPhasePeriod && s.phase_period <= kMaxPhasePeriod)) {
+    fail("simulation.phase_period", "a period from 2 to 65536 projector pixels");
   }
   if (s.phase_steps < 3 || s.phase_steps > 64) fail("simulation.phase_steps", "3 to 64 steps");
   auto check_range = [&](double value, double low, double high, const std::string& field,

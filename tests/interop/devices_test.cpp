@@ -59,6 +59,42 @@ TEST(UsbDevices, StableIdentityPrefersTheSerialAndFallsBackToThePort) {
   EXPECT_EQ(find_devices("usb:0403:6001@1-4", all).size(), 1u);
 }
 
+// The forms an id may take; anything else is refused with what was expected (the CLI's --find and
+// --camera usb:... say so with exit status 2 instead of finding nothing or the wrong device).
+TEST(UsbDevices, StableIdSyntax) {
+  for (const char* good : {"usb:046d:085c", "USB:046D:085C", "usb:046d:085c:A1B2C3",
+                           "usb:0403:6001@1-4", "usb:0403:6001@1-4.2.1", "usb:0403:6001@3-0"}) {
+    EXPECT_EQ(stable_id_problem(good), "") << good;
+  }
+  for (const char* bad : {"",
+                          "usb:",
+                          "usb::",
+                          "usb:046d",
+                          "usb:046d:",
+                          "usb:zzzz:0000",
+                          "usb:12345:0000",
+                          "usb:1234:56789",
+                          "usb:-1:1",
+                          "pci:1234:5678",
+                          "usb:1234:5678@",
+                          "usb:1234:5678:",
+                          "usb:1234:5678:\xff",
+                          "usb:1234:5678:a\nb",
+                          "usb:1234:5678@1",
+                          "usb:1234:5678@1-",
+                          "usb:1234:5678@-1",
+                          "usb:1234:5678@1-2..3",
+                          "usb:1234:5678@1-2-3",
+                          "usb:1234:5678@1234-1",
+                          "usb:0x12:0x34",
+                          "usb:1234:5678#1-1"}) {
+    EXPECT_NE(stable_id_problem(bad), "") << bad;
+  }
+  EXPECT_TRUE(matches(stable_id(camera()), camera()));
+  EXPECT_EQ(stable_id_problem(stable_id(camera())), "");
+  EXPECT_EQ(stable_id_problem(stable_id(serial_adapter())), "");
+}
+
 TEST(UsbDevices, Formatting) {
   EXPECT_EQ(format_devices({}), "no USB devices\n");
   const std::string table = format_devices({camera(), serial_adapter()});

@@ -79,7 +79,7 @@ const facet::cli::Registration registration{
                       "display the capture ran with, if it kept one)");
       cmd->add_option("--name", args->name,
                       "display name (default: the display's, else the capture folder's name)");
-      cmd->callback([args] {
+      cmd->callback([args, cmd] {
         facet::calibration::CalibrateOptions options;
         if (!args->grid.empty()) options.fit.grid = parse_grid(args->grid);
         if (args->node_spacing_px) {
@@ -98,6 +98,7 @@ const facet::cli::Registration registration{
           throw facet::InputError("--feather", "", "an angle in degrees in (0, 180]");
         }
         options.blend.feather_rad = args->feather_deg * M_PI / 180;
+        if (cmd->count("--name") > 0) facet::cli::check_name(args->name, "--name");
         options.display_name = args->name;
         if (!args->display.empty())
           options.display = facet::projection_io::read_display_template(args->display);

@@ -57,6 +57,9 @@ struct CaptureArgs {
 std::string resolve_camera_device(const std::string& camera) {
   if (!camera.starts_with("usb:")) return camera;
 #ifdef FACET_CAPTURE_HAS_USB_IDS
+  if (const std::string problem = interop::stable_id_problem(camera); !problem.empty()) {
+    throw InputError("--camera", "", problem);
+  }
   std::vector<std::string> matched;
   std::string seen;
   for (const calibration::VideoDevice& device : calibration::list_video_devices()) {
@@ -114,10 +117,30 @@ int run_capture(const CaptureArgs& args) {
                      "a fake camera (fake:RIG.json): a real camera must see the patterns on the "
                      "projectors");
   }
-  if (args.projector_gamma && !(*args.projector_gamma > 0)) {
-    throw InputError("--projector-gamma", "", "a positive number");
+  if (!args.camera_size.empty()) {
+    parse_size(args.camera_size, "--camera-size");
+    if (fake) {
+      throw InputError("--camera-size", "",
+                       "a real camera: a fake camera's size comes from its rig (camera.size)");
+    }
   }
-  if (args.settle_ms < 0) throw InputError("--settle-ms", "", "milliseconds >= 0");
+  if (args.projector_gamma && !(*args.projector_gamma > 0 && *args.projector_gamma <= kMaxGamma)) {
+    throw InputError("--projector-gamma", "", "a gamma in (0, 10]");
+  }
+  if (!(args.camera_gamma > 0 && args.camera_gamma <= kMaxGamma)) {
+    throw InputError("--camera-gamma", "", "a gamma in (0, 10]");
+  }
+  // Checked up front whatever the camera (a fake one ignores some): a minute's settling, a
+  // thousand dropped or averaged frames per pattern are more than any camera needs.
+  if (args.settle_ms < 0 || args.settle_ms > 60'000) {
+    throw InputError("--settle-ms", "", "milliseconds from 0 to 60000");
+  }
+  if (args.discard < 0 || args.discard > 1000) {
+    throw InputError("--discard", "", "a number of frames from 0 to 1000");
+  }
+  if (args.average < 1 || args.average > 1000) {
+    throw InputError("--average", "", "a number of exposures from 1 to 1000");
+  }
 
   std::optional<Rig> rig;
   if (fake) {
@@ -141,10 +164,13 @@ int run_capture(const CaptureArgs& args) {
   if (args.phase_period) patterns.phase_period = *args.phase_period;
   if (args.phase_steps) patterns.phase_steps = *args.phase_steps;
   if (args.no_phase) patterns.phase_period.reset();
-  if (patterns.phase_period && !(*patterns.phase_period > 0)) {
-    throw InputError("--phase-period", "", "a period > 0 in projector pixels");
+  if (patterns.phase_period &&
+      !(*patterns.phase_period >= kMinPhasePeriod && *patterns.phase_period <= kMaxPhasePeriod)) {
+    throw InputError("--phase-period", "", "a period from 2 to 65536 projector pixels");
   }
-  if (patterns.phase_steps < 3) throw InputError("--phase-steps", "", "3 or more steps");
+  if (patterns.phase_steps < 3 || patterns.phase_steps > 64) {
+    throw InputError("--phase-steps", "", "3 to 64 steps");
+  }
 
   calibration::LiveCaptureSetup setup;
   for (const projection_io::DisplayProjector& p : display.projectors) {
@@ -303,7 +329,8 @@ const Registration registration{
       cmd->add_flag("--allow-clipping", args->allow_clipping,
                     "report clipping on white frames but go on");
       cmd->add_option("--stop-after", args->stop_after,
-                      "stop after capturing this many frames (a deterministic interruption)");
+                      "stop after capturing this many frames (a deterministic interruption)")
+          ->check(unsigned_only());
       cmd->add_flag("--windowed", args->windowed,
                     "fake camera: show the patterns in windows as for a real camera");
       cmd->add_flag("--headless", args->headless,

@@ -29,14 +29,22 @@ const Registration registration{
                           "With --watch: stop after this many seconds (default: until Ctrl-C)");
       command->add_option("--find", options->find,
                           "Only the devices a stable id (usb:VVVV:PPPP[:SERIAL|@BUS-PATH]) names");
-      command->callback([options] {
-        if (options->seconds < 0) throw InputError("--for", "", "expected seconds >= 0");
+      command->callback([options, command] {
+        // Left out, --watch goes on until Ctrl-C; given, it is a time in (0, 1e6] s (11.6 days):
+        // 0, NaN, infinity or 1e308 would watch forever.
+        if (command->count("--for") > 0) {
+          if (!options->watch) throw InputError("--for", "", "--watch as well: it times the watch");
+          if (!(options->seconds > 0 && options->seconds <= 1e6)) {
+            throw InputError("--for", "", "seconds in (0, 1e6]; leave --for out to stop on Ctrl-C");
+          }
+        }
         const interop::UsbListing listing = interop::list_usb_devices();
         if (!listing.problem.empty()) std::cerr << "facet: note: " << listing.problem << "\n";
         std::vector<interop::UsbDevice> devices = listing.devices;
         if (!options->find.empty()) {
-          if (options->find.rfind("usb:", 0) != 0) {
-            throw InputError("--find", "", "expected usb:VVVV:PPPP[:SERIAL|@BUS-PATH]");
+          if (const std::string problem = interop::stable_id_problem(options->find);
+              !problem.empty()) {
+            throw InputError("--find", "", problem);
           }
           devices = interop::find_devices(options->find, devices);
         }

@@ -16,6 +16,7 @@ struct DisplayOptions {
   std::string display;
   std::string size;
   std::string name;
+  bool name_given = false;
   std::string out;
   DomeOrientationFlags orientation;
 };
@@ -29,10 +30,12 @@ const Registration registration{
           "a display.json) as a folder holding display.json, the warps and the blends");
       command->add_option("display", options->display, "The display to write")->required();
       command->add_option("--size", options->size, "Output size WxH of a built-in display");
-      command->add_option("--name", options->name, "Name in display.json (default: the folder's)");
+      command->add_option("--name", options->name, "Name in display.json (default: the folder's)")
+          ->each([options](const std::string&) { options->name_given = true; });
       command->add_option("--out", options->out, "Folder to create")->required();
       options->orientation.add_to(*command);
       command->callback([options] {
+        if (options->name_given) check_name(options->name, "--name");
         std::optional<glm::ivec2> size;
         if (!options->size.empty()) size = parse_size(options->size, "--size");
         const auto orientation = builtin_dome_orientation(options->orientation, options->display);

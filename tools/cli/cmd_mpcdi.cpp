@@ -93,8 +93,8 @@ const Registration registration{
           char end = 0;
           if (std::sscanf(importing->eye.c_str(), "%lf,%lf,%lf%c", &eye.x, &eye.y, &eye.z, &end) !=
                   3 ||
-              !std::isfinite(eye.x + eye.y + eye.z)) {
-            throw InputError("--eye", "", "expected x,y,z: three finite numbers");
+              !(std::abs(eye.x) <= 1e7 && std::abs(eye.y) <= 1e7 && std::abs(eye.z) <= 1e7)) {
+            throw InputError("--eye", "", "expected x,y,z: three numbers within ±1e7");
           }
           options.eye = eye;
         }

@@ -6,22 +6,15 @@
 #include <string>
 
 #include "command.hpp"
+#include "display_flags.hpp"
 #include "facet/calibration/patterns.hpp"
 #include "facet/projection/errors.hpp"
+#include "facet/projection/rig.hpp"
 
 namespace {
 
-glm::ivec2 parse_size(const std::string& text) {
-  int width = 0, height = 0;
-  char separator = 0, extra = 0;
-  if (std::sscanf(text.c_str(), "%d%c%d%c", &width, &separator, &height, &extra) != 3 ||
-      (separator != 'x' && separator != 'X') || width < 1 || height < 1 || width > 65536 ||
-      height > 65536) {
-    throw facet::InputError("--size", "",
-                            "WxH with positive integers, e.g. 1920x1080, got '" + text + "'");
-  }
-  return {width, height};
-}
+// The shared WxH reader (sscanf's %d wrapped 4294967297 to 1), within the image limits.
+glm::ivec2 parse_size(const std::string& text) { return facet::cli::parse_size(text, "--size"); }
 
 struct PatternsArgs {
   std::string size;
@@ -51,8 +44,10 @@ const facet::cli::Registration registration{
         const glm::ivec2 size = parse_size(args->size);
         facet::calibration::PatternSetOptions options;
         if (args->phase_period) {
-          if (!std::isfinite(*args->phase_period) || !(*args->phase_period > 0)) {
-            throw facet::InputError("--phase-period", "", "a positive number of projector pixels");
+          if (!(*args->phase_period >= facet::kMinPhasePeriod &&
+                *args->phase_period <= facet::kMaxPhasePeriod)) {
+            throw facet::InputError("--phase-period", "",
+                                    "a period from 2 to 65536 projector pixels");
           }
           options.phase_period = args->phase_period;
         }

@@ -24,6 +24,7 @@
 #include "facet/driver/reference.hpp"
 #include "facet/driver/render_method.hpp"
 #include "facet/driver/scene_names.hpp"
+#include "facet/projection/atomic_folder.hpp"
 #include "facet/projection/errors.hpp"
 #include "facet/projection/interrupt.hpp"
 #include "frames_flag.hpp"
@@ -130,37 +131,39 @@ nlohmann::json compare_with_reference(const Scene& scene, const std::vector<Outp
 // Writes the output set through write(temporary folder), then renames its files into `folder`
 // (created when missing; files of other names in it are kept), so that a failure or an
 // interruption leaves no partial set: the temporary folder is removed.
-void write_output_set(const std::filesystem::path& out,
-                      const std::function<void(const std::filesystem::path&)>& write,
-                      const std::string& stopped) {
+// The rules of render's --out: a new path, an empty folder, or a folder of an earlier render
+// (its <output>.png, .ids.exr, .depth.exr and .reference.ids.exr files and nothing else), which
+// is replaced whole; never the current folder, a parent of it or of an input, or anything else.
+OutputFolderRules render_out_rules(const RenderOptions& options) {
   namespace fs = std::filesystem;
-  fs::path folder = out.lexically_normal();
-  if (!folder.has_filename()) folder = folder.parent_path();
-  const fs::path parent = folder.has_parent_path() ? folder.parent_path() : fs::path(".");
-  std::error_code error;
-  fs::create_directories(parent, error);
-  const fs::path temporary =
-      parent / ("." + folder.filename().string() + ".tmp" + std::to_string(::getpid()));
-  fs::remove_all(temporary, error);
-  if (error || !fs::create_directories(temporary, error) || error)
-    throw InputError(out.string(), "--out", "expected a folder that can be created");
-  try {
-    write(temporary);
-    throw_if_interrupted(stopped);
-    fs::create_directories(folder, error);
-    if (error || !fs::is_directory(folder))
-      throw InputError(out.string(), "--out", "expected a folder that can be created");
-    for (const fs::directory_entry& entry : fs::directory_iterator(temporary))
-      fs::rename(entry.path(), folder / entry.path().filename());
-    fs::remove(temporary);
-  } catch (...) {
-    fs::remove_all(temporary, error);
-    throw;
+  OutputFolderRules rules;
+  rules.flag = "--out";
+  rules.expected =
+      "a new path, an empty folder, or a folder of an earlier facet render (<output>.png, "
+      ".ids.exr and .depth.exr files, nothing else)";
+  rules.is_own_output = [](const fs::path& folder) {
+    std::error_code error;
+    for (const fs::directory_entry& entry : fs::directory_iterator(folder, error)) {
+      const std::string name = entry.path().filename().string();
+      const bool own =
+          name.ends_with(".png") || name.ends_with(".ids.exr") || name.ends_with(".depth.exr");
+      if (!own || !entry.is_regular_file(error) || entry.is_symlink(error)) return false;
+    }
+    return !error;
+  };
+  for (const std::string& input :
+       {options.display, options.scene, options.material, options.reference_scene}) {
+    std::error_code error;
+    if (!input.empty() && fs::exists(input, error)) rules.inputs.emplace_back(input);
   }
+  return rules;
 }
 
 void run(const RenderOptions& options) {
   const std::uint64_t frame_count = checked_frames(options.frames);
+  // Before any work: an --out that may not be written is refused at once.
+  const OutputFolderRules out_rules = render_out_rules(options);
+  if (!options.out.empty()) check_output_folder(options.out, out_rules);
   if (options.msaa < 0) throw InputError("command line", "--msaa", "expected 0 or more samples");
   std::optional<glm::ivec2> size;
   if (!options.size.empty()) size = parse_size(options.size, "--size");
@@ -180,8 +183,9 @@ void run(const RenderOptions& options) {
     std::cerr << "facet render: warning: " << line << "\n";
   };
   if (options.face_size) {
-    if (*options.face_size < 1) {
-      throw InputError("command line", "--face-size", "expected a cube face size >= 1 pixel");
+    if (*options.face_size < 1 || *options.face_size > 16384) {
+      throw InputError("command line", "--face-size",
+                       "expected a cube face size from 1 to 16384 pixels");
     }
     settings.cube_face_size = *options.face_size;
   }
@@ -192,19 +196,38 @@ void run(const RenderOptions& options) {
     throw InputError("command line", "--coverage",
                      "expected grid or walk; got '" + options.coverage + "'");
   }
-  if (options.anisotropy != kAutomaticAnisotropy && !(options.anisotropy >= 1.0f)) {
-    throw InputError("command line", "--anisotropy", "expected 0 (automatic) or a level >= 1");
+  // GL caps the level at GL_MAX_TEXTURE_MAX_ANISOTROPY, 16 on every GPU that has it: a larger
+  // level (or infinity) would be clamped without a word.
+  if (options.anisotropy != kAutomaticAnisotropy &&
+      !(options.anisotropy >= 1.0f && options.anisotropy <= 16.0f)) {
+    throw InputError("command line", "--anisotropy",
+                     "expected 0 (automatic) or a level from 1 to 16, got " +
+                         std::to_string(options.anisotropy));
   }
   settings.material = load_material_shader(options.material);
   const ViewRequest view_request = options.view.request();  // malformed flags before the scene
   const SceneName scene_name = parse_scene_name(options.scene);
-  std::vector<std::uint32_t> source_ids;
-  const Scene scene = load_scene(scene_name, &source_ids);
-  std::optional<Scene> reference_scene;
+  // The reference scene's name is checked with the scene's, and refused under its own flag.
+  auto as_reference_scene = [&](auto&& step) {
+    try {
+      return step();
+    } catch (const InputError& error) {
+      if (error.field() != "--scene") throw;
+      throw InputError(error.source(), "--reference-scene", error.expected());
+    }
+  };
+  std::optional<SceneName> reference_scene_name;
   if (!options.reference_scene.empty()) {
     if (!options.reference)
       throw InputError("command line", "--reference-scene", "expected --reference as well");
-    reference_scene = load_scene(parse_scene_name(options.reference_scene));
+    reference_scene_name =
+        as_reference_scene([&] { return parse_scene_name(options.reference_scene); });
+  }
+  std::vector<std::uint32_t> source_ids;
+  const Scene scene = load_scene(scene_name, &source_ids);
+  std::optional<Scene> reference_scene;
+  if (reference_scene_name) {
+    reference_scene = as_reference_scene([&] { return load_scene(*reference_scene_name); });
   }
   const SceneView view = choose_view(scene, view_request, scene_name.builtin_city(), "render");
 
@@ -261,7 +284,7 @@ void run(const RenderOptions& options) {
   if (options.out.empty()) {
     compare("");
   } else {
-    write_output_set(
+    write_folder_atomically(
         options.out,
         [&](const std::filesystem::path& folder) {
           compare(folder);
@@ -279,8 +302,9 @@ void run(const RenderOptions& options) {
               write_depth_exr(folder / (outputs[i].name + ".depth.exr"), s, depth);
             }
           }
+          throw_if_interrupted(stopped);
         },
-        stopped);
+        out_rules);
   }
   throw_if_interrupted(stopped);
 

@@ -21,6 +21,7 @@
 #include "facet/projection/interrupt.hpp"
 #include "facet/projection/progress.hpp"
 #include "facet/projection/test_pattern.hpp"
+#include "facet/projection/warp.hpp"
 #include "frames_flag.hpp"
 #include "view_flags.hpp"
 
@@ -117,8 +118,8 @@ void run(const RunOptions& options) {
   }
   if (!options.method.empty()) display.method = options.method;
   if (options.tolerance) {
-    if (!(*options.tolerance > 0))
-      throw InputError("command line", "--tolerance", "a positive number of output pixels");
+    if (!(*options.tolerance > 0 && *options.tolerance <= kMaxImageSide))
+      throw InputError("command line", "--tolerance", "a number of output pixels in (0, 16384]");
     display.settings.facets.layout = FacetTolerance{*options.tolerance};
     display.settings.facets.origin.source = "command line";
     display.settings.facets.origin.field = "--tolerance";
@@ -136,6 +137,9 @@ void run(const RunOptions& options) {
   }
   const bool headless = options.headless || (!options.windowed && !have_display_server());
   // Before the scene, so that a missing display server is reported at once.
+  if (headless && !options.report.empty())
+    throw InputError("command line", "--report",
+                     "a windowed run: the report is of window placement and shown pixels");
   if (!headless) monitors_of_display_server("--windowed");
   const driver::ViewRequest view_request = options.view.request();
   const driver::SceneName scene_name = driver::parse_scene_name(options.scene);

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "command.hpp"
+#include "display_flags.hpp"
 #include "facet/calibration/simulate.hpp"
 #include "facet/projection/errors.hpp"
 #include "facet/projection/interrupt.hpp"
@@ -16,16 +17,9 @@
 
 namespace {
 
+// The shared WxH reader (sscanf's %d wrapped 4294967297 to 1), within the image limits.
 glm::ivec2 parse_size(const std::string& text) {
-  int width = 0, height = 0;
-  char separator = 0, extra = 0;
-  if (std::sscanf(text.c_str(), "%d%c%d%c", &width, &separator, &height, &extra) != 3 ||
-      (separator != 'x' && separator != 'X') || width < 1 || height < 1 || width > 32768 ||
-      height > 32768) {
-    throw facet::InputError("--camera-size", "",
-                            "WxH with positive integers, e.g. 1280x1024, got '" + text + "'");
-  }
-  return {width, height};
+  return facet::cli::parse_size(text, "--camera-size");
 }
 
 struct SimulateArgs {
@@ -56,10 +50,19 @@ void apply_overrides(const SimulateArgs& args, facet::Rig& rig) {
   if (args.peak) s.peak = *args.peak;
   if (args.bits) s.bits = *args.bits;
   if (args.seed) s.seed = *args.seed;
-  if (args.phase_period) s.phase_period = *args.phase_period;
+  if (args.phase_period) {
+    if (!(*args.phase_period >= facet::kMinPhasePeriod &&
+          *args.phase_period <= facet::kMaxPhasePeriod)) {
+      throw facet::InputError("--phase-period", "", "a period from 2 to 65536 projector pixels");
+    }
+    s.phase_period = *args.phase_period;
+  }
   if (args.no_phase) s.phase = false;
   if (args.no_falloff) s.falloff = false;
   if (args.gamma) {
+    if (!(*args.gamma > 0 && *args.gamma <= facet::kMaxGamma)) {
+      throw facet::InputError("--gamma", "", "a gamma in (0, 10]");
+    }
     for (auto& projector : rig.projectors) projector.gamma = *args.gamma;
   }
   if (args.camera_size) {
@@ -91,7 +94,7 @@ const facet::cli::Registration registration{
       cmd->add_option("--peak", args->peak, "brightest white, fraction of full scale");
       cmd->add_option("--gamma", args->gamma, "gamma of every projector");
       cmd->add_option("--bits", args->bits, "PNG bits per sample, 8 or 16");
-      cmd->add_option("--seed", args->seed, "noise seed");
+      cmd->add_option("--seed", args->seed, "noise seed")->check(facet::cli::unsigned_only());
       cmd->add_option("--phase-period", args->phase_period, "phase period in projector pixels");
       cmd->add_flag("--no-phase", args->no_phase, "Gray code only, no phase-shift frames");
       cmd->add_flag("--no-falloff", args->no_falloff, "uniform brightness (no 1/d², no cosine)");

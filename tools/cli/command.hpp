@@ -21,4 +21,26 @@ struct Registration {
   Registration(int order, CommandSetup setup);
 };
 
+// A check for an unsigned option: CLI11 converts "-1" to an unsigned type by wrapping it to the
+// largest value; this refuses any sign instead.
+inline CLI::Validator unsigned_only() {
+  return CLI::Validator(
+      [](std::string& value) -> std::string {
+        const auto first = value.find_first_not_of(" \t");
+        if (first != std::string::npos && (value[first] == '-' || value[first] == '+')) {
+          return "expected an integer from 0 up without a sign, got '" + value + "'";
+        }
+        return "";
+      },
+      "");
+}
+
+// A name given on the command line (a display's): 1 to 256 bytes of valid UTF-8, neither blank
+// nor holding control characters; else an InputError naming `flag` and what is wrong.
+void check_name(const std::string& name, const std::string& flag);
+
+// The whole CLI: parses argv, runs the subcommand and returns the exit status (0, 1 for a bug, 2
+// for the user's mistake, 3 for a lost peer). main() is this alone.
+int run(int argc, char** argv);
+
 }  // namespace facet::cli

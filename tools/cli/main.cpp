@@ -129,9 +129,76 @@ int report_failure(std::exception_ptr failure, const std::string& command, int a
   }
 }
 
-}  // namespace facet::cli
+namespace {
 
-int main(int argc, char** argv) {
+// Whether `text` is well-formed UTF-8: no stray continuation bytes, no overlong forms, no
+// surrogates, nothing past U+10FFFF.
+bool valid_utf8(const std::string& text) {
+  std::size_t i = 0;
+  while (i < text.size()) {
+    const auto byte = [&](std::size_t k) { return static_cast<unsigned char>(text[k]); };
+    const unsigned char lead = byte(i);
+    std::size_t length = 0;
+    std::uint32_t code = 0, least = 0;
+    if (lead < 0x80) {
+      ++i;
+      continue;
+    } else if ((lead & 0xe0) == 0xc0) {
+      length = 2, code = lead & 0x1f, least = 0x80;
+    } else if ((lead & 0xf0) == 0xe0) {
+      length = 3, code = lead & 0x0f, least = 0x800;
+    } else if ((lead & 0xf8) == 0xf0) {
+      length = 4, code = lead & 0x07, least = 0x10000;
+    } else {
+      return false;
+    }
+    if (i + length > text.size()) return false;
+    for (std::size_t k = 1; k < length; ++k) {
+      if ((byte(i + k) & 0xc0) != 0x80) return false;
+      code = (code << 6) | (byte(i + k) & 0x3f);
+    }
+    if (code < least || code > 0x10ffff || (code >= 0xd800 && code <= 0xdfff)) return false;
+    i += length;
+  }
+  return true;
+}
+
+}  // namespace
+
+void check_name(const std::string& name, const std::string& flag) {
+  auto refuse = [&](const std::string& why) {
+    throw facet::InputError("command line", flag,
+                            "a name of 1 to 256 bytes of UTF-8 without control characters, " + why);
+  };
+  if (name.size() > 256) refuse("got " + std::to_string(name.size()) + " bytes");
+  if (name.find_first_not_of(" \t") == std::string::npos) refuse("got a blank one");
+  if (!valid_utf8(name)) refuse("got bytes that are not UTF-8");
+  for (const char c : name) {
+    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) refuse("got a control character");
+  }
+}
+
+namespace {
+
+// An empty value (--out=, --scene "") is refused naming its flag, for every option of every
+// command: none means anything by it, and taken for the flag left out it would run the default.
+void refuse_empty_values(CLI::App& command) {
+  for (CLI::Option* option : command.get_options()) {
+    if (option->get_expected_max() == 0) continue;
+    option->check(CLI::Validator(
+        [](std::string& value) -> std::string {
+          return value.empty() ? "expected a value, got an empty one" : "";
+        },
+        ""));
+  }
+  for (CLI::App* sub : command.get_subcommands([](CLI::App*) { return true; })) {
+    refuse_empty_values(*sub);
+  }
+}
+
+}  // namespace
+
+int run(int argc, char** argv) {
   CLI::App app{
       "facet: calibration and piecewise perspective rendering for dome, cylinder and "
       "wall projector displays"};
@@ -140,6 +207,7 @@ int main(int argc, char** argv) {
   std::stable_sort(commands.begin(), commands.end(),
                    [](const auto& a, const auto& b) { return a.first < b.first; });
   for (auto& [order, setup] : commands) setup(app);
+  refuse_empty_values(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -161,3 +229,5 @@ int main(int argc, char** argv) {
   }
   return 0;
 }
+
+}  // namespace facet::cli

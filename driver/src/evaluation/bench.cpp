@@ -240,8 +240,8 @@ std::vector<BenchScenario> make_bench_scenarios(const BenchOptions& options) {
     }
   }
   parse_scene_name(options.scene);  // InputError for a bad --scene before any work
-  if (!(options.size_scale > 0) || options.size_scale > 4) {
-    throw InputError("command line", "--size-scale", "expected a scale in (0, 4]");
+  if (!(options.size_scale >= 1.0 / 64) || options.size_scale > 4) {
+    throw InputError("command line", "--size-scale", "expected a scale in [1/64, 4]");
   }
   if (options.frames < 1) throw InputError("command line", "--frames", "expected at least 1");
   const double scale = options.size_scale * (options.quick ? 0.125 : 1.0);

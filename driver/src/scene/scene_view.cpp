@@ -79,6 +79,8 @@ glm::dvec3 parse_point(std::string_view text, std::string_view flag) {
     if (item.empty() || error != std::errc() || end != item.data() + item.size() ||
         !std::isfinite(value))
       refuse("'" + std::string(item) + "' is not a finite number");
+    // 10,000 km: past it a float (what the GL draws with) keeps less than a metre.
+    if (std::abs(value) > kMaxPointMetres) refuse("'" + std::string(item) + "' is past ±1e7 m");
     point[axis] = value;
     if (comma != std::string_view::npos) rest = rest.substr(comma + 1);
   }

@@ -118,6 +118,18 @@ SessionDisplay load_session_display(std::string_view display, std::optional<glm:
 void scale_session_display(SessionDisplay& display, double factor) {
   if (!(factor > 0 && factor <= 1))
     throw InputError("command line", "--scale", "a factor in (0, 1]");
+  // Every output keeps at least 8 pixels a side: below that (--scale 1e-9 made 1x1 outputs)
+  // there is nothing to preview.
+  for (const SessionOutput& output : display.outputs) {
+    const glm::dvec2 scaled = glm::round(glm::dvec2(output.spec.warp.output_size) * factor);
+    if (scaled.x < 8 || scaled.y < 8) {
+      throw InputError(
+          "command line", "--scale",
+          "a factor in (0, 1] that leaves every output at least 8 pixels a side, but " +
+              std::to_string(factor) + " makes " + output.spec.name + " " +
+              std::to_string(int(scaled.x)) + "x" + std::to_string(int(scaled.y)));
+    }
+  }
   for (SessionOutput& output : display.outputs) {
     Warp& warp = output.spec.warp;
     const glm::ivec2 old_size = warp.output_size;

@@ -10,6 +10,7 @@
 #include "facet/projection/atomic_file.hpp"
 #include "facet/projection/errors.hpp"
 #include "facet/projection/input_file.hpp"
+#include "facet/projection/warp.hpp"
 #include "json_fields.hpp"
 
 namespace facet::projection_io {
@@ -312,8 +313,8 @@ void validate_display_config(const DisplayConfig& config, const std::string& sou
   if (!valid_method(config.render.method)) {
     render["method"].fail("a render method name of lower-case letters, digits, '_' and '-'");
   }
-  if (!(config.render.tolerance_px > 0) || !std::isfinite(config.render.tolerance_px)) {
-    render["tolerance_px"].fail("a positive number of output pixels");
+  if (!(config.render.tolerance_px > 0 && config.render.tolerance_px <= kMaxImageSide)) {
+    render["tolerance_px"].fail("a number of output pixels in (0, 16384]");
   }
   if (!(config.render.z_near > 0) || !std::isfinite(config.render.z_near)) {
     render["z_near"].fail("a positive number of metres");

@@ -24,6 +24,8 @@ struct ViewRequest {
 // Parses "X,Y,Z": three finite numbers (metres, world frame), separated by commas, spaces
 // allowed around them. InputError("command line", flag, what was expected and what was given).
 glm::dvec3 parse_point(std::string_view text, std::string_view flag);
+// The largest coordinate parse_point accepts, in metres.
+inline constexpr double kMaxPointMetres = 1e7;
 
 struct SceneView {
   // The built-in city's camera path (CityCameraPath) drives the eye; the fields below are unused.

@@ -38,6 +38,9 @@ std::string vid_pid(const UsbDevice& device);
 // The identity a config names a device by: "usb:VVVV:PPPP:SERIAL" when the device reports a
 // serial number (it survives re-plugging into another port), else "usb:VVVV:PPPP@BUS-PATH".
 std::string stable_id(const UsbDevice& device);
+// What is wrong with `id` as a device id usb:VVVV:PPPP[:SERIAL|@BUS-PATH] (VVVV and PPPP four hex
+// digits each, SERIAL printable ASCII, BUS-PATH as bus_path writes it), or "" when nothing is.
+std::string stable_id_problem(const std::string& id);
 // Whether `id` (a stable_id, or just "usb:VVVV:PPPP" for any such device) names `device`.
 bool matches(const std::string& id, const UsbDevice& device);
 // The devices `id` names; several only for the bare VID:PID form.

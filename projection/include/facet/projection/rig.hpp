@@ -74,6 +74,11 @@ struct RigCamera {
   bool operator==(const RigCamera&) const = default;
 };
 
+// Limits shared by rig files and the CLI's flags (simulate, patterns, capture).
+inline constexpr double kMinPhasePeriod = 2;      // projector pixels: a shorter period aliases
+inline constexpr double kMaxPhasePeriod = 65536;  // the largest projector side
+inline constexpr double kMaxGamma = 10;           // gammas in (0, 10], as MPCDI's and the CLI's
+
 // Image formation of a simulated capture, in the order they apply (see calibration/simulate.hpp).
 struct SimulationSettings {
   bool phase = true;            // add phase-shift frames
