@@ -18,7 +18,9 @@
 #include <cstdio>
 #include <cstring>
 #include <deque>
+#include <future>
 #include <map>
+#include <memory>
 #include <mutex>
 #include <set>
 #include <thread>
@@ -67,6 +69,7 @@ enum class Published : std::uint8_t {
 };
 
 constexpr auto kPoll = std::chrono::milliseconds(20);  // how often blocked threads look up
+constexpr auto kCloseWait = std::chrono::seconds(2);   // Socket::close
 
 Clock::duration period(double seconds) {
   return std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(seconds));
@@ -139,9 +142,20 @@ class Socket {
   Socket() = default;
   ~Socket() { close(); }
   // Closes it now; a receive blocked on it returns at once.
-  void close() {
-    if (open_) nng_close(socket_);
+  // NNG 1.5.2 can deadlock in nng_close while a peer's pipe is going away (nanomsg/nng#1543 and
+  // #1813; seen here in about 1 of 50 secondaries stopping): the close runs on a thread of its
+  // own, and after kCloseWait the socket is left to it, and to the process's exit, which NNG does
+  // not hold up (it has no exit handler). False then.
+  bool close() {
+    if (!open_) return true;
     open_ = false;
+    auto closed = std::make_shared<std::promise<void>>();
+    std::future<void> done = closed->get_future();
+    std::thread([socket = socket_, closed] {
+      nng_close(socket);
+      closed->set_value();
+    }).detach();
+    return done.wait_for(kCloseWait) == std::future_status::ready;
   }
   Socket(const Socket&) = delete;
   Socket& operator=(const Socket&) = delete;
@@ -564,8 +578,12 @@ class Secondary final : public FrameSync {
     question_asked_.notify_all();
     listener_.join();
     responder_.join();
-    subscriber_.close();
-    answers_.close();
+    for (Socket* socket : {&subscriber_, &answers_}) {
+      if (!socket->close())
+        options_.report("node " + self_.name +
+                        ": an NNG socket did not close within 2 s (an NNG 1.5.2 deadlock); left "
+                        "to the process's exit");
+    }
   }
 
   std::optional<FrameState> next_frame(const FrameState&) override {
