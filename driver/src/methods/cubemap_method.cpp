@@ -3,8 +3,16 @@
 // along its exact eye direction. The directions come from the warp inverse once, in prepare(),
 // as an RGBA32F lookup texture per output; colour is sampled bilinearly, triangle IDs from the
 // nearest texel. Its error is resampling: about one face texel, in output pixels.
+//
+// As in Trapp & Döllner's projection tile screens, the faces are made with per-face frustum
+// culling: objects on the CPU (bounding sphere against each face's frustum) and triangles in a
+// geometry stage (cube_face.geom); in six passes, one per face needed, or in one layered pass
+// (RenderSettings::cube_creation); and the colour faces get mipmaps, sampled trilinearly
+// (RenderSettings::cube_mipmaps).
 #include <algorithm>
 #include <array>
+#include <bit>
+#include <cmath>
 #include <glm/gtc/type_ptr.hpp>
 
 #include "facet/driver/gpu_timer.hpp"
@@ -53,6 +61,25 @@ glm::dmat4 clip_from_eye(const CubeFace& face, double z_near) {
   return m;
 }
 
+// Bit f set when the sphere (eye frame) may meet face f's frustum: a_m·p >= |a_s·p|,
+// a_m·p >= |a_t·p| and a_m·p >= z_near. Conservative: a bit is clear only when the sphere lies
+// wholly beyond one of those planes.
+unsigned faces_of_sphere(const glm::dvec3& centre, double radius, double z_near) {
+  unsigned mask = 0;
+  for (int f = 0; f < 6; ++f) {
+    const CubeFace& face = kFaces[f];
+    const double m = glm::dot(face.a_m, centre);
+    const double s = glm::dot(face.a_s, centre);
+    const double t = glm::dot(face.a_t, centre);
+    // The side planes (a_m ∓ a_s)·p >= 0 have normals of length √2.
+    const double side = radius * std::sqrt(2.0);
+    if (m - s < -side || m + s < -side || m - t < -side || m + t < -side) continue;
+    if (m < z_near - radius) continue;
+    mask |= 1u << f;
+  }
+  return mask;
+}
+
 class CubemapMethod final : public RenderMethod {
  public:
   std::string_view name() const override { return "cubemap"; }
@@ -96,19 +123,36 @@ class CubemapMethod final : public RenderMethod {
     }
 
     const int n = settings.cube_face_size;
+    layered_ = settings_.cube_creation == RenderSettings::CubeCreation::layered;
+    use_gs_ = layered_ || settings_.cube_culling == RenderSettings::CubeCulling::triangles;
+    const int levels = settings_.cube_mipmaps ? int(std::floor(std::log2(double(n)))) + 1 : 1;
     colour_cube_ = Texture::create(GL_TEXTURE_CUBE_MAP);
-    glTextureStorage2D(colour_cube_.id(), 1, GL_SRGB8_ALPHA8, n, n);
-    glTextureParameteri(colour_cube_.id(), GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    glTextureStorage2D(colour_cube_.id(), levels, GL_SRGB8_ALPHA8, n, n);
+    glTextureParameteri(colour_cube_.id(), GL_TEXTURE_MIN_FILTER,
+                        levels > 1 ? GL_LINEAR_MIPMAP_LINEAR : GL_LINEAR);
     glTextureParameteri(colour_cube_.id(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
     id_cube_ = Texture::create(GL_TEXTURE_CUBE_MAP);
     glTextureStorage2D(id_cube_.id(), 1, GL_R32UI, n, n);
     glTextureParameteri(id_cube_.id(), GL_TEXTURE_MIN_FILTER, GL_NEAREST);
     glTextureParameteri(id_cube_.id(), GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-    face_depth_ = Texture::create_2d(GL_DEPTH_COMPONENT32F, n, n);
+    // Layered: one depth image per face (a cube map), as every attachment of a layered
+    // framebuffer must be layered. Six passes share one.
+    if (layered_) {
+      face_depth_ = Texture::create(GL_TEXTURE_CUBE_MAP);
+      glTextureStorage2D(face_depth_.id(), 1, GL_DEPTH_COMPONENT32F, n, n);
+    } else {
+      face_depth_ = Texture::create_2d(GL_DEPTH_COMPONENT32F, n, n);
+    }
     // Held for every frame: the lookup textures (RGBA32F per output pixel), both cube maps (six
-    // n x n faces of SRGB8_ALPHA8 and of R32UI) and the face depth buffer (DEPTH32F).
-    buffer_bytes_ = 6ull * std::uint64_t(n) * std::uint64_t(n) * (4 + 4) +
-                    std::uint64_t(n) * std::uint64_t(n) * 4;
+    // n x n faces of SRGB8_ALPHA8, with its mipmaps, and of R32UI) and the face depth buffer
+    // (DEPTH32F, six faces when layered).
+    std::uint64_t colour_texels = 0;
+    for (int level = 0; level < levels; ++level) {
+      const std::uint64_t edge = std::uint64_t(std::max(1, n >> level));
+      colour_texels += edge * edge;
+    }
+    const std::uint64_t texels = std::uint64_t(n) * std::uint64_t(n);
+    buffer_bytes_ = 6ull * (colour_texels * 4 + texels * 4) + (layered_ ? 6ull : 1ull) * texels * 4;
     for (const OutputSpec& output : outputs) {
       buffer_bytes_ += 16ull * std::uint64_t(output.warp.output_size.x) *
                        std::uint64_t(output.warp.output_size.y);
@@ -116,17 +160,28 @@ class CubemapMethod final : public RenderMethod {
     face_framebuffer_ = Framebuffer::create();
     const GLenum buffers[2] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
     glNamedFramebufferDrawBuffers(face_framebuffer_.id(), 2, buffers);
-    face_framebuffer_.attach(GL_DEPTH_ATTACHMENT, face_depth_);
+    if (layered_) {
+      glNamedFramebufferTexture(face_framebuffer_.id(), GL_COLOR_ATTACHMENT0, colour_cube_.id(), 0);
+      glNamedFramebufferTexture(face_framebuffer_.id(), GL_COLOR_ATTACHMENT1, id_cube_.id(), 0);
+      glNamedFramebufferTexture(face_framebuffer_.id(), GL_DEPTH_ATTACHMENT, face_depth_.id(), 0);
+      face_framebuffer_.check_complete();
+    } else {
+      face_framebuffer_.attach(GL_DEPTH_ATTACHMENT, face_depth_);
+    }
+    if (!primitives_query_) primitives_query_ = Query::create(GL_PRIMITIVES_GENERATED);
     if (!empty_vao_) empty_vao_ = VertexArray::create();
 
-    if (!face_program_ || linked_material_ != settings.material) {
+    if (!face_program_ || linked_material_ != settings.material || linked_gs_ != use_gs_) {
       ProgramBuilder face;
       face.define("WRITE_TRIANGLE_ID", "1")
+          .define("CUBE_GS", use_gs_ ? "1" : "0")
           .shader("baselines/cube_face.vert")
           .shader("baselines/pull_scene.vert");
+      if (use_gs_) face.shader("baselines/cube_face.geom");
       add_material_stages(face, settings.material);
       face_program_ = link_with_material(face, settings.material);
       linked_material_ = settings.material;
+      linked_gs_ = use_gs_;
     }
     if (!lookup_program_) {
       lookup_program_ = ProgramBuilder()
@@ -158,51 +213,77 @@ class CubemapMethod final : public RenderMethod {
     } else {
       glDisable(GL_CULL_FACE);
     }
+    // Every face of GL's cube keeps the same handedness, so one winding serves all (layered).
+    const bool mirrored = glm::dot(glm::cross(kFaces[0].a_s, kFaces[0].a_t), kFaces[0].a_m) > 0;
+    glFrontFace(mirrored ? GL_CW : GL_CCW);
     face_program_.use();
     glBindVertexArray(empty_vao_.id());
     gpu_scene_->bind_for_pulling();
     const int n = settings_.cube_face_size;
-    for (int f = 0; f < 6; ++f) {
-      if (!face_needed_[f]) continue;
-      const CubeFace& face = kFaces[f];
-      glNamedFramebufferTextureLayer(face_framebuffer_.id(), GL_COLOR_ATTACHMENT0,
-                                     colour_cube_.id(), 0, f);
-      glNamedFramebufferTextureLayer(face_framebuffer_.id(), GL_COLOR_ATTACHMENT1, id_cube_.id(), 0,
-                                     f);
-      face_framebuffer_.check_complete();
-      glBindFramebuffer(GL_FRAMEBUFFER, face_framebuffer_.id());
-      glViewport(0, 0, n, n);
-      const float background[4] = {0, 0, 0, 1};
-      const GLuint zero_id[4] = {0, 0, 0, 0};
-      const float far_depth = 0;
-      glClearNamedFramebufferfv(face_framebuffer_.id(), GL_COLOR, 0, background);
-      glClearNamedFramebufferuiv(face_framebuffer_.id(), GL_COLOR, 1, zero_id);
-      glClearNamedFramebufferfv(face_framebuffer_.id(), GL_DEPTH, 0, &far_depth);
-      // A face whose (a_s, a_t) frame is mirrored against the view direction flips the winding
-      // that the rasterizer sees.
-      const bool mirrored = glm::dot(glm::cross(face.a_s, face.a_t), face.a_m) > 0;
-      glFrontFace(mirrored ? GL_CW : GL_CCW);
-      const glm::dmat4 T_clip_eye = clip_from_eye(face, settings_.z_near);
-      for (std::size_t o = 0; o < scene.objects.size(); ++o) {
-        const Object& object = scene.objects[o];
-        if (!in_front_of_face(object.bounds_world, T_eye_world, face)) continue;
-        const glm::mat4 T_clip_object(T_clip_eye * T_eye_world * glm::dmat4(object.T_world_object));
-        glUniformMatrix4fv(0, 1, GL_FALSE, glm::value_ptr(T_clip_object));
-        glUniformMatrix4fv(1, 1, GL_FALSE, glm::value_ptr(object.T_world_object));
-        const glm::mat4 T_eye_object(T_eye_world * glm::dmat4(object.T_world_object));
-        glUniformMatrix4fv(4, 1, GL_FALSE, glm::value_ptr(T_eye_object));
-        std::uint32_t id = triangle_base_[o] + 1;
-        for (std::uint32_t k = 0; k < object.primitive_count; ++k) {
-          const Primitive& primitive = scene.primitives[object.first_primitive + k];
-          set_material(primitive.material);
-          glUniform1ui(2, primitive.first_index);
-          glUniform1ui(3, id);
-          glDrawArrays(GL_TRIANGLES, 0, GLsizei(primitive.index_count));
-          stats.replicas += primitive.index_count / 3;
-          id += primitive.index_count / 3;
+    glViewport(0, 0, n, n);
+    unsigned needed_mask = 0;
+    for (int f = 0; f < 6; ++f) needed_mask |= face_needed_[f] ? 1u << f : 0u;
+
+    // Per object: the faces its bounding sphere meets (of those the outputs need), and its
+    // projection onto each.
+    object_faces_.assign(scene.objects.size(), 0u);
+    object_clip_.resize(scene.objects.size());
+    for (std::size_t o = 0; o < scene.objects.size(); ++o) {
+      const Object& object = scene.objects[o];
+      if (object.bounds_world.empty()) continue;
+      const glm::dvec3 lo(object.bounds_world.p_min), hi(object.bounds_world.p_max);
+      const glm::dvec3 centre(T_eye_world * glm::dvec4(0.5 * (lo + hi), 1.0));
+      // T_eye_world is rigid: the radius stays.
+      const double radius = 0.5 * glm::length(hi - lo);
+      object_faces_[o] = settings_.cube_culling == RenderSettings::CubeCulling::none
+                             ? needed_mask
+                             : faces_of_sphere(centre, radius, settings_.z_near) & needed_mask;
+      for (int f = 0; f < 6; ++f) {
+        if (object_faces_[o] & (1u << f)) {
+          const glm::dmat4 T_clip_eye = clip_from_eye(kFaces[f], settings_.z_near);
+          object_clip_[o][f] =
+              glm::mat4(T_clip_eye * T_eye_world * glm::dmat4(object.T_world_object));
         }
       }
     }
+
+    const float background[4] = {0, 0, 0, 1};
+    const GLuint zero_id[4] = {0, 0, 0, 0};
+    const float far_depth = 0;
+    if (use_gs_) {
+      glUniform1i(6, layered_ ? 1 : 0);
+      glUniform1i(7, settings_.cube_culling == RenderSettings::CubeCulling::triangles ? 1 : 0);
+      glBeginQuery(GL_PRIMITIVES_GENERATED, primitives_query_.id());
+    }
+    if (layered_) {
+      glBindFramebuffer(GL_FRAMEBUFFER, face_framebuffer_.id());
+      glClearNamedFramebufferfv(face_framebuffer_.id(), GL_COLOR, 0, background);
+      glClearNamedFramebufferuiv(face_framebuffer_.id(), GL_COLOR, 1, zero_id);
+      glClearNamedFramebufferfv(face_framebuffer_.id(), GL_DEPTH, 0, &far_depth);
+      draw_objects(T_eye_world, ~0u, stats);
+    } else {
+      for (int f = 0; f < 6; ++f) {
+        // Faces no output needs are cleared too: filtering across a face's edge (seamless cube
+        // sampling, coarse mip levels) may reach them.
+        glNamedFramebufferTextureLayer(face_framebuffer_.id(), GL_COLOR_ATTACHMENT0,
+                                       colour_cube_.id(), 0, f);
+        glNamedFramebufferTextureLayer(face_framebuffer_.id(), GL_COLOR_ATTACHMENT1, id_cube_.id(),
+                                       0, f);
+        face_framebuffer_.check_complete();
+        glBindFramebuffer(GL_FRAMEBUFFER, face_framebuffer_.id());
+        glClearNamedFramebufferfv(face_framebuffer_.id(), GL_COLOR, 0, background);
+        glClearNamedFramebufferuiv(face_framebuffer_.id(), GL_COLOR, 1, zero_id);
+        if (!face_needed_[f]) continue;
+        glClearNamedFramebufferfv(face_framebuffer_.id(), GL_DEPTH, 0, &far_depth);
+        draw_objects(T_eye_world, 1u << f, stats);
+      }
+    }
+    if (use_gs_) {
+      glEndQuery(GL_PRIMITIVES_GENERATED);
+      // Triangles the geometry stage sent to a face: the replicas.
+      stats.replicas = primitives_query_.result();
+    }
+    if (settings_.cube_mipmaps) glGenerateTextureMipmap(colour_cube_.id());
     glFrontFace(GL_CCW);
     glDisable(GL_CULL_FACE);
     glClipControl(GL_LOWER_LEFT, GL_NEGATIVE_ONE_TO_ONE);
@@ -238,19 +319,37 @@ class CubemapMethod final : public RenderMethod {
     gpu_scene_->bind_material_texture(m, 0);
   }
 
-  // False when every corner of the world box lies behind the face's near plane: nothing of the
-  // object can reach that face.
-  bool in_front_of_face(const Aabb& box, const glm::dmat4& T_eye_world,
-                        const CubeFace& face) const {
-    if (box.empty()) return false;
-    for (int c = 0; c < 8; ++c) {
-      const glm::dvec3 p_world((c & 1) ? box.p_max.x : box.p_min.x,
-                               (c & 2) ? box.p_max.y : box.p_min.y,
-                               (c & 4) ? box.p_max.z : box.p_min.z);
-      const glm::dvec3 p_eye(T_eye_world * glm::dvec4(p_world, 1.0));
-      if (glm::dot(face.a_m, p_eye) >= settings_.z_near) return true;
+  // Draws every object that meets a face of `faces` into those faces: six passes give one face
+  // (through the geometry stage when it culls triangles, or projected in the vertex stage),
+  // layered creation all of them at once.
+  void draw_objects(const glm::dmat4& T_eye_world, unsigned faces, RenderStats& stats) {
+    const Scene& scene = *scene_;
+    for (std::size_t o = 0; o < scene.objects.size(); ++o) {
+      const Object& object = scene.objects[o];
+      const unsigned mask = object_faces_[o] & faces;
+      if (mask == 0) continue;
+      if (use_gs_) {
+        glUniform1ui(5, mask);
+        glUniformMatrix4fv(10, 6, GL_FALSE, glm::value_ptr(object_clip_[o][0]));
+      } else {
+        const int f = std::countr_zero(mask);
+        glUniformMatrix4fv(0, 1, GL_FALSE, glm::value_ptr(object_clip_[o][f]));
+      }
+      glUniformMatrix4fv(1, 1, GL_FALSE, glm::value_ptr(object.T_world_object));
+      const glm::mat4 T_eye_object(T_eye_world * glm::dmat4(object.T_world_object));
+      glUniformMatrix4fv(4, 1, GL_FALSE, glm::value_ptr(T_eye_object));
+      std::uint32_t id = triangle_base_[o] + 1;
+      for (std::uint32_t k = 0; k < object.primitive_count; ++k) {
+        const Primitive& primitive = scene.primitives[object.first_primitive + k];
+        set_material(primitive.material);
+        glUniform1ui(2, primitive.first_index);
+        glUniform1ui(3, id);
+        glDrawArrays(GL_TRIANGLES, 0, GLsizei(primitive.index_count));
+        // Without the geometry stage, every triangle of the object is drawn into the face.
+        if (!use_gs_) stats.replicas += primitive.index_count / 3;
+        id += primitive.index_count / 3;
+      }
     }
-    return false;
   }
 
   const Scene* scene_ = nullptr;
@@ -264,7 +363,13 @@ class CubemapMethod final : public RenderMethod {
   Framebuffer face_framebuffer_;
   VertexArray empty_vao_;
   Program face_program_, lookup_program_;
-  MaterialShader linked_material_;  // face_program_'s
+  MaterialShader linked_material_;      // face_program_'s
+  bool linked_gs_ = false;              // face_program_ has the geometry stage
+  bool layered_ = false;                // settings_.cube_creation == layered
+  bool use_gs_ = false;                 // layered, or six passes culling triangles
+  Query primitives_query_;              // GL_PRIMITIVES_GENERATED: triangles sent to faces
+  std::vector<unsigned> object_faces_;  // per object: faces it meets
+  std::vector<std::array<glm::mat4, 6>> object_clip_;  // per object and face: T_clip_object
 };
 
 }  // namespace

@@ -47,6 +47,22 @@ struct RenderSettings {
   bool merge_coplanar_facets = true;
   // Cube-map baseline: edge length of a cube face in pixels.
   int cube_face_size = 1024;
+  // Cube-map baseline: how the faces are made. six_pass draws the scene once per face the
+  // outputs need; layered draws it once, a geometry stage sending every triangle to each face
+  // (gl_Layer), for GPUs. Six passes are the faster on llvmpipe (driver/README.md, "cubemap").
+  enum class CubeCreation { six_pass, layered };
+  CubeCreation cube_creation = CubeCreation::six_pass;
+  // Cube-map baseline: per-face culling. objects: an object is drawn only into the faces whose
+  // frustum its bounding sphere meets (on the CPU); triangles: besides, a geometry stage leaves a
+  // triangle out of a face when all its vertices lie beyond one plane of the face's frustum
+  // (layered creation culls with it always, unless none). none draws everything into every face.
+  // The pixels are the same for all three; objects is the fastest on llvmpipe.
+  enum class CubeCulling { none, objects, triangles };
+  CubeCulling cube_culling = CubeCulling::objects;
+  // Cube-map baseline: mipmaps of the colour faces (glGenerateMipmap after drawing them), sampled
+  // trilinearly by the lookup pass, as Trapp & Döllner do. Triangle IDs always come from the
+  // nearest level-0 texel, so the IDs and the edge errors do not change.
+  bool cube_mipmaps = true;
   // Per-vertex baseline: tessellation level cap (1 = no tessellation).
   int max_tessellation = 1;
   // Tessellator form: cap on its tessellation levels, 0 for GL_MAX_TESS_GEN_LEVEL (64 or more).
