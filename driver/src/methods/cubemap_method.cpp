@@ -7,7 +7,7 @@
 // As in Trapp & Döllner's projection tile screens, the faces are made with per-face frustum
 // culling: objects on the CPU (bounding sphere against each face's frustum) and triangles in a
 // geometry stage (cube_face.geom); in six passes, one per face needed, or in one layered pass
-// (RenderSettings::cube_creation); and the colour faces get mipmaps, sampled trilinearly
+// (RenderSettings::cube_creation); and mipmaps of the colour faces, sampled trilinearly
 // (RenderSettings::cube_mipmaps).
 #include <algorithm>
 #include <array>

@@ -61,8 +61,10 @@ struct RenderSettings {
   CubeCulling cube_culling = CubeCulling::objects;
   // Cube-map baseline: mipmaps of the colour faces (glGenerateMipmap after drawing them), sampled
   // trilinearly by the lookup pass, as Trapp & Döllner do. Triangle IDs always come from the
-  // nearest level-0 texel, so the IDs and the edge errors do not change.
-  bool cube_mipmaps = true;
+  // nearest level-0 texel, so IDs and edge errors do not change: only the colour (less aliasing
+  // where face texels are smaller than output pixels) and the time (11-26% more on llvmpipe),
+  // hence off by default.
+  bool cube_mipmaps = false;
   // Per-vertex baseline: tessellation level cap (1 = no tessellation).
   int max_tessellation = 1;
   // Tessellator form: cap on its tessellation levels, 0 for GL_MAX_TESS_GEN_LEVEL (64 or more).
