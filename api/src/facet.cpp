@@ -587,17 +587,17 @@ void Renderer::warp_perspective(std::size_t output, unsigned int texture) {
 
 void Renderer::warp_image(unsigned int texture, ImageKind kind, double fisheye_fov_deg) {
   const std::string source = "warp_image";
-  ContentProjection projection =
-      kind == ImageKind::fisheye ? fisheye_content(fisheye_fov_deg) : equirect_content();
-  projection.validate(source);
-  std::vector<std::size_t> outputs(impl_->display->outputs.size());
-  for (std::size_t i = 0; i < outputs.size(); ++i) outputs[i] = i;
-  warp_content(outputs, texture, projection, std::numeric_limits<std::size_t>::max(), source);
+  warp_whole_view(
+      texture, kind == ImageKind::fisheye ? fisheye_content(fisheye_fov_deg) : equirect_content(),
+      source);
 }
 
 void Renderer::warp_cubemap(unsigned int texture) {
-  const std::string source = "warp_cubemap";
-  const ContentProjection projection = cubemap_content();
+  warp_whole_view(texture, cubemap_content(), "warp_cubemap");
+}
+
+void Renderer::warp_whole_view(unsigned int texture, const ContentProjection& projection,
+                               const std::string& source) {
   projection.validate(source);
   std::vector<std::size_t> outputs(impl_->display->outputs.size());
   for (std::size_t i = 0; i < outputs.size(); ++i) outputs[i] = i;

@@ -327,6 +327,9 @@ class Renderer {
   void warp_content(const std::vector<std::size_t>& outputs, unsigned int texture,
                     const ContentProjection& projection, std::size_t key,
                     const std::string& source);
+  // Content of the whole view (a dome master, a panorama, a cube map) into every output.
+  void warp_whole_view(unsigned int texture, const ContentProjection& projection,
+                       const std::string& source);
 };
 
 }  // namespace facet
