@@ -347,36 +347,44 @@ std::uint32_t sole_piece_of_sphere(const FacetSet& set, const glm::dvec3& centre
     return kNoPiece;
   const auto near = grid.buckets(grid.chart_point_box(centre));
   if (!near) return kNoPiece;
-  // The cells within two of those about the centre.
+  // The cells within two of those about the centre. A piece listed in several cells is tested
+  // again; the answer cannot change.
   const std::uint32_t columns = grid.columns(), rows = grid.rows();
   const std::uint32_t row_lo = near->first_row >= 2 ? near->first_row - 2 : 0;
   const std::uint32_t row_hi = std::min(near->first_row + near->rows + 1, rows - 1);
-  std::vector<std::uint32_t> nearby;
+  if (grid.periodic() && std::int64_t(near->columns) + 4 > std::int64_t(columns)) return kNoPiece;
+  std::uint32_t sole = kNoPiece;
   for (std::uint32_t j = row_lo; j <= row_hi; ++j) {
     for (std::int64_t k = -2; k < std::int64_t(near->columns) + 2; ++k) {
       std::int64_t i = std::int64_t(near->first_column) + k;
       if (grid.periodic()) {
-        if (std::int64_t(near->columns) + 4 > std::int64_t(columns)) return kNoPiece;
         i = (i % std::int64_t(columns) + columns) % columns;
       } else if (i < 0 || i >= std::int64_t(columns)) {
         continue;
       }
       const std::size_t b = std::size_t(j) * columns + std::size_t(i);
-      for (std::uint32_t m = grid.bucket_first()[b]; m < grid.bucket_first()[b + 1]; ++m)
-        nearby.push_back(pieces.piece_of_facet[grid.bucket_facets()[m]]);
+      for (std::uint32_t m = grid.bucket_first()[b]; m < grid.bucket_first()[b + 1]; ++m) {
+        const std::uint32_t p = pieces.piece_of_facet[grid.bucket_facets()[m]];
+        if (p == sole) continue;
+        // Signed distances of the centre from the piece's four planes through the eye: the
+        // sphere may meet the piece unless it lies wholly outside one plane, and lies inside the
+        // piece when it is inside all four.
+        bool may_meet = true, inside = true;
+        for (const glm::dvec3& plane : pieces.planes[p]) {
+          const double length = glm::length(plane);
+          if (!(length > 0)) {
+            inside = false;
+            continue;
+          }
+          const double d = glm::dot(plane, centre) / length;
+          may_meet = may_meet && !(d < -radius);
+          inside = inside && d >= radius * (1 + 1e-9) + 1e-12;
+        }
+        if (!may_meet) continue;
+        if (sole != kNoPiece || !inside) return kNoPiece;  // two may meet it, or it spills over
+        sole = p;
+      }
     }
-  }
-  std::sort(nearby.begin(), nearby.end());
-  nearby.erase(std::unique(nearby.begin(), nearby.end()), nearby.end());
-  std::uint32_t sole = kNoPiece;
-  for (const std::uint32_t p : nearby) {
-    if (!sphere_may_meet_cone(centre, radius, pieces.planes[p].data(), 4)) continue;
-    if (sole != kNoPiece) return kNoPiece;  // two may meet it
-    bool inside = true;
-    for (const glm::dvec3& plane : pieces.planes[p])
-      inside = inside && glm::dot(glm::normalize(plane), centre) >= radius * (1 + 1e-9) + 1e-12;
-    if (!inside) return kNoPiece;
-    sole = p;
   }
   return sole;
 }
@@ -384,20 +392,25 @@ std::uint32_t sole_piece_of_sphere(const FacetSet& set, const glm::dvec3& centre
 bool sphere_may_meet_facets(const FacetSet& set, const glm::dvec3& centre, double radius) {
   const auto& nodes = set.index.nodes();
   if (nodes.empty()) return false;
-  if (glm::length(centre) <= radius) return true;  // the eye is inside: every direction
+  const double distance = glm::length(centre);
+  if (distance <= radius) return true;  // the eye is inside: every direction
+  // The sphere's cone about the eye: axis v_centre, half-angle s with sin s = radius / distance.
+  const glm::dvec3 v_centre = centre / distance;
+  const double sin_sphere = std::min(1.0, radius / distance);
+  const double cos_sphere = std::sqrt(std::max(0.0, 1.0 - sin_sphere * sin_sphere));
   std::uint32_t stack[128];
   int top = 0;
   stack[top++] = 0;
   while (top > 0) {
     const CoverageIndex::Node& node = nodes[stack[--top]];
     if (node.cos_half_angle > -1) {
-      // Angular test of the sphere's cone against the node's cone.
-      const double distance = glm::length(centre);
-      const double sphere_half = std::asin(std::min(1.0, radius / distance));
-      const double node_half = std::acos(std::clamp(node.cos_half_angle, -1.0, 1.0));
-      const double between =
-          std::acos(std::clamp(glm::dot(node.axis, centre / distance), -1.0, 1.0));
-      if (between > node_half + sphere_half + 1e-9) continue;
+      // The cones miss when the angle between their axes exceeds the sum n + s of their
+      // half-angles, i.e. when its cosine is below cos(n + s) (n + s < pi). A margin of 1e-9 in
+      // the cosine keeps the test conservative against rounding.
+      const double sin_sum = node.sin_half_angle * cos_sphere + node.cos_half_angle * sin_sphere;
+      const double cos_sum = node.cos_half_angle * cos_sphere - node.sin_half_angle * sin_sphere;
+      const bool sum_below_pi = sin_sum > 0 || cos_sum > 0;
+      if (sum_below_pi && glm::dot(node.axis, v_centre) < cos_sum - 1e-9) continue;
     }
     if (node.count > 0) {
       for (std::uint32_t k = node.first; k < node.first + node.count; ++k) {
