@@ -219,6 +219,13 @@ int SceneBuilder::add_material(const MaterialData& material) {
   out.texture = material.texture;
   out.repeat = material.repeat;
   out.unlit = material.unlit;
+  if (!material.shader.empty()) {
+    try {
+      out.shader = driver::load_material_shader(material.shader);
+    } catch (const InputError& e) {
+      throw InputError("API", field + ".shader", e.source() + ": " + e.expected());
+    }
+  }
   scene_->materials.push_back(out);
   return int(scene_->materials.size() - 1);
 }

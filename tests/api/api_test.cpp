@@ -188,6 +188,40 @@ TEST(Api, SceneFromArraysRendersTheSameIdsAsFromGltf) {
   EXPECT_EQ(shaded.read_output_ids(0), a);
   EXPECT_NE(shaded.read_output_rgba8(0), from_arrays.read_output_rgba8(0));
   EXPECT_THROW(wireframe.set_material_shader("chrome"), InputError);
+  // A material's own shader: the green cubes in pen and ink, the red ones as before.
+  SceneBuilder inked;
+  const int inked_red = inked.add_material({.base_colour = {0.8f, 0.2f, 0.2f, 1}});
+  const int inked_green =
+      inked.add_material({.base_colour = {0.2f, 0.8f, 0.2f, 1}, .shader = "pen-and-ink"});
+  const int inked_meshes[2] = {
+      inked.add_mesh({big.positions, big.normals, big.uvs, big.indices}, inked_red),
+      inked.add_mesh({small.positions, small.normals, small.uvs, small.indices}, inked_green)};
+  for (std::size_t k = 0; k < poses.size(); ++k) inked.add_object(inked_meshes[k % 2], poses[k]);
+  Renderer own(display, std::move(inked).build());
+  own.render(true);
+  EXPECT_EQ(own.read_output_ids(0), a);
+  const auto own_rgba = own.read_output_rgba8(0), plain_rgba = from_arrays.read_output_rgba8(0);
+  std::size_t red_same = 0, red_pixels = 0, green_changed = 0, green_pixels = 0;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    if (a[i] == 0) continue;
+    const bool same = std::equal(&own_rgba[4 * i], &own_rgba[4 * i] + 4, &plain_rgba[4 * i]);
+    // Which material a pixel shows: its colour in the plain render.
+    const bool greenish = plain_rgba[4 * i + 1] > plain_rgba[4 * i];
+    (greenish ? green_pixels : red_pixels)++;
+    (greenish ? green_changed : red_same) += greenish ? !same : same;
+  }
+  std::printf("own shaders: red %zu of %zu unchanged, green %zu of %zu changed\n", red_same,
+              red_pixels, green_changed, green_pixels);
+  EXPECT_GT(red_pixels, 100u);
+  EXPECT_EQ(red_same, red_pixels);
+  EXPECT_GT(green_changed, green_pixels / 2);
+  SceneBuilder unknown;
+  try {
+    unknown.add_material({.shader = "chrome"});
+    ADD_FAILURE() << "an unknown shader was taken";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.field(), "materials[0].shader") << e.what();
+  }
   fs::remove_all(folder);
 }
 

@@ -387,6 +387,44 @@ TEST(Gltf, LoadsUnlitMaterialsAndCameras) {
   expect_near(scene.cameras[1].T_world_camera, expected);
 }
 
+// A material's extras.facet_shader: a built-in's name, or a .frag file beside the glTF file;
+// anything else is an InputError naming the glTF file and the field.
+TEST(Gltf, MaterialsTakeTheirOwnShaderFromExtras) {
+  TempDir dir;
+  const std::string box = box_gltf();
+  const std::string lit = R"({"name": "lit"})";
+  ASSERT_NE(box.find(lit), std::string::npos);
+  const auto with_shader = [&](const std::string& value) {
+    std::string text = box;
+    text.replace(text.find(lit), lit.size(),
+                 R"({"name": "lit", "extras": {"facet_shader": )" + value + "}}");
+    return dir.write("shaded.gltf", text);
+  };
+  const Scene ink = load_gltf(with_shader(R"("pen-and-ink")"));
+  ASSERT_EQ(ink.materials.size(), 2u);
+  EXPECT_FALSE(ink.materials[0].shader.has_value());
+  ASSERT_TRUE(ink.materials[1].shader.has_value());
+  EXPECT_EQ(ink.materials[1].shader->name, "pen-and-ink");
+
+  const fs::path paint =
+      dir.write("paint.frag", "vec4 shade(MaterialInput m) { return vec4(1, 0, 1, 1); }\n");
+  const Scene painted = load_gltf(with_shader(R"("paint.frag")"));
+  ASSERT_TRUE(painted.materials[1].shader.has_value());
+  EXPECT_NE(painted.materials[1].shader->text.find("vec4(1, 0, 1, 1)"), std::string::npos);
+  EXPECT_EQ(fs::path(painted.materials[1].shader->file), paint);
+
+  for (const std::string value : {R"("missing.frag")", R"("chalk")", "42", R"("")"}) {
+    try {
+      load_gltf(with_shader(value));
+      ADD_FAILURE() << value << " was taken";
+    } catch (const InputError& e) {
+      const std::string message = e.what();
+      EXPECT_NE(message.find("shaded.gltf"), std::string::npos) << message;
+      EXPECT_EQ(e.field(), "materials[1].extras.facet_shader") << message;
+    }
+  }
+}
+
 TEST(SceneView, DefaultEyeLeavesClosedGeometry) {
   TempDir dir;
   const Scene scene = load_gltf(dir.write("box.gltf", box_gltf()));

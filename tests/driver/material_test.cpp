@@ -167,6 +167,80 @@ TEST(Materials, IdsDoNotDependOnTheMaterial) {
   }
 }
 
+// Scene materials may each bring their own shader (Material::shader): every method links one
+// program per distinct shader and draws each material with its own, leaving the IDs as they are.
+// Even materials of the small city take a user's file that paints magenta, material 1 the
+// built-in procedural material, the others the render's lit one. Checked on every pixel whose
+// 3x3 neighbourhood shows one triangle: magenta exactly where an even material is seen, the
+// lit render's colour where an odd one from 3 on is, and some other colour for material 1.
+TEST(Materials, EachSceneMaterialShadesWithItsOwnShader) {
+  test::shared_context();
+  const Scratch scratch;
+  const fs::path magenta =
+      scratch.write("magenta.frag", "vec4 shade(MaterialInput m) { return vec4(1, 0, 1, 1); }\n");
+  const Scene scene = small_city();
+  Scene shaded = scene;
+  ASSERT_GE(shaded.materials.size(), 4u);
+  for (std::size_t m = 0; m < shaded.materials.size(); m += 2)
+    shaded.materials[m].shader = load_material_shader(magenta.string());
+  shaded.materials[1].shader = load_material_shader("procedural");
+  // The material of each triangle ID (0: no triangle).
+  std::vector<std::uint32_t> material_of_id{UINT32_MAX};
+  for (const Object& object : scene.objects)
+    for (std::uint32_t k = 0; k < object.primitive_count; ++k) {
+      const Primitive& primitive = scene.primitives[object.first_primitive + k];
+      material_of_id.insert(material_of_id.end(), primitive.index_count / 3, primitive.material);
+    }
+  const auto outputs = load_display_outputs("builtin:cylinder360", glm::ivec2(192, 144));
+  RenderSettings settings;
+  settings.facets.layout = FacetStrips{24};
+  const glm::dmat4 view = city_view(3.0);
+  for (std::string_view method :
+       {"facets", "facets-gs", "naive", "tessellated", "cubemap", "vertex"}) {
+    const Rendered lit = render(method, scene, outputs, settings, view);
+    const Rendered own = render(method, shaded, outputs, settings, view);
+    ASSERT_EQ(own.ids[0], lit.ids[0]) << method;
+    const auto& ids = own.ids[0];
+    const int w = 192, h = 144;
+    std::size_t even = 0, even_magenta = 0, odd = 0, odd_lit = 0, procedural = 0,
+                procedural_changed = 0;
+    for (int y = 1; y + 1 < h; ++y)
+      for (int x = 1; x + 1 < w; ++x) {
+        const std::size_t at = std::size_t(y) * w + x;
+        const std::uint32_t id = ids[at];
+        if (id == 0 || id >= material_of_id.size()) continue;
+        bool one_triangle = true;
+        for (int dy = -1; dy <= 1; ++dy)
+          for (int dx = -1; dx <= 1; ++dx)
+            one_triangle = one_triangle && ids[std::size_t(y + dy) * w + x + dx] == id;
+        if (!one_triangle) continue;
+        const std::uint8_t* c = &own.colour[0][4 * at];
+        const std::uint8_t* c_lit = &lit.colour[0][4 * at];
+        const std::uint32_t m = material_of_id[id];
+        if (m % 2 == 0) {
+          ++even;
+          even_magenta += c[0] == 255 && c[1] == 0 && c[2] == 255;
+        } else if (m == 1) {
+          ++procedural;
+          procedural_changed += !std::equal(c, c + 3, c_lit);
+        } else {
+          ++odd;
+          odd_lit += std::equal(c, c + 3, c_lit);
+        }
+      }
+    std::printf("%s: magenta %zu of %zu, lit %zu of %zu, procedural changed %zu of %zu\n",
+                std::string(method).c_str(), even_magenta, even, odd_lit, odd, procedural_changed,
+                procedural);
+    EXPECT_GT(even, 500u) << method;
+    EXPECT_EQ(even_magenta, even) << method;
+    EXPECT_GT(odd, 500u) << method;
+    EXPECT_EQ(odd_lit, odd) << method;
+    if (procedural > 0) {
+      EXPECT_GT(procedural_changed, 0u) << method;
+    }
+  }
+}
+
 double linear_from_srgb(std::uint8_t value) {
   const double c = value / 255.0;
   return c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4);

@@ -173,6 +173,10 @@ struct MaterialData {
   int texture = -1;             // SceneBuilder::add_texture's index, or -1
   bool repeat = true;           // texture coordinates wrap (else clamp to edge)
   bool unlit = false;           // shown as authored (no lighting)
+  // Its own shading: empty for the Display's (set_material_shader), else a built-in material's
+  // name or a GLSL file (".frag") defining `vec4 shade(MaterialInput m)`, as there. A file that
+  // does not compile is an InputError from the Renderer's constructor, naming its line.
+  std::string shader{};
 };
 
 // Builds a Scene from the application's arrays: no file needed. Indices returned are 0, 1, 2, ...

@@ -21,6 +21,7 @@
 #include "facet/driver/shader_library.hpp"
 #include "facet/projection/errors.hpp"
 #include "facet/projection/warp_inverse.hpp"
+#include "material_programs.hpp"
 #include "render_methods_internal.hpp"
 
 namespace facet::driver::detail {
@@ -171,18 +172,18 @@ class CubemapMethod final : public RenderMethod {
     if (!primitives_query_) primitives_query_ = Query::create(GL_PRIMITIVES_GENERATED);
     if (!empty_vao_) empty_vao_ = VertexArray::create();
 
-    if (!face_program_ || linked_material_ != settings.material || linked_gs_ != use_gs_) {
+    if (linked_gs_ != use_gs_) face_programs_.clear();
+    linked_gs_ = use_gs_;
+    face_programs_.prepare(scene, settings.material, [this](const MaterialShader& shader) {
       ProgramBuilder face;
       face.define("WRITE_TRIANGLE_ID", "1")
           .define("CUBE_GS", use_gs_ ? "1" : "0")
           .shader("baselines/cube_face.vert")
           .shader("baselines/pull_scene.vert");
       if (use_gs_) face.shader("baselines/cube_face.geom");
-      add_material_stages(face, settings.material);
-      face_program_ = link_with_material(face, settings.material);
-      linked_material_ = settings.material;
-      linked_gs_ = use_gs_;
-    }
+      add_material_stages(face, shader);
+      return link_with_material(face, shader);
+    });
     if (!lookup_program_) {
       lookup_program_ = ProgramBuilder()
                             .shader("baselines/fullscreen.vert")
@@ -216,7 +217,6 @@ class CubemapMethod final : public RenderMethod {
     // Every face of GL's cube keeps the same handedness, so one winding serves all (layered).
     const bool mirrored = glm::dot(glm::cross(kFaces[0].a_s, kFaces[0].a_t), kFaces[0].a_m) > 0;
     glFrontFace(mirrored ? GL_CW : GL_CCW);
-    face_program_.use();
     glBindVertexArray(empty_vao_.id());
     gpu_scene_->bind_for_pulling();
     const int n = settings_.cube_face_size;
@@ -251,8 +251,12 @@ class CubemapMethod final : public RenderMethod {
     const GLuint zero_id[4] = {0, 0, 0, 0};
     const float far_depth = 0;
     if (use_gs_) {
-      glUniform1i(6, layered_ ? 1 : 0);
-      glUniform1i(7, settings_.cube_culling == RenderSettings::CubeCulling::triangles ? 1 : 0);
+      for (std::size_t slot = 0; slot < face_programs_.size(); ++slot) {
+        const GLuint program = face_programs_.program(slot).id();
+        glProgramUniform1i(program, 6, layered_ ? 1 : 0);
+        glProgramUniform1i(
+            program, 7, settings_.cube_culling == RenderSettings::CubeCulling::triangles ? 1 : 0);
+      }
       glBeginQuery(GL_PRIMITIVES_GENERATED, primitives_query_.id());
     }
     if (layered_) {
@@ -324,23 +328,36 @@ class CubemapMethod final : public RenderMethod {
   // layered creation all of them at once.
   void draw_objects(const glm::dmat4& T_eye_world, unsigned faces, RenderStats& stats) {
     const Scene& scene = *scene_;
+    const Program* in_use = nullptr;
     for (std::size_t o = 0; o < scene.objects.size(); ++o) {
       const Object& object = scene.objects[o];
       const unsigned mask = object_faces_[o] & faces;
       if (mask == 0) continue;
-      if (use_gs_) {
-        glUniform1ui(5, mask);
-        glUniformMatrix4fv(10, 6, GL_FALSE, glm::value_ptr(object_clip_[o][0]));
-      } else {
-        const int f = std::countr_zero(mask);
-        glUniformMatrix4fv(0, 1, GL_FALSE, glm::value_ptr(object_clip_[o][f]));
-      }
-      glUniformMatrix4fv(1, 1, GL_FALSE, glm::value_ptr(object.T_world_object));
       const glm::mat4 T_eye_object(T_eye_world * glm::dmat4(object.T_world_object));
-      glUniformMatrix4fv(4, 1, GL_FALSE, glm::value_ptr(T_eye_object));
+      // The object's uniforms, sent to each program that draws one of its primitives.
+      const auto send_object = [&] {
+        if (use_gs_) {
+          glUniform1ui(5, mask);
+          glUniformMatrix4fv(10, 6, GL_FALSE, glm::value_ptr(object_clip_[o][0]));
+        } else {
+          const int f = std::countr_zero(mask);
+          glUniformMatrix4fv(0, 1, GL_FALSE, glm::value_ptr(object_clip_[o][f]));
+        }
+        glUniformMatrix4fv(1, 1, GL_FALSE, glm::value_ptr(object.T_world_object));
+        glUniformMatrix4fv(4, 1, GL_FALSE, glm::value_ptr(T_eye_object));
+      };
+      bool object_sent = false;
       std::uint32_t id = triangle_base_[o] + 1;
       for (std::uint32_t k = 0; k < object.primitive_count; ++k) {
         const Primitive& primitive = scene.primitives[object.first_primitive + k];
+        const Program& program = face_programs_.program_of(primitive.material);
+        if (&program != in_use) {
+          program.use();
+          in_use = &program;
+          object_sent = false;
+        }
+        if (!object_sent) send_object();
+        object_sent = true;
         set_material(primitive.material);
         glUniform1ui(2, primitive.first_index);
         glUniform1ui(3, id);
@@ -362,9 +379,9 @@ class CubemapMethod final : public RenderMethod {
   std::uint64_t buffer_bytes_ = 0;  // RenderStats::gpu_buffer_bytes
   Framebuffer face_framebuffer_;
   VertexArray empty_vao_;
-  Program face_program_, lookup_program_;
-  MaterialShader linked_material_;      // face_program_'s
-  bool linked_gs_ = false;              // face_program_ has the geometry stage
+  MaterialPrograms face_programs_;
+  Program lookup_program_;
+  bool linked_gs_ = false;              // face_programs_ have the geometry stage
   bool layered_ = false;                // settings_.cube_creation == layered
   bool use_gs_ = false;                 // layered, or six passes culling triangles
   Query primitives_query_;              // GL_PRIMITIVES_GENERATED: triangles sent to faces

@@ -29,11 +29,10 @@ class FacetGsPipeline final : public PairPipelineBase {
       scan_.prepare();
       feedback_ = TransformFeedback::create();
     }
-    if (!draw_ || linked_material_ != settings.material) {
-      draw_ = link_replication_program({"replication/triangle_index.vert", "replication/draw.geom"},
-                                       {{"WRITE_TRIANGLE_ID", "1"}}, &settings.material);
-      linked_material_ = settings.material;
-    }
+    draw_.prepare(scene, settings.material, [](const MaterialShader& shader) {
+      return link_replication_program({"replication/triangle_index.vert", "replication/draw.geom"},
+                                      {{"WRITE_TRIANGLE_ID", "1"}}, &shader);
+    });
   }
 
   void draw(std::size_t i, OutputTarget& target, GpuTimer* timer) override {
@@ -95,8 +94,8 @@ class FacetGsPipeline final : public PairPipelineBase {
     return "the replicated index is one shader storage block of 8 bytes a pair";
   }
 
-  Program count_, replicate_, args_, draw_;
-  MaterialShader linked_material_;  // draw_'s
+  Program count_, replicate_, args_;
+  MaterialPrograms draw_;
   PrefixScan scan_;
   TransformFeedback feedback_;
 };

@@ -45,11 +45,10 @@ class FacetPipeline final : public PairPipelineBase {
       args_ = build_program({"replication/draw_args.comp"}, {{"VERTICES_PER_REPLICA", "3"}});
       scan_.prepare();
     }
-    if (!draw_ || linked_material_ != settings.material) {
-      draw_ = link_replication_program({"replication/draw.vert"}, {{"WRITE_TRIANGLE_ID", "1"}},
-                                       &settings.material);
-      linked_material_ = settings.material;
-    }
+    draw_.prepare(scene, settings.material, [](const MaterialShader& shader) {
+      return link_replication_program({"replication/draw.vert"}, {{"WRITE_TRIANGLE_ID", "1"}},
+                                      &shader);
+    });
     // The grid pass is built for each output's kind of grid (replication_lib.comp, grid_chart).
     for (const OutputState& out : outputs_) {
       const CoverageGrid& grid = out.facets.grid;
@@ -145,8 +144,8 @@ class FacetPipeline final : public PairPipelineBase {
            (grid.cell_buckets() ? 32u : 0u);
   }
 
-  Program count_, walk_, count_walk_, scatter_, args_, draw_;
-  MaterialShader linked_material_;                  // draw_'s
+  Program count_, walk_, count_walk_, scatter_, args_;
+  MaterialPrograms draw_;
   std::map<std::uint32_t, Program> grid_programs_;  // the grid pass per grid_kind
   PrefixScan scan_;
 };

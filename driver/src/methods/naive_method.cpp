@@ -19,11 +19,10 @@ class NaiveMethod final : public FacetMethodBase {
   void prepare(const Scene& scene, const GpuScene& gpu_scene, std::span<const OutputSpec> outputs,
                const RenderSettings& settings) override {
     FacetMethodBase::prepare(scene, gpu_scene, outputs, settings);
-    if (!draw_ || linked_material_ != settings.material) {
-      draw_ = link_replication_program({"replication/naive.vert"}, {{"WRITE_TRIANGLE_ID", "1"}},
-                                       &settings.material);
-      linked_material_ = settings.material;
-    }
+    draw_.prepare(scene, settings.material, [](const MaterialShader& shader) {
+      return link_replication_program({"replication/naive.vert"}, {{"WRITE_TRIANGLE_ID", "1"}},
+                                      &shader);
+    });
   }
 
   RenderStats render(const glm::dmat4& T_eye_world, std::span<OutputTarget> targets,
@@ -55,13 +54,14 @@ class NaiveMethod final : public FacetMethodBase {
       bind_output(i);
       targets[i].bind();
       begin_facet_drawing(settings_.cull_back_faces);
-      draw_.use();
       glBindVertexArray(empty_vao_.id());
       const FacetPieces& pieces = out.facets.pieces;
       std::uint32_t bound_material = UINT32_MAX;
+      const Program* in_use = nullptr;
       for (std::uint32_t f = 0; f < pieces.size(); ++f) {
         if (!pieces.drawn(f)) continue;
-        glUniform1ui(44, f);
+        for (std::size_t slot = 0; slot < draw_.size(); ++slot)
+          glProgramUniform1ui(draw_.program(slot).id(), 44, f);
         for (std::uint32_t m = 0; m < material_count(); ++m) {
           for (std::uint32_t r : records_by_material_[m]) {
             const GpuRecord& record = records_[r];
@@ -71,7 +71,12 @@ class NaiveMethod final : public FacetMethodBase {
               continue;
             }
             if (m != bound_material) {
-              set_material(draw_, m);
+              const Program& program = draw_.program_of(m);
+              if (&program != in_use) {
+                program.use();
+                in_use = &program;
+              }
+              set_material(program, m);
               bound_material = m;
             }
             glUniform1ui(45, r);
@@ -90,8 +95,7 @@ class NaiveMethod final : public FacetMethodBase {
   }
 
  private:
-  Program draw_;
-  MaterialShader linked_material_;  // draw_'s
+  MaterialPrograms draw_;
 };
 
 }  // namespace

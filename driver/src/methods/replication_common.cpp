@@ -309,19 +309,25 @@ void FacetMethodBase::write_draw_commands(std::size_t i, const Program& args_pro
 }
 
 void FacetMethodBase::draw_replicas(std::size_t i, const OutputTarget& target,
-                                    const Program& program, GLenum mode) const {
+                                    const MaterialPrograms& programs, GLenum mode) const {
   const OutputState& out = outputs_[i];
   bind_output(i);
   target.bind();
   begin_facet_drawing(false);
-  set_list_uniforms(program, i);
-  program.use();
+  for (std::size_t slot = 0; slot < programs.size(); ++slot)
+    set_list_uniforms(programs.program(slot), i);
   glBindVertexArray(empty_vao_.id());
   glBindBuffer(GL_DRAW_INDIRECT_BUFFER, out.draw_args.id());
   if (out.draws_per_material > 1) glBindBuffer(GL_PARAMETER_BUFFER_ARB, out.draw_counts.id());
   glMemoryBarrier(GL_COMMAND_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
+  const Program* in_use = nullptr;
   for (std::uint32_t m = 0; m < material_count(); ++m) {
     if (out.material_ranges[2 * m] == out.material_ranges[2 * m + 1]) continue;
+    const Program& program = programs.program_of(m);
+    if (&program != in_use) {
+      program.use();
+      in_use = &program;
+    }
     set_material(program, m);
     const std::uintptr_t first_command = std::uintptr_t(m) * out.draws_per_material;
     const auto* commands = reinterpret_cast<const void*>(first_command * kDrawCommandBytes);

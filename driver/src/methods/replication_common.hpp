@@ -13,6 +13,7 @@
 #include "facet/driver/material_shader.hpp"
 #include "facet/driver/program.hpp"
 #include "facet/driver/render_method.hpp"
+#include "material_programs.hpp"
 
 namespace facet::driver::detail {
 
@@ -142,9 +143,10 @@ class FacetMethodBase : public RenderMethod {
   void size_draw_commands(OutputState& out, std::uint64_t replica_capacity) const;
   // Pass 2c for output i: draw_args.comp writes the commands and their counts.
   void write_draw_commands(std::size_t i, const Program& args_program) const;
-  // Pass 3 for output i into `target`: the commands of each material, drawn with `program` as
-  // `mode` (one glDrawArraysIndirect, or a glMultiDrawArraysIndirectCount of chunks).
-  void draw_replicas(std::size_t i, const OutputTarget& target, const Program& program,
+  // Pass 3 for output i into `target`: the commands of each material, drawn with its program of
+  // `programs` as `mode` (one glDrawArraysIndirect, or a glMultiDrawArraysIndirectCount of
+  // chunks).
+  void draw_replicas(std::size_t i, const OutputTarget& target, const MaterialPrograms& programs,
                      GLenum mode) const;
   // Depth, clip-control and clip-distance state of pass 3, and its undoing.
   static void begin_facet_drawing(bool cull_back_faces);

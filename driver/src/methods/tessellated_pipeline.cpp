@@ -34,22 +34,20 @@ class TessellatedPipeline final : public FacetMethodBase {
     }
     if (settings.tessellated_max_level > 0)
       max_level_ = std::min(max_level_, std::uint32_t(settings.tessellated_max_level));
-    if (linked_material_ != settings.material) programs_.clear();
-    linked_material_ = settings.material;
     // The grid code is specialised per kind of grid, as for `facets`' grid pass.
     for (const OutputState& out : outputs_) {
       const CoverageGrid& grid = out.facets.grid;
       const std::uint32_t kind = grid_kind(grid);
-      if (programs_.contains(kind)) continue;
-      programs_.emplace(kind,
-                        link_replication_program(
-                            {"replication/tess_patch.vert", "replication/tess_replicas.tesc",
-                             "replication/tess_replicas.tese", "replication/tess_replicas.geom"},
-                            {{"WRITE_TRIANGLE_ID", "1"},
-                             {"GRID_CHART", std::to_string(std::uint32_t(grid.chart()))},
-                             {"GRID_PERIODIC", grid.periodic() ? "1" : "0"},
-                             {"GRID_CELL_BUCKETS", grid.cell_buckets() ? "1" : "0"}},
-                            &settings.material));
+      programs_[kind].prepare(scene, settings.material, [&grid](const MaterialShader& shader) {
+        return link_replication_program(
+            {"replication/tess_patch.vert", "replication/tess_replicas.tesc",
+             "replication/tess_replicas.tese", "replication/tess_replicas.geom"},
+            {{"WRITE_TRIANGLE_ID", "1"},
+             {"GRID_CHART", std::to_string(std::uint32_t(grid.chart()))},
+             {"GRID_PERIODIC", grid.periodic() ? "1" : "0"},
+             {"GRID_CELL_BUCKETS", grid.cell_buckets() ? "1" : "0"}},
+            &shader);
+      });
     }
   }
 
@@ -83,7 +81,7 @@ class TessellatedPipeline final : public FacetMethodBase {
  private:
   void draw(std::size_t i, const OutputTarget& target) {
     const OutputState& out = outputs_[i];
-    const Program& program = programs_.at(grid_kind(out.facets.grid));
+    const MaterialPrograms& programs = programs_.at(grid_kind(out.facets.grid));
     // The walk finds a facet at most once per triangle (a quad's two facets each count).
     const std::uint64_t most_replicas = out.facets.mesh.facets.size();
     const std::uint64_t per_patch = std::uint64_t(max_level_) * max_level_;
@@ -91,14 +89,22 @@ class TessellatedPipeline final : public FacetMethodBase {
     bind_output(i);
     target.bind();
     begin_facet_drawing(false);
-    set_list_uniforms(program, i);
-    glProgramUniform1ui(program.id(), program.uniform_location("max_level"), max_level_);
-    program.use();
+    for (std::size_t slot = 0; slot < programs.size(); ++slot) {
+      const Program& program = programs.program(slot);
+      set_list_uniforms(program, i);
+      glProgramUniform1ui(program.id(), program.uniform_location("max_level"), max_level_);
+    }
     glPatchParameteri(GL_PATCH_VERTICES, 1);
     glBindVertexArray(empty_vao_.id());
+    const Program* in_use = nullptr;
     for (std::uint32_t m = 0; m < material_count(); ++m) {
       const std::uint32_t begin = out.material_ranges[2 * m], end = out.material_ranges[2 * m + 1];
       if (begin == end) continue;
+      const Program& program = programs.program_of(m);
+      if (&program != in_use) {
+        program.use();
+        in_use = &program;
+      }
       set_material(program, m);
       glDrawArraysInstanced(GL_PATCHES, GLint(begin), GLsizei(end - begin), instances);
     }
@@ -113,8 +119,7 @@ class TessellatedPipeline final : public FacetMethodBase {
   }
 
   std::uint32_t max_level_ = 64;
-  std::map<std::uint32_t, Program> programs_;  // per grid_kind
-  MaterialShader linked_material_;             // programs_'
+  std::map<std::uint32_t, MaterialPrograms> programs_;  // per grid_kind
 };
 
 }  // namespace

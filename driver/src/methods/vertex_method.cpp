@@ -20,6 +20,7 @@
 #include "facet/driver/shader_library.hpp"
 #include "facet/projection/errors.hpp"
 #include "facet/projection/warp_inverse.hpp"
+#include "material_programs.hpp"
 #include "render_methods_internal.hpp"
 
 namespace facet::driver::detail {
@@ -194,22 +195,17 @@ class VertexMethod final : public RenderMethod {
     if (!empty_vao_) empty_vao_ = VertexArray::create();
     if (!counters_) counters_ = Buffer::create(kCounters * sizeof(std::uint32_t));
     const bool tessellated = settings.max_tessellation > 1;
-    Program& draw = tessellated ? tess_program_ : plain_program_;
-    if (linked_material_ != settings.material) {
-      plain_program_ = Program();
-      tess_program_ = Program();
-      linked_material_ = settings.material;
-    }
-    if (!draw) {
-      draw = tessellated
+    MaterialPrograms& draw = tessellated ? tess_programs_ : plain_programs_;
+    draw.prepare(scene, settings.material, [tessellated](const MaterialShader& shader) {
+      return tessellated
                  ? link_vertex_program(
                        {"baselines/vertex.vert", "baselines/pull_scene.vert",
                         "baselines/vertex.tesc", "baselines/vertex.tese", "baselines/vertex.geom"},
-                       true, settings.material)
+                       true, shader)
                  : link_vertex_program({"baselines/vertex.vert", "baselines/pull_scene.vert",
                                         "baselines/vertex.geom"},
-                                       false, settings.material);
-    }
+                                       false, shader);
+    });
     if (!mask_program_) {
       mask_program_ = ProgramBuilder()
                           .shader("baselines/fullscreen.vert")
@@ -228,7 +224,7 @@ class VertexMethod final : public RenderMethod {
     stats.gpu_buffer_bytes = counters_.size();
     for (const OutputState& out : outputs_) stats.gpu_buffer_bytes += out.texture_bytes;
     const bool tessellated = settings_.max_tessellation > 1;
-    const Program& draw = tessellated ? tess_program_ : plain_program_;
+    const MaterialPrograms& draw = tessellated ? tess_programs_ : plain_programs_;
 
     // Eye-frame bounding spheres of the objects.
     std::vector<glm::dvec3> centre(scene.objects.size());
@@ -262,31 +258,44 @@ class VertexMethod final : public RenderMethod {
       if (out.coverage_mask) draw_mask(out, 1.0f);
       glDepthFunc(GL_GREATER);
 
-      draw.use();
-      glUniformMatrix3fv(20, 1, GL_FALSE, glm::value_ptr(out.R_base_eye));
-      glUniform1i(21, out.base_kind);
-      glUniform4fv(22, 1, glm::value_ptr(out.base_params));
-      glUniform2f(23, float(out.size.x), float(out.size.y));
-      glUniform1f(24, out.s_period);
-      glUniform1i(25, out.wraps ? 1 : 0);
-      glUniform1i(26, settings_.cull_back_faces ? 1 : 0);
-      if (tessellated) {
-        glUniform1f(27, kTessellationTolerancePx);
-        glUniform1f(28, float(settings_.max_tessellation));
+      for (std::size_t slot = 0; slot < draw.size(); ++slot) {
+        const GLuint program = draw.program(slot).id();
+        glProgramUniformMatrix3fv(program, 20, 1, GL_FALSE, glm::value_ptr(out.R_base_eye));
+        glProgramUniform1i(program, 21, out.base_kind);
+        glProgramUniform4fv(program, 22, 1, glm::value_ptr(out.base_params));
+        glProgramUniform2f(program, 23, float(out.size.x), float(out.size.y));
+        glProgramUniform1f(program, 24, out.s_period);
+        glProgramUniform1i(program, 25, out.wraps ? 1 : 0);
+        glProgramUniform1i(program, 26, settings_.cull_back_faces ? 1 : 0);
+        if (tessellated) {
+          glProgramUniform1f(program, 27, kTessellationTolerancePx);
+          glProgramUniform1f(program, 28, float(settings_.max_tessellation));
+        }
+        glProgramUniform1f(program, 29, float(settings_.z_near));
+        glProgramUniform1f(program, 30, out.fisheye_rho_limit);
       }
-      glUniform1f(29, float(settings_.z_near));
-      glUniform1f(30, out.fisheye_rho_limit);
       out.node_offsets.bind_unit(1);
 
+      const Program* in_use = nullptr;
       for (std::size_t o = 0; o < scene.objects.size(); ++o) {
         if (!may_be_seen(out, centre[o], radius[o])) continue;
         const Object& object = scene.objects[o];
         const glm::mat4 T_eye_object(T_eye_world * glm::dmat4(object.T_world_object));
-        glUniformMatrix4fv(0, 1, GL_FALSE, glm::value_ptr(T_eye_object));
-        glUniformMatrix4fv(1, 1, GL_FALSE, glm::value_ptr(object.T_world_object));
+        bool object_sent = false;
         std::uint32_t id = triangle_base_[o] + 1;
         for (std::uint32_t k = 0; k < object.primitive_count; ++k) {
           const Primitive& primitive = scene.primitives[object.first_primitive + k];
+          const Program& program = draw.program_of(primitive.material);
+          if (&program != in_use) {
+            program.use();
+            in_use = &program;
+            object_sent = false;
+          }
+          if (!object_sent) {
+            glUniformMatrix4fv(0, 1, GL_FALSE, glm::value_ptr(T_eye_object));
+            glUniformMatrix4fv(1, 1, GL_FALSE, glm::value_ptr(object.T_world_object));
+            object_sent = true;
+          }
           set_material(primitive.material);
           glUniform1ui(2, primitive.first_index);
           glUniform1ui(3, id);
@@ -354,8 +363,8 @@ class VertexMethod final : public RenderMethod {
   std::vector<OutputState> outputs_;
   VertexArray empty_vao_;
   Buffer counters_;
-  Program plain_program_, tess_program_, mask_program_;
-  MaterialShader linked_material_;  // plain_program_'s and tess_program_'s
+  MaterialPrograms plain_programs_, tess_programs_;
+  Program mask_program_;
 };
 
 }  // namespace

@@ -15,6 +15,7 @@
 #include <map>
 #include <string>
 
+#include "facet/driver/material_shader.hpp"
 #include "facet/projection/errors.hpp"
 
 namespace facet::driver {
@@ -97,7 +98,25 @@ class GltfReader {
                        TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE;
       }
       out.unlit = in.extensions.count("KHR_materials_unlit") > 0;
+      if (in.extras.IsObject() && in.extras.Has("facet_shader"))
+        out.shader = read_shader(in.extras.Get("facet_shader"),
+                                 "materials[" + std::to_string(i) + "].extras.facet_shader");
       scene.materials.push_back(out);
+    }
+  }
+
+  // A material's own shading: a built-in material's name, or a .frag file relative to the glTF
+  // file's folder (load_material_shader checks it; its error becomes one naming this field).
+  MaterialShader read_shader(const tinygltf::Value& value, const std::string& field) const {
+    const std::string expected = "a built-in material's name or a GLSL file (*.frag)";
+    if (!value.IsString() || value.Get<std::string>().empty()) fail(field, expected);
+    std::string name = value.Get<std::string>();
+    if (name.ends_with(".frag") && std::filesystem::path(name).is_relative())
+      name = (std::filesystem::path(source_).parent_path() / name).string();
+    try {
+      return load_material_shader(name);
+    } catch (const InputError& e) {
+      fail(field, expected + ": " + e.source() + ": " + e.expected());
     }
   }
 

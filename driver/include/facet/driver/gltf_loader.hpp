@@ -17,8 +17,11 @@ namespace facet::driver {
 //   lines are skipped. Missing normals are computed (area-weighted); missing texture
 //   coordinates are 0.
 // - Materials: pbrMetallicRoughness base colour factor and base colour texture (converted to
-//   RGBA8); KHR_materials_unlit marks a material unlit (Material::unlit). Primitives without a
-//   material get a default white one.
+//   RGBA8); KHR_materials_unlit marks a material unlit (Material::unlit). A material's
+//   `extras.facet_shader` gives its own shading (Material::shader): a built-in material's name
+//   ("pen-and-ink") or a GLSL file (*.frag, relative to the glTF file's folder) defining
+//   shade() against shaders/scene/material_interface.frag. Primitives without a material get a
+//   default white one.
 // - Cameras: every node of the scene with a camera (perspective or orthographic) becomes a
 //   SceneCamera with the node's world transform, scale removed; the camera's own projection is
 //   not used: the display decides what is seen.

@@ -1,5 +1,6 @@
 #pragma once
-// Materials: the fragment shading of every render method, chosen per run (`--material`). A
+// Materials: the fragment shading of every render method, chosen per run (`--material`) or per
+// scene material (Material::shader; MaterialPrograms links one program per distinct shader). A
 // material is GLSL that defines `vec4 shade(MaterialInput m)`, compiled against the interface in
 // shaders/scene/material_interface.frag (world position, normal, uv, barycentric coordinates and
 // edge distances in output pixels, distance from the eye, depth, pixel position, triangle ID,
@@ -11,16 +12,9 @@
 #include <string_view>
 
 #include "facet/driver/program.hpp"
+#include "facet/driver/scene.hpp"  // MaterialShader
 
 namespace facet::driver {
-
-struct MaterialShader {
-  std::string name = "lit";  // a built-in's name, or the file as the user gave it
-  // What compiler messages name: shaders/scene/materials/NAME.frag, or the user's file.
-  std::string file;
-  std::string text;  // the material's GLSL; empty: the built-in `name`
-  bool operator==(const MaterialShader&) const = default;
-};
 
 // "lit" (the default), "solid-wireframe", "pen-and-ink", "procedural".
 std::span<const std::string_view> builtin_material_names();

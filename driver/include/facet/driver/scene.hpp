@@ -10,6 +10,7 @@
 #include <glm/vec3.hpp>
 #include <glm/vec4.hpp>
 #include <limits>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -37,6 +38,16 @@ struct Image {
   std::vector<std::uint8_t> rgba;  // width * height * 4 bytes
 };
 
+// A material's fragment shading (driver/material_shader.hpp loads and links it): GLSL defining
+// `vec4 shade(MaterialInput m)` against shaders/scene/material_interface.frag.
+struct MaterialShader {
+  std::string name = "lit";  // a built-in's name, or the file as the user gave it
+  // What compiler messages name: shaders/scene/materials/NAME.frag, or the user's file.
+  std::string file;
+  std::string text;  // the material's GLSL; empty: the built-in `name`
+  bool operator==(const MaterialShader&) const = default;
+};
+
 struct Material {
   std::string name;
   glm::vec4 base_colour{1.0f};  // linear RGBA factor, multiplied with the texture
@@ -44,6 +55,8 @@ struct Material {
   bool repeat = true;           // texture coordinates wrap (else clamp to edge)
   // Shown as authored: base colour times texture, no lighting (glTF KHR_materials_unlit).
   bool unlit = false;
+  // Its own shading; none: the render's (RenderSettings::material, the CLI's --material).
+  std::optional<MaterialShader> shader{};
 };
 
 // A run of triangles that share one material: indices [first_index, first_index + index_count).

@@ -1,0 +1,42 @@
+#pragma once
+// The draw programs of a render method, one per distinct material shader of a scene: the render's
+// own (RenderSettings::material) and each scene material's Material::shader.
+#include <cstdint>
+#include <functional>
+#include <vector>
+
+#include "facet/driver/material_shader.hpp"
+#include "facet/driver/program.hpp"
+#include "facet/driver/scene.hpp"
+
+namespace facet::driver::detail {
+
+class MaterialPrograms {
+ public:
+  // Links the program of `shader` with the method's other stages.
+  using Link = std::function<Program(const MaterialShader& shader)>;
+
+  // Slot 0 is `render_shader`; each distinct Material::shader of `scene` gets the next slot.
+  // Programs of shaders linked before are kept; the others are linked with `link` (whose
+  // InputError names a user's file that does not compile).
+  void prepare(const Scene& scene, const MaterialShader& render_shader, const Link& link);
+  // Forgets every program, so that the next prepare links all of them (the other stages changed).
+  void clear();
+
+  std::size_t size() const { return programs_.size(); }
+  const Program& program(std::size_t slot) const { return programs_.at(slot); }
+  // The slot that shades scene material m; slot 0 for an index beyond the scene's materials.
+  std::uint32_t slot_of(std::uint32_t material) const {
+    return material < material_slot_.size() ? material_slot_[material] : 0u;
+  }
+  const Program& program_of(std::uint32_t material) const {
+    return programs_.at(slot_of(material));
+  }
+
+ private:
+  std::vector<MaterialShader> shaders_;  // per slot
+  std::vector<Program> programs_;        // per slot
+  std::vector<std::uint32_t> material_slot_;
+};
+
+}  // namespace facet::driver::detail
