@@ -275,6 +275,57 @@ TEST(Baselines, CubeMapRejectsBadFaceSize) {
   EXPECT_THROW(method->prepare(f.scene, gpu_scene, outputs, settings), InputError);
 }
 
+// ---- The perspective-image baseline ("perspective") ----
+
+// A projector-like output: a 90° x 73.7° perspective base with a smooth offset of up to 8 px,
+// 256x192.
+const Fixture& projector_fixture() {
+  static const Fixture f([] {
+    Warp warp = Warp::analytic(BaseProjection::perspective(-1, 1, 0.75, -0.75), {256, 192}, {9, 7});
+    for (int j = 0; j < warp.grid_size.y; ++j)
+      for (int i = 0; i < warp.grid_size.x; ++i)
+        warp.offset_px[warp.node_index(i, j)] = glm::vec2(
+            float(8 * std::sin(0.7 * i) * std::cos(0.5 * j)), float(6 * std::sin(0.4 * (i + j))));
+    warp.validate("test projector");
+    return warp;
+  }());
+  return f;
+}
+
+// One perspective image of 512 texels across the output's covering frustum (its 1% margin
+// included): a texel spans about 256 / 512 · 1.02 = 0.51 output px, so nearest-texel IDs move an
+// edge by at most half its diagonal, 0.36 px, and the offsets' stretch (up to about 10%) takes
+// that to 0.4 px; 0.02 px more for snapping and rounding, as for facets. Away from edges the IDs
+// agree (id_mismatch <= 0.001). Measured: 0.275 px, id_mismatch 0. A 64-texel image is
+// measurably worse (5,603 differing pixels against 924), and an output no single
+// image can hold (the 360° cylinder) is an InputError.
+TEST(Baselines, PerspectiveImageIdsMatchTheReferenceWithinHalfATexel) {
+  const Fixture& f = projector_fixture();
+  RenderSettings fine, coarse;
+  fine.cube_face_size = 512;
+  coarse.cube_face_size = 64;
+  const std::vector<std::uint32_t> ids = render(f, "perspective", fine).ids;
+  const IdComparison c = print("perspective 512", compare(f, ids));
+  const EdgeDisplacement e = edges(f, "perspective 512", ids);
+  EXPECT_GT(c.compared_pixels, 256u * 192u / 2);
+  EXPECT_LE(c.id_mismatch, 0.001);
+  EXPECT_EQ(e.beyond_window, 0u);
+  EXPECT_LE(e.max_px, 0.4 + 0.02);
+  const IdComparison rough =
+      print("perspective 64", compare(f, render(f, "perspective", coarse).ids));
+  EXPECT_GT(rough.differing_pixels, 2 * c.differing_pixels);
+
+  test::shared_context();
+  const GpuScene gpu_scene = upload_scene(fixture().scene);
+  auto method = make_render_method("perspective");
+  const OutputSpec cylinder[1] = {{"cylinder", fixture().warp}};
+  EXPECT_THROW(method->prepare(fixture().scene, gpu_scene, cylinder, fine), InputError);
+  const OutputSpec projector[1] = {{"projector", f.warp}};
+  RenderSettings bad_size;
+  bad_size.cube_face_size = 0;
+  EXPECT_THROW(method->prepare(f.scene, gpu_scene, projector, bad_size), InputError);
+}
+
 // ---- The per-vertex projection baseline ("vertex") ----
 
 RenderSettings vertex_settings(int max_tessellation) {

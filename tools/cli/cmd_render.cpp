@@ -384,7 +384,7 @@ const Registration registration{
                         "passes 1 and 2); by default the view moves every frame");
       command
           ->add_option("--method", options->method,
-                       "facets | facets-gs | tessellated | cubemap | naive | vertex")
+                       "facets | facets-gs | tessellated | cubemap | perspective | naive | vertex")
           ->capture_default_str();
       command
           ->add_option("--material", options->material,
@@ -393,7 +393,8 @@ const Registration registration{
           ->capture_default_str();
       options->layout.add_to(*command);
       options->view.add_to(*command);
-      command->add_option("--face-size", options->face_size, "Cube-map face size in pixels");
+      command->add_option("--face-size", options->face_size,
+                          "Cube-map face size, or the perspective image's longer side, in pixels");
       command->add_option("--size", options->size, "Output size WxH (built-in displays)");
       command
           ->add_option("--frames", options->frames,

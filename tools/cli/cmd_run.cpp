@@ -221,7 +221,8 @@ const Registration registration{
       options->view.add_to(*command);
       command->add_option(
           "--method", options->method,
-          "facets, facets-gs, tessellated, naive, cubemap or vertex (default: the display's)");
+          "facets, facets-gs, tessellated, naive, cubemap, perspective or vertex (default: the "
+          "display's)");
       command->add_option("--tolerance", options->tolerance, "Facet tolerance in output pixels");
       command
           ->add_option("--material", options->material,

@@ -13,9 +13,11 @@
 #include "facet/driver/display_outputs.hpp"
 #include "facet/driver/gpu_scene.hpp"
 #include "facet/driver/gpu_timer.hpp"
+#include "facet/driver/perspective_image.hpp"
 #include "facet/driver/reference.hpp"
 #include "facet/driver/scene_names.hpp"
 #include "facet/driver/scene_view.hpp"
+#include "facet/projection/content_projection.hpp"
 #include "facet/projection/errors.hpp"
 #include "facet/projection/facet_error.hpp"
 #include "facet/projection/rig.hpp"
@@ -163,6 +165,60 @@ std::pair<double, double> cube_texel_error(const Warp& warp, const WarpInverse& 
         const auto projected = warp.project(moved, inverted->st.x);
         if (projected) worst = std::max(worst, glm::length(projected->q - q));
       }
+      max_px = std::max(max_px, worst);
+      sum_sq += worst * worst;
+      ++n;
+    }
+  }
+  return {max_px, n ? std::sqrt(sum_sq / double(n)) : 0.0};
+}
+
+// The perspective baseline's rows ("perspective", the seed's IB row), one per image size,
+// placed after the cube map's: for outputs one perspective image can hold (view deformation,
+// dome4's projectors).
+std::vector<BenchSetting> with_perspective_images(std::vector<BenchSetting> settings,
+                                                  const std::vector<int>& sizes) {
+  auto at = settings.end();
+  for (auto it = settings.begin(); it != settings.end(); ++it)
+    if (it->method == "cubemap") at = it + 1;
+  std::vector<BenchSetting> rows;
+  for (int size : sizes) {
+    BenchSetting s{"perspective", format("image=%d", size), {}, {}, {}};
+    s.settings.cube_face_size = size;
+    rows.push_back(s);
+  }
+  settings.insert(at, rows.begin(), rows.end());
+  return settings;
+}
+
+// As cube_texel_error for the perspective baseline's image of `larger_side` texels over the
+// output's covering_frustum: the half-diagonal of the image texel holding each pixel's exact
+// direction, mapped through the warp.
+std::pair<double, double> perspective_texel_error(const Warp& warp, const WarpInverse& inverse,
+                                                  int larger_side) {
+  const Frustum frustum = covering_frustum(warp, "bench");
+  const glm::ivec2 image = perspective_image_size(frustum, larger_side);
+  const double half_u = (frustum.tan_extent[1] - frustum.tan_extent[0]) / (2.0 * image.x);
+  const double half_v = (frustum.tan_extent[2] - frustum.tan_extent[3]) / (2.0 * image.y);
+  const glm::ivec2 size = warp.output_size;
+  const int stride = std::max(1, int(std::sqrt(double(size.x) * size.y / 65536.0)));
+  double max_px = 0, sum_sq = 0;
+  std::size_t n = 0;
+  for (int y = stride / 2; y < size.y; y += stride) {
+    for (int x = stride / 2; x < size.x; x += stride) {
+      const glm::dvec2 q(x + 0.5, y + 0.5);
+      const auto inverted = inverse.invert(q);
+      if (!inverted) continue;
+      const glm::dvec3 v_view = glm::transpose(frustum.R_eye_frustum) * inverted->v_eye;
+      if (!(v_view.z < 0)) continue;
+      const glm::dvec2 tangent = glm::dvec2(v_view) / -v_view.z;
+      double worst = 0;
+      for (const double su : {-1.0, 1.0})
+        for (const double sv : {-1.0, 1.0}) {
+          const glm::dvec3 moved(tangent.x + su * half_u, tangent.y + sv * half_v, -1.0);
+          const auto projected = warp.project(frustum.R_eye_frustum * moved, inverted->st.x);
+          if (projected) worst = std::max(worst, glm::length(projected->q - q));
+        }
       max_px = std::max(max_px, worst);
       sum_sq += worst * worst;
       ++n;
@@ -365,6 +421,7 @@ std::vector<BenchScenario> make_bench_scenarios(const BenchOptions& options) {
           s.settings = sweep({FacetGrid{cells.x, cells.y}, quarter, FacetTolerance{1}}, quarter,
                              {quarter, FacetTolerance{1}}, faces_sweep, tess);
         }
+        s.settings = with_perspective_images(std::move(s.settings), faces_sweep);
         s.matched_cube_face = matched_face;
         scenarios.push_back(std::move(s));
       }
@@ -402,6 +459,7 @@ std::vector<BenchScenario> make_bench_scenarios(const BenchOptions& options) {
               {FacetTolerance{0.25}, FacetTolerance{1}, FacetTolerance{0.5}, FacetTolerance{0.1}},
               FacetTolerance{1}, {FacetTolerance{1}, FacetTolerance{0.25}}, faces_sweep, tess);
         }
+        s.settings = with_perspective_images(std::move(s.settings), faces_sweep);
         s.matched_cube_face = matched_face;
         scenarios.push_back(std::move(s));
       }
@@ -583,13 +641,24 @@ BenchReport run_bench(const BenchOptions& options, const std::string& renderer,
         row.geometric_max_px = max_px;
         row.geometric_rms_px = std::sqrt(sum_sq / double(scenario.outputs.size()));
         row.geometric_source = "cube texel";
+      } else if (setting.method == "perspective") {
+        double max_px = 0, sum_sq = 0;
+        for (std::size_t i = 0; i < scenario.outputs.size(); ++i) {
+          const auto [m, rms] = perspective_texel_error(scenario.outputs[i].warp, inverses[i],
+                                                        setting.settings.cube_face_size);
+          max_px = std::max(max_px, m);
+          sum_sq += rms * rms;
+        }
+        row.geometric_max_px = max_px;
+        row.geometric_rms_px = std::sqrt(sum_sq / double(scenario.outputs.size()));
+        row.geometric_source = "image texel";
       } else {
         row.geometric_max_px = row.max_edge_px;
         row.geometric_rms_px = row.p99_edge_px;
         row.geometric_source = "reference edges";
       }
       say(format(
-          "  %-9s %-12s prepared in %7.0f ms: id_mismatch %.5f, edges max %.2f px (output "
+          "  %-11s %-12s prepared in %7.0f ms: id_mismatch %.5f, edges max %.2f px (output "
           "%zu pixel %d,%d) p99 %.2f px, %llu depth ties, %llu drawn outside the display "
           "(up to %.2f px), geometric max %.3f px",
           setting.method.c_str(), setting.label.c_str(), prepare_ms, row.id_mismatch,
@@ -664,7 +733,7 @@ BenchReport run_bench(const BenchOptions& options, const std::string& renderer,
       row.seam_copies = last.seam_copies;
       row.gpu_buffer_bytes = last.gpu_buffer_bytes;
       say(
-          format("  %-9s %-12s %9.2f ms/frame (median of %d), GPU %8.2f ms, ratio %.3f, "
+          format("  %-11s %-12s %9.2f ms/frame (median of %d), GPU %8.2f ms, ratio %.3f, "
                  "%.1f MiB buffers",
                  row.method.c_str(), row.setting.c_str(), row.frame_ms, options.frames, row.gpu_ms,
                  row.replication_ratio, double(row.gpu_buffer_bytes) / (1024.0 * 1024.0)));

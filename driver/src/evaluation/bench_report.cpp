@@ -205,6 +205,7 @@ cv::Scalar method_colour(const std::string& method) {  // BGR
   if (method == "tessellated") return {150, 120, 0};
   if (method == "naive") return {200, 90, 30};
   if (method == "cubemap") return {60, 160, 40};
+  if (method == "perspective") return {110, 110, 110};
   return {160, 50, 150};
 }
 
@@ -309,7 +310,8 @@ cv::Mat plot_image(const BenchReport& report) {
            {12, 20}, 0.5);
   put_text(image,
            "Software rasterizer times are meaningful only as ratios within this run. Geometric "
-           "error: facet max (facet methods), cube texel (cubemap), reference edge max (vertex).",
+           "error: facet max (facet methods), cube texel (cubemap), image texel (perspective), "
+           "reference edge max (vertex).",
            {12, 40}, 0.38);
   for (std::size_t s = 0; s < scenarios.size(); ++s) {
     std::vector<const BenchRow*> rows;

@@ -10,17 +10,18 @@
 namespace facet::driver {
 namespace {
 
-constexpr std::array<std::string_view, 6> kNames = {"facets",  "facets-gs", "tessellated",
-                                                    "cubemap", "naive",     "vertex"};
+constexpr std::array<std::string_view, 7> kNames = {
+    "facets", "facets-gs", "tessellated", "cubemap", "perspective", "naive", "vertex"};
 
 using Factory = std::unique_ptr<RenderMethod> (*)();
 
 // The methods built so far; a listed name with no factory here is not available yet.
-const std::array<std::pair<std::string_view, Factory>, 6> kFactories = {{
+const std::array<std::pair<std::string_view, Factory>, 7> kFactories = {{
     {"facets", &detail::make_facet_pipeline},
     {"facets-gs", &detail::make_facet_gs_pipeline},
     {"tessellated", &detail::make_tessellated_pipeline},
     {"cubemap", &detail::make_cubemap_method},
+    {"perspective", &detail::make_perspective_method},
     {"naive", &detail::make_naive_method},
     {"vertex", &detail::make_vertex_method},
 }};

@@ -12,6 +12,7 @@ std::unique_ptr<RenderMethod> make_facet_gs_pipeline();     // "facets-gs" (face
 std::unique_ptr<RenderMethod> make_tessellated_pipeline();  // "tessellated"
 std::unique_ptr<RenderMethod> make_naive_method();          // "naive" (naive_method.cpp)
 std::unique_ptr<RenderMethod> make_cubemap_method();        // "cubemap" (cubemap_method.cpp)
+std::unique_ptr<RenderMethod> make_perspective_method();    // "perspective"
 std::unique_ptr<RenderMethod> make_vertex_method();         // "vertex" (vertex_method.cpp)
 
 }  // namespace facet::driver::detail

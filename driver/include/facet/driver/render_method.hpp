@@ -45,7 +45,8 @@ struct RenderSettings {
   // Facet methods: draw the two facets of a tensor cell that share one projection as one quad
   // (FacetPieces); false draws every facet on its own, as the hierarchy walk lists them.
   bool merge_coplanar_facets = true;
-  // Cube-map baseline: edge length of a cube face in pixels.
+  // Cube-map baseline: edge length of a cube face in pixels; perspective baseline: the longer
+  // side of its image.
   int cube_face_size = 1024;
   // Cube-map baseline: how the faces are made. six_pass draws the scene once per face the
   // outputs need; layered draws it once, a geometry stage sending every triangle to each face

@@ -1,0 +1,291 @@
+// The image-based baseline of view deformation ("perspective"; the seed paper's IB row): render
+// the scene once per output into one perspective image that holds every direction the output
+// shows (covering_frustum: the narrowest such frustum about the mean covered direction), then
+// give every output pixel that image's value along its exact eye direction. The directions come
+// from the warp inverse once, in prepare(), as image coordinates per output pixel; colour is
+// sampled bilinearly, triangle IDs from the nearest texel. Its error is resampling: about one
+// image texel, in output pixels. An output that shows a direction 80° or more from its mean
+// (a 180° dome, a 360° cylinder) cannot be held by one image: an InputError.
+#include <algorithm>
+#include <cmath>
+#include <glm/gtc/type_ptr.hpp>
+
+#include "facet/driver/gpu_timer.hpp"
+#include "facet/driver/material_shader.hpp"
+#include "facet/driver/perspective_image.hpp"
+#include "facet/driver/program.hpp"
+#include "facet/projection/content_projection.hpp"
+#include "facet/projection/errors.hpp"
+#include "facet/projection/warp_inverse.hpp"
+#include "material_programs.hpp"
+#include "render_methods_internal.hpp"
+
+namespace facet::driver {
+
+glm::ivec2 perspective_image_size(const Frustum& frustum, int larger_side) {
+  const double width = frustum.tan_extent[1] - frustum.tan_extent[0];
+  const double height = frustum.tan_extent[2] - frustum.tan_extent[3];
+  const double longer = std::max(width, height);
+  return {std::max(1, int(std::lround(larger_side * width / longer))),
+          std::max(1, int(std::lround(larger_side * height / longer)))};
+}
+
+glm::dmat4 perspective_image_clip_from_eye(const Frustum& frustum, double z_near) {
+  const double l = frustum.tan_extent[0], r = frustum.tan_extent[1];
+  const double t = frustum.tan_extent[2], b = frustum.tan_extent[3];
+  glm::dmat4 P(0.0);  // columns
+  P[0][0] = 2 / (r - l);
+  P[2][0] = (r + l) / (r - l);
+  P[1][1] = 2 / (t - b);
+  P[2][1] = (t + b) / (t - b);
+  P[3][2] = z_near;
+  P[2][3] = -1;
+  return P * glm::dmat4(glm::transpose(frustum.R_eye_frustum));
+}
+
+std::optional<glm::dvec2> perspective_image_st(const Frustum& frustum, const glm::dvec3& v_eye) {
+  const glm::dvec3 v = glm::transpose(frustum.R_eye_frustum) * v_eye;
+  if (!(v.z < 0)) return std::nullopt;
+  const double u = v.x / -v.z, w = v.y / -v.z;
+  const double l = frustum.tan_extent[0], r = frustum.tan_extent[1];
+  const double t = frustum.tan_extent[2], b = frustum.tan_extent[3];
+  return glm::dvec2((u - l) / (r - l), (w - b) / (t - b));
+}
+
+namespace detail {
+namespace {
+
+class PerspectiveMethod final : public RenderMethod {
+ public:
+  std::string_view name() const override { return "perspective"; }
+
+  void prepare(const Scene& scene, const GpuScene& gpu_scene, std::span<const OutputSpec> outputs,
+               const RenderSettings& settings) override {
+    if (settings.cube_face_size < 1 || settings.cube_face_size > 16384) {
+      throw InputError("render settings", "cube_face_size",
+                       "expected the perspective image's longer side, 1 to 16384 pixels, got " +
+                           std::to_string(settings.cube_face_size));
+    }
+    if (!(settings.z_near > 0)) {
+      throw InputError("render settings", "z_near", "expected a positive near distance");
+    }
+    scene_ = &scene;
+    gpu_scene_ = &gpu_scene;
+    settings_ = settings;
+    triangle_base_ = scene_triangle_base(scene);
+    outputs_.clear();
+    buffer_bytes_ = 0;
+    for (const OutputSpec& output : outputs) {
+      OutputState out;
+      out.frustum = covering_frustum(output.warp, output.name);
+      out.image_size = perspective_image_size(out.frustum, settings.cube_face_size);
+      const WarpInverse inverse(output.warp);
+      const glm::ivec2 size = output.warp.output_size;
+      const auto st = inverse.st_at_pixel_centres();
+      std::vector<glm::vec4> lookup(st.size(), glm::vec4(0));
+      for (int y = 0; y < size.y; ++y) {
+        for (int x = 0; x < size.x; ++x) {
+          const glm::dvec2 s = st[std::size_t(y) * size.x + x];
+          if (std::isnan(s.x)) continue;
+          const auto image_st = perspective_image_st(out.frustum, output.warp.v_eye_from_st(s));
+          if (!image_st) continue;
+          // GL rows start at the bottom.
+          lookup[std::size_t(size.y - 1 - y) * size.x + x] =
+              glm::vec4(float(image_st->x), float(image_st->y), 0.0f, 1.0f);
+        }
+      }
+      out.lookup = Texture::create_2d(GL_RGBA32F, size.x, size.y);
+      glTextureParameteri(out.lookup.id(), GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+      glTextureParameteri(out.lookup.id(), GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+      glTextureSubImage2D(out.lookup.id(), 0, 0, 0, size.x, size.y, GL_RGBA, GL_FLOAT,
+                          lookup.data());
+      const glm::ivec2 n = out.image_size;
+      out.colour = Texture::create_2d(GL_SRGB8_ALPHA8, n.x, n.y);
+      glTextureParameteri(out.colour.id(), GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+      glTextureParameteri(out.colour.id(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+      glTextureParameteri(out.colour.id(), GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+      glTextureParameteri(out.colour.id(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+      out.ids = Texture::create_2d(GL_R32UI, n.x, n.y);
+      glTextureParameteri(out.ids.id(), GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+      glTextureParameteri(out.ids.id(), GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+      out.depth = Texture::create_2d(GL_DEPTH_COMPONENT32F, n.x, n.y);
+      out.framebuffer = Framebuffer::create();
+      out.framebuffer.attach(GL_COLOR_ATTACHMENT0, out.colour);
+      out.framebuffer.attach(GL_COLOR_ATTACHMENT1, out.ids);
+      out.framebuffer.attach(GL_DEPTH_ATTACHMENT, out.depth);
+      const GLenum buffers[2] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
+      glNamedFramebufferDrawBuffers(out.framebuffer.id(), 2, buffers);
+      out.framebuffer.check_complete();
+      // Held for every frame: the lookup (RGBA32F per output pixel) and the image's colour
+      // (SRGB8_ALPHA8), IDs (R32UI) and depth (DEPTH32F).
+      buffer_bytes_ += 16ull * std::uint64_t(size.x) * std::uint64_t(size.y) +
+                       12ull * std::uint64_t(n.x) * std::uint64_t(n.y);
+      outputs_.push_back(std::move(out));
+    }
+    if (!empty_vao_) empty_vao_ = VertexArray::create();
+    scene_programs_.prepare(scene, settings.material, [](const MaterialShader& shader) {
+      ProgramBuilder builder;
+      builder.define("WRITE_TRIANGLE_ID", "1")
+          .define("CUBE_GS", "0")
+          .shader("baselines/cube_face.vert")
+          .shader("baselines/pull_scene.vert");
+      add_material_stages(builder, shader);
+      return link_with_material(builder, shader);
+    });
+    if (!lookup_program_) {
+      lookup_program_ = ProgramBuilder()
+                            .shader("baselines/fullscreen.vert")
+                            .shader("baselines/perspective_lookup.frag")
+                            .link();
+    }
+    check_gl_error("perspective prepare");
+  }
+
+  RenderStats render(const glm::dmat4& T_eye_world, std::span<OutputTarget> targets,
+                     GpuTimer* timer) override {
+    FACET_ASSERT(scene_ && targets.size() == outputs_.size());
+    const Scene& scene = *scene_;
+    RenderStats stats;
+    stats.triangles_in = scene.triangle_count();
+    stats.triangles_visible = stats.triangles_in;
+    stats.gpu_buffer_bytes = buffer_bytes_;
+    if (timer) timer->begin("image");
+    glEnable(GL_FRAMEBUFFER_SRGB);
+    glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE);
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_GREATER);
+    if (settings_.cull_back_faces) {
+      glEnable(GL_CULL_FACE);
+      glCullFace(GL_BACK);
+    } else {
+      glDisable(GL_CULL_FACE);
+    }
+    glBindVertexArray(empty_vao_.id());
+    gpu_scene_->bind_for_pulling();
+    const float background[4] = {0, 0, 0, 1};
+    const GLuint zero_id[4] = {0, 0, 0, 0};
+    const float far_depth = 0;
+    for (const OutputState& out : outputs_) {
+      glBindFramebuffer(GL_FRAMEBUFFER, out.framebuffer.id());
+      glViewport(0, 0, out.image_size.x, out.image_size.y);
+      glClearNamedFramebufferfv(out.framebuffer.id(), GL_COLOR, 0, background);
+      glClearNamedFramebufferuiv(out.framebuffer.id(), GL_COLOR, 1, zero_id);
+      glClearNamedFramebufferfv(out.framebuffer.id(), GL_DEPTH, 0, &far_depth);
+      const glm::dmat4 T_clip_eye = perspective_image_clip_from_eye(out.frustum, settings_.z_near);
+      stats.replicas += draw_objects(T_eye_world, T_clip_eye);
+    }
+    glDisable(GL_CULL_FACE);
+    glClipControl(GL_LOWER_LEFT, GL_NEGATIVE_ONE_TO_ONE);
+    if (timer) timer->end();
+
+    if (timer) timer->begin("lookup");
+    glDisable(GL_DEPTH_TEST);
+    lookup_program_.use();
+    for (std::size_t i = 0; i < targets.size(); ++i) {
+      targets[i].clear();
+      targets[i].bind();
+      outputs_[i].lookup.bind_unit(0);
+      outputs_[i].colour.bind_unit(1);
+      outputs_[i].ids.bind_unit(2);
+      glDrawArrays(GL_TRIANGLES, 0, 3);
+      targets[i].resolve();
+    }
+    glBindVertexArray(0);
+    glDepthFunc(GL_LESS);
+    if (timer) {
+      timer->end();
+      timer->end_frame();
+    }
+    check_gl_error("perspective render");
+    return stats;
+  }
+
+ private:
+  struct OutputState {
+    Frustum frustum;
+    glm::ivec2 image_size{0, 0};
+    Texture lookup, colour, ids, depth;
+    Framebuffer framebuffer;
+  };
+
+  // Draws every object whose bounding sphere may meet the image's frustum; returns the triangles
+  // drawn.
+  std::uint64_t draw_objects(const glm::dmat4& T_eye_world, const glm::dmat4& T_clip_eye) {
+    const Scene& scene = *scene_;
+    // The frustum's side and near planes in the eye frame: (n, d) with n·p + d >= 0 inside.
+    glm::dvec4 planes[5];
+    const glm::dmat4 M = glm::transpose(T_clip_eye);
+    planes[0] = M[3] + M[0];
+    planes[1] = M[3] - M[0];
+    planes[2] = M[3] + M[1];
+    planes[3] = M[3] - M[1];
+    planes[4] = glm::dvec4(0, 0, -1, -settings_.z_near);
+    std::uint64_t drawn = 0;
+    const Program* in_use = nullptr;
+    for (std::size_t o = 0; o < scene.objects.size(); ++o) {
+      const Object& object = scene.objects[o];
+      if (object.bounds_world.empty()) continue;
+      const glm::dvec3 lo(object.bounds_world.p_min), hi(object.bounds_world.p_max);
+      const glm::dvec3 centre(T_eye_world * glm::dvec4(0.5 * (lo + hi), 1.0));
+      const double radius = 0.5 * glm::length(hi - lo);  // T_eye_world is rigid
+      bool outside = false;
+      for (const glm::dvec4& plane : planes) {
+        const double length = glm::length(glm::dvec3(plane));
+        outside = outside || glm::dot(glm::dvec3(plane), centre) + plane.w < -radius * length;
+      }
+      if (outside) continue;
+      const glm::dmat4 T_eye_object = T_eye_world * glm::dmat4(object.T_world_object);
+      const glm::mat4 T_clip_object(T_clip_eye * T_eye_object), T_eye_object_f(T_eye_object);
+      bool object_sent = false;
+      std::uint32_t id = triangle_base_[o] + 1;
+      for (std::uint32_t k = 0; k < object.primitive_count; ++k) {
+        const Primitive& primitive = scene.primitives[object.first_primitive + k];
+        const Program& program = scene_programs_.program_of(primitive.material);
+        if (&program != in_use) {
+          program.use();
+          in_use = &program;
+          object_sent = false;
+        }
+        if (!object_sent) {
+          glUniformMatrix4fv(0, 1, GL_FALSE, glm::value_ptr(T_clip_object));
+          glUniformMatrix4fv(1, 1, GL_FALSE, glm::value_ptr(object.T_world_object));
+          glUniformMatrix4fv(4, 1, GL_FALSE, glm::value_ptr(T_eye_object_f));
+          object_sent = true;
+        }
+        set_material(primitive.material);
+        glUniform1ui(2, primitive.first_index);
+        glUniform1ui(3, id);
+        glDrawArrays(GL_TRIANGLES, 0, GLsizei(primitive.index_count));
+        drawn += primitive.index_count / 3;
+        id += primitive.index_count / 3;
+      }
+    }
+    return drawn;
+  }
+
+  void set_material(std::uint32_t m) {
+    const Material& material = scene_->materials.at(m);
+    glUniform4fv(8, 1, glm::value_ptr(material.base_colour));
+    glUniform1i(9, material.texture >= 0 ? 1 : 0);
+    gpu_scene_->bind_material_texture(m, 0);
+  }
+
+  const Scene* scene_ = nullptr;
+  const GpuScene* gpu_scene_ = nullptr;
+  RenderSettings settings_;
+  std::vector<std::uint32_t> triangle_base_;
+  std::vector<OutputState> outputs_;
+  std::uint64_t buffer_bytes_ = 0;  // RenderStats::gpu_buffer_bytes
+  VertexArray empty_vao_;
+  MaterialPrograms scene_programs_;
+  Program lookup_program_;
+};
+
+}  // namespace
+
+std::unique_ptr<RenderMethod> make_perspective_method() {
+  return std::make_unique<PerspectiveMethod>();
+}
+
+}  // namespace detail
+}  // namespace facet::driver
