@@ -86,7 +86,8 @@ class Display {
   glm::ivec2 output_size(std::size_t output) const;  // pixels
 
   // How scenes are rendered into every output: "facets" (default; piecewise perspective
-  // replication, the best quality), "facets-gs", "tessellated", "cubemap", "naive", "vertex".
+  // replication, the best quality), "facets-gs", "tessellated", "cubemap", "perspective" (one
+  // perspective image per output: projectors and views narrower than 160°), "naive", "vertex".
   // InputError for another name.
   void set_method(const std::string& method);
   const std::string& method() const;
