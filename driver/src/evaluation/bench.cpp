@@ -630,28 +630,21 @@ BenchReport run_bench(const BenchOptions& options, const std::string& renderer,
           setting.method == "tessellated" || setting.method == "naive") {
         std::tie(row.geometric_max_px, row.geometric_rms_px) = facet_error_of(setting);
         row.geometric_source = "facet error";
-      } else if (setting.method == "cubemap") {
+      } else if (setting.method == "cubemap" || setting.method == "perspective") {
+        // The texel error of the intermediate image, worst and RMS pooled over the outputs.
+        const bool cube = setting.method == "cubemap";
         double max_px = 0, sum_sq = 0;
         for (std::size_t i = 0; i < scenario.outputs.size(); ++i) {
-          const auto [m, rms] = cube_texel_error(scenario.outputs[i].warp, inverses[i],
-                                                 setting.settings.cube_face_size);
+          const Warp& warp = scenario.outputs[i].warp;
+          const int size = setting.settings.cube_face_size;
+          const auto [m, rms] = cube ? cube_texel_error(warp, inverses[i], size)
+                                     : perspective_texel_error(warp, inverses[i], size);
           max_px = std::max(max_px, m);
           sum_sq += rms * rms;
         }
         row.geometric_max_px = max_px;
         row.geometric_rms_px = std::sqrt(sum_sq / double(scenario.outputs.size()));
-        row.geometric_source = "cube texel";
-      } else if (setting.method == "perspective") {
-        double max_px = 0, sum_sq = 0;
-        for (std::size_t i = 0; i < scenario.outputs.size(); ++i) {
-          const auto [m, rms] = perspective_texel_error(scenario.outputs[i].warp, inverses[i],
-                                                        setting.settings.cube_face_size);
-          max_px = std::max(max_px, m);
-          sum_sq += rms * rms;
-        }
-        row.geometric_max_px = max_px;
-        row.geometric_rms_px = std::sqrt(sum_sq / double(scenario.outputs.size()));
-        row.geometric_source = "image texel";
+        row.geometric_source = cube ? "cube texel" : "image texel";
       } else {
         row.geometric_max_px = row.max_edge_px;
         row.geometric_rms_px = row.p99_edge_px;

@@ -316,13 +316,6 @@ class CubemapMethod final : public RenderMethod {
   }
 
  private:
-  void set_material(std::uint32_t m) {
-    const Material& material = scene_->materials.at(m);
-    glUniform4fv(8, 1, glm::value_ptr(material.base_colour));
-    glUniform1i(9, material.texture >= 0 ? 1 : 0);
-    gpu_scene_->bind_material_texture(m, 0);
-  }
-
   // Draws every object that meets a face of `faces` into those faces: six passes give one face
   // (through the geometry stage when it culls triangles, or projected in the vertex stage),
   // layered creation all of them at once.
@@ -346,26 +339,11 @@ class CubemapMethod final : public RenderMethod {
         glUniformMatrix4fv(1, 1, GL_FALSE, glm::value_ptr(object.T_world_object));
         glUniformMatrix4fv(4, 1, GL_FALSE, glm::value_ptr(T_eye_object));
       };
-      bool object_sent = false;
-      std::uint32_t id = triangle_base_[o] + 1;
-      for (std::uint32_t k = 0; k < object.primitive_count; ++k) {
-        const Primitive& primitive = scene.primitives[object.first_primitive + k];
-        const Program& program = face_programs_.program_of(primitive.material);
-        if (&program != in_use) {
-          program.use();
-          in_use = &program;
-          object_sent = false;
-        }
-        if (!object_sent) send_object();
-        object_sent = true;
-        set_material(primitive.material);
-        glUniform1ui(2, primitive.first_index);
-        glUniform1ui(3, id);
-        glDrawArrays(GL_TRIANGLES, 0, GLsizei(primitive.index_count));
-        // Without the geometry stage, every triangle of the object is drawn into the face.
-        if (!use_gs_) stats.replicas += primitive.index_count / 3;
-        id += primitive.index_count / 3;
-      }
+      const std::uint64_t drawn =
+          draw_object_primitives(scene, *gpu_scene_, o, triangle_base_[o] + 1, face_programs_,
+                                 in_use, GL_TRIANGLES, send_object);
+      // Without the geometry stage, every triangle of the object is drawn into the face.
+      if (!use_gs_) stats.replicas += drawn;
     }
   }
 

@@ -1,6 +1,7 @@
 #include "material_programs.hpp"
 
 #include <algorithm>
+#include <glm/gtc/type_ptr.hpp>
 #include <utility>
 
 namespace facet::driver::detail {
@@ -35,6 +36,35 @@ void MaterialPrograms::clear() {
   shaders_.clear();
   programs_.clear();
   material_slot_.clear();
+}
+
+std::uint64_t draw_object_primitives(const Scene& scene, const GpuScene& gpu, std::size_t o,
+                                     std::uint32_t first_id, const MaterialPrograms& programs,
+                                     const Program*& in_use, GLenum mode,
+                                     const std::function<void()>& send_object) {
+  const Object& object = scene.objects[o];
+  bool object_sent = false;
+  std::uint32_t id = first_id;
+  for (std::uint32_t k = 0; k < object.primitive_count; ++k) {
+    const Primitive& primitive = scene.primitives[object.first_primitive + k];
+    const Program& program = programs.program_of(primitive.material);
+    if (&program != in_use) {
+      program.use();
+      in_use = &program;
+      object_sent = false;
+    }
+    if (!object_sent) send_object();
+    object_sent = true;
+    const Material& material = scene.materials.at(primitive.material);
+    glUniform4fv(8, 1, glm::value_ptr(material.base_colour));
+    glUniform1i(9, material.texture >= 0 ? 1 : 0);
+    gpu.bind_material_texture(primitive.material, 0);
+    glUniform1ui(2, primitive.first_index);
+    glUniform1ui(3, id);
+    glDrawArrays(mode, 0, GLsizei(primitive.index_count));
+    id += primitive.index_count / 3;
+  }
+  return id - first_id;
 }
 
 }  // namespace facet::driver::detail

@@ -5,6 +5,7 @@
 #include <functional>
 #include <vector>
 
+#include "facet/driver/gpu_scene.hpp"
 #include "facet/driver/material_shader.hpp"
 #include "facet/driver/program.hpp"
 #include "facet/driver/scene.hpp"
@@ -38,5 +39,17 @@ class MaterialPrograms {
   std::vector<Program> programs_;        // per slot
   std::vector<std::uint32_t> material_slot_;
 };
+
+// Draws scene object o's primitives, each with its material's program of `programs`, for the
+// programs that pull the scene's vertices one primitive at a time (baselines/pull_scene.vert):
+// uniform 2 is the primitive's first index, 3 its first triangle ID (IDs run from `first_id`), 8
+// and 9 the material's base colour and whether it has a texture (bound to unit 0).
+// `send_object` sets the object's own uniforms on the program in use, and is called again
+// whenever the program changes; `in_use` carries the program in use from call to call (nullptr
+// at first). `mode`: GL_TRIANGLES, or GL_PATCHES for tessellation. Returns the triangles drawn.
+std::uint64_t draw_object_primitives(const Scene& scene, const GpuScene& gpu, std::size_t o,
+                                     std::uint32_t first_id, const MaterialPrograms& programs,
+                                     const Program*& in_use, GLenum mode,
+                                     const std::function<void()>& send_object);
 
 }  // namespace facet::driver::detail

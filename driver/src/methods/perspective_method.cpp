@@ -236,38 +236,14 @@ class PerspectiveMethod final : public RenderMethod {
       if (outside) continue;
       const glm::dmat4 T_eye_object = T_eye_world * glm::dmat4(object.T_world_object);
       const glm::mat4 T_clip_object(T_clip_eye * T_eye_object), T_eye_object_f(T_eye_object);
-      bool object_sent = false;
-      std::uint32_t id = triangle_base_[o] + 1;
-      for (std::uint32_t k = 0; k < object.primitive_count; ++k) {
-        const Primitive& primitive = scene.primitives[object.first_primitive + k];
-        const Program& program = scene_programs_.program_of(primitive.material);
-        if (&program != in_use) {
-          program.use();
-          in_use = &program;
-          object_sent = false;
-        }
-        if (!object_sent) {
-          glUniformMatrix4fv(0, 1, GL_FALSE, glm::value_ptr(T_clip_object));
-          glUniformMatrix4fv(1, 1, GL_FALSE, glm::value_ptr(object.T_world_object));
-          glUniformMatrix4fv(4, 1, GL_FALSE, glm::value_ptr(T_eye_object_f));
-          object_sent = true;
-        }
-        set_material(primitive.material);
-        glUniform1ui(2, primitive.first_index);
-        glUniform1ui(3, id);
-        glDrawArrays(GL_TRIANGLES, 0, GLsizei(primitive.index_count));
-        drawn += primitive.index_count / 3;
-        id += primitive.index_count / 3;
-      }
+      drawn += draw_object_primitives(
+          scene, *gpu_scene_, o, triangle_base_[o] + 1, scene_programs_, in_use, GL_TRIANGLES, [&] {
+            glUniformMatrix4fv(0, 1, GL_FALSE, glm::value_ptr(T_clip_object));
+            glUniformMatrix4fv(1, 1, GL_FALSE, glm::value_ptr(object.T_world_object));
+            glUniformMatrix4fv(4, 1, GL_FALSE, glm::value_ptr(T_eye_object_f));
+          });
     }
     return drawn;
-  }
-
-  void set_material(std::uint32_t m) {
-    const Material& material = scene_->materials.at(m);
-    glUniform4fv(8, 1, glm::value_ptr(material.base_colour));
-    glUniform1i(9, material.texture >= 0 ? 1 : 0);
-    gpu_scene_->bind_material_texture(m, 0);
   }
 
   const Scene* scene_ = nullptr;

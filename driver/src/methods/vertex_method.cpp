@@ -281,27 +281,12 @@ class VertexMethod final : public RenderMethod {
         if (!may_be_seen(out, centre[o], radius[o])) continue;
         const Object& object = scene.objects[o];
         const glm::mat4 T_eye_object(T_eye_world * glm::dmat4(object.T_world_object));
-        bool object_sent = false;
-        std::uint32_t id = triangle_base_[o] + 1;
-        for (std::uint32_t k = 0; k < object.primitive_count; ++k) {
-          const Primitive& primitive = scene.primitives[object.first_primitive + k];
-          const Program& program = draw.program_of(primitive.material);
-          if (&program != in_use) {
-            program.use();
-            in_use = &program;
-            object_sent = false;
-          }
-          if (!object_sent) {
-            glUniformMatrix4fv(0, 1, GL_FALSE, glm::value_ptr(T_eye_object));
-            glUniformMatrix4fv(1, 1, GL_FALSE, glm::value_ptr(object.T_world_object));
-            object_sent = true;
-          }
-          set_material(primitive.material);
-          glUniform1ui(2, primitive.first_index);
-          glUniform1ui(3, id);
-          glDrawArrays(tessellated ? GL_PATCHES : GL_TRIANGLES, 0, GLsizei(primitive.index_count));
-          id += primitive.index_count / 3;
-        }
+        draw_object_primitives(scene, *gpu_scene_, o, triangle_base_[o] + 1, draw, in_use,
+                               tessellated ? GL_PATCHES : GL_TRIANGLES, [&] {
+                                 glUniformMatrix4fv(0, 1, GL_FALSE, glm::value_ptr(T_eye_object));
+                                 glUniformMatrix4fv(1, 1, GL_FALSE,
+                                                    glm::value_ptr(object.T_world_object));
+                               });
         stats.triangles_in += triangle_base_[o + 1] - triangle_base_[o];
       }
       if (out.coverage_mask) draw_mask(out, 0.0f);
@@ -347,13 +332,6 @@ class VertexMethod final : public RenderMethod {
     out.coverage_mask.bind_unit(0);
     glDrawArrays(GL_TRIANGLES, 0, 3);
     glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
-  }
-
-  void set_material(std::uint32_t m) {
-    const Material& material = scene_->materials.at(m);
-    glUniform4fv(8, 1, glm::value_ptr(material.base_colour));
-    glUniform1i(9, material.texture >= 0 ? 1 : 0);
-    gpu_scene_->bind_material_texture(m, 0);
   }
 
   const Scene* scene_ = nullptr;
