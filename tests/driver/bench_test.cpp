@@ -1,12 +1,14 @@
 // facet bench from the command line: --quick writes bench.json, bench.csv and bench.png with every
 // render method, the same rows in JSON and CSV, a readable plot, and facets-gs IDs identical to
-// facets. Bad flags exit 2 and write nothing. No timing assertions: times only have to exist.
+// facets. Bad flags exit 2 and write nothing; --out replaces only an earlier bench. No timing
+// assertions: times only have to exist.
 #include "facet/driver/bench.hpp"
 
 #include <OpenImageIO/imageio.h>
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -18,6 +20,7 @@
 #include <vector>
 
 #include "cli_process.hpp"
+#include "facet/projection/atomic_folder.hpp"
 #include "facet/projection/errors.hpp"
 
 namespace facet {
@@ -35,6 +38,15 @@ fs::path fresh_folder(const std::string& name) {
   fs::remove_all(folder);
   fs::create_directories(folder);
   return folder;
+}
+
+// The names in `folder`, sorted (hidden temporaries included).
+std::vector<std::string> names_in(const fs::path& folder) {
+  std::vector<std::string> names;
+  for (const auto& entry : fs::directory_iterator(folder))
+    names.push_back(entry.path().filename().string());
+  std::sort(names.begin(), names.end());
+  return names;
 }
 
 // RFC 4180 fields: quoted fields may hold commas and doubled quotes.
@@ -157,9 +169,81 @@ TEST(BenchCli, QuickWritesJsonCsvAndPlotWithEveryMethod) {
   for (unsigned char v : pixels) dark += v < 128;
   EXPECT_GT(dark, pixels.size() / 1000);
   // No temporary folder is left beside the output.
-  for (const auto& entry : fs::directory_iterator(folder)) {
-    EXPECT_EQ(entry.path().filename().string().find(".partial"), std::string::npos) << entry.path();
+  EXPECT_EQ(names_in(folder), (std::vector<std::string>{"bench", "log.txt"}));
+}
+
+// A report of two rows, enough for every file.
+driver::BenchReport small_report(const std::string& renderer) {
+  driver::BenchReport report;
+  report.renderer = renderer;
+  report.frames = 1;
+  for (const char* method : {"facets", "cubemap"}) {
+    driver::BenchRow row;
+    row.scenario = "cylinder";
+    row.method = method;
+    row.setting = "s";
+    row.frames = 1;
+    row.frame_ms = 2;
+    row.geometric_max_px = 0.5;
+    report.rows.push_back(row);
   }
+  return report;
+}
+
+OutputFolderRules bench_rules() {
+  OutputFolderRules rules;
+  rules.flag = "--out";
+  rules.is_own_output = driver::is_bench_output;
+  return rules;
+}
+
+// bench's --out goes through the one folder writer: an earlier bench (with the log
+// tools/gpu-bench keeps beside it) is replaced whole, a folder holding anything else is refused
+// before writing, and a failure while writing leaves the earlier output and no temporary.
+TEST(BenchFiles, ReplaceOnlyAnEarlierBenchAndLeaveNothingOnFailure) {
+  const fs::path folder = fresh_folder("files");
+  const fs::path out = folder / "bench";
+  driver::write_bench_files(small_report("first"), out, bench_rules());
+  const std::vector<std::string> files = {"bench.csv", "bench.json", "bench.png"};
+  EXPECT_EQ(names_in(out), files);
+  EXPECT_TRUE(driver::is_bench_output(out));
+  std::ofstream(out / "bench.log") << "log";
+  EXPECT_TRUE(driver::is_bench_output(out));
+  driver::write_bench_files(small_report("second"), out, bench_rules());
+  EXPECT_EQ(names_in(out), files);
+  EXPECT_EQ(nlohmann::json::parse(slurp(out / "bench.json"))["renderer"], "second");
+
+  // JSON refuses a string that is not UTF-8: the write fails half way, after the temporary
+  // folder exists.
+  EXPECT_THROW(driver::write_bench_files(small_report("bad \xff"), out, bench_rules()),
+               nlohmann::json::exception);
+  EXPECT_EQ(nlohmann::json::parse(slurp(out / "bench.json"))["renderer"], "second");
+  EXPECT_EQ(names_in(folder), std::vector<std::string>{"bench"});
+
+  // Not a bench's folder: a stranger's file, a folder without bench.json, a link.
+  const fs::path foreign = folder / "foreign";
+  fs::create_directories(foreign);
+  std::ofstream(foreign / "notes.txt") << "mine";
+  const fs::path partial = folder / "partial";
+  fs::create_directories(partial);
+  std::ofstream(partial / "bench.csv") << "a,b";
+  const fs::path linked = folder / "linked";
+  fs::create_directories(linked);
+  fs::create_symlink(out / "bench.json", linked / "bench.json");
+  for (const fs::path& target : {foreign, partial, linked}) {
+    EXPECT_FALSE(driver::is_bench_output(target)) << target;
+    try {
+      driver::write_bench_files(small_report("third"), target, bench_rules());
+      ADD_FAILURE() << "no InputError for " << target;
+    } catch (const InputError& e) {
+      EXPECT_EQ(e.source(), target.string());
+      EXPECT_EQ(e.field(), "--out");
+    }
+  }
+  EXPECT_EQ(slurp(foreign / "notes.txt"), "mine");
+  EXPECT_EQ(names_in(foreign), std::vector<std::string>{"notes.txt"});
+  EXPECT_EQ(names_in(folder), (std::vector<std::string>{"bench", "foreign", "linked", "partial"}));
+  fs::remove_all(folder);
 }
 
 TEST(BenchCli, BadFlagsExitTwoAndWriteNothing) {
@@ -173,6 +257,18 @@ TEST(BenchCli, BadFlagsExitTwoAndWriteNothing) {
         << flags << ": " << slurp(folder / "log.txt");
     EXPECT_FALSE(fs::exists(out)) << flags;
   }
+  // An --out that holds someone else's file is refused before any rendering, and kept.
+  const fs::path foreign = folder / "foreign";
+  fs::create_directories(foreign);
+  std::ofstream(foreign / "notes.txt") << "mine";
+  EXPECT_EQ(run("bench --quick --scenario cylinder --frames 1 --out " + foreign.string(),
+                folder / "log.txt"),
+            2)
+      << slurp(folder / "log.txt");
+  EXPECT_NE(slurp(folder / "log.txt").find("--out"), std::string::npos)
+      << slurp(folder / "log.txt");
+  EXPECT_EQ(names_in(foreign), std::vector<std::string>{"notes.txt"});
+  EXPECT_EQ(slurp(foreign / "notes.txt"), "mine");
 }
 
 // Every scenario's outputs and settings, without rendering: the quick and the full sweeps name

@@ -7,6 +7,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <system_error>
 
 #include "command.hpp"
 #include "facet/driver/bench.hpp"
@@ -14,6 +15,7 @@
 #include "facet/driver/gl_context.hpp"
 #include "facet/driver/scene_names.hpp"
 #include "facet/projection/atomic_file.hpp"
+#include "facet/projection/atomic_folder.hpp"
 #include "facet/projection/errors.hpp"
 #include "facet/projection/interrupt.hpp"
 #include "frames_flag.hpp"
@@ -72,6 +74,23 @@ void run_cluster(const BenchCommandOptions& command) {
   std::printf("wrote %s\n", file.string().c_str());
 }
 
+// The rules of bench's --out: a new path, an empty folder, or the folder of an earlier bench
+// (is_bench_output), which is replaced whole; never the current folder, a parent of it, or a
+// folder that is or holds the rig or scene file read.
+OutputFolderRules bench_out_rules(const BenchCommandOptions& command) {
+  OutputFolderRules rules;
+  rules.flag = "--out";
+  rules.expected =
+      "a new path, an empty folder, or a folder of an earlier facet bench (bench.json, bench.csv, "
+      "bench.png, bench.log, nothing else)";
+  rules.is_own_output = is_bench_output;
+  for (const std::string& input : {command.rig, command.scene}) {
+    std::error_code error;
+    if (!input.empty() && std::filesystem::exists(input, error)) rules.inputs.emplace_back(input);
+  }
+  return rules;
+}
+
 void run(const BenchCommandOptions& command) {
   if (command.scenario == "cluster") return run_cluster(command);
   BenchOptions options;
@@ -85,6 +104,9 @@ void run(const BenchCommandOptions& command) {
   parse_scene_name(command.scene);  // exit 2 before any GL work
   if (command.quick && command.frames == BenchCommandOptions{}.frames) options.frames = 3;
   if (command.out.empty()) throw InputError("command line", "--out", "expected a folder");
+  // Before any GL work: an --out that may not be written is refused at once.
+  const OutputFolderRules out_rules = bench_out_rules(command);
+  check_output_folder(command.out, out_rules);
 
   auto context = create_headless_context();
   // From here on SIGINT and SIGTERM stop the bench cleanly (Interrupted, exit 128 + signal): at
@@ -101,7 +123,7 @@ void run(const BenchCommandOptions& command) {
         throw_if_interrupted(stopped);
       });
   throw_if_interrupted(stopped);
-  write_bench_files(report, command.out);
+  write_bench_files(report, command.out, out_rules);
   std::printf("\n");
   for (const std::string& note : report.notes) std::printf("%s\n\n", note.c_str());
   const std::filesystem::path out(command.out);

@@ -128,9 +128,6 @@ nlohmann::json compare_with_reference(const Scene& scene, const std::vector<Outp
           {"outputs", per_output}};
 }
 
-// Writes the output set through write(temporary folder), then renames its files into `folder`
-// (created when missing; files of other names in it are kept), so that a failure or an
-// interruption leaves no partial set: the temporary folder is removed.
 // The rules of render's --out: a new path, an empty folder, or a folder of an earlier render
 // (its <output>.png, .ids.exr, .depth.exr and .reference.ids.exr files and nothing else), which
 // is replaced whole; never the current folder, a parent of it or of an input, or anything else.

@@ -1,6 +1,4 @@
 // bench.json, bench.csv, bench.png and the closing note of `facet bench`.
-#include <unistd.h>
-
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -14,6 +12,7 @@
 #include <set>
 
 #include "facet/driver/bench.hpp"
+#include "facet/projection/atomic_folder.hpp"
 #include "facet/projection/errors.hpp"
 
 namespace facet::driver {
@@ -601,51 +600,47 @@ std::vector<std::string> bench_notes(const std::vector<BenchRow>& rows,
   return notes;
 }
 
-void write_bench_files(const BenchReport& report, const std::filesystem::path& folder) {
+bool is_bench_output(const std::filesystem::path& folder) {
   namespace fs = std::filesystem;
   std::error_code error;
-  const fs::path parent = folder.has_parent_path() ? folder.parent_path() : fs::path(".");
-  fs::create_directories(parent, error);
-  const fs::path temporary =
-      parent / ("." + folder.filename().string() + ".partial-" + std::to_string(::getpid()));
-  fs::remove_all(temporary, error);
-  if (!fs::create_directories(temporary, error) || error) {
-    throw InputError(folder.string(), "--out", "expected a folder that can be created");
+  bool holds_json = false;
+  for (const fs::directory_entry& entry : fs::directory_iterator(folder, error)) {
+    const std::string name = entry.path().filename().string();
+    const bool own =
+        name == "bench.json" || name == "bench.csv" || name == "bench.png" || name == "bench.log";
+    if (!own || entry.is_symlink(error) || !entry.is_regular_file(error)) return false;
+    holds_json = holds_json || name == "bench.json";
   }
-  try {
-    nlohmann::json rows = nlohmann::json::array();
-    std::set<std::string> methods;
-    for (const BenchRow& row : report.rows) {
-      rows.push_back(row_json(row));
-      methods.insert(row.method);
-    }
-    const nlohmann::json json = {{"renderer", report.renderer},
-                                 {"frames", report.frames},
-                                 {"size_scale", report.size_scale},
-                                 {"quick", report.quick},
-                                 {"frame_step_s", kBenchFrameStepS},
-                                 {"methods", methods},
-                                 {"rows", rows},
-                                 {"scale_fits", scale_fits_json(report.scale_fits)},
-                                 {"notes", report.notes}};
-    write_text(temporary / "bench.json", json.dump(2) + "\n");
-    write_text(temporary / "bench.csv", csv_text(report));
-    if (!cv::imwrite((temporary / "bench.png").string(), plot_image(report))) {
-      throw InputError((folder / "bench.png").string(), "", "could not be written");
-    }
-    fs::create_directories(folder, error);
-    if (!fs::is_directory(folder)) {
-      throw InputError(folder.string(), "--out", "expected a folder that can be created");
-    }
-    for (const char* name : {"bench.json", "bench.csv", "bench.png"}) {
-      fs::rename(temporary / name, folder / name, error);
-      if (error) throw InputError((folder / name).string(), "--out", "a file that can be replaced");
-    }
-    fs::remove_all(temporary, error);
-  } catch (...) {
-    fs::remove_all(temporary, error);
-    throw;
-  }
+  return !error && holds_json;
+}
+
+void write_bench_files(const BenchReport& report, const std::filesystem::path& folder,
+                       const OutputFolderRules& rules) {
+  write_folder_atomically(
+      folder,
+      [&](const std::filesystem::path& temporary) {
+        nlohmann::json rows = nlohmann::json::array();
+        std::set<std::string> methods;
+        for (const BenchRow& row : report.rows) {
+          rows.push_back(row_json(row));
+          methods.insert(row.method);
+        }
+        const nlohmann::json json = {{"renderer", report.renderer},
+                                     {"frames", report.frames},
+                                     {"size_scale", report.size_scale},
+                                     {"quick", report.quick},
+                                     {"frame_step_s", kBenchFrameStepS},
+                                     {"methods", methods},
+                                     {"rows", rows},
+                                     {"scale_fits", scale_fits_json(report.scale_fits)},
+                                     {"notes", report.notes}};
+        write_text(temporary / "bench.json", json.dump(2) + "\n");
+        write_text(temporary / "bench.csv", csv_text(report));
+        if (!cv::imwrite((temporary / "bench.png").string(), plot_image(report))) {
+          throw InputError((folder / "bench.png").string(), "", "could not be written");
+        }
+      },
+      rules);
 }
 
 }  // namespace facet::driver
