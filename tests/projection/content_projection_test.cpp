@@ -1,5 +1,6 @@
 // Content images in the eye's frame: every format's map and its inverse agree, a dome master's
-// layout is the documented one, and a projector's covering frustum holds its directions.
+// layout is the documented one, the cube faces are OpenGL's, and a projector's covering frustum
+// holds its directions.
 #include "facet/projection/content_projection.hpp"
 
 #include <gtest/gtest.h>
@@ -7,6 +8,7 @@
 #include <cmath>
 #include <numbers>
 #include <random>
+#include <vector>
 
 #include "facet/projection/errors.hpp"
 
@@ -18,6 +20,51 @@ constexpr double kPi = std::numbers::pi;
 glm::dvec3 random_direction(std::mt19937& random) {
   std::normal_distribution<double> normal;
   return glm::normalize(glm::dvec3(normal(random), normal(random), normal(random)));
+}
+
+// OpenGL 4.5 core, table 8.19, written out apart from kCubeFaces: for direction r, the major
+// axis's face, then sc, tc and |ma|. The face order is GL's: +x, -x, +y, -y, +z, -z.
+struct GlCubeCoordinates {
+  int face;
+  double sc, tc, ma;
+};
+GlCubeCoordinates gl_cube_coordinates(const glm::dvec3& r) {
+  const double ax = std::abs(r.x), ay = std::abs(r.y), az = std::abs(r.z);
+  if (ax >= ay && ax >= az)
+    return r.x >= 0 ? GlCubeCoordinates{0, -r.z, -r.y, ax} : GlCubeCoordinates{1, r.z, -r.y, ax};
+  if (ay >= az)
+    return r.y >= 0 ? GlCubeCoordinates{2, r.x, r.z, ay} : GlCubeCoordinates{3, r.x, -r.z, ay};
+  return r.z >= 0 ? GlCubeCoordinates{4, r.x, -r.y, az} : GlCubeCoordinates{5, -r.x, -r.y, az};
+}
+
+// kCubeFaces and cube_face_of, the one table the cubemap content format and the cube-map render
+// method both use, are GL's: the same face for every direction and the same sc, tc and |ma| on
+// it, exactly (the axes are unit vectors of ±1 and 0). A face or sign that differs fails here.
+TEST(CubeFaces, AreOpenGLsFaceSelectionAndAxes) {
+  std::mt19937 random(8);
+  std::vector<glm::dvec3> directions;
+  for (int k = 0; k < 2000; ++k) directions.push_back(random_direction(random));
+  // Each axis and the diagonals between them, where the tie rules decide.
+  for (int x = -1; x <= 1; ++x)
+    for (int y = -1; y <= 1; ++y)
+      for (int z = -1; z <= 1; ++z)
+        if (x || y || z) directions.emplace_back(x, y, z);
+  int seen[6] = {};
+  for (const glm::dvec3& r : directions) {
+    const GlCubeCoordinates gl = gl_cube_coordinates(r);
+    const int face = cube_face_of(r);
+    ASSERT_EQ(face, gl.face) << r.x << " " << r.y << " " << r.z;
+    const CubeFaceAxes& axes = kCubeFaces[std::size_t(face)];
+    EXPECT_EQ(glm::dot(axes.a_s, r), gl.sc) << face;
+    EXPECT_EQ(glm::dot(axes.a_t, r), gl.tc) << face;
+    EXPECT_EQ(glm::dot(axes.a_m, r), gl.ma) << face;
+    ++seen[face];
+  }
+  for (int f = 0; f < 6; ++f) EXPECT_GT(seen[f], 200) << "face " << f;
+  // One handedness for every face, which lets the cube-map method draw all six with one winding.
+  for (const CubeFaceAxes& axes : kCubeFaces)
+    EXPECT_EQ(glm::dot(glm::cross(axes.a_s, axes.a_t), axes.a_m),
+              glm::dot(glm::cross(kCubeFaces[0].a_s, kCubeFaces[0].a_t), kCubeFaces[0].a_m));
 }
 
 TEST(ContentProjection, EveryFormatInvertsItsMap) {

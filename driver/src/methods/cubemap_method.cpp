@@ -19,6 +19,7 @@
 #include "facet/driver/material_shader.hpp"
 #include "facet/driver/program.hpp"
 #include "facet/driver/shader_library.hpp"
+#include "facet/projection/content_projection.hpp"
 #include "facet/projection/errors.hpp"
 #include "facet/projection/warp_inverse.hpp"
 #include "material_programs.hpp"
@@ -27,31 +28,13 @@
 namespace facet::driver::detail {
 namespace {
 
-// GL's cube-map face selection (GL 4.5 core, table 8.19): for a direction r on face f, the face
-// coordinates are sc = a_s·r, tc = a_t·r over the major axis |ma| = a_m·r, and the texel row 0 is
-// tc = −1. Faces in GL order +X, −X, +Y, −Y, +Z, −Z.
-struct CubeFace {
-  glm::dvec3 a_s, a_t, a_m;
-};
-constexpr std::array<CubeFace, 6> kFaces = {{
-    {{0, 0, -1}, {0, -1, 0}, {1, 0, 0}},
-    {{0, 0, 1}, {0, -1, 0}, {-1, 0, 0}},
-    {{1, 0, 0}, {0, 0, 1}, {0, 1, 0}},
-    {{1, 0, 0}, {0, 0, -1}, {0, -1, 0}},
-    {{1, 0, 0}, {0, -1, 0}, {0, 0, 1}},
-    {{-1, 0, 0}, {0, -1, 0}, {0, 0, -1}},
-}};
-
-int face_of(const glm::dvec3& v) {
-  const glm::dvec3 a = glm::abs(v);
-  if (a.x >= a.y && a.x >= a.z) return v.x >= 0 ? 0 : 1;
-  if (a.y >= a.z) return v.y >= 0 ? 2 : 3;
-  return v.z >= 0 ? 4 : 5;
-}
+// The faces, their axes and GL's face selection are projection's (kCubeFaces, cube_face_of; GL 4.5
+// table 8.19): the faces drawn here are those GL's cube lookup samples and a cubemap content
+// image holds.
 
 // Clip coordinates of an eye-frame point for face f: (sc, tc, z_near, ma), so that window x, y
 // follow the face's texel columns and rows and depth is z_near / ma, reversed-Z.
-glm::dmat4 clip_from_eye(const CubeFace& face, double z_near) {
+glm::dmat4 clip_from_eye(const CubeFaceAxes& face, double z_near) {
   glm::dmat4 m(0.0);
   for (int c = 0; c < 3; ++c) {
     m[c][0] = face.a_s[c];
@@ -68,7 +51,7 @@ glm::dmat4 clip_from_eye(const CubeFace& face, double z_near) {
 unsigned faces_of_sphere(const glm::dvec3& centre, double radius, double z_near) {
   unsigned mask = 0;
   for (int f = 0; f < 6; ++f) {
-    const CubeFace& face = kFaces[f];
+    const CubeFaceAxes& face = kCubeFaces[std::size_t(f)];
     const double m = glm::dot(face.a_m, centre);
     const double s = glm::dot(face.a_s, centre);
     const double t = glm::dot(face.a_t, centre);
@@ -112,7 +95,7 @@ class CubemapMethod final : public RenderMethod {
           const glm::dvec2 s = st[std::size_t(y) * size.x + x];
           if (std::isnan(s.x)) continue;
           const glm::dvec3 v_eye = output.warp.v_eye_from_st(s);
-          face_needed_[face_of(v_eye)] = true;
+          face_needed_[cube_face_of(v_eye)] = true;
           lookup[std::size_t(size.y - 1 - y) * size.x + x] = glm::vec4(glm::vec3(v_eye), 1.0f);
         }
       }
@@ -215,7 +198,8 @@ class CubemapMethod final : public RenderMethod {
       glDisable(GL_CULL_FACE);
     }
     // Every face of GL's cube keeps the same handedness, so one winding serves all (layered).
-    const bool mirrored = glm::dot(glm::cross(kFaces[0].a_s, kFaces[0].a_t), kFaces[0].a_m) > 0;
+    const CubeFaceAxes& first = kCubeFaces[0];
+    const bool mirrored = glm::dot(glm::cross(first.a_s, first.a_t), first.a_m) > 0;
     glFrontFace(mirrored ? GL_CW : GL_CCW);
     glBindVertexArray(empty_vao_.id());
     gpu_scene_->bind_for_pulling();
@@ -240,7 +224,7 @@ class CubemapMethod final : public RenderMethod {
                              : faces_of_sphere(centre, radius, settings_.z_near) & needed_mask;
       for (int f = 0; f < 6; ++f) {
         if (object_faces_[o] & (1u << f)) {
-          const glm::dmat4 T_clip_eye = clip_from_eye(kFaces[f], settings_.z_near);
+          const glm::dmat4 T_clip_eye = clip_from_eye(kCubeFaces[std::size_t(f)], settings_.z_near);
           object_clip_[o][f] =
               glm::mat4(T_clip_eye * T_eye_world * glm::dmat4(object.T_world_object));
         }

@@ -40,7 +40,8 @@ std::string to_string(ContentFormat format);
 ContentFormat content_format_from_string(const std::string& name, const std::string& source,
                                          const std::string& field);
 
-// OpenGL's cube-map face axes (OpenGL 4.5 table 8.19), faces +x, −x, +y, −y, +z, −z.
+// OpenGL's cube-map face axes (OpenGL 4.5 table 8.19), faces +x, −x, +y, −y, +z, −z: the one
+// table of cube faces, for the cubemap content format and the driver's cube-map render method.
 struct CubeFaceAxes {
   glm::dvec3 a_s, a_t, a_m;
 };
