@@ -9,6 +9,7 @@
 #include "facet/projection/errors.hpp"
 #include "facet/projection/memory_budget.hpp"
 #include "facet/projection/warp_inverse.hpp"
+#include "json_fields.hpp"
 
 namespace facet::interop {
 
@@ -55,11 +56,7 @@ void write_lookup(const Warp& warp, const std::filesystem::path& path) {
       base["elevation"] = warp.base.elevation_deg;
       break;
   }
-  nlohmann::json rotation = nlohmann::json::array();
-  for (int r = 0; r < 3; ++r) {
-    rotation.push_back({warp.R_eye_base[0][r], warp.R_eye_base[1][r], warp.R_eye_base[2][r]});
-  }
-  base["rotation"] = rotation;
+  base["rotation"] = json_fields::from_dmat3(warp.R_eye_base);
   base["output_size"] = {w, h};
   const nlohmann::json header = {{"format", "facet-lookup/1"}, {"warp", base}};
 

@@ -21,6 +21,7 @@
 #include "facet/projection/warp_inverse.hpp"
 #include "facet/projection_io/warp_file.hpp"
 #include "image_map.hpp"
+#include "json_fields.hpp"
 
 namespace facet::interop {
 namespace {
@@ -158,8 +159,8 @@ Warp region_warp(const RegionWarpInput& in, MpcdiWarpValues values, const std::s
 // ---- profile a3
 // ----------------------------------------------------------------------------------
 
-// facet.json's record of a warp's base and rotation, so that an a3 round trip lands on the same
-// base image (the a3 PFM itself only holds screen points).
+// facet.json's record of a warp's base and rotation (rows, as in every facet file), so that an a3
+// round trip lands on the same base image (the a3 PFM itself only holds screen points).
 nlohmann::json base_hint(const BaseProjection& base, const glm::dmat3& R_eye_base) {
   nlohmann::json hint = {{"kind", to_string(base.kind)}};
   switch (base.kind) {
@@ -178,10 +179,7 @@ nlohmann::json base_hint(const BaseProjection& base, const glm::dmat3& R_eye_bas
       hint["elevation"] = base.elevation_deg;
       break;
   }
-  nlohmann::json rotation = nlohmann::json::array();
-  for (int c = 0; c < 3; ++c)
-    rotation.push_back({R_eye_base[c].x, R_eye_base[c].y, R_eye_base[c].z});
-  hint["rotation_columns"] = rotation;
+  hint["rotation"] = json_fields::from_dmat3(R_eye_base);
   return hint;
 }
 
@@ -210,8 +208,14 @@ std::optional<BaseCover> base_from_hint(const nlohmann::json* hint) {
         break;
     }
     cover.base.validate();
-    const auto columns = json.at("rotation_columns").get<std::array<std::array<double, 3>, 3>>();
-    for (int c = 0; c < 3; ++c) cover.R_eye_base[c] = {columns[c][0], columns[c][1], columns[c][2]};
+    if (json.contains("rotation")) {
+      cover.R_eye_base =
+          json_fields::to_dmat3(json["rotation"], json_fields::FieldPath("facet.json"));
+    } else {
+      // Containers written before the rows convention stored the columns.
+      cover.R_eye_base = glm::transpose(
+          json_fields::to_dmat3(json.at("rotation_columns"), json_fields::FieldPath("facet.json")));
+    }
     // Only a proper rotation is worth trusting.
     const glm::dmat3 should_be_identity = glm::transpose(cover.R_eye_base) * cover.R_eye_base;
     for (int c = 0; c < 3; ++c) {

@@ -1,8 +1,12 @@
-// MPCDI profile a3 (warps as 3D screen points): round trips, the eye point, crafted files.
+// MPCDI profile a3 (warps as 3D screen points): round trips, the eye point, crafted files, and
+// the base rotation stored as rows by every facet file that records it.
+#include <OpenImageIO/imageio.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <nlohmann/json.hpp>
 
+#include "facet/interop/lookup.hpp"
 #include "facet/interop/mpcdi.hpp"
 #include "facet/interop/pfm.hpp"
 #include "facet/projection/errors.hpp"
@@ -121,6 +125,66 @@ TEST(MpcdiA3, RoundTripReproducesACalibratedWarpWithin001Px) {
   const double worst = max_difference_px(warp, back);
   std::printf("a3 round trip, calibrated-like warp: max %.5f px\n", worst);
   EXPECT_LT(worst, 0.01);
+}
+
+// A rotation with no symmetry: stored as columns where rows are read, it comes back transposed.
+glm::dmat3 skew_rotation() {
+  const double a = 0.5, b = -0.3, c = 0.2;  // radians about y, then x, then z
+  const glm::dmat3 y(std::cos(a), 0, -std::sin(a), 0, 1, 0, std::sin(a), 0, std::cos(a));
+  const glm::dmat3 x(1, 0, 0, 0, std::cos(b), std::sin(b), 0, -std::sin(b), std::cos(b));
+  const glm::dmat3 z(std::cos(c), std::sin(c), 0, -std::sin(c), std::cos(c), 0, 0, 0, 1);
+  return y * x * z;
+}
+
+// The JSON header attribute `name` of an EXR file.
+nlohmann::json exr_json(const std::filesystem::path& path, const char* name) {
+  auto in = OIIO::ImageInput::open(path.string());
+  if (!in) return nullptr;
+  return nlohmann::json::parse(in->spec().get_string_attribute(name));
+}
+
+// Every facet file that records a base's rotation (the warp's facet:warp header, the lookup
+// export's facet:lookup, an a3 container's facet.json) stores R_eye_base as a list of rows, and
+// each reads back the same matrix: exactly for the warp file and facet.json (JSON keeps every
+// double), and the a3 import lands on the same base (under 0.01 px) from facet.json's rows and
+// from the columns earlier containers stored.
+TEST(MpcdiA3, BaseRotationIsStoredAsRowsEverywhereAndRoundTrips) {
+  test::ScratchFolder scratch("a3-rotation");
+  const glm::dmat3 R = skew_rotation();
+  ASSERT_GT(std::abs(R[0][1] - R[1][0]), 0.1);  // not symmetric
+  const Warp warp =
+      Warp::analytic(BaseProjection::perspective(-0.6, 0.6, 0.45, -0.45), {400, 300}, {33, 25}, R);
+  const auto rows_of = [](const nlohmann::json& rotation) {
+    glm::dmat3 m(0.0);
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c) m[c][r] = rotation.at(r).at(c).get<double>();
+    return m;
+  };
+
+  const auto config = one_projector_display(scratch.path, warp);
+  EXPECT_EQ(rows_of(exr_json(scratch.path / "p0.warp.exr", "facet:warp")["rotation"]), R);
+  EXPECT_EQ(read_warp((scratch.path / "p0.warp.exr").string()).R_eye_base, R);
+
+  write_lookup(warp, scratch.path / "lookup.exr");
+  EXPECT_EQ(rows_of(exr_json(scratch.path / "lookup.exr", "facet:lookup")["warp"]["rotation"]), R);
+
+  MpcdiFiles files = export_mpcdi(config, a3_options(2));
+  nlohmann::json hints = nlohmann::json::parse(files.at("facet.json"));
+  nlohmann::json& base = hints["regions"]["p0"]["base"];
+  EXPECT_EQ(rows_of(base["rotation"]), R);
+  const Warp back = import_mpcdi(files, "rotation.mpcdi").projectors[0].warp;
+  EXPECT_EQ(back.R_eye_base, R);
+  EXPECT_LT(max_difference_px(warp, back), 0.01);
+
+  // A container from before: the same rotation as columns, under its old name.
+  nlohmann::json columns = nlohmann::json::array();
+  for (int c = 0; c < 3; ++c) columns.push_back({R[c].x, R[c].y, R[c].z});
+  base.erase("rotation");
+  base["rotation_columns"] = columns;
+  files["facet.json"] = hints.dump();
+  const Warp old = import_mpcdi(files, "old.mpcdi").projectors[0].warp;
+  EXPECT_EQ(old.R_eye_base, R);
+  EXPECT_LT(max_difference_px(warp, old), 0.01);
 }
 
 TEST(MpcdiA3, FisheyeAndCylindricalBasesGoThroughAsTheyAre) {

@@ -9,6 +9,7 @@
 #include "facet/projection/errors.hpp"
 #include "facet/projection/input_file.hpp"
 #include "facet/projection_io/exr_header.hpp"
+#include "json_fields.hpp"
 
 namespace facet {
 namespace {
@@ -39,11 +40,7 @@ json base_to_json(const Warp& warp) {
   json meta = {{"format", kFormat},
                {"output_size", {warp.output_size.x, warp.output_size.y}},
                {"base", to_string(base.kind)}};
-  json rotation = json::array();
-  for (int r = 0; r < 3; ++r) {
-    rotation.push_back({warp.R_eye_base[0][r], warp.R_eye_base[1][r], warp.R_eye_base[2][r]});
-  }
-  meta["rotation"] = rotation;
+  meta["rotation"] = json_fields::from_dmat3(warp.R_eye_base);
   switch (base.kind) {
     case BaseKind::perspective:
       meta["tan_extent"] = base.tan_extent;
@@ -82,21 +79,8 @@ void base_from_json(const json& meta, const std::string& path, Warp& warp) {
   warp.base.kind =
       base_kind_from_string(meta["base"].get<std::string>(), path, field_prefix + "base");
   if (meta.contains("rotation")) {
-    const json& rotation = meta["rotation"];
-    if (!rotation.is_array() || rotation.size() != 3) {
-      throw InputError(path, field_prefix + "rotation", "expected 3 rows of 3 numbers");
-    }
-    for (int r = 0; r < 3; ++r) {
-      if (!rotation[r].is_array() || rotation[r].size() != 3) {
-        throw InputError(path, field_prefix + "rotation", "expected 3 rows of 3 numbers");
-      }
-      for (int c = 0; c < 3; ++c) {
-        if (!rotation[r][c].is_number()) {
-          throw InputError(path, field_prefix + "rotation", "expected numbers");
-        }
-        warp.R_eye_base[c][r] = rotation[r][c].get<double>();
-      }
-    }
+    warp.R_eye_base = json_fields::to_dmat3(
+        meta["rotation"], json_fields::FieldPath(path, field_prefix + "rotation"));
   }
   switch (warp.base.kind) {
     case BaseKind::perspective:
