@@ -4,6 +4,7 @@
 #include "facet/driver/cluster.hpp"
 
 #include <gtest/gtest.h>
+#include <sys/inotify.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -174,6 +175,74 @@ TEST(NodeDisplay, ANodeKeepsItsProjectorsAndItsRoleIsChecked) {
   EXPECT_EQ(master.display.outputs.size(), 2u);
   EXPECT_EQ(load_node_display(json.string(), std::nullopt, std::nullopt, {}).display.outputs.size(),
             4u);
+  fs::remove_all(folder);
+}
+
+// How often `path` is opened while `work` runs (inotify: an IN_OPEN event per open; closes are
+// watched too, so that two opens in a row are not merged into one event).
+template <typename Work>
+int opens_of(const fs::path& path, Work work) {
+  const int fd = inotify_init1(IN_NONBLOCK | IN_CLOEXEC);
+  if (fd < 0) return -1;
+  if (inotify_add_watch(fd, path.c_str(), IN_OPEN | IN_CLOSE) < 0) {
+    ::close(fd);
+    return -1;
+  }
+  work();
+  int opens = 0;
+  alignas(inotify_event) char buffer[4096];
+  for (;;) {
+    const ssize_t n = ::read(fd, buffer, sizeof buffer);
+    if (n <= 0) break;
+    for (ssize_t k = 0; k < n;) {
+      const auto* event = reinterpret_cast<const inotify_event*>(buffer + k);
+      opens += (event->mask & IN_OPEN) != 0;
+      k += ssize_t(sizeof(inotify_event) + event->len);
+    }
+  }
+  ::close(fd);
+  return opens;
+}
+
+// A display.json is read once per run: for its outputs, render settings and blends, and for a
+// cluster node's section (it was read twice, and three times for a node).
+TEST(NodeDisplay, ADisplayJsonIsReadOnce) {
+  const fs::path folder =
+      fs::temp_directory_path() / ("facet-read-once-" + std::to_string(::getpid()));
+  fs::remove_all(folder);
+  write_session_display(load_session_display("builtin:wall2x2", glm::ivec2(64, 40)), "wall",
+                        folder / "wall");
+  const fs::path json = folder / "wall" / "display.json";
+  pio::DisplayConfig config = pio::read_display_config(json);
+  pio::DisplayCluster cluster;
+  cluster.nodes.push_back(
+      {"a", "tcp://127.0.0.1:7400", {config.projectors[0].name, config.projectors[1].name}, true});
+  cluster.nodes.push_back(
+      {"b", "tcp://127.0.0.1:7410", {config.projectors[2].name, config.projectors[3].name}, false});
+  cluster.master = "a";
+  config.cluster = cluster;
+  fs::remove(json);
+  pio::write_display_config(config, json);
+
+  // The counter sees a read of its own.
+  EXPECT_EQ(opens_of(json, [&] { pio::read_display_config(json); }), 1);
+  SessionDisplay display;
+  EXPECT_EQ(opens_of(json, [&] { display = load_session_display(json.string()); }), 1);
+  EXPECT_EQ(display.outputs.size(), 4u);
+  ASSERT_TRUE(display.config);
+  EXPECT_EQ(display.config->projectors.size(), 4u);
+  NodeDisplay node;
+  EXPECT_EQ(opens_of(json,
+                     [&] {
+                       node = load_node_display(json.string(), std::nullopt, std::nullopt,
+                                                {"b", false, std::nullopt, 5});
+                     }),
+            1);
+  ASSERT_TRUE(node.cluster);
+  EXPECT_EQ(node.cluster->node, "b");
+  ASSERT_TRUE(node.cluster->config.cluster);
+  EXPECT_EQ(node.cluster->config.cluster->master, "a");
+  EXPECT_EQ(node.display.outputs.size(), 2u);
   fs::remove_all(folder);
 }
 

@@ -791,7 +791,8 @@ ClusterNodeShare keep_cluster_node_outputs(SessionDisplay& display,
                                            const std::filesystem::path& display_file,
                                            const std::string& node) {
   ClusterNodeShare share;
-  share.config = projection_io::read_display_config(display_file);
+  share.config =
+      display.config ? *display.config : projection_io::read_display_config(display_file);
   if (!share.config.cluster)
     throw InputError(display_file.string(), "cluster",
                      "a cluster section for --node (nodes, their projectors and the master)");

@@ -9,12 +9,32 @@
 
 namespace facet::driver {
 
-std::vector<OutputSpec> load_display_outputs(std::string_view display,
-                                             std::optional<glm::ivec2> size) {
+namespace {
+
+// One output per projector of `config`, its warp read and checked against the projector's size.
+std::vector<OutputSpec> display_config_outputs(const projection_io::DisplayConfig& config,
+                                               const std::string& source) {
+  std::vector<OutputSpec> outputs;
+  for (const auto& projector : config.projectors) {
+    const std::string path = config.resolve(projector.warp).string();
+    Warp warp = read_warp(path);
+    if (warp.output_size != projector.size) {
+      throw InputError(source, "projectors." + projector.name + ".size",
+                       "expected the size of " + path);
+    }
+    outputs.push_back({projector.name, std::move(warp)});
+  }
+  return outputs;
+}
+
+}  // namespace
+
+LoadedDisplay load_display(std::string_view display, std::optional<glm::ivec2> size) {
   if (size && (size->x < 1 || size->y < 1)) {
     throw InputError("command line", "--size", "expected a positive output size");
   }
-  std::vector<OutputSpec> outputs;
+  LoadedDisplay loaded;
+  std::vector<OutputSpec>& outputs = loaded.outputs;
   if (display == "builtin:cylinder360") {
     outputs.push_back({"cylinder360", Warp::analytic(BaseProjection::cylindrical(-180, 180, 1, -1),
                                                      size.value_or(glm::ivec2(1600, 1200)))});
@@ -51,20 +71,14 @@ std::vector<OutputSpec> load_display_outputs(std::string_view display,
     name = name.substr(0, name.size() - std::string_view(".warp.exr").size());
     outputs.push_back({name.empty() ? "output" : name, std::move(warp)});
   } else if (display.ends_with(".json")) {
-    const auto config = projection_io::read_display_config(std::filesystem::path(display));
+    projection_io::DisplayConfig config =
+        projection_io::read_display_config(std::filesystem::path(display));
     if (size) {
       throw InputError("command line", "--size",
                        "expected no --size with a display.json (each projector has its own)");
     }
-    for (const auto& projector : config.projectors) {
-      const std::string path = config.resolve(projector.warp).string();
-      Warp warp = read_warp(path);
-      if (warp.output_size != projector.size) {
-        throw InputError(std::string(display), "projectors." + projector.name + ".size",
-                         "expected the size of " + path);
-      }
-      outputs.push_back({projector.name, std::move(warp)});
-    }
+    outputs = display_config_outputs(config, std::string(display));
+    loaded.config = std::move(config);
   } else {
     throw InputError(
         "command line", "--display",
@@ -72,7 +86,12 @@ std::vector<OutputSpec> load_display_outputs(std::string_view display,
         "display.json; got '" +
             std::string(display) + "'");
   }
-  return outputs;
+  return loaded;
+}
+
+std::vector<OutputSpec> load_display_outputs(std::string_view display,
+                                             std::optional<glm::ivec2> size) {
+  return load_display(display, size).outputs;
 }
 
 }  // namespace facet::driver

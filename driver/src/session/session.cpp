@@ -80,9 +80,12 @@ SessionDisplay load_session_display(std::string_view display, std::optional<glm:
   // caller gives facets.warn); the tolerance is the display's own, or --tolerance's default.
   result.settings.facets.near_miss = kRunNearMiss;
   result.settings.facets.origin = {"command line", "--tolerance", {}};
-  std::vector<OutputSpec> specs = load_display_outputs(display, size);
-  if (display.ends_with(".json")) {
-    const auto config = projection_io::read_display_config(std::filesystem::path(display));
+  // A display.json is read once: its outputs, settings and (for a cluster node) its cluster
+  // section all come from this one value.
+  LoadedDisplay loaded = load_display(display, size);
+  std::vector<OutputSpec>& specs = loaded.outputs;
+  if (loaded.config) {
+    const projection_io::DisplayConfig& config = *loaded.config;
     result.method = config.render.method;
     result.settings.facets.layout = FacetTolerance{config.render.tolerance_px};
     result.settings.facets.origin = {std::string(display), "render.tolerance_px", {}};
@@ -97,6 +100,7 @@ SessionDisplay load_session_display(std::string_view display, std::optional<glm:
       output.placement = projector.output;
       result.outputs.push_back(std::move(output));
     }
+    result.config = std::move(loaded.config);
     return result;
   }
   result.settings.facets.layout = FacetTolerance{0.25};

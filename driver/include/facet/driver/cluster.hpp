@@ -167,9 +167,10 @@ struct ClusterBenchRow {
 std::vector<ClusterBenchRow> bench_cluster(const ClusterBenchOptions& options,
                                            const std::function<void(const std::string&)>& progress);
 
-// A node's part of a display: reads the cluster section of `display_file` (a display.json) and
-// keeps in `display` (load_session_display's result for the same file) the outputs of node
-// `node`'s projectors only. InputError when the file has no cluster section or no such node.
+// A node's part of a display: takes the cluster section of `display_file` (a display.json) from
+// display.config (load_session_display's result for the same file; read from the file only when
+// `display` has none) and keeps in `display` the outputs of node `node`'s projectors only.
+// InputError when the file has no cluster section or no such node.
 struct ClusterNodeShare {
   projection_io::DisplayConfig config;
   std::string node;

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "facet/driver/render_method.hpp"
+#include "facet/projection_io/display_config.hpp"
 
 namespace facet::driver {
 
@@ -27,5 +28,13 @@ namespace facet::driver {
 // file's own InputError for a bad file.
 std::vector<OutputSpec> load_display_outputs(std::string_view display,
                                              std::optional<glm::ivec2> size = std::nullopt);
+
+// load_display_outputs, and for a display.json the file as read: the one read of it, for callers
+// that need more of it than the warps (load_session_display, a cluster node's section).
+struct LoadedDisplay {
+  std::vector<OutputSpec> outputs;
+  std::optional<projection_io::DisplayConfig> config;  // set for a display.json
+};
+LoadedDisplay load_display(std::string_view display, std::optional<glm::ivec2> size = std::nullopt);
 
 }  // namespace facet::driver

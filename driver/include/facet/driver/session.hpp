@@ -40,13 +40,17 @@ struct SessionDisplay {
   std::string method = "facets";
   RenderSettings settings;
   projection_io::MissingMonitor missing_monitor = projection_io::MissingMonitor::window;
+  // The display.json as read, when the display is one: what else needs it (a cluster node's
+  // section) takes it from here rather than reading the file again.
+  std::optional<projection_io::DisplayConfig> config;
 };
 
 // Loads a display the way `facet render` names it (see load_display_outputs): a built-in, a
 // .warp.exr, or a display.json, whose blend and black maps, gammas, outputs, render method and
 // tolerance are used too. Built-ins and warp files get one window each, side by side, and sRGB
 // encoding; builtin:wall2x2 blends its overlaps, the others have no blend. `size` overrides a
-// built-in's output size. Throws InputError for bad input.
+// built-in's output size. A display.json is read once, and kept in SessionDisplay::config.
+// Throws InputError for bad input.
 SessionDisplay load_session_display(std::string_view display,
                                     std::optional<glm::ivec2> size = std::nullopt);
 
