@@ -15,12 +15,14 @@
 #include <signal.h>
 #include <sys/resource.h>
 #include <sys/stat.h>
+#include <sys/sysmacros.h>
 #include <sys/time.h>
 #include <sys/types.h>
 #include <sys/wait.h>
 #include <unistd.h>
 #include <zip.h>
 
+#include <CLI/CLI.hpp>
 #include <algorithm>
 #include <chrono>
 #include <cstdint>
@@ -31,6 +33,7 @@
 #include <iostream>
 #include <iterator>
 #include <limits>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <opencv2/core.hpp>
 #include <opencv2/videoio.hpp>
@@ -39,6 +42,8 @@
 #include <thread>
 #include <utility>
 #include <vector>
+
+#include "../../tools/cli/command.hpp"
 
 namespace {
 
@@ -1863,6 +1868,665 @@ void add_flags(std::vector<Variant>& out) {
       {"sgct", "import", kSgc.string(), "--orientation", "inf", "--out", "@out"}, "--orientation");
 }
 
+// ---- Every value-taking flag of every command: at least 20 bad values each ----------------------
+//
+// Each flag gets bad values by the type of value it takes (a count, a real, an angle, WxH, a
+// point, a name from a list, a name, an input file, an output), on a command line that is valid
+// without it. These run in forked children of this process (see run_cli): an exec of facet spends
+// about 0.15 s of CPU in the dynamic loader alone, which 3,000 variants cannot afford.
+
+// Variants run in a forked child calling facet::cli::run, by name; the flag each one exercises;
+// and those with the scratch fixtures below (whose foreign files must survive the run).
+std::set<std::string>& in_process() {
+  static std::set<std::string> names;
+  return names;
+}
+std::map<std::string, std::string>& flag_of() {
+  static std::map<std::string, std::string> flags;
+  return flags;
+}
+std::set<std::string>& with_fixtures() {
+  static std::set<std::string> names;
+  return names;
+}
+
+const std::string kLongName(300, 'n');  // longer than a file name may be (255)
+
+// Things a path may name that are not what a command wants, in the scratch folder.
+void make_fixtures(const fs::path& dir) {
+  fs::create_directories(dir / "dir");
+  fs::create_directories(dir / "foreign");
+  spit(dir / "foreign/keep", "the user's");
+  spit(dir / "file", "the user's");
+  spit(dir / "empty", "");
+  std::string garbage(4096, '\0');
+  for (std::size_t i = 0; i < garbage.size(); ++i) {
+    garbage[i] = static_cast<char>((i * 2654435761u) >> 13);
+  }
+  spit(dir / "garbage", garbage);
+  spit(dir / "nul", std::string("{\"a\0\": 1}", 10));
+  spit(dir / "invalid_utf8", "{\"\xff\xfe\": \"\xc0\x80\"}");
+  spit(dir / "deep", std::string(100000, '[') + std::string(100000, ']'));
+  spit(dir / "array", "[1, 2, 3]");
+  ::mkfifo((dir / "fifo").c_str(), 0644);
+  ::mknod((dir / "null_dev").c_str(), S_IFCHR | 0666, ::makedev(1, 3));  // a copy of /dev/null
+  fs::create_symlink("/dev/zero", dir / "zero_link");
+  fs::create_symlink("/dev/null", dir / "null_link");
+  fs::create_symlink("/dev/full", dir / "full_link");
+  fs::create_symlink(dir / "gone", dir / "dangling");
+  fs::create_symlink(dir / "loop", dir / "loop");
+  fs::create_symlink(dir / "foreign", dir / "foreign_link");
+  fs::create_symlink(dir / "file", dir / "file_link");
+}
+
+// The fixtures' foreign files are untouched.
+bool fixtures_intact(const fs::path& dir) {
+  return slurp(dir / "file") == "the user's" && slurp(dir / "foreign/keep") == "the user's" &&
+         fs::is_directory(dir / "dir") && fs::is_fifo(dir / "fifo") &&
+         fs::is_symlink(dir / "null_link") && fs::is_symlink(dir / "full_link") &&
+         fs::is_character_file(dir / "null_dev");
+}
+
+std::vector<std::string> operator+(std::vector<std::string> a, const std::vector<std::string>& b) {
+  a.insert(a.end(), b.begin(), b.end());
+  return a;
+}
+
+// Text that is no number at all.
+const std::vector<std::string> kNotNumbers = {
+    "", " ", "abc", "5abc", "1 2", "\xff\xfe", "7\xed\xa0\x80", "1,2", "1..2", "+-1", "e5", "."};
+const std::vector<std::string> kNonFinite = {"nan",  "NaN",      "-nan", "inf",
+                                             "-inf", "infinity", "1e400"};
+
+// A count from 1 up (`over`: values past its largest).
+std::vector<std::string> counts(std::vector<std::string> over = {}) {
+  return kNotNumbers +
+         std::vector<std::string>{
+             "nan", "inf",   "-inf",       "-1",          "0",
+             "1.5", "1e308", "2147483648", "-2147483649", "99999999999999999999"} +
+         over;
+}
+// A count from 0 up.
+std::vector<std::string> naturals(std::vector<std::string> over = {}) {
+  return kNotNumbers + std::vector<std::string>{"nan",   "inf",         "-inf",
+                                                "-1",    "-2147483648", "1.5",
+                                                "1e308", "2147483648",  "99999999999999999999"} +
+         over;
+}
+// Any unsigned integer.
+std::vector<std::string> unsigneds() {
+  return kNotNumbers + std::vector<std::string>{"nan",
+                                                "inf",
+                                                "-inf",
+                                                "-1",
+                                                "1.5",
+                                                "1e308",
+                                                "18446744073709551616",
+                                                "99999999999999999999"};
+}
+// A positive real (`over`: values past its largest).
+std::vector<std::string> positives(std::vector<std::string> over = {}) {
+  return kNotNumbers + kNonFinite + std::vector<std::string>{"-1", "0", "1e308", "-1e308"} + over;
+}
+// A real from 0 up.
+std::vector<std::string> non_negatives(std::vector<std::string> over = {}) {
+  return kNotNumbers + kNonFinite + std::vector<std::string>{"-1", "-1e-9", "1e308", "-1e308"} +
+         over;
+}
+// An angle in [-limit, limit] degrees.
+std::vector<std::string> angles(const std::string& past) {
+  return kNotNumbers + kNonFinite +
+         std::vector<std::string>{"1e308", "-1e308", past, "-" + past, past + "deg"};
+}
+// WxH in pixels (`over`: sizes past the largest).
+std::vector<std::string> sizes(std::vector<std::string> over = {}) {
+  return std::vector<std::string>{"",
+                                  "x",
+                                  "5",
+                                  "5x",
+                                  "x5",
+                                  "0x0",
+                                  "0x5",
+                                  "5x0",
+                                  "-5x5",
+                                  "5x-5",
+                                  "1.5x2",
+                                  "axb",
+                                  "5x5x5",
+                                  "5x5abc",
+                                  "5x5\xff",
+                                  "5*5",
+                                  "5,5",
+                                  "nanxnan",
+                                  "infx5",
+                                  "\xff\xfe",
+                                  "100000x100000",
+                                  "2000000000x2000000000",
+                                  "99999999999x1",
+                                  "1x99999999999"} +
+         over;
+}
+// A point X,Y,Z.
+std::vector<std::string> points() {
+  return {"",        "1",        "1,2",       "1,2,3,4",    "nan,0,0",   "0,nan,0", "0,0,nan",
+          "inf,0,0", "0,-inf,0", "1e308,0,0", "0,0,-1e308", "1e400,0,0", "a,b,c",   "1,2,3abc",
+          ",,",      "1;2;3",    "\xff,0,0",  "1,,2",       " ",         "0,0,1e39"};
+}
+// Two reals A,B (`more`: values bad for this flag's meaning).
+std::vector<std::string> pairs(std::vector<std::string> more = {}) {
+  return std::vector<std::string>{"",      "1",      "1,2,3",   "nan,1",    "1,nan",
+                                  "inf,1", "1,-inf", "1e308,1", "1,-1e308", "1e400,0",
+                                  "a,b",   "1,2abc", ",",       "1;2",      "\xff,1",
+                                  " ",     "1,,2",   "nan,nan", "1,2,",     "+-1,2"} +
+         more;
+}
+// One of a list of names, `valid` being one of them.
+std::vector<std::string> choices(const std::string& valid) {
+  std::string upper = valid;
+  for (char& c : upper) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+  return {"",
+          " ",
+          "bogus",
+          upper,
+          valid + " ",
+          " " + valid,
+          valid + "," + valid,
+          valid + "-",
+          valid + "\xff",
+          "\xff\xfe",
+          "nan",
+          "inf",
+          "0",
+          "-1",
+          "1e308",
+          "5abc",
+          "../" + valid,
+          valid + "\n",
+          valid.substr(0, valid.size() - 1),
+          "x" + valid,
+          valid + valid};
+}
+// A name (of a display, a node, a camera): blank, not UTF-8, holding control characters or too
+// long.
+std::vector<std::string> names() {
+  return {"",
+          " ",
+          "\t",
+          "  \t ",
+          "\xff\xfe",
+          "a\xc0\xaf",
+          "a\xed\xa0\x80",
+          "a\xe2\x82",
+          "\xf8\x88\x80\x80\x80",
+          "\xf4\x90\x80\x80",
+          "\xc3",
+          "\x80"
+          "qrs",
+          "a\nb",
+          "a\tb",
+          "a\x01",
+          "a\x7f",
+          "a\rb",
+          "a\x1b[31m",
+          std::string(257, 'n'),
+          std::string(100000, 'n')};
+}
+// An input file of a kind named by `extension`.
+std::vector<std::string> inputs(const std::string& extension) {
+  return {"",
+          "{dir}/missing" + extension,
+          "{dir}/dir",
+          "{dir}/fifo",
+          "/dev/zero",
+          "/dev/null",
+          "{dir}/zero_link",
+          "{dir}/null_dev",
+          "{dir}/dangling",
+          "{dir}/empty",
+          "{dir}/garbage",
+          "{dir}/nul",
+          "{dir}/invalid_utf8",
+          "{dir}/" + kLongName + extension,
+          "{dir}/file/x" + extension,
+          "{dir}/loop",
+          "\xff\xfe" + extension,
+          "{dir}/deep",
+          "{dir}/array",
+          "{dir}/foreign"};
+}
+// An output folder.
+std::vector<std::string> out_folders() {
+  return {"",
+          ".",
+          "{dir}",
+          "{dir}/",
+          "{dir}/fifo",
+          "{dir}/file",
+          "{dir}/file_link",
+          "{dir}/foreign",
+          "{dir}/foreign/",
+          "{dir}/foreign_link",
+          "{dir}/file/x",
+          "{dir}/" + kLongName,
+          "{dir}/loop",
+          "{dir}/loop/x",
+          "{dir}/zero_link",
+          "{dir}/null_link",
+          "{dir}/null_dev",
+          "{dir}/dangling",
+          "/proc/facet_hostile_out",
+          "/sys/facet_hostile_out"};
+}
+// An output file with `extension`.
+std::vector<std::string> out_files(const std::string& extension) {
+  return {"",
+          ".",
+          "{dir}",
+          "{dir}/",
+          "{dir}/fifo",
+          "{dir}/dir",
+          "{dir}/foreign/",
+          "{dir}/foreign_link",
+          "{dir}/file/x" + extension,
+          "{dir}/" + kLongName + extension,
+          "{dir}/loop",
+          "{dir}/loop/x" + extension,
+          "{dir}/zero_link",
+          "{dir}/null_link",
+          "{dir}/null_dev",
+          "{dir}/dangling",
+          "{dir}/missing/x" + extension,
+          "/proc/facet_hostile_out" + extension,
+          "/sys/facet_hostile_out" + extension,
+          "{dir}/full_link"};
+}
+// A scene name.
+std::vector<std::string> scenes() {
+  return {"",
+          "builtin:",
+          "builtin:bogus",
+          "builtin:city:0",
+          "builtin:city:-1",
+          "builtin:city:100000000",
+          "builtin:city:nan",
+          "builtin:city:1e308",
+          "builtin:city:5abc",
+          "builtin:city-fine:0",
+          "builtin:city-fine:100000",
+          "{dir}/missing.gltf",
+          "{dir}/dir",
+          "{dir}/fifo",
+          "/dev/zero",
+          "{dir}/garbage",
+          "depth:",
+          "depth:{dir}/missing.exr",
+          "depth:/dev/zero",
+          "builtin:city+depth:",
+          "\xff\xfe",
+          "{dir}/loop"};
+}
+
+// One command line that is valid as it stands; `output` is what it would write (relative to the
+// scratch folder); `make` writes its inputs there.
+struct Base {
+  std::vector<std::string> args;
+  std::string output;
+  std::function<void(const fs::path&)> make;
+};
+
+// The variants of `flag` on `base`, one per value, as --flag=VALUE (so that values starting with
+// '-' stay values).
+void add_flag_values(std::vector<Variant>& out, const std::string& command, const Base& base,
+                     const std::string& flag, const std::vector<std::string>& values,
+                     std::vector<std::string> before = {}) {
+  const std::string label = command + " " + flag;
+  std::size_t i = 0;
+  for (const std::string& value : values) {
+    const std::string name = "flag_" + sanitize(command) + "_" + sanitize(flag.substr(2)) + "_" +
+                             std::to_string(i++) + "_" + sanitize(value.substr(0, 24));
+    // The base without the flag itself (given twice, CLI11 would refuse it for that alone).
+    std::vector<std::string> args;
+    for (std::size_t k = 0; k < base.args.size(); ++k) {
+      if (base.args[k] == flag) {
+        ++k;
+        continue;
+      }
+      args.push_back(base.args[k]);
+    }
+    args.insert(args.end(), before.begin(), before.end());
+    args.push_back(flag + "=" + value);
+    const auto make = base.make;
+    // A file's or folder's error may name it rather than the flag.
+    const fs::path as_path(value);
+    const std::string extension = as_path.extension().string();
+    const bool path_like =
+        value.find('/') != std::string::npos ||
+        (extension.size() > 1 && std::isalpha(static_cast<unsigned char>(extension[1])));
+    std::vector<std::string> mentions{flag};
+    if (path_like) mentions.push_back(value);
+    out.push_back({name,
+                   [make](const fs::path& dir) {
+                     make_fixtures(dir);
+                     if (make) make(dir);
+                   },
+                   std::move(args), base.output, std::move(mentions)});
+    in_process().insert(name);
+    flag_of()[name] = label;
+    with_fixtures().insert(name);
+  }
+}
+
+// The bases, and the flags of each command.
+Base render_base() {
+  return {
+      {"render", "--display", "builtin:dome180", "--size", "64x64", "--out", "@out"}, "out", {}};
+}
+Base run_base() {
+  return {
+      {"run", "builtin:dome180", "--size", "64x64", "--headless", "--frames", "1", "--out", "@out"},
+      "out",
+      {}};
+}
+const std::string kDome180 = (kSource / "configs/displays/dome180/display.json").string();
+const std::string kDome180Warp = (kSource / "configs/displays/dome180/dome180.warp.exr").string();
+
+void add_flags_render(std::vector<Variant>& out) {
+  const Base b = render_base();
+  add_flag_values(out, "render", b, "--display",
+                  inputs(".json") + std::vector<std::string>{"builtin:", "builtin:bogus"});
+  add_flag_values(out, "render", b, "--scene", scenes());
+  add_flag_values(out, "render", b, "--method", choices("facets"));
+  add_flag_values(out, "render", b, "--material", choices("lit") + inputs(".frag"));
+  add_flag_values(out, "render", b, "--builder", choices("fewest"));
+  add_flag_values(out, "render", b, "--eye", points());
+  add_flag_values(out, "render", b, "--look-at", points(), {"--eye=0,1.6,0"});
+  add_flag_values(out, "render", b, "--camera", names() + std::vector<std::string>{"nobody"});
+  add_flag_values(out, "render", b, "--face-size", counts({"1000000"}), {"--method=cubemap"});
+  add_flag_values(out, "render", b, "--size", sizes());
+  add_flag_values(out, "render", b, "--frames", counts({"1000001"}));
+  add_flag_values(out, "render", b, "--msaa", naturals({"4096"}));
+  add_flag_values(out, "render", b, "--tilt", angles("91"));
+  add_flag_values(out, "render", b, "--orientation", angles("361"));
+  add_flag_values(out, "render", b, "--out", out_folders());
+  add_flag_values(out, "render", b, "--reference-scene", scenes(), {"--reference"});
+  add_flag_values(out, "render", b, "--anisotropy", non_negatives({"1000"}));
+  add_flag_values(out, "render", b, "--coverage", choices("grid"));
+  add_flag_values(out, "render", b, "--pieces", counts({"100000000"}));
+  add_flag_values(out, "render", b, "--grid", sizes({"65536x1", "1x65536"}));
+  add_flag_values(out, "render", b, "--tolerance", positives({"1e-9", "1e-300"}));
+}
+
+void add_flags_run(std::vector<Variant>& out) {
+  const Base b = run_base();
+  add_flag_values(out, "run", b, "--scene", scenes());
+  add_flag_values(out, "run", b, "--size", sizes());
+  add_flag_values(out, "run", b, "--eye", points());
+  add_flag_values(out, "run", b, "--look-at", points(), {"--eye=0,1.6,0"});
+  add_flag_values(out, "run", b, "--camera", names() + std::vector<std::string>{"nobody"});
+  add_flag_values(out, "run", b, "--method", choices("facets"));
+  add_flag_values(out, "run", b, "--tolerance", positives({"1e-9", "1e-300"}));
+  add_flag_values(out, "run", b, "--material", choices("lit") + inputs(".frag"));
+  add_flag_values(out, "run", b, "--scale", positives({"1.5", "1e-9"}));
+  add_flag_values(out, "run", b, "--tilt", angles("91"));
+  add_flag_values(out, "run", b, "--orientation", angles("361"));
+  add_flag_values(out, "run", b, "--frames", counts({"1000001"}));
+  add_flag_values(out, "run", b, "--out", out_folders());
+  add_flag_values(out, "run", b, "--pattern", choices("grid"));
+  add_flag_values(out, "run", b, "--save-every", counts({"1000001"}));
+  add_flag_values(out, "run", b, "--report", out_files(".json"));
+  const Base cluster{{"run", "@display.json", "--headless", "--frames", "1", "--out", "@out"},
+                     "out",
+                     [](const fs::path& dir) {
+                       display_context(dir);
+                       spit(dir / "display.json", cluster_base(dir).dump(1));
+                     }};
+  add_flag_values(out, "run", cluster, "--node",
+                  names() + std::vector<std::string>{"nobody", "MID"});
+  add_flag_values(out, "run", cluster, "--join-timeout", positives({"1e9"}), {"--node=left"});
+  add_flag_values(out, "run", cluster, "--rate", positives({"1e9"}), {"--node=left"});
+}
+
+void add_flags_play(std::vector<Variant>& out) {
+  const Base b{{"play", "@x.png", "--headless", "--frames", "1", "--out", "@out"},
+               "out",
+               [](const fs::path& dir) { spit(dir / "x.png", still_image(".png", 64, 64)); }};
+  add_flag_values(out, "play", b, "--display",
+                  inputs(".json") + std::vector<std::string>{"builtin:", "builtin:bogus"});
+  add_flag_values(out, "play", b, "--size", sizes(), {"--display=builtin:dome180"});
+  add_flag_values(out, "play", b, "--scale", positives({"1.5", "1e-9"}));
+  add_flag_values(out, "play", b, "--format", choices("fisheye"));
+  add_flag_values(out, "play", b, "--fov", positives({"361", "1e9"}));
+  add_flag_values(out, "play", b, "--tilt", angles("91"));
+  add_flag_values(out, "play", b, "--orientation", angles("361"));
+  add_flag_values(out, "play", b, "--frames", counts({"1000001"}));
+  add_flag_values(out, "play", b, "--start-frame", naturals());
+  add_flag_values(out, "play", b, "--out", out_folders());
+  add_flag_values(out, "play", b, "--stats", out_files(".jsonl"));
+  Base cluster = b;
+  cluster.args = {"play",     "@x.png", "--display", "@display.json", "--headless",
+                  "--frames", "1",      "--out",     "@out"};
+  cluster.make = [](const fs::path& dir) {
+    display_context(dir);
+    spit(dir / "display.json", cluster_base(dir).dump(1));
+    spit(dir / "x.png", still_image(".png", 64, 64));
+  };
+  add_flag_values(out, "play", cluster, "--node", names() + std::vector<std::string>{"nobody"});
+  add_flag_values(out, "play", cluster, "--join-timeout", positives({"1e9"}), {"--node=left"});
+  add_flag_values(out, "play", cluster, "--rate", positives({"1e9"}), {"--node=left"});
+}
+
+void add_flags_preview_display_depth(std::vector<Variant>& out) {
+  const Base preview{{"preview", kDome180, "--out", "@out.png"}, "out.png", {}};
+  const Base builtin{{"preview", "builtin:dome180", "--out", "@out.png"}, "out.png", {}};
+  add_flag_values(out, "preview", builtin, "--size", sizes());
+  add_flag_values(out, "preview", preview, "--tilt", angles("91"));
+  add_flag_values(out, "preview", preview, "--orientation", angles("361"));
+  add_flag_values(out, "preview", preview, "--view", choices("fisheye"));
+  add_flag_values(out, "preview", preview, "--fov", positives({"361", "1e9"}), {"--view=fisheye"});
+  add_flag_values(out, "preview", preview, "--show", choices("blend"));
+  add_flag_values(out, "preview", preview, "--preview-size", counts({"7", "8193"}));
+  add_flag_values(out, "preview", preview, "--out", out_files(".png"));
+  const Base display{{"display", "builtin:dome180", "--out", "@out"}, "out", {}};
+  add_flag_values(out, "display", display, "--size", sizes());
+  add_flag_values(out, "display", display, "--name", names());
+  add_flag_values(out, "display", display, "--out", out_folders());
+  add_flag_values(out, "display", display, "--tilt", angles("91"));
+  add_flag_values(out, "display", display, "--orientation", angles("361"));
+  const Base depth{{"depth-image", "--size", "32x32", "--out", "@out.exr"}, "out.exr", {}};
+  add_flag_values(out, "depth-image", depth, "--scene", scenes());
+  add_flag_values(out, "depth-image", depth, "--out", out_files(".exr"));
+  add_flag_values(out, "depth-image", depth, "--kind", choices("dpci"));
+  add_flag_values(out, "depth-image", depth, "--size", sizes());
+  add_flag_values(out, "depth-image", depth, "--eye", points());
+  const Base lookup{{"lookup", "--warp", kDome180Warp, "--out", "@out.exr"}, "out.exr", {}};
+  add_flag_values(out, "lookup", lookup, "--out", out_files(".exr"));
+  const Base lookup_bare{{"lookup", "--out", "@out.exr"}, "out.exr", {}};
+  add_flag_values(out, "lookup", lookup_bare, "--warp", inputs(".warp.exr"));
+  const Base lookup_display{{"lookup", "--out", "@out"}, "out", {}};
+  add_flag_values(out, "lookup", lookup_display, "--display", inputs(".json"));
+  const Base devices{{"devices"}, "out", {}};
+  add_flag_values(out, "devices", devices, "--for", positives({"1e9"}), {"--watch"});
+  add_flag_values(out, "devices", devices, "--find",
+                  std::vector<std::string>{"",
+                                           " ",
+                                           "usb:",
+                                           "usb:zzzz:0000",
+                                           "usb:12345:0000",
+                                           "usb:1234",
+                                           "usb:1234:",
+                                           "usb:1234:56789",
+                                           "usb:-1:1",
+                                           "pci:1234:5678",
+                                           "usb:1234:5678@",
+                                           "usb:1234:5678:",
+                                           "\xff\xfe",
+                                           "nan",
+                                           "1e308",
+                                           "-1",
+                                           "usb:1234:5678:\xff",
+                                           "usb::",
+                                           "usb:0x12:0x34",
+                                           "USB",
+                                           "usb:1234:5678@\n"});
+}
+
+void add_flags_calibration(std::vector<Variant>& out) {
+  const Base simulate{{"simulate", "--rig", "builtin:wall2x2", "--out", "@out"}, "out", {}};
+  add_flag_values(out, "simulate", simulate, "--rig",
+                  inputs(".json") + std::vector<std::string>{"builtin:", "builtin:bogus"});
+  add_flag_values(out, "simulate", simulate, "--out", out_folders());
+  add_flag_values(out, "simulate", simulate, "--noise", non_negatives({"2"}));
+  add_flag_values(out, "simulate", simulate, "--defocus", non_negatives({"1e6"}));
+  add_flag_values(out, "simulate", simulate, "--camera-blur", non_negatives({"1e6"}));
+  add_flag_values(out, "simulate", simulate, "--ambient", non_negatives({"2"}));
+  add_flag_values(out, "simulate", simulate, "--peak", positives({"2"}));
+  add_flag_values(out, "simulate", simulate, "--gamma", positives({"1000"}));
+  add_flag_values(out, "simulate", simulate, "--bits", counts({"9", "12"}));
+  add_flag_values(out, "simulate", simulate, "--seed", unsigneds());
+  add_flag_values(out, "simulate", simulate, "--phase-period", positives({"1e9"}));
+  add_flag_values(out, "simulate", simulate, "--camera-size", sizes());
+  const Base patterns{{"patterns", "--size", "64x32", "--out", "@out"}, "out", {}};
+  add_flag_values(out, "patterns", patterns, "--size", sizes());
+  add_flag_values(out, "patterns", patterns, "--out", out_folders());
+  add_flag_values(out, "patterns", patterns, "--phase-period", positives({"1e9"}));
+  add_flag_values(out, "patterns", patterns, "--phase-steps", counts({"2", "65"}));
+  add_flag_values(out, "patterns", patterns, "--bit-depth", counts({"9", "12"}));
+  const Base calibrate{{"calibrate", kCapture.string(), "--out", "@out"}, "out", {}};
+  add_flag_values(out, "calibrate", calibrate, "--out", out_folders());
+  add_flag_values(out, "calibrate", calibrate, "--grid", sizes({"1x1", "65536x1"}));
+  add_flag_values(out, "calibrate", calibrate, "--node-spacing", positives({"1e-9"}));
+  add_flag_values(out, "calibrate", calibrate, "--black-level", non_negatives({"1", "2"}));
+  add_flag_values(out, "calibrate", calibrate, "--feather", non_negatives({"1e6"}));
+  add_flag_values(out, "calibrate", calibrate, "--display", inputs(".json"));
+  add_flag_values(out, "calibrate", calibrate, "--name", names());
+}
+
+void add_flags_capture(std::vector<Variant>& out) {
+  const Base b{{"capture", "--display", "@display.json", "--camera", "fake:builtin:wall2x2",
+                "--out", "@out", "--quiet", "--settle-ms", "0"},
+               "out",
+               [](const fs::path& dir) {
+                 json projectors = json::array();
+                 for (int i = 0; i < 4; ++i) {
+                   projectors.push_back({{"name", "p" + std::to_string(i)},
+                                         {"size", {1024, 576}},
+                                         {"gamma", 2.2},
+                                         {"output", {{"window", {1024 * i, 0, 1024, 576}}}}});
+                 }
+                 spit(dir / "display.json",
+                      json{{"format", "facet-display/1"},
+                           {"name", "hostile"},
+                           {"eye", {0, 0, 0}},
+                           {"render", {{"method", "naive"}, {"tolerance_px", 0.5}}},
+                           {"missing_monitor", "window"},
+                           {"projectors", projectors}}
+                          .dump(1));
+               }};
+  Base no_display = b;
+  no_display.args = {"capture", "--camera", "fake:builtin:wall2x2", "--out", "@out", "--quiet"};
+  add_flag_values(out, "capture", no_display, "--display", inputs(".json"));
+  Base no_camera = b;
+  no_camera.args = {"capture", "--display", "@display.json", "--out", "@out", "--quiet"};
+  add_flag_values(out, "capture", no_camera, "--camera",
+                  std::vector<std::string>{"",
+                                           "fake:",
+                                           "fake:builtin:bogus",
+                                           "fake:{dir}/missing.json",
+                                           "fake:{dir}/dir",
+                                           "fake:{dir}/fifo",
+                                           "fake:/dev/zero",
+                                           "fake:{dir}/empty",
+                                           "fake:{dir}/garbage",
+                                           "fake:{dir}/loop",
+                                           "/dev/video999",
+                                           "{dir}/file",
+                                           "{dir}/fifo",
+                                           "-1",
+                                           "99999999999",
+                                           "usb:",
+                                           "usb:zzzz:0000",
+                                           "\xff\xfe",
+                                           "nan",
+                                           "1e308",
+                                           " "});
+  add_flag_values(out, "capture", b, "--out", out_folders());
+  add_flag_values(out, "capture", b, "--camera-model", inputs(".cameramodel"));
+  add_flag_values(out, "capture", b, "--camera-pose", inputs(".json"));
+  add_flag_values(out, "capture", b, "--camera-size", sizes());
+  add_flag_values(out, "capture", b, "--camera-gamma", positives({"1000"}));
+  add_flag_values(out, "capture", b, "--projector-gamma", positives({"1000"}));
+  add_flag_values(out, "capture", b, "--average", counts({"1000001"}));
+  add_flag_values(out, "capture", b, "--settle-ms", naturals({"100000000"}));
+  add_flag_values(out, "capture", b, "--discard", naturals({"100000000"}));
+  add_flag_values(out, "capture", b, "--bits", counts({"9", "12"}));
+  add_flag_values(out, "capture", b, "--phase-period", positives({"1e9"}));
+  add_flag_values(out, "capture", b, "--phase-steps", counts({"2", "65"}));
+  add_flag_values(out, "capture", b, "--max-clipped", non_negatives({"2"}));
+  add_flag_values(out, "capture", b, "--stop-after", unsigneds());
+}
+
+void add_flags_interop(std::vector<Variant>& out) {
+  const Base bourke{{"bourke", "import", kBourke.string(), "--out", "@out"}, "out", {}};
+  add_flag_values(out, "bourke import", bourke, "--out", out_folders());
+  add_flag_values(out, "bourke import", bourke, "--size", sizes({"1000x1000"}));
+  add_flag_values(out, "bourke import", bourke, "--fov", positives({"361", "1e9"}));
+  add_flag_values(out, "bourke import", bourke, "--grid", sizes({"1x1", "65536x1"}));
+  add_flag_values(out, "bourke import", bourke, "--intensity-gamma", positives({"1000"}));
+  add_flag_values(out, "bourke import", bourke, "--zenith", choices("centre"));
+  add_flag_values(out, "bourke import", bourke, "--tilt", angles("91"));
+  add_flag_values(out, "bourke import", bourke, "--orientation", angles("361"));
+  const Base mpcdi_export{{"mpcdi", "export", kDome180, "--out", "@out.mpcdi"}, "out.mpcdi", {}};
+  add_flag_values(out, "mpcdi export", mpcdi_export, "--out", out_files(".mpcdi"));
+  add_flag_values(out, "mpcdi export", mpcdi_export, "--node-spacing", positives({"1e-9"}));
+  add_flag_values(out, "mpcdi export", mpcdi_export, "--profile", choices("3d"));
+  const Base mpcdi_import{{"mpcdi", "import", kMpcdi.string(), "--out", "@out"}, "out", {}};
+  add_flag_values(out, "mpcdi import", mpcdi_import, "--out", out_folders());
+  add_flag_values(out, "mpcdi import", mpcdi_import, "--warp-values", choices("auto"));
+  add_flag_values(out, "mpcdi import", mpcdi_import, "--grid", sizes({"1x1", "65536x1"}));
+  add_flag_values(out, "mpcdi import", mpcdi_import, "--eye", points());
+  add_flag_values(out, "mpcdi import", mpcdi_import, "--tilt", angles("91"));
+  add_flag_values(out, "mpcdi import", mpcdi_import, "--orientation", angles("361"));
+  const Base sgct_export{{"sgct", "export", kDome180, "--out", "@out"}, "out", {}};
+  add_flag_values(out, "sgct export", sgct_export, "--out", out_folders());
+  add_flag_values(out, "sgct export", sgct_export, "--node-spacing", positives({"1e-9"}));
+  add_flag_values(out, "sgct export", sgct_export, "--mask-gamma", positives({"1000"}));
+  const Base sgct_import{{"sgct", "import", kSgc.string(), "--out", "@out"}, "out", {}};
+  add_flag_values(out, "sgct import", sgct_import, "--out", out_folders());
+  add_flag_values(out, "sgct import", sgct_import, "--size", sizes());
+  add_flag_values(out, "sgct import", sgct_import, "--grid", sizes({"1x1", "65536x1"}));
+  add_flag_values(out, "sgct import", sgct_import, "--mask-gamma", positives({"1000"}));
+  add_flag_values(out, "sgct import", sgct_import, "--tilt", angles("91"));
+  add_flag_values(out, "sgct import", sgct_import, "--orientation", angles("361"));
+}
+
+void add_flags_error_bench(std::vector<Variant>& out) {
+  const Base error{{"error"}, "out", {}};
+  add_flag_values(out, "error", error, "--warp", inputs(".warp.exr"));
+  add_flag_values(out, "error", error, "--base", choices("fisheye"));
+  add_flag_values(out, "error", error, "--size", sizes());
+  add_flag_values(out, "error", error, "--azimuth", pairs({"5,5", "-400,400"}));
+  add_flag_values(out, "error", error, "--tan-elevation", pairs({"1,1", "-1,1"}));
+  add_flag_values(out, "error", error, "--elevation", pairs({"10,10", "100,-100"}),
+                  {"--base=equirectangular"});
+  add_flag_values(out, "error", error, "--tan-extent",
+                  pairs({"1,1,1,1", "-1,1,1", "-1,1,1,-1,5", "nan,1,1,-1", "-1,1,1,inf"}),
+                  {"--base=perspective"});
+  add_flag_values(out, "error", error, "--fov", positives({"361", "1e9"}), {"--base=fisheye"});
+  add_flag_values(out, "error", error, "--builder", choices("fewest"));
+  add_flag_values(out, "error", error, "--pieces", counts({"100000000"}));
+  add_flag_values(out, "error", error, "--grid", sizes({"65536x1", "1x65536"}));
+  add_flag_values(out, "error", error, "--tolerance", positives({"1e-9", "1e-300"}));
+  const Base bench{{"bench", "--quick", "--scenario", "cylinder", "--out", "@out"}, "out", {}};
+  add_flag_values(out, "bench", bench, "--scenario", choices("cylinder"));
+  add_flag_values(out, "bench", bench, "--frames", counts({"1000001"}));
+  add_flag_values(out, "bench", bench, "--size-scale", positives({"1e-9", "1000"}));
+  add_flag_values(out, "bench", bench, "--out", out_folders());
+  add_flag_values(out, "bench", bench, "--rig",
+                  inputs(".json") + std::vector<std::string>{"builtin:", "builtin:bogus"},
+                  {"--scenario=dome4"});
+  add_flag_values(out, "bench", bench, "--scene", scenes());
+}
+
 // Every input kind with its generator: one test each, its variants run in turn (one process per
 // kind keeps ctest's per-test start-up out of the suite's time).
 struct Kind {
@@ -1889,6 +2553,14 @@ const Kind kKinds[] = {
     {"material_frag", add_material},
     {"cluster_section_and_node", add_cluster_section},
     {"depth_image", add_depth_image},
+    {"flags_render", add_flags_render},
+    {"flags_run", add_flags_run},
+    {"flags_play", add_flags_play},
+    {"flags_preview_display_depth_lookup_devices", add_flags_preview_display_depth},
+    {"flags_simulate_patterns_calibrate", add_flags_calibration},
+    {"flags_capture", add_flags_capture},
+    {"flags_bourke_mpcdi_sgct", add_flags_interop},
+    {"flags_error_bench", add_flags_error_bench},
 };
 
 // ---- Running one variant ------------------------------------------------------------------------
@@ -1901,7 +2573,35 @@ struct Outcome {
   std::string stderr_text;
 };
 
-Outcome run_cli(const std::vector<std::string>& args, const fs::path& cwd, const fs::path& log) {
+// The threads of this process.
+std::size_t thread_count() {
+  std::error_code ec;
+  const auto tasks = fs::directory_iterator("/proc/self/task", ec);
+  return ec ? std::size_t(-1) : std::size_t(std::distance(fs::begin(tasks), fs::end(tasks)));
+}
+
+// Those the shared libraries' initialisers start before main (log4cplus, loaded with OpenCV,
+// starts an idle pool of 4), which every facet process has too and facet never calls.
+const std::size_t kStartupThreads = thread_count();
+
+// A fork copies only the calling thread, so the CLI runs in a forked child only while no other
+// thread has started since (OpenEXR's pool, once a variant's files are written with it), whose
+// locks the child could inherit held.
+bool single_threaded() { return thread_count() <= kStartupThreads; }
+
+// Runs facet with `args` in `cwd`, under the limits, stderr to `log`: exec'ing the executable, or
+// with `in_process` calling facet::cli::run in the forked child (the same code without the
+// dynamic loader's 0.15 s of CPU per start).
+Outcome run_cli(const std::vector<std::string>& args, const fs::path& cwd, const fs::path& log,
+                bool in_process = false) {
+  if (in_process && !single_threaded()) {
+    static bool told = false;
+    if (!std::exchange(told, true)) std::cout << "other threads running: exec'ing facet instead\n";
+    in_process = false;
+  }
+  std::cout.flush();
+  std::cerr.flush();
+  std::fflush(nullptr);
   std::vector<std::string> storage{"facet"};
   storage.insert(storage.end(), args.begin(), args.end());
   std::vector<char*> argv;
@@ -1924,6 +2624,15 @@ Outcome run_cli(const std::vector<std::string>& args, const fs::path& cwd, const
     ::dup2(err, 2);
     ::unsetenv("DISPLAY");
     ::unsetenv("WAYLAND_DISPLAY");
+    if (in_process) {
+      // Ends as main() would, less the static destructors: those of the libraries' pools
+      // (log4cplus's) would wait for threads that the fork did not copy.
+      const int status = facet::cli::run(static_cast<int>(storage.size()), argv.data());
+      std::cout.flush();
+      std::cerr.flush();
+      std::fflush(nullptr);
+      ::_exit(status);
+    }
     ::execv(FACET_CLI, argv.data());
     ::_exit(127);
   }
@@ -1931,6 +2640,8 @@ Outcome run_cli(const std::vector<std::string>& args, const fs::path& cwd, const
   const auto deadline = std::chrono::steady_clock::now() + kWallLimit;
   int status = 0;
   rusage usage{};
+  // Polled from 0.1 ms up to 5 ms: a refused flag ends within a millisecond or two.
+  auto poll = std::chrono::microseconds(100);
   for (;;) {
     const pid_t done = ::wait4(child, &status, WNOHANG, &usage);
     if (done == child) break;
@@ -1941,7 +2652,8 @@ Outcome run_cli(const std::vector<std::string>& args, const fs::path& cwd, const
       ::wait4(child, &status, 0, &usage);
       break;
     }
-    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    std::this_thread::sleep_for(poll);
+    poll = std::min<std::chrono::microseconds>(poll * 2, std::chrono::milliseconds(5));
   }
   ::kill(-child, SIGKILL);  // anything it left running in its group
   if (WIFEXITED(status)) outcome.exit_code = WEXITSTATUS(status);
@@ -1977,9 +2689,11 @@ void check_variant(const Variant& variant) {
   if (variant.make) variant.make(scratch);
   std::vector<std::string> args;
   for (const std::string& a : variant.args) {
-    args.push_back(a.starts_with("@") ? (scratch / a.substr(1)).string() : a);
+    args.push_back(replace_all(a.starts_with("@") ? (scratch / a.substr(1)).string() : a, "{dir}",
+                               scratch.string()));
   }
-  const Outcome outcome = run_cli(args, scratch, root / (variant.name + ".stderr"));
+  const Outcome outcome = run_cli(args, scratch, root / (variant.name + ".stderr"),
+                                  in_process().contains(variant.name));
   std::string command = "facet";
   for (const std::string& a : args) command += " " + a;
   SCOPED_TRACE(command + "\nstderr: " + outcome.stderr_text);
@@ -1991,7 +2705,8 @@ void check_variant(const Variant& variant) {
   EXPECT_EQ(outcome.stderr_text.find("internal error"), std::string::npos);
   const bool named =
       std::any_of(variant.mentions.begin(), variant.mentions.end(), [&](const std::string& m) {
-        const std::string bare = m.starts_with("--") ? m.substr(2) : m;
+        const std::string bare =
+            replace_all(m.starts_with("--") ? m.substr(2) : m, "{dir}", scratch.string());
         return !bare.empty() && outcome.stderr_text.find(bare) != std::string::npos;
       });
   EXPECT_TRUE(named) << "stderr names none of the input or field";
@@ -1999,6 +2714,9 @@ void check_variant(const Variant& variant) {
       << variant.output << " left behind";
   EXPECT_TRUE(leftover_temporaries(scratch).empty()) << "a hidden temporary left behind";
   EXPECT_FALSE(fs::exists(fs::symlink_status(root / "escape")));
+  if (with_fixtures().contains(variant.name)) {
+    EXPECT_TRUE(fixtures_intact(scratch)) << "a file or folder of the user's changed";
+  }
   fs::remove_all(scratch, ec);
   fs::remove(root / (variant.name + ".stderr"), ec);
   if (fs::is_empty(root, ec)) fs::remove(root, ec);
@@ -2011,6 +2729,15 @@ TEST_P(Hostile, EveryVariantExitsTwoNamingTheInputAndLeavesNothing) {
   GetParam().add(variants);
   EXPECT_GE(variants.size(), 20u);
   std::cout << GetParam().name << ": " << variants.size() << " variants\n";
+  // Each flag a kind covers: at least 20 bad values.
+  std::map<std::string, std::size_t> per_flag;
+  for (const Variant& variant : variants) {
+    if (flag_of().contains(variant.name)) ++per_flag[flag_of().at(variant.name)];
+  }
+  for (const auto& [flag, count] : per_flag) {
+    std::cout << "  " << flag << ": " << count << " variants\n";
+    EXPECT_GE(count, 20u) << flag;
+  }
   for (const Variant& variant : variants) {
     SCOPED_TRACE("variant " + variant.name);
     check_variant(variant);
@@ -2021,5 +2748,39 @@ INSTANTIATE_TEST_SUITE_P(Inputs, Hostile, ::testing::ValuesIn(kKinds),
                          [](const ::testing::TestParamInfo<Kind>& param) {
                            return std::string(param.param.name);
                          });
+
+// Every value-taking flag of every command (as the CLI itself lists them) has at least 20 of the
+// variants above: a flag added without its bad values fails here.
+TEST(HostileFlags, EveryValueTakingFlagOfEveryCommandHasTwentyVariants) {
+  CLI::App app;
+  for (auto& [order, setup] : facet::cli::CommandRegistry::commands()) setup(app);
+  std::set<std::string> flags;
+  std::function<void(CLI::App*, const std::string&)> walk = [&](CLI::App* command,
+                                                                const std::string& path) {
+    for (const CLI::Option* option : command->get_options()) {
+      if (option->get_expected_max() == 0 || option->get_lnames().empty()) continue;
+      flags.insert(path + " --" + option->get_lnames().front());
+    }
+    for (CLI::App* sub : command->get_subcommands([](CLI::App*) { return true; })) {
+      const std::string name = sub->get_name();
+      walk(sub, name.empty() ? path : (path.empty() ? name : path + " " + name));
+    }
+  };
+  walk(&app, "");
+  ASSERT_GT(flags.size(), 100u);
+  std::vector<Variant> variants;
+  for (const Kind& kind : kKinds) {
+    if (std::string(kind.name).starts_with("flags_")) kind.add(variants);
+  }
+  std::map<std::string, std::size_t> per_flag;
+  for (const Variant& variant : variants) ++per_flag[flag_of().at(variant.name)];
+  std::size_t total = 0;
+  for (const std::string& flag : flags) {
+    EXPECT_GE(per_flag[flag], 20u) << flag;
+    total += per_flag[flag];
+  }
+  for (const auto& [flag, count] : per_flag) EXPECT_TRUE(flags.contains(flag)) << flag;
+  std::cout << flags.size() << " value-taking flags, " << total << " variants\n";
+}
 
 }  // namespace
