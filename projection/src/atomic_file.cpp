@@ -1,8 +1,10 @@
 #include "facet/projection/atomic_file.hpp"
 
+#include <fcntl.h>
 #include <unistd.h>
 
 #include <atomic>
+#include <cerrno>
 #include <string>
 #include <system_error>
 
@@ -32,6 +34,34 @@ void write_atomically(const std::filesystem::path& path,
     std::error_code ignored;
     std::filesystem::remove(temporary, ignored);
     throw;
+  }
+}
+
+void check_output_file(const std::filesystem::path& path, std::string_view flag) {
+  namespace fs = std::filesystem;
+  const std::string field(flag);
+  if (path.empty()) throw InputError("command line", field, "expected a file to write");
+  const std::string name = path.filename().string();
+  if (name.empty() || name == "." || name == "..")
+    throw InputError(path.string(), field, "a file to write, not a folder");
+  if (name.size() > 255) throw InputError(path.string(), field, "a file name of at most 255 bytes");
+  std::error_code error;
+  const fs::file_status status = fs::symlink_status(path, error);
+  if (fs::exists(status) && !fs::is_regular_file(status))
+    throw InputError(path.string(), field, "a regular file or a new path to write");
+  const fs::path folder = path.has_parent_path() ? path.parent_path() : fs::path(".");
+  if (!fs::is_directory(fs::status(folder, error)))
+    throw InputError(path.string(), field, "a file in an existing folder");
+  // A file made and removed at once: /proc, /sys and read-only folders take none.
+  const fs::path probe = folder / (".facet-probe" + std::to_string(::getpid()));
+  const int fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
+  if (fd >= 0) {
+    ::close(fd);
+    ::unlink(probe.c_str());
+  } else if (errno != EEXIST) {
+    throw InputError(
+        path.string(), field,
+        "a file in a folder that takes new files: " + std::generic_category().message(errno));
   }
 }
 

@@ -1,7 +1,9 @@
 #include "facet/projection/atomic_folder.hpp"
 
+#include <sys/stat.h>
 #include <unistd.h>
 
+#include <cerrno>
 #include <string>
 #include <system_error>
 
@@ -36,11 +38,11 @@ fs::path sibling(const fs::path& folder, const char* tag) {
   return folder.parent_path() / name;
 }
 
-void create_folders(const fs::path& path) {
+void create_folders(const fs::path& path, const std::string& flag) {
   std::error_code error;
   fs::create_directories(path, error);
   if (error)
-    throw InputError(path.string(), "", "a folder that can be created: " + error.message());
+    throw InputError(path.string(), flag, "a folder that can be created: " + error.message());
 }
 
 }  // namespace
@@ -59,8 +61,29 @@ fs::path check_output_folder(const fs::path& folder, const OutputFolderRules& ru
       throw InputError(out.string(), rules.flag,
                        "a folder that neither is nor holds the input " + input.string());
   }
+  if (out.filename().string().size() > 255)
+    throw InputError(out.string(), rules.flag, "a folder name of at most 255 bytes");
   const fs::file_status status = fs::symlink_status(out, error);
-  if (!fs::exists(status)) return out;
+  if (!fs::exists(status)) {
+    // Created later, in its nearest existing ancestor: which must be a folder (not a file, nor a
+    // link that leads nowhere or in a loop) that takes a new folder (/proc and /sys do not).
+    fs::path above = out.parent_path();
+    while (!above.empty() && !fs::exists(fs::symlink_status(above, error)) &&
+           above != above.parent_path())
+      above = above.parent_path();
+    if (above.empty()) above = ".";
+    if (!fs::is_directory(fs::status(above, error)))
+      throw InputError(out.string(), rules.flag,
+                       "a folder that can be created: " + above.string() + " is no folder");
+    const fs::path probe = above / (".facet-probe" + std::to_string(::getpid()));
+    if (::mkdir(probe.c_str(), 0700) == 0) {
+      ::rmdir(probe.c_str());
+    } else if (errno != EEXIST) {
+      throw InputError(out.string(), rules.flag,
+                       "a folder that can be created: " + std::generic_category().message(errno));
+    }
+    return out;
+  }
   bool replaceable = fs::is_directory(status);
   if (replaceable && !fs::is_empty(out, error))
     replaceable = !error && rules.is_own_output && rules.is_own_output(out);
@@ -74,11 +97,11 @@ void write_folder_atomically(const fs::path& folder,
   fs::path out = check_output_folder(folder, rules);
   // A bare name lives in the current folder: give it one so that its siblings do too.
   if (!out.has_parent_path()) out = fs::path(".") / out;
-  create_folders(out.parent_path());
+  create_folders(out.parent_path(), rules.flag);
   const fs::path temporary = sibling(out, ".tmp");
   std::error_code error;
   fs::remove_all(temporary, error);
-  create_folders(temporary);
+  create_folders(temporary, rules.flag);
   try {
     fill(temporary);
     const bool replacing = fs::exists(fs::symlink_status(out, error));

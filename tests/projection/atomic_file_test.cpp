@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -25,6 +26,11 @@ fs::path fresh_folder(const std::string& name) {
   fs::remove_all(folder);
   fs::create_directories(folder);
   return folder;
+}
+
+std::string slurp_all(const fs::path& path) {
+  std::ifstream in(path);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
 }
 
 void write_text(const fs::path& path, const std::string& text) {
@@ -84,6 +90,37 @@ TEST(AtomicFile, RefusesAnOutputThatIsAnInput) {
         << out;
   }
   EXPECT_NO_THROW(refuse_output_over_inputs(folder / "new.exr", "--out", {input}));
+  fs::remove_all(folder);
+}
+
+// A path the write could never take is refused up front, naming the flag; a new file in an
+// existing folder, or an existing regular file, is taken.
+TEST(AtomicFile, CheckOutputFileRefusesUnwritablePathsNamingTheFlag) {
+  const fs::path folder = fresh_folder("check");
+  std::ofstream(folder / "file") << "the user's";
+  fs::create_directories(folder / "dir");
+  fs::create_symlink(folder / "loop", folder / "loop");
+  const std::vector<fs::path> refused = {"",
+                                         ".",
+                                         folder / "dir",
+                                         folder / "dir/",
+                                         folder / "loop",
+                                         folder / "missing/x.png",
+                                         folder / "file/x.png",
+                                         folder / "loop/x.png",
+                                         folder / (std::string(256, 'n') + ".png"),
+                                         "/proc/facet_atomic_check.png"};
+  for (const fs::path& out : refused) {
+    try {
+      check_output_file(out, "--out");
+      ADD_FAILURE() << out << " taken";
+    } catch (const InputError& error) {
+      EXPECT_EQ(error.field(), "--out") << out;
+    }
+  }
+  EXPECT_NO_THROW(check_output_file(folder / "new.png", "--out"));
+  EXPECT_NO_THROW(check_output_file(folder / "file", "--out"));
+  EXPECT_EQ(slurp_all(folder / "file"), "the user's");
   fs::remove_all(folder);
 }
 
@@ -169,6 +206,19 @@ TEST(AtomicFolder, RefusesAForeignFolderByNameBeforeWriting) {
   EXPECT_THROW(check_output_folder(folder / "out" / "keep.txt", reading), InputError);
   EXPECT_THROW(check_output_folder("", reading), InputError);
   EXPECT_EQ(check_output_folder(folder / "new/", reading), folder / "new");
+  // A folder that could never be created, found before any work: under a file, under a link in
+  // a loop, with a name longer than 255 bytes, or where no folder can be made (/proc).
+  fs::create_symlink(folder / "loop", folder / "loop");
+  for (const fs::path& never :
+       {folder / "file" / "x", folder / "file" / "x" / "y", folder / "loop" / "x",
+        folder / std::string(256, 'n'), fs::path("/proc/facet_atomic_check")}) {
+    try {
+      check_output_folder(never, own_run_rules());
+      ADD_FAILURE() << never << " taken";
+    } catch (const InputError& e) {
+      EXPECT_EQ(e.field(), "--out") << never;
+    }
+  }
   fs::remove_all(folder);
 }
 

@@ -14,6 +14,13 @@ namespace facet {
 void write_atomically(const std::filesystem::path& path,
                       const std::function<void(const std::filesystem::path&)>& write);
 
+// The checks an output file passes before a command starts its work, so that a path it could
+// never write is refused at once rather than after the work: InputError naming `path` and `flag`
+// when `path` is empty or names a folder (".", "..", a trailing '/'), exists and is not a regular
+// file (write_atomically's check), has a file name longer than 255 bytes, or its folder is not an
+// existing folder that takes a new file (one is made and removed at once to find out).
+void check_output_file(const std::filesystem::path& path, std::string_view flag);
+
 // InputError naming `out` and `flag` when `out` is the same file as one of `inputs` (after links
 // and relative paths): writing it would replace an input the command reads.
 void refuse_output_over_inputs(const std::filesystem::path& out, std::string_view flag,

@@ -24,7 +24,10 @@ struct OutputFolderRules {
 // `folder` as written ("out/" is "out") once it passes the checks write_folder_atomically makes
 // before writing anything. InputError naming the folder and rules.flag when it is empty, is the
 // current folder or one of its parents, is or holds one of rules.inputs, or exists and is not an
-// empty folder or one that rules.is_own_output accepts (a symbolic link is not a folder here).
+// empty folder or one that rules.is_own_output accepts (a symbolic link is not a folder here); or
+// when it does not exist and could not be created: a name longer than 255 bytes, or a nearest
+// existing ancestor that is not a folder or takes no new folder (one is made and removed at once
+// to find out: /proc and /sys take none).
 std::filesystem::path check_output_folder(const std::filesystem::path& folder,
                                           const OutputFolderRules& rules = {});
 
