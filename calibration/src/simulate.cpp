@@ -272,6 +272,10 @@ SimulationReport simulate_capture(const Rig& rig, const std::filesystem::path& o
                                   const std::string& source, const ProgressSink& progress) {
   const auto start = std::chrono::steady_clock::now();
   rig.validate(source);
+  // Checked before any work (naming the flag), and again when written.
+  OutputFolderRules out_rules;
+  out_rules.flag = "--out";
+  check_output_folder(out, out_rules);
   const CameraModel camera = rig_camera_model(rig.camera, source);
 
   Capture capture;

@@ -20,6 +20,10 @@ OutputFolderRules out_folder_rules() {
 
 }  // namespace
 
+void check_out_folder(const std::filesystem::path& folder) {
+  check_output_folder(folder, out_folder_rules());
+}
+
 std::string sanitize_name(const std::string& text) {
   std::string name;
   for (char c : text) {

@@ -6,6 +6,7 @@
 #include "command.hpp"
 #include "display_flags.hpp"
 #include "facet/interop/bourke.hpp"
+#include "facet/interop/display_folder.hpp"
 #include "facet/projection/errors.hpp"
 #include "facet/projection/input_file.hpp"
 
@@ -49,6 +50,7 @@ const Registration registration{
         const FisheyeZenith zenith =
             fisheye_zenith_from_string(options->zenith, "command line", "--zenith");
         const glm::dmat3 R_eye_dome = options->orientation.value().R_eye_dome();
+        interop::check_out_folder(options->out);  // before the import's work
         require_regular_file(options->file);
         std::ifstream stream(options->file, std::ios::binary);
         if (!stream) throw InputError(options->file, "", "cannot open the file");

@@ -32,6 +32,7 @@ const Registration registration{
           ->required();
       command->callback([options] {
         if (!options->warp.empty()) {
+          check_output_file(options->out, "--out");
           refuse_output_over_inputs(options->out, "--out", {options->warp});
           interop::write_lookup(read_warp(options->warp), options->out);
           std::cout << "wrote " << options->out << "\n";

@@ -5,7 +5,9 @@
 
 #include "command.hpp"
 #include "display_flags.hpp"
+#include "facet/interop/display_folder.hpp"
 #include "facet/interop/mpcdi.hpp"
+#include "facet/projection/atomic_file.hpp"
 #include "facet/projection/errors.hpp"
 
 namespace facet::cli {
@@ -37,6 +39,7 @@ const Registration registration{
         if (!(exporting->spacing >= 0.5 && exporting->spacing <= 1024)) {
           throw InputError("--node-spacing", "", "expected a spacing in [0.5, 1024] pixels");
         }
+        check_output_file(exporting->out, "--out");  // before the export's work
         const auto display = projection_io::read_display_config(exporting->display);
         interop::MpcdiExportOptions options;
         options.node_spacing_px = exporting->spacing;
@@ -73,6 +76,7 @@ const Registration registration{
       importing->orientation.add_to(*import_command);
       import_command->callback([importing] {
         const DomeOrientation orientation = importing->orientation.value();
+        interop::check_out_folder(importing->out);  // before the import's work
         interop::MpcdiImportOptions options;
         if (importing->values == "absolute") {
           options.values = interop::MpcdiWarpValues::absolute;

@@ -17,6 +17,7 @@
 #include "facet/driver/content_player.hpp"
 #include "facet/driver/gl_context.hpp"
 #include "facet/driver/session.hpp"
+#include "facet/driver/session_runner.hpp"
 #include "facet/projection/atomic_file.hpp"
 #include "facet/projection/content_projection.hpp"
 #include "facet/projection/errors.hpp"
@@ -120,6 +121,14 @@ void play(const PlayOptions& options) {
     throw InputError("command line", "--stats",
                      "windows: headless runs write stats.jsonl into --out");
   if (!options.stats.empty()) refuse_output_over_inputs(options.stats, "--stats", {options.file});
+  if (headless) {
+    // --out before any GL work or a cluster's join.
+    driver::HeadlessRunOptions out_check;
+    out_check.out_dir = options.out;
+    out_check.inputs = {options.file};
+    if (!options.display.starts_with("builtin:")) out_check.inputs.push_back(options.display);
+    driver::check_headless_out(out_check, "'facet play' or 'facet run'");
+  }
   // A cluster node joins its cluster before any GL work.
   std::unique_ptr<driver::FrameSync> sync;
   if (cluster_share) {

@@ -13,6 +13,7 @@
 #include "display_flags.hpp"
 #include "facet/driver/output_images.hpp"
 #include "facet/driver/session.hpp"
+#include "facet/projection/atomic_file.hpp"
 #include "facet/projection/display_preview.hpp"
 #include "facet/projection/errors.hpp"
 #include "facet/projection_io/display_config.hpp"
@@ -36,6 +37,7 @@ double percent(double part, double whole) { return whole > 0 ? 100 * part / whol
 
 void preview(const PreviewCommandOptions& options) {
   if (options.out.empty()) throw InputError("command line", "--out", "a PNG file to write");
+  check_output_file(options.out, "--out");  // before the preview is drawn
   const PreviewShow show = preview_show_from_string(options.show, "command line", "--show");
   if (show == PreviewShow::residual)
     throw InputError("command line", "--show",

@@ -143,6 +143,15 @@ void run(const RunOptions& options) {
   if (!headless) monitors_of_display_server("--windowed");
   const driver::ViewRequest view_request = options.view.request();
   const driver::SceneName scene_name = driver::parse_scene_name(options.scene);
+  if (headless) {
+    // --out before the scene, the facets and any GL work.
+    driver::HeadlessRunOptions out_check;
+    out_check.out_dir = options.out;
+    if (!options.display.starts_with("builtin:")) out_check.inputs.push_back(options.display);
+    if (scene_name.kind == driver::SceneName::Kind::file)
+      out_check.inputs.push_back(scene_name.file);
+    driver::check_headless_out(out_check, "'facet run'");
+  }
   driver::Scene scene = driver::load_scene(scene_name);  // moved into the headless Session
   const driver::CameraPath path =
       driver::camera_path(choose_view(scene, view_request, scene_name.builtin_city(), "run"));

@@ -6,6 +6,7 @@
 
 #include "command.hpp"
 #include "display_flags.hpp"
+#include "facet/interop/display_folder.hpp"
 #include "facet/interop/sgct_cluster.hpp"
 #include "facet/projection/errors.hpp"
 #include "facet/projection_io/display_config.hpp"
@@ -49,6 +50,7 @@ const Registration registration{
         if (!(exporting->gamma > 0 && exporting->gamma <= 10)) {
           throw InputError("--mask-gamma", "", "expected a gamma in (0, 10]");
         }
+        interop::check_out_folder(exporting->out);  // before the export's work
         const auto display = projection_io::read_display_config(exporting->display);
         interop::SgctExportOptions options;
         options.node_spacing_px = exporting->spacing;
@@ -85,6 +87,7 @@ const Registration registration{
       options->orientation.add_to(*import_command);
       import_command->callback([options] {
         const DomeOrientation orientation = options->orientation.value();
+        interop::check_out_folder(options->out);  // before the import's work
         if (!(options->gamma > 0 && options->gamma <= 10)) {
           throw InputError("--mask-gamma", "", "expected a gamma in (0, 10]");
         }

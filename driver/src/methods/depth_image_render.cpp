@@ -181,6 +181,7 @@ DepthImage run_depth_image_command(const DepthImageCommand& command) {
   if (command.out.empty() || command.out.extension() != ".exr")
     throw InputError("command line", "--out",
                      "expected a FILE.exr to write; got '" + command.out.string() + "'");
+  check_output_file(command.out, "--out");  // before any work
   if (command.size) request.size = *command.size;
   check_image_size(request.size, "command line", "--size");
   const SceneName name = parse_scene_name(command.scene);

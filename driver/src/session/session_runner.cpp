@@ -100,7 +100,22 @@ std::string frame_file_name(std::uint64_t frame) {
   return name;
 }
 
+OutputFolderRules headless_out_rules(const HeadlessRunOptions& options,
+                                     const std::string& earlier) {
+  OutputFolderRules rules;
+  rules.flag = "--out";
+  rules.expected = "a new path, an empty folder, or a folder from an earlier " + earlier +
+                   " (stats.jsonl and folders of NNNNN.png, nothing else)";
+  rules.is_own_output = holds_earlier_run;
+  rules.inputs = options.inputs;
+  return rules;
+}
+
 }  // namespace
+
+void check_headless_out(const HeadlessRunOptions& options, const std::string& earlier) {
+  check_output_folder(options.out_dir, headless_out_rules(options, earlier));
+}
 
 void write_headless_frames(const HeadlessRunOptions& options, const std::string& earlier,
                            const SessionDisplay& display, std::span<const OutputTarget> targets,
@@ -112,12 +127,7 @@ void write_headless_frames(const HeadlessRunOptions& options, const std::string&
                      "from 1 to " + std::to_string(kMaxFrames) + " frames");
   if (options.save_every < 1)
     throw InputError("command line", "--save-every", "a frame interval of at least 1");
-  OutputFolderRules rules;
-  rules.flag = "--out";
-  rules.expected = "a new path, an empty folder, or a folder from an earlier " + earlier +
-                   " (stats.jsonl and folders of NNNNN.png, nothing else)";
-  rules.is_own_output = holds_earlier_run;
-  rules.inputs = options.inputs;
+  const OutputFolderRules rules = headless_out_rules(options, earlier);
   const fs::path out_dir = check_output_folder(options.out_dir, rules);
   const bool replacing = fs::exists(fs::symlink_status(out_dir));
   write_folder_atomically(

@@ -70,6 +70,10 @@ using RenderHeadlessFrame = std::function<nlohmann::json(const FrameState& state
 using HeadlessFrameDone = std::function<void(std::uint64_t done, nlohmann::json& line,
                                              std::span<const std::filesystem::path> images)>;
 
+// The check write_headless_frames makes of options.out_dir (with options.inputs; `earlier` as
+// there), for a command to make before its work: InputError naming the folder and --out.
+void check_headless_out(const HeadlessRunOptions& options, const std::string& earlier);
+
 // The frame loop of every headless run (run_headless_session, run_headless_play). Checks
 // options.frames (1 to kMaxFrames), options.save_every (>= 1) and options.out_dir, which may be
 // new, an empty folder or an earlier headless run's folder (stats.jsonl and folders of

@@ -43,6 +43,10 @@ std::string sanitize_name(const std::string& text);
 // exist or be empty (InputError naming it otherwise).
 void write_display_folder(const ImportedDisplay& display, const std::filesystem::path& folder);
 
+// The checks write_display_folder and write_files_folder make of `folder` (the --out flag) before
+// writing, for a command to make before its work: InputError naming it and --out.
+void check_out_folder(const std::filesystem::path& folder);
+
 // Writes files given as name → bytes the same way into `folder`.
 void write_files_folder(const std::map<std::string, std::string>& files,
                         const std::filesystem::path& folder);
