@@ -8,6 +8,7 @@
 
 #include "facet/calibration/image_io.hpp"
 #include "facet/projection/atomic_file.hpp"
+#include "facet/projection/atomic_folder.hpp"
 #include "facet/projection/errors.hpp"
 #include "facet/projection/input_file.hpp"
 #include "facet/projection/progress.hpp"
@@ -159,13 +160,7 @@ std::vector<CaptureFrame> standard_frames(const std::string& projector_name, glm
   return frames;
 }
 
-LiveCaptureReport run_live_capture(PatternOutputs& outputs, LiveCamera& camera,
-                                   const LiveCaptureSetup& setup,
-                                   const LiveCaptureOptions& options) {
-  const auto start = std::chrono::steady_clock::now();
-  auto log = [&](const std::string& line) {
-    if (options.log) options.log(line);
-  };
+void check_live_capture_options(const LiveCaptureOptions& options) {
   if (options.average < 1) throw InputError("--average", "", "a number of exposures >= 1");
   if (options.bits != 8 && options.bits != 16) throw InputError("--bits", "", "8 or 16");
   if (!(options.camera_gamma > 0 && options.camera_gamma <= kMaxGamma)) {
@@ -174,8 +169,29 @@ LiveCaptureReport run_live_capture(PatternOutputs& outputs, LiveCamera& camera,
   if (!(options.max_clipped_fraction >= 0 && options.max_clipped_fraction <= 1)) {
     throw InputError("--max-clipped", "", "a fraction of camera pixels from 0 to 1");
   }
+  if (options.out.empty()) throw InputError("--out", "", "a capture folder");
+  OutputFolderRules rules;
+  rules.flag = "--out";
+  rules.expected = std::string(
+                       "a new or empty folder, or the folder of an interrupted 'facet capture' (it "
+                       "has no ") +
+                   kCaptureJournalFile + ")";
+  rules.is_own_output = [](const fs::path& folder) {
+    std::error_code error;
+    return fs::is_regular_file(folder / kCaptureJournalFile, error);
+  };
+  check_output_folder(options.out, rules);
+}
+
+LiveCaptureReport run_live_capture(PatternOutputs& outputs, LiveCamera& camera,
+                                   const LiveCaptureSetup& setup,
+                                   const LiveCaptureOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  auto log = [&](const std::string& line) {
+    if (options.log) options.log(line);
+  };
+  check_live_capture_options(options);
   const fs::path out = options.out;
-  if (out.empty()) throw InputError("--out", "", "a capture folder");
   FACET_ASSERT(setup.model.has_value());
   const glm::ivec2 camera_size = camera.size();
   if (camera_size != setup.model->imager_size()) {
@@ -228,7 +244,7 @@ LiveCaptureReport run_live_capture(PatternOutputs& outputs, LiveCamera& camera,
     newline_needed = !journal.ends_with_newline;
   } else if (fs::exists(out, error) &&
              (!fs::is_directory(out, error) || !fs::is_empty(out, error))) {
-    throw InputError(out.string(), "",
+    throw InputError(out.string(), "--out",
                      std::string("a new or empty folder, or the folder of an interrupted 'facet "
                                  "capture' (it has no ") +
                          kCaptureJournalFile + ")");

@@ -144,7 +144,16 @@ int run_capture(const CaptureArgs& args) {
 
   std::optional<Rig> rig;
   if (fake) {
-    rig = load_rig(args.camera.substr(5));
+    // The rig's errors name the flag that gave it: its name alone may be the mistake.
+    const std::string rig_name = args.camera.substr(5);
+    if (rig_name.empty()) {
+      throw InputError("--camera", "", "fake:RIG, RIG a rig file or builtin:NAME; got 'fake:'");
+    }
+    try {
+      rig = load_rig(rig_name);
+    } catch (const InputError& error) {
+      throw InputError("--camera " + error.source(), error.field(), error.expected());
+    }
     if (!args.camera_model.empty() || !args.camera_pose.empty()) {
       throw InputError("--camera-model", "",
                        "no --camera-model or --camera-pose with a fake camera: the rig gives both");
@@ -171,6 +180,17 @@ int run_capture(const CaptureArgs& args) {
   if (patterns.phase_steps < 3 || patterns.phase_steps > 64) {
     throw InputError("--phase-steps", "", "3 to 64 steps");
   }
+
+  // Checked before the camera and the projectors start.
+  calibration::LiveCaptureOptions options;
+  options.out = args.out;
+  options.average = args.average;
+  options.bits = args.bits ? *args.bits : rig ? rig->simulation.bits : 16;
+  options.camera_gamma = args.camera_gamma;
+  options.max_clipped_fraction = args.max_clipped;
+  options.allow_clipping = args.allow_clipping;
+  options.stop_after = args.stop_after;
+  calibration::check_live_capture_options(options);
 
   calibration::LiveCaptureSetup setup;
   for (const projection_io::DisplayProjector& p : display.projectors) {
@@ -215,25 +235,17 @@ int run_capture(const CaptureArgs& args) {
     setup.model = calibration::CameraModel::read(args.camera_model);
     if (!args.camera_pose.empty()) calibration::read_camera_pose(args.camera_pose, setup.camera);
     setup.screen = display.screen;
-    calibration::VideoCameraOptions options;
-    if (!args.camera_size.empty()) options.size = parse_size(args.camera_size, "--camera-size");
-    options.discard = args.discard;
+    calibration::VideoCameraOptions video;
+    if (!args.camera_size.empty()) video.size = parse_size(args.camera_size, "--camera-size");
+    video.discard = args.discard;
     const std::string device = resolve_camera_device(args.camera);
-    camera = calibration::open_video_camera(device, args.camera, options);
+    camera = calibration::open_video_camera(device, args.camera, video);
   }
   presenter = fake && !args.windowed
                   ? driver::create_headless_presenter(sizes, settle)
                   : driver::create_windowed_presenter(display, args.display, settle);
   PresenterOutputs outputs(*presenter);
 
-  calibration::LiveCaptureOptions options;
-  options.out = args.out;
-  options.average = args.average;
-  options.bits = args.bits ? *args.bits : rig ? rig->simulation.bits : 16;
-  options.camera_gamma = args.camera_gamma;
-  options.max_clipped_fraction = args.max_clipped;
-  options.allow_clipping = args.allow_clipping;
-  options.stop_after = args.stop_after;
   driver::PatternPresenter* watched = presenter.get();
   // SIGINT and SIGTERM stop the capture after the frame in hand, leaving it resumable (exit 3).
   options.interrupted = [watched] { return interrupt_signal() != 0 || watched->closed(); };

@@ -120,6 +120,13 @@ struct LiveCaptureReport {
   double seconds = 0;
 };
 
+// The checks run_live_capture makes of `options` before anything else, for a command to make
+// before its camera and projectors start: InputError naming the flag for average < 1, bits not 8
+// or 16, a camera gamma outside (0, 10], a clipped fraction outside [0, 1], and an --out that is
+// neither new (and creatable) nor an empty folder nor an interrupted capture's folder (it holds
+// capture.journal), or is the current folder or one of its parents.
+void check_live_capture_options(const LiveCaptureOptions& options);
+
 // Runs or resumes the capture described above. Throws InputError (nothing finished, the folder
 // stays resumable) for: an output path that is a file or a folder holding something else, a
 // journal whose identity differs, bad options (average < 1, bits not 8 or 16, camera gamma <= 0),
