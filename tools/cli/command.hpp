@@ -3,6 +3,8 @@
 // main.cpp. The callback set up by `add` runs after parsing; an InputError it throws becomes exit
 // status 2.
 #include <CLI/CLI.hpp>
+#include <charconv>
+#include <cstdint>
 #include <functional>
 #include <string>
 #include <vector>
@@ -21,14 +23,22 @@ struct Registration {
   Registration(int order, CommandSetup setup);
 };
 
-// A check for an unsigned option: CLI11 converts "-1" to an unsigned type by wrapping it to the
-// largest value; this refuses any sign instead.
+// A check for a 64-bit unsigned option: CLI11 converts "-1" to an unsigned type by wrapping it to
+// the largest value, and a number past 2^64 - 1 to that value (strtoull's overflow, unchecked);
+// this refuses any sign, and digits past the type's range, instead.
 inline CLI::Validator unsigned_only() {
   return CLI::Validator(
       [](std::string& value) -> std::string {
         const auto first = value.find_first_not_of(" \t");
         if (first != std::string::npos && (value[first] == '-' || value[first] == '+')) {
           return "expected an integer from 0 up without a sign, got '" + value + "'";
+        }
+        if (first == std::string::npos) return "";
+        std::uint64_t number = 0;
+        const std::from_chars_result parsed =
+            std::from_chars(value.data() + first, value.data() + value.size(), number);
+        if (parsed.ec == std::errc::result_out_of_range) {
+          return "expected an integer from 0 to 18446744073709551615, got '" + value + "'";
         }
         return "";
       },
