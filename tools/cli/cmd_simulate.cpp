@@ -33,7 +33,25 @@ struct SimulateArgs {
   bool no_phase = false, no_falloff = false, clean = false;
 };
 
-// Flags override the rig file; each is checked again by Rig::validate, naming the flag.
+// The flag that set the rig's `field` (as Rig::validate names it), or "" when none did.
+std::string overriding_flag(const SimulateArgs& args, const std::string& field) {
+  const struct {
+    const char *field, *flag;
+    bool given;
+  } overrides[] = {{"simulation.noise", "--noise", args.noise.has_value()},
+                   {"simulation.defocus_px", "--defocus", args.defocus.has_value()},
+                   {"simulation.camera_blur_px", "--camera-blur", args.camera_blur.has_value()},
+                   {"simulation.ambient", "--ambient", args.ambient.has_value()},
+                   {"simulation.peak", "--peak", args.peak.has_value()},
+                   {"simulation.bits", "--bits", args.bits.has_value()},
+                   {"camera.size", "--camera-size", args.camera_size.has_value()}};
+  for (const auto& o : overrides) {
+    if (o.given && field == o.field) return o.flag;
+  }
+  return "";
+}
+
+// Flags override the rig file; each is checked again by Rig::validate, which names the flag.
 void apply_overrides(const SimulateArgs& args, facet::Rig& rig) {
   auto& s = rig.simulation;
   if (args.clean) {
@@ -105,7 +123,13 @@ const facet::cli::Registration registration{
       cmd->callback([args] {
         facet::Rig rig = facet::load_rig(args->rig);
         apply_overrides(*args, rig);
-        rig.validate(args->rig + " (with the command-line overrides)");
+        try {
+          rig.validate(args->rig + " (with the command-line overrides)");
+        } catch (const facet::InputError& error) {
+          const std::string flag = overriding_flag(*args, error.field());
+          if (flag.empty()) throw;
+          throw facet::InputError(flag, "", error.expected());
+        }
         // From here on SIGINT and SIGTERM stop the simulation cleanly (exit 128 + signal).
         facet::watch_interrupts();
         facet::TerminalProgress progress(stderr, "facet simulate");
