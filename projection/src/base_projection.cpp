@@ -124,6 +124,9 @@ void BaseProjection::validate(const std::string& source) const {
               "tan_extent",
               "expected finite tangents [left, right, top, bottom]; a perspective field of view "
               "of 180° or more cannot be represented");
+      require(std::abs(l) <= kMaxTangent && std::abs(r) <= kMaxTangent &&
+                  std::abs(t) <= kMaxTangent && std::abs(b) <= kMaxTangent,
+              "tan_extent", "expected tangents within ±1e6");
       require(l < r && b < t, "tan_extent",
               "expected left < right and bottom < top; got [" + number(l) + ", " + number(r) +
                   ", " + number(t) + ", " + number(b) + "]");
@@ -138,6 +141,8 @@ void BaseProjection::validate(const std::string& source) const {
       const auto [top, bottom] = tan_elevation;
       require(std::isfinite(top) && std::isfinite(bottom) && top != bottom, "tan_elevation",
               "expected two different finite tangents [top, bottom]");
+      require(std::abs(top) <= kMaxTangent && std::abs(bottom) <= kMaxTangent, "tan_elevation",
+              "expected tangents within ±1e6");
       break;
     }
     case BaseKind::equirectangular: {

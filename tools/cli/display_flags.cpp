@@ -1,5 +1,6 @@
 #include "display_flags.hpp"
 
+#include <map>
 #include <sstream>
 #include <vector>
 
@@ -13,6 +14,9 @@ namespace {
 std::vector<double> parse_numbers(const std::string& text, const std::string& flag,
                                   std::size_t count_min, std::size_t count_max) {
   std::vector<double> values;
+  // getline drops a last empty item: "1,2," would be read as "1,2".
+  if (text.ends_with(','))
+    throw InputError("command line", flag, "expected comma-separated numbers; got '" + text + "'");
   std::stringstream stream(text);
   std::string item;
   while (std::getline(stream, item, ',')) {
@@ -100,7 +104,20 @@ Warp DisplayFlags::make_warp() const {
       break;
     }
   }
-  projection.validate("command line");
+  // The projection's own checks name its fields: named here by the flags that set them.
+  try {
+    projection.validate("command line");
+  } catch (const InputError& error) {
+    const std::map<std::string, std::string> flags{
+        {"azimuth", "--azimuth"},
+        {"tan_elevation", "--tan-elevation"},
+        {"elevation", "--elevation"},
+        {"tan_extent", fov.empty() ? "--tan-extent" : "--fov"},
+        {"fov", "--fov"}};
+    const auto flag = flags.find(error.field());
+    if (flag == flags.end()) throw;
+    throw InputError("command line", flag->second, error.expected());
+  }
   return Warp::analytic(projection, parse_size(size, "--size"));
 }
 

@@ -17,6 +17,11 @@ std::string to_string(BaseKind kind);
 BaseKind base_kind_from_string(const std::string& name, const std::string& source = {},
                                const std::string& field = "base");
 
+// The largest tangent a perspective's or a cylinder's edge may have (89.99994°): beyond it the
+// facet builders chase a map that no output pixel can resolve (tan 1e9 at 160x120 built facets
+// until it ran out of memory).
+inline constexpr double kMaxTangent = 1e6;
+
 struct BaseProjection {
   BaseKind kind = BaseKind::perspective;
   // perspective: tangents [left, right, top, bottom] of the image edges.
@@ -42,7 +47,8 @@ struct BaseProjection {
                                         double bottom_deg);
 
   // Throws InputError naming `source` and the field when a parameter is non-finite or out of its
-  // domain (for example a perspective field of view of 180° or more).
+  // domain (for example a perspective field of view of 180° or more, or a tangent beyond
+  // kMaxTangent).
   void validate(const std::string& source = {}) const;
 
   // True when s = 0 and s = 1 are the same direction (a full 360° azimuth).
