@@ -12,9 +12,11 @@
 #include <OpenImageIO/imageio.h>
 #include <fcntl.h>
 #include <gtest/gtest.h>
+#include <poll.h>
 #include <signal.h>
 #include <sys/resource.h>
 #include <sys/stat.h>
+#include <sys/syscall.h>
 #include <sys/sysmacros.h>
 #include <sys/time.h>
 #include <sys/types.h>
@@ -74,6 +76,9 @@ struct Variant {
   std::vector<std::string> args;
   std::string output;
   std::vector<std::string> mentions;
+  // `make` writes with OpenImageIO, OpenEXR or OpenCV, whose pools of threads must not start in
+  // this process (see run_cli): it runs in a forked child. Without, it runs here (one fork less).
+  bool make_starts_threads = true;
 };
 
 // Variants that fail only under the suite's address-space limit (a size a machine with that much
@@ -1872,15 +1877,10 @@ void add_flags(std::vector<Variant>& out) {
 //
 // Each flag gets bad values by the type of value it takes (a count, a real, an angle, WxH, a
 // point, a name from a list, a name, an input file, an output), on a command line that is valid
-// without it. These run in forked children of this process (see run_cli): an exec of facet spends
-// about 0.15 s of CPU in the dynamic loader alone, which 3,000 variants cannot afford.
+// without it.
 
-// Variants run in a forked child calling facet::cli::run, by name; the flag each one exercises;
-// and those with the scratch fixtures below (whose foreign files must survive the run).
-std::set<std::string>& in_process() {
-  static std::set<std::string> names;
-  return names;
-}
+// The flag each variant exercises, by name; and those with the scratch fixtures below (whose
+// foreign files must survive the run).
 std::map<std::string, std::string>& flag_of() {
   static std::map<std::string, std::string> flags;
   return flags;
@@ -2204,13 +2204,17 @@ void add_flag_values(std::vector<Variant>& out, const std::string& command, cons
         (extension.size() > 1 && std::isalpha(static_cast<unsigned char>(extension[1])));
     std::vector<std::string> mentions{flag};
     if (path_like) mentions.push_back(value);
+    // A path after a scheme (depth:FILE, fake:RIG) may be named alone.
+    if (const auto colon = value.find(':');
+        path_like && colon != std::string::npos && colon < value.find('/')) {
+      mentions.push_back(value.substr(colon + 1));
+    }
     out.push_back({name,
                    [make](const fs::path& dir) {
                      make_fixtures(dir);
                      if (make) make(dir);
                    },
-                   std::move(args), base.output, std::move(mentions)});
-    in_process().insert(name);
+                   std::move(args), base.output, std::move(mentions), false});
     flag_of()[name] = label;
     with_fixtures().insert(name);
   }
@@ -2286,10 +2290,31 @@ void add_flags_run(std::vector<Variant>& out) {
   add_flag_values(out, "run", cluster, "--rate", positives({"1e9"}), {"--node=left"});
 }
 
+// A valid 64×64 PNG, written once in a forked child (OpenImageIO's threads must not start here):
+// the play flags' inputs are then written without it, in this process.
+const std::string& still_png() {
+  static const std::string bytes = [] {
+    const fs::path path =
+        fs::temp_directory_path() / ("facet_hostile_png_" + std::to_string(::getpid()));
+    std::fflush(nullptr);
+    const pid_t child = ::fork();
+    if (child == 0) {
+      spit(path, still_image(".png", 64, 64));
+      ::_exit(0);
+    }
+    int status = 0;
+    ::waitpid(child, &status, 0);
+    std::string png = slurp(path);
+    fs::remove(path);
+    return png;
+  }();
+  return bytes;
+}
+
 void add_flags_play(std::vector<Variant>& out) {
   const Base b{{"play", "@x.png", "--headless", "--frames", "1", "--out", "@out"},
                "out",
-               [](const fs::path& dir) { spit(dir / "x.png", still_image(".png", 64, 64)); }};
+               [](const fs::path& dir) { spit(dir / "x.png", still_png()); }};
   add_flag_values(out, "play", b, "--display",
                   inputs(".json") + std::vector<std::string>{"builtin:", "builtin:bogus"});
   add_flag_values(out, "play", b, "--size", sizes(), {"--display=builtin:dome180"});
@@ -2308,7 +2333,7 @@ void add_flags_play(std::vector<Variant>& out) {
   cluster.make = [](const fs::path& dir) {
     display_context(dir);
     spit(dir / "display.json", cluster_base(dir).dump(1));
-    spit(dir / "x.png", still_image(".png", 64, 64));
+    spit(dir / "x.png", still_png());
   };
   add_flag_values(out, "play", cluster, "--node", names() + std::vector<std::string>{"nobody"});
   add_flag_values(out, "play", cluster, "--join-timeout", positives({"1e9"}), {"--node=left"});
@@ -2475,7 +2500,9 @@ void add_flags_interop(std::vector<Variant>& out) {
   add_flag_values(out, "bourke import", bourke, "--zenith", choices("centre"));
   add_flag_values(out, "bourke import", bourke, "--tilt", angles("91"));
   add_flag_values(out, "bourke import", bourke, "--orientation", angles("361"));
-  const Base mpcdi_export{{"mpcdi", "export", kDome180, "--out", "@out.mpcdi"}, "out.mpcdi", {}};
+  // A display both exports take (dome180's footprints are wider than one frustum holds).
+  const std::string wall = (kSource / "configs/displays/wall2x2/display.json").string();
+  const Base mpcdi_export{{"mpcdi", "export", wall, "--out", "@out.mpcdi"}, "out.mpcdi", {}};
   add_flag_values(out, "mpcdi export", mpcdi_export, "--out", out_files(".mpcdi"));
   add_flag_values(out, "mpcdi export", mpcdi_export, "--node-spacing", positives({"1e-9"}));
   add_flag_values(out, "mpcdi export", mpcdi_export, "--profile", choices("3d"));
@@ -2486,7 +2513,7 @@ void add_flags_interop(std::vector<Variant>& out) {
   add_flag_values(out, "mpcdi import", mpcdi_import, "--eye", points());
   add_flag_values(out, "mpcdi import", mpcdi_import, "--tilt", angles("91"));
   add_flag_values(out, "mpcdi import", mpcdi_import, "--orientation", angles("361"));
-  const Base sgct_export{{"sgct", "export", kDome180, "--out", "@out"}, "out", {}};
+  const Base sgct_export{{"sgct", "export", wall, "--out", "@out"}, "out", {}};
   add_flag_values(out, "sgct export", sgct_export, "--out", out_folders());
   add_flag_values(out, "sgct export", sgct_export, "--node-spacing", positives({"1e-9"}));
   add_flag_values(out, "sgct export", sgct_export, "--mask-gamma", positives({"1000"}));
@@ -2500,12 +2527,14 @@ void add_flags_interop(std::vector<Variant>& out) {
 }
 
 void add_flags_error_bench(std::vector<Variant>& out) {
-  const Base error{{"error"}, "out", {}};
+  // Small, so that a value taken as valid costs little (at the default 1600x1200: 3 s).
+  const Base error{{"error", "--size", "160x120"}, "out", {}};
   add_flag_values(out, "error", error, "--warp", inputs(".warp.exr"));
   add_flag_values(out, "error", error, "--base", choices("fisheye"));
   add_flag_values(out, "error", error, "--size", sizes());
   add_flag_values(out, "error", error, "--azimuth", pairs({"5,5", "-400,400"}));
-  add_flag_values(out, "error", error, "--tan-elevation", pairs({"1,1", "-1,1"}));
+  // Top below bottom ("-1,1") is a valid, upside-down cylinder; these are not.
+  add_flag_values(out, "error", error, "--tan-elevation", pairs({"1,1", "0,-0", "1e9,-1"}));
   add_flag_values(out, "error", error, "--elevation", pairs({"10,10", "100,-100"}),
                   {"--base=equirectangular"});
   add_flag_values(out, "error", error, "--tan-extent",
@@ -2516,14 +2545,21 @@ void add_flags_error_bench(std::vector<Variant>& out) {
   add_flag_values(out, "error", error, "--pieces", counts({"100000000"}));
   add_flag_values(out, "error", error, "--grid", sizes({"65536x1", "1x65536"}));
   add_flag_values(out, "error", error, "--tolerance", positives({"1e-9", "1e-300"}));
-  const Base bench{{"bench", "--quick", "--scenario", "cylinder", "--out", "@out"}, "out", {}};
+  // One frame at a tenth of --quick's sizes: 2.5 s when a value is taken as valid (50 s without).
+  const Base bench{{"bench", "--quick", "--scenario", "cylinder", "--frames", "1", "--size-scale",
+                    "0.1", "--out", "@out"},
+                   "out",
+                   {}};
   add_flag_values(out, "bench", bench, "--scenario", choices("cylinder"));
   add_flag_values(out, "bench", bench, "--frames", counts({"1000001"}));
   add_flag_values(out, "bench", bench, "--size-scale", positives({"1e-9", "1000"}));
   add_flag_values(out, "bench", bench, "--out", out_folders());
-  add_flag_values(out, "bench", bench, "--rig",
-                  inputs(".json") + std::vector<std::string>{"builtin:", "builtin:bogus"},
-                  {"--scenario=dome4"});
+  // The rig is the dome4 scenario's: that scenario instead of cylinder (given twice, the
+  // scenario alone would be refused).
+  Base bench_dome4 = bench;
+  bench_dome4.args[3] = "dome4";
+  add_flag_values(out, "bench", bench_dome4, "--rig",
+                  inputs(".json") + std::vector<std::string>{"builtin:", "builtin:bogus"});
   add_flag_values(out, "bench", bench, "--scene", scenes());
 }
 
@@ -2589,12 +2625,13 @@ const std::size_t kStartupThreads = thread_count();
 // locks the child could inherit held.
 bool single_threaded() { return thread_count() <= kStartupThreads; }
 
-// Runs facet with `args` in `cwd`, under the limits, stderr to `log`: exec'ing the executable, or
-// with `in_process` calling facet::cli::run in the forked child (the same code without the
-// dynamic loader's 0.15 s of CPU per start).
-Outcome run_cli(const std::vector<std::string>& args, const fs::path& cwd, const fs::path& log,
-                bool in_process = false) {
-  if (in_process && !single_threaded()) {
+// Runs facet with `args` in `cwd`, under the limits, stderr to `log`: calling facet::cli::run in a
+// forked child (the same code as the executable's main, without the dynamic loader's 0.15 s of
+// CPU per start, which 4,000 variants cannot afford), or exec'ing the executable while other
+// threads run in this process.
+Outcome run_cli(const std::vector<std::string>& args, const fs::path& cwd, const fs::path& log) {
+  bool in_process = true;
+  if (!single_threaded()) {
     static bool told = false;
     if (!std::exchange(told, true)) std::cout << "other threads running: exec'ing facet instead\n";
     in_process = false;
@@ -2640,21 +2677,31 @@ Outcome run_cli(const std::vector<std::string>& args, const fs::path& cwd, const
   const auto deadline = std::chrono::steady_clock::now() + kWallLimit;
   int status = 0;
   rusage usage{};
-  // Polled from 0.1 ms up to 5 ms: a refused flag ends within a millisecond or two.
+  // Woken by the child's end through a pidfd (a refused flag ends within a millisecond or two);
+  // without one, polled from 0.1 ms up to 5 ms.
+  const int pidfd = static_cast<int>(::syscall(SYS_pidfd_open, child, 0));
   auto poll = std::chrono::microseconds(100);
   for (;;) {
     const pid_t done = ::wait4(child, &status, WNOHANG, &usage);
     if (done == child) break;
-    if (std::chrono::steady_clock::now() > deadline) {
+    const auto now = std::chrono::steady_clock::now();
+    if (now > deadline) {
       outcome.timed_out = true;
       ::kill(-child, SIGKILL);
       ::kill(child, SIGKILL);
       ::wait4(child, &status, 0, &usage);
       break;
     }
-    std::this_thread::sleep_for(poll);
-    poll = std::min<std::chrono::microseconds>(poll * 2, std::chrono::milliseconds(5));
+    if (pidfd >= 0) {
+      pollfd ended{pidfd, POLLIN, 0};
+      const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - now);
+      ::poll(&ended, 1, static_cast<int>(std::min<std::int64_t>(left.count() + 1, 1000)));
+    } else {
+      std::this_thread::sleep_for(poll);
+      poll = std::min<std::chrono::microseconds>(poll * 2, std::chrono::milliseconds(5));
+    }
   }
+  if (pidfd >= 0) ::close(pidfd);
   ::kill(-child, SIGKILL);  // anything it left running in its group
   if (WIFEXITED(status)) outcome.exit_code = WEXITSTATUS(status);
   if (WIFSIGNALED(status)) outcome.signal = WTERMSIG(status);
@@ -2686,14 +2733,37 @@ void check_variant(const Variant& variant) {
   std::error_code ec;
   fs::remove_all(scratch, ec);
   fs::create_directories(scratch);
-  if (variant.make) variant.make(scratch);
+  // In a forked child: writing the inputs (with OpenImageIO, OpenEXR, OpenCV) starts pools of
+  // threads, which must not run here for the CLI to run in forked children of this process.
+  if (variant.make && !variant.make_starts_threads) variant.make(scratch);
+  if (variant.make && variant.make_starts_threads) {
+    std::fflush(nullptr);
+    const pid_t child = ::fork();
+    if (child == 0) {
+      int status = 0;
+      try {
+        variant.make(scratch);
+      } catch (...) {
+        status = 1;
+      }
+      std::fflush(nullptr);
+      ::_exit(status);
+    }
+    int status = 0;
+    ::waitpid(child, &status, 0);
+    ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << "writing the inputs failed";
+  }
   std::vector<std::string> args;
   for (const std::string& a : variant.args) {
     args.push_back(replace_all(a.starts_with("@") ? (scratch / a.substr(1)).string() : a, "{dir}",
                                scratch.string()));
   }
-  const Outcome outcome = run_cli(args, scratch, root / (variant.name + ".stderr"),
-                                  in_process().contains(variant.name));
+  const auto started = std::chrono::steady_clock::now();
+  const Outcome outcome = run_cli(args, scratch, root / (variant.name + ".stderr"));
+  // Reported, not asserted (the machine's load sets it): a refusal takes milliseconds.
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  if (seconds > 1.0) std::cout << "  slow: " << variant.name << " " << seconds << " s\n";
   std::string command = "facet";
   for (const std::string& a : args) command += " " + a;
   SCOPED_TRACE(command + "\nstderr: " + outcome.stderr_text);
@@ -2703,11 +2773,17 @@ void check_variant(const Variant& variant) {
   EXPECT_EQ(outcome.exit_code, 2);
   EXPECT_LT(outcome.max_resident_kib, kMaxResidentKiB);
   EXPECT_EQ(outcome.stderr_text.find("internal error"), std::string::npos);
+  // A flag's or a field's name counts only outside the scratch folder's path, which holds the
+  // variant's name (and so the flag's, when it has no '-'); a path counts anywhere.
+  const std::string stderr_outside_scratch =
+      replace_all(outcome.stderr_text, scratch.string(), "SCRATCH");
   const bool named =
       std::any_of(variant.mentions.begin(), variant.mentions.end(), [&](const std::string& m) {
+        const bool path = m.find("{dir}") != std::string::npos || m.starts_with("/");
         const std::string bare =
             replace_all(m.starts_with("--") ? m.substr(2) : m, "{dir}", scratch.string());
-        return !bare.empty() && outcome.stderr_text.find(bare) != std::string::npos;
+        const std::string& text = path ? outcome.stderr_text : stderr_outside_scratch;
+        return !bare.empty() && text.find(bare) != std::string::npos;
       });
   EXPECT_TRUE(named) << "stderr names none of the input or field";
   EXPECT_FALSE(fs::exists(fs::symlink_status(scratch / variant.output)))
