@@ -17,6 +17,28 @@ double cross(glm::dvec2 a, glm::dvec2 b) { return a.x * b.y - a.y * b.x; }
 constexpr double kCellSlack = 1e-10;
 constexpr int kMaxNewtonSteps = 32;
 
+// Newton's method on the bilinear map of a cell with mapped corners q00, q10, q01, q11, from the
+// cell-local start f. False when it does not reach WarpInverse::kTolerancePx.
+bool newton_in_cell(glm::dvec2 q00, glm::dvec2 q10, glm::dvec2 q01, glm::dvec2 q11, glm::dvec2 q,
+                    glm::dvec2& f) {
+  for (int step = 0; step < kMaxNewtonSteps; ++step) {
+    const glm::dvec2 bottom = q00 * (1 - f.x) + q10 * f.x, top = q01 * (1 - f.x) + q11 * f.x;
+    const glm::dvec2 residual = bottom * (1 - f.y) + top * f.y - q;
+    if (glm::length(residual) <= WarpInverse::kTolerancePx * 0.5) return true;
+    const glm::dvec2 d_dx = (q10 - q00) * (1 - f.y) + (q11 - q01) * f.y;
+    const glm::dvec2 d_dy = top - bottom;
+    const double det = cross(d_dx, d_dy);
+    if (!(std::abs(det) > 1e-300)) return false;
+    // Cramer's rule for J·δ = −residual.
+    const glm::dvec2 delta(cross(d_dy, residual) / det, cross(residual, d_dx) / det);
+    f += delta;
+    if (!std::isfinite(f.x) || !std::isfinite(f.y)) return false;
+  }
+  const glm::dvec2 q_f =
+      (q00 * (1 - f.x) + q10 * f.x) * (1 - f.y) + (q01 * (1 - f.x) + q11 * f.x) * f.y;
+  return glm::length(q_f - q) <= WarpInverse::kTolerancePx;
+}
+
 }  // namespace
 
 WarpInverse::WarpInverse(Warp warp) : warp_(std::move(warp)) {
@@ -142,24 +164,8 @@ glm::dvec2 WarpInverse::q_node(int i, int j) const {
 }
 
 bool WarpInverse::solve_in_cell(glm::ivec2 cell, glm::dvec2 q, glm::dvec2& f) const {
-  const glm::dvec2 q00 = q_node(cell.x, cell.y), q10 = q_node(cell.x + 1, cell.y),
-                   q01 = q_node(cell.x, cell.y + 1), q11 = q_node(cell.x + 1, cell.y + 1);
-  for (int step = 0; step < kMaxNewtonSteps; ++step) {
-    const glm::dvec2 bottom = q00 * (1 - f.x) + q10 * f.x, top = q01 * (1 - f.x) + q11 * f.x;
-    const glm::dvec2 residual = bottom * (1 - f.y) + top * f.y - q;
-    if (glm::length(residual) <= kTolerancePx * 0.5) return true;
-    const glm::dvec2 d_dx = (q10 - q00) * (1 - f.y) + (q11 - q01) * f.y;
-    const glm::dvec2 d_dy = top - bottom;
-    const double det = cross(d_dx, d_dy);
-    if (!(std::abs(det) > 1e-300)) return false;
-    // Cramer's rule for J·δ = −residual.
-    const glm::dvec2 delta(cross(d_dy, residual) / det, cross(residual, d_dx) / det);
-    f += delta;
-    if (!std::isfinite(f.x) || !std::isfinite(f.y)) return false;
-  }
-  const glm::dvec2 q_f =
-      (q00 * (1 - f.x) + q10 * f.x) * (1 - f.y) + (q01 * (1 - f.x) + q11 * f.x) * f.y;
-  return glm::length(q_f - q) <= kTolerancePx;
+  return newton_in_cell(q_node(cell.x, cell.y), q_node(cell.x + 1, cell.y),
+                        q_node(cell.x, cell.y + 1), q_node(cell.x + 1, cell.y + 1), q, f);
 }
 
 std::optional<WarpInverse::Inverted> WarpInverse::invert(glm::dvec2 q) const {
@@ -237,18 +243,68 @@ std::optional<glm::dvec2> WarpInverse::walk_from(glm::ivec2 cell, glm::dvec2 q) 
   return std::nullopt;
 }
 
-std::vector<glm::dvec2> WarpInverse::st_at_pixel_centres() const {
+void WarpInverse::for_each_pixel_centre(
+    const std::function<void(std::size_t, glm::dvec2)>& found) const {
   const glm::ivec2 size = warp_.output_size;
-  std::vector<glm::dvec2> st(cell_of_pixel_.size(),
-                             glm::dvec2(std::numeric_limits<double>::quiet_NaN()));
+  // Along a row, consecutive pixel centres mostly lie in the same cell: Newton starts there from
+  // the previous pixel's cell-local solution, a pixel away, and converges in a step or two
+  // instead of four or five from the cell's middle. It still stops only within kTolerancePx, so
+  // the answer is the same point to that tolerance; anything else (another cell, a solution
+  // outside this one, no convergence) takes st_from_q's path.
   detail::parallel_for(std::size_t(std::max(size.y, 0)), [&](std::size_t y, std::size_t) {
+    const std::int32_t* cells = cell_of_pixel_.data() + y * std::size_t(size.x);
+    std::int32_t previous = -1;  // the cell of the previous pixel's solution, or −1
+    glm::dvec2 f(0.5), q00(0.0), q10(0.0), q01(0.0), q11(0.0);
     for (int x = 0; x < size.x; ++x) {
-      if (auto found = st_from_q(glm::dvec2(x + 0.5, double(y) + 0.5))) {
-        st[y * size.x + x] = *found;
+      const glm::dvec2 q(x + 0.5, double(y) + 0.5);
+      const std::int32_t cell = cells[x];
+      if (cell >= 0 && cell == previous) {
+        glm::dvec2 g = f;
+        if (newton_in_cell(q00, q10, q01, q11, q, g) && g.x >= -kCellSlack && g.y >= -kCellSlack &&
+            g.x <= 1 + kCellSlack && g.y <= 1 + kCellSlack) {
+          const glm::ivec2 c(cell % cells_.x, cell / cells_.x);
+          const glm::dvec2 clamped = glm::clamp(g, 0.0, 1.0);
+          const glm::dvec2 st((c.x + clamped.x) / cells_.x, (c.y + clamped.y) / cells_.y);
+          // Uncovered here: st_from_q also tries the other cells that may hold q.
+          if (warp_.coverage_at(st) >= 0.5) {
+            f = g;
+            found(y * std::size_t(size.x) + x, st);
+            continue;
+          }
+        }
+      }
+      previous = -1;
+      const auto st = st_from_q(q);
+      if (!st) continue;
+      found(y * std::size_t(size.x) + x, *st);
+      // Start the next pixel from this solution when it lies in the cell stored for that pixel.
+      const glm::ivec2 c = glm::min(glm::ivec2(*st * glm::dvec2(cells_)), cells_ - 1);
+      if (cell == c.y * cells_.x + c.x) {
+        previous = cell;
+        f = *st * glm::dvec2(cells_) - glm::dvec2(c);
+        q00 = q_node(c.x, c.y);
+        q10 = q_node(c.x + 1, c.y);
+        q01 = q_node(c.x, c.y + 1);
+        q11 = q_node(c.x + 1, c.y + 1);
       }
     }
   });
+}
+
+std::vector<glm::dvec2> WarpInverse::st_at_pixel_centres() const {
+  std::vector<glm::dvec2> st(cell_of_pixel_.size(),
+                             glm::dvec2(std::numeric_limits<double>::quiet_NaN()));
+  for_each_pixel_centre([&](std::size_t pixel, glm::dvec2 found) { st[pixel] = found; });
   return st;
+}
+
+std::vector<glm::vec3> WarpInverse::v_eye_at_pixel_centres() const {
+  std::vector<glm::vec3> v_eye(cell_of_pixel_.size(),
+                               glm::vec3(std::numeric_limits<float>::quiet_NaN()));
+  for_each_pixel_centre([&](std::size_t pixel, glm::dvec2 found) {
+    v_eye[pixel] = glm::vec3(glm::normalize(warp_.v_eye_from_st(found)));
+  });
+  return v_eye;
 }
 
 std::int32_t WarpInverse::cell_at_pixel(glm::ivec2 pixel) const {

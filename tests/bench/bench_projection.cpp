@@ -2,10 +2,13 @@
 #include <benchmark/benchmark.h>
 
 #include <random>
+#include <string>
 
 #include "facet/projection/coverage.hpp"
 #include "facet/projection/facet_error.hpp"
 #include "facet/projection/facets.hpp"
+#include "facet/projection/warp_inverse.hpp"
+#include "facet/projection_io/warp_file.hpp"
 
 namespace {
 
@@ -54,6 +57,24 @@ void BM_CoverageQuery(benchmark::State& state) {
   }
 }
 BENCHMARK(BM_CoverageQuery)->Arg(160)->Arg(640);
+
+// facet play's preparation before its first frame: the warp inverse of one of dome4's four
+// 1024×768 projectors at every pixel centre, as ContentPass builds its direction lookup.
+facet::Warp dome4_projector() {
+  return facet::read_warp(std::string(FACET_SOURCE_DIR) + "/configs/displays/dome4/p0.warp.exr");
+}
+
+void BM_WarpInverseBuild(benchmark::State& state) {
+  const auto warp = dome4_projector();
+  for (auto _ : state) benchmark::DoNotOptimize(facet::WarpInverse(warp));
+}
+BENCHMARK(BM_WarpInverseBuild)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+void BM_WarpInversePixelCentres(benchmark::State& state) {
+  const facet::WarpInverse inverse(dome4_projector());
+  for (auto _ : state) benchmark::DoNotOptimize(inverse.st_at_pixel_centres());
+}
+BENCHMARK(BM_WarpInversePixelCentres)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 }  // namespace
 

@@ -217,5 +217,46 @@ TEST(WarpInverse, RealSimcadDomeWarpsRoundTrip) {
   }
 }
 
+// st_at_pixel_centres starts Newton from the neighbouring pixel's solution; st_from_q, the exact
+// per-query path, starts from the middle of the cell. Both must find the same pixel centres and
+// the same points to within the inverse's tolerance, on real warps.
+TEST(WarpInverse, PixelCentresAgreeWithPerQueryInverseOnRealDomeWarps) {
+  for (int channel = 1; channel <= 6; ++channel) {
+    const std::string path = std::string(FACET_SHARED_DATA_DIR) +
+                             "/warps/sgct-dome/simcad/channel" + std::to_string(channel) +
+                             "_warp_mesh.csv";
+    SCOPED_TRACE(path);
+    const Warp warp = simcad_warp(path, {1280, 800});
+    const WarpInverse inverse(warp);
+    const auto st = inverse.st_at_pixel_centres();
+    const auto v_eye = inverse.v_eye_at_pixel_centres();
+    std::size_t covered = 0, disagree = 0;
+    double worst_px = 0, worst_v = 0;
+    for (int y = 0; y < warp.output_size.y; ++y) {
+      for (int x = 0; x < warp.output_size.x; ++x) {
+        const std::size_t k = std::size_t(y) * warp.output_size.x + x;
+        const auto exact = inverse.st_from_q({x + 0.5, y + 0.5});
+        if (exact.has_value() == std::isnan(st[k].x) ||
+            exact.has_value() == std::isnan(v_eye[k].x)) {
+          ++disagree;
+          continue;
+        }
+        if (!exact) continue;
+        ++covered;
+        // The two answers' images in the output, and the directions against the exact one.
+        worst_px = std::max(worst_px, glm::length(warp.q_from_st(st[k]) - warp.q_from_st(*exact)));
+        const glm::vec3 v_exact(glm::normalize(warp.v_eye_from_st(*exact)));
+        worst_v = std::max(worst_v, double(glm::length(v_eye[k] - v_exact)));
+      }
+    }
+    EXPECT_EQ(disagree, 0u);
+    EXPECT_GT(covered, std::size_t(1280 * 800) / 2);
+    // Each answer maps within kTolerancePx of the pixel centre: worst case, output px.
+    EXPECT_LE(worst_px, 2 * WarpInverse::kTolerancePx);
+    // Unit vectors rounded to float: a few float ulps.
+    EXPECT_LE(worst_v, 1e-6);
+  }
+}
+
 }  // namespace
 }  // namespace facet

@@ -106,15 +106,14 @@ ContentPass::ContentPass(std::span<const OutputSpec> outputs, ResampleOptions op
   for (const OutputSpec& output : outputs) {
     const WarpInverse inverse(output.warp);
     const glm::ivec2 size = output.warp.output_size;
-    const std::vector<glm::dvec2> st = inverse.st_at_pixel_centres();
+    const std::vector<glm::vec3> v_eye = inverse.v_eye_at_pixel_centres();
     // GL rows start at the bottom.
-    std::vector<glm::vec4> lookup(st.size(), glm::vec4(0));
+    std::vector<glm::vec4> lookup(v_eye.size(), glm::vec4(0));
     for (int y = 0; y < size.y; ++y) {
       for (int x = 0; x < size.x; ++x) {
-        const glm::dvec2 s = st[std::size_t(y) * size.x + x];
-        if (std::isnan(s.x)) continue;
-        const glm::dvec3 v_eye = glm::normalize(output.warp.v_eye_from_st(s));
-        lookup[std::size_t(size.y - 1 - y) * size.x + x] = glm::vec4(glm::vec3(v_eye), 1.0f);
+        const glm::vec3 v = v_eye[std::size_t(y) * size.x + x];
+        if (std::isnan(v.x)) continue;
+        lookup[std::size_t(size.y - 1 - y) * size.x + x] = glm::vec4(v, 1.0f);
       }
     }
     Texture texture = Texture::create_2d(GL_RGBA32F, size.x, size.y);

@@ -10,7 +10,9 @@
 // the cell stored for the pixel that holds q and walk to neighbouring cells when the solution
 // leaves the cell; where that finds nothing (q outside the image, a walk blocked by uncovered
 // cells) the cells whose bounding boxes hold q are tried, found through a coarse grid of bins.
+#include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <glm/glm.hpp>
 #include <optional>
 #include <vector>
@@ -43,8 +45,13 @@ class WarpInverse {
   std::optional<glm::dvec2> st_from_q(glm::dvec2 q) const;
 
   // invert() at every output pixel centre (x + 0.5, y + 0.5), row 0 at the top, row-major;
-  // uncovered pixels hold NaN in every component. Runs on all hardware threads.
+  // uncovered pixels hold NaN in every component. Runs on all hardware threads. Newton starts
+  // from the neighbouring pixel's solution where both lie in one cell, so an answer may differ
+  // from st_from_q's in the last bits, never by more than kTolerancePx in output pixels.
   std::vector<glm::dvec2> st_at_pixel_centres() const;
+  // The same pixel centres' unit eye directions, normalize(Warp::v_eye_from_st(st)) rounded to
+  // float (as a direction lookup texture holds them); NaN where uncovered.
+  std::vector<glm::vec3> v_eye_at_pixel_centres() const;
 
   // The cell (i + j·(Gw − 1)) stored for the pixel holding q's centre, or −1: for tests.
   std::int32_t cell_at_pixel(glm::ivec2 pixel) const;
@@ -58,6 +65,8 @@ class WarpInverse {
   // Moves from cell to neighbouring cell towards q until the solution lies inside the cell.
   std::optional<glm::dvec2> walk_from(glm::ivec2 cell, glm::dvec2 q) const;
   glm::dvec2 q_node(int i, int j) const;
+  // Calls found(y · width + x, st) for every covered pixel centre, rows in parallel.
+  void for_each_pixel_centre(const std::function<void(std::size_t, glm::dvec2)>& found) const;
   void build_bins();
 
   Warp warp_;
