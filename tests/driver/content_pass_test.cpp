@@ -9,9 +9,13 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
 #include <numbers>
 #include <vector>
 
+#include "facet/driver/direction_cache.hpp"
 #include "facet/driver/session.hpp"
 #include "facet/projection/warp_inverse.hpp"
 #include "gl_test_context.hpp"
@@ -245,6 +249,52 @@ TEST(ContentPass, DomeMasterDotsLandWhereTheWarpSays) {
   }
   EXPECT_GE(found, 24);
   std::printf("dome master dots: %d measured, worst centroid error %.3f px\n", found, worst_px);
+}
+
+// The direction cache hands back exactly what the inverse computes, rereads it on the next call,
+// and ignores a file that does not match (a damaged payload, another warp).
+TEST(DirectionCache, ReadsBackTheComputedLookupAndIgnoresADamagedFile) {
+  const std::filesystem::path folder = test_paths::scratch_path("facet_direction_cache");
+  std::filesystem::remove_all(folder);
+  const Warp warp = dome4_outputs().at(1).warp;
+  const std::vector<glm::vec3> computed = WarpInverse(warp).v_eye_at_pixel_centres();
+  auto same_bits = [&](const std::vector<glm::vec3>& v) {
+    return v.size() == computed.size() &&
+           std::memcmp(v.data(), computed.data(), v.size() * sizeof(glm::vec3)) == 0;
+  };
+
+  const DirectionLookup first = direction_lookup(warp, folder);
+  EXPECT_FALSE(first.from_cache);
+  EXPECT_TRUE(same_bits(first.v_eye));
+  std::vector<std::filesystem::path> files;
+  for (const auto& entry : std::filesystem::directory_iterator(folder)) files.push_back(entry);
+  ASSERT_EQ(files.size(), 1u);  // the file alone: no temporary left behind
+
+  const DirectionLookup second = direction_lookup(warp, folder);
+  EXPECT_TRUE(second.from_cache);
+  EXPECT_TRUE(same_bits(second.v_eye));
+
+  // One payload byte changed: not trusted, computed again and rewritten.
+  {
+    std::fstream file(files[0], std::ios::in | std::ios::out | std::ios::binary);
+    file.seekg(-5, std::ios::end);
+    const char byte = char(file.get() ^ 0x55);
+    file.seekp(-5, std::ios::end);
+    file.put(byte);
+  }
+  const DirectionLookup damaged = direction_lookup(warp, folder);
+  EXPECT_FALSE(damaged.from_cache);
+  EXPECT_TRUE(same_bits(damaged.v_eye));
+  EXPECT_TRUE(direction_lookup(warp, folder).from_cache);
+
+  // Another warp (one node moved by a thousandth of a pixel) has a file of its own.
+  Warp moved = warp;
+  moved.offset_px[moved.offset_px.size() / 2].x += 1e-3f;
+  EXPECT_NE(direction_cache_key(moved), direction_cache_key(warp));
+  EXPECT_FALSE(direction_lookup(moved, folder).from_cache);
+  // No folder: computed, nothing written.
+  EXPECT_FALSE(direction_lookup(warp, {}).from_cache);
+  std::filesystem::remove_all(folder);
 }
 
 }  // namespace

@@ -27,6 +27,13 @@ namespace {
 
 namespace fs = std::filesystem;
 
+// facet play keeps its direction lookups under $XDG_CACHE_HOME: in a scratch folder of this
+// process here, not in the user's cache.
+const bool kScratchCache = [] {
+  ::setenv("XDG_CACHE_HOME", test_paths::scratch_path("facet_play_cache").c_str(), 1);
+  return true;
+}();
+
 constexpr int kSide = 128;  // a square dome master, shown 1:1 on builtin:dome180 at 128x128
 constexpr int kBits = 8;
 constexpr int kBlock = 16;
@@ -176,6 +183,33 @@ TEST_F(PlayCli, BadInputExitsTwoWithAClearMessage) {
   EXPECT_EQ(play(video.string() + " --start-frame 40 --headless --out " + out.string()), 2);
   EXPECT_NE(log().find("--start-frame"), std::string::npos) << log();
   EXPECT_FALSE(fs::exists(out)) << "nothing is written on bad input";
+}
+
+// A second start reads the direction lookups back from --direction-cache; the pictures are the
+// same bytes as with the lookups computed.
+TEST_F(PlayCli, DirectionCacheGivesTheSamePictures) {
+  cv::Mat dome(96, 96, CV_8UC3);
+  cv::randu(dome, cv::Scalar::all(0), cv::Scalar::all(255));
+  cv::imwrite((dir_ / "dome.png").string(), dome);
+  const fs::path cache = dir_ / "directions";
+  const std::string still = (dir_ / "dome.png").string() + " --headless";
+  ASSERT_EQ(play(still + " --no-direction-cache --out " + (dir_ / "computed").string()), 0)
+      << log();
+  EXPECT_FALSE(fs::exists(cache));
+  for (const char* run : {"first", "second"}) {
+    ASSERT_EQ(
+        play(still + " --direction-cache " + cache.string() + " --out " + (dir_ / run).string()), 0)
+        << log();
+  }
+  ASSERT_EQ(std::distance(fs::directory_iterator(cache), fs::directory_iterator()), 1);
+  const std::string computed = test::slurp(dir_ / "computed" / "dome180" / "00000.png");
+  EXPECT_FALSE(computed.empty());
+  EXPECT_EQ(test::slurp(dir_ / "first" / "dome180" / "00000.png"), computed);
+  EXPECT_EQ(test::slurp(dir_ / "second" / "dome180" / "00000.png"), computed);
+  EXPECT_EQ(play(still + " --no-direction-cache --direction-cache " + cache.string() + " --out " +
+                 (dir_ / "both").string()),
+            2);
+  EXPECT_NE(log().find("--no-direction-cache"), std::string::npos) << log();
 }
 
 TEST_F(PlayCli, StillEquirectOnACylinder) {

@@ -15,6 +15,7 @@
 #include "facet/driver/cluster.hpp"
 #include "facet/driver/content_media.hpp"
 #include "facet/driver/content_player.hpp"
+#include "facet/driver/direction_cache.hpp"
 #include "facet/driver/gl_context.hpp"
 #include "facet/driver/session.hpp"
 #include "facet/driver/session_runner.hpp"
@@ -44,6 +45,8 @@ struct PlayOptions {
   std::string node;   // a cluster node of the display
   double join_timeout_s = 60;
   std::optional<double> rate_hz;
+  std::string direction_cache;  // empty: driver::default_direction_cache()
+  bool no_direction_cache = false;
 };
 
 // What changes a node's pictures besides the display, for the cluster's content digest: the
@@ -105,6 +108,14 @@ void play(const PlayOptions& options) {
   playback.projection.validate("command line");
   playback.loop = options.loop;
   playback.start_frame = options.start_frame;
+  if (options.no_direction_cache && !options.direction_cache.empty())
+    throw InputError("command line", "--no-direction-cache",
+                     "either --direction-cache DIR or --no-direction-cache, not both");
+  if (!options.no_direction_cache) {
+    playback.resample.direction_cache = options.direction_cache.empty()
+                                            ? driver::default_direction_cache()
+                                            : std::filesystem::path(options.direction_cache);
+  }
   if (options.start_frame < 0 || options.start_frame >= media->frame_count())
     throw InputError("command line", "--start-frame",
                      "a frame from 0 to " + std::to_string(media->frame_count() - 1) + " of " +
@@ -210,6 +221,12 @@ const Registration registration{
                           "Output frames at 60 Hz, 1 to 1000000 (headless default: one pass of "
                           "the video, 1 for a still; windowed: until closed)");
       command->add_flag("--loop", options->loop, "Loop the video");
+      command->add_option("--direction-cache", options->direction_cache,
+                          "Folder keeping each output's direction lookup (the warp inverse at "
+                          "every pixel) between starts, keyed by the warp's content (default "
+                          "$XDG_CACHE_HOME/facet/directions or ~/.cache/facet/directions)");
+      command->add_flag("--no-direction-cache", options->no_direction_cache,
+                        "Compute the direction lookups at every start and write none");
       command->add_option("--start-frame", options->start_frame,
                           "Video frame shown at time 0 (default 0)");
       command

@@ -4,9 +4,9 @@
 #include <cmath>
 #include <glm/gtc/type_ptr.hpp>
 
+#include "facet/driver/direction_cache.hpp"
 #include "facet/driver/program.hpp"
 #include "facet/projection/errors.hpp"
-#include "facet/projection/warp_inverse.hpp"
 
 namespace facet::driver {
 
@@ -104,9 +104,10 @@ void ContentTexture::upload(const ContentImage& image) {
 ContentPass::ContentPass(std::span<const OutputSpec> outputs, ResampleOptions options)
     : options_(options) {
   for (const OutputSpec& output : outputs) {
-    const WarpInverse inverse(output.warp);
     const glm::ivec2 size = output.warp.output_size;
-    const std::vector<glm::vec3> v_eye = inverse.v_eye_at_pixel_centres();
+    const DirectionLookup directions = direction_lookup(output.warp, options.direction_cache);
+    lookups_from_cache_ += directions.from_cache ? 1 : 0;
+    const std::vector<glm::vec3>& v_eye = directions.v_eye;
     // GL rows start at the bottom.
     std::vector<glm::vec4> lookup(v_eye.size(), glm::vec4(0));
     for (int y = 0; y < size.y; ++y) {

@@ -8,6 +8,7 @@
 // finer (cube maps: trilinear and anisotropic, bilinear when magnified). The caller then applies
 // the output's BlendPass, as sessions do (ContentPlayer does both).
 #include <cstdint>
+#include <filesystem>
 #include <glm/glm.hpp>
 #include <span>
 #include <vector>
@@ -64,13 +65,18 @@ struct ResampleOptions {
   // present), one tap in the shader. Off by default: llvmpipe's returns stray texels.
   bool hardware_anisotropy = false;
   bool bicubic_when_magnifying = true;
+  // A folder keeping each output's direction lookup between starts (direction_cache.hpp): read
+  // back when it holds one for the same warp, else computed and written there. Empty: always
+  // computed, nothing written.
+  std::filesystem::path direction_cache;
 };
 
 class ContentPass {
  public:
   ContentPass() = default;
   // Inverts every output's warp at its pixel centres (WarpInverse, all hardware threads) into a
-  // direction lookup texture per output. Needs a current context.
+  // direction lookup texture per output, or reads them from options.direction_cache. Needs a
+  // current context.
   explicit ContentPass(std::span<const OutputSpec> outputs, ResampleOptions options = {});
 
   // Draws output `output`'s pixels into the bound framebuffer (its size the output's; the
@@ -82,6 +88,8 @@ class ContentPass {
   std::size_t output_count() const { return lookups_.size(); }
   glm::ivec2 output_size(std::size_t output) const { return sizes_.at(output); }
   int max_anisotropy() const { return max_anisotropy_; }
+  // How many outputs' direction lookups were read from the cache rather than computed.
+  std::size_t lookups_from_cache() const { return lookups_from_cache_; }
   // The sampler's anisotropy (1 unless ResampleOptions::hardware_anisotropy and the GL has it).
   float hardware_anisotropy() const { return hardware_anisotropy_; }
 
@@ -90,6 +98,7 @@ class ContentPass {
   std::vector<glm::ivec2> sizes_;
   ResampleOptions options_;
   int max_anisotropy_ = 1;
+  std::size_t lookups_from_cache_ = 0;
   float hardware_anisotropy_ = 1;
   bool sampler_has_anisotropy_ = false;
   Program program_;
