@@ -40,10 +40,20 @@ struct Fnv1a {
   }
 };
 
+// FNV-1a over 64-bit words (then the remaining bytes): eight times fewer steps than bytewise,
+// tens of megabytes being read at every start.
 std::uint64_t payload_digest(const std::vector<glm::vec3>& v_eye) {
-  Fnv1a hash;
-  hash.bytes(v_eye.data(), v_eye.size() * sizeof(glm::vec3));
-  return hash.state;
+  const std::size_t size = v_eye.size() * sizeof(glm::vec3);
+  const auto* bytes = reinterpret_cast<const unsigned char*>(v_eye.data());
+  std::uint64_t state = 14695981039346656037ull;
+  std::size_t k = 0;
+  for (; k + 8 <= size; k += 8) {
+    std::uint64_t word;
+    std::memcpy(&word, bytes + k, 8);
+    state = (state ^ word) * 1099511628211ull;
+  }
+  for (; k < size; ++k) state = (state ^ bytes[k]) * 1099511628211ull;
+  return state;
 }
 
 std::string file_name(std::uint64_t key) {
