@@ -2327,6 +2327,29 @@ void add_flags_play(std::vector<Variant>& out) {
   add_flag_values(out, "play", b, "--start-frame", naturals());
   add_flag_values(out, "play", b, "--out", out_folders());
   add_flag_values(out, "play", b, "--stats", out_files(".jsonl"));
+  // A cache folder: any folder facet may write in will do, so only paths that cannot be one.
+  add_flag_values(out, "play", b, "--direction-cache",
+                  {"",
+                   "{dir}/fifo",
+                   "{dir}/file",
+                   "{dir}/file_link",
+                   "{dir}/file/x",
+                   "{dir}/file/x/y",
+                   "{dir}/fifo/x",
+                   "{dir}/" + kLongName,
+                   "{dir}/cache/" + kLongName,
+                   "{dir}/loop",
+                   "{dir}/loop/x",
+                   "{dir}/null_link",
+                   "{dir}/null_dev",
+                   "{dir}/null_dev/x",
+                   "/dev/null",
+                   "/dev/null/x",
+                   "/proc/facet_hostile_out",
+                   "/proc/facet_hostile_out/x",
+                   "/sys/facet_hostile_out",
+                   "/sys/facet_hostile_out/x"});
+  add_flag_values(out, "play", b, "--direction-cache", {"{dir}/cache"}, {"--no-direction-cache"});
   Base cluster = b;
   cluster.args = {"play",     "@x.png", "--display", "@display.json", "--headless",
                   "--frames", "1",      "--out",     "@out"};

@@ -404,6 +404,36 @@ TEST(InteropCli, LookupOfADisplayWritesNothingWhenOneWarpIsBad) {
   EXPECT_FALSE(fs::exists(lookups));
 }
 
+// A display's lookups go into --out as one folder: a second run replaces an earlier lookup
+// folder; a folder holding anything else, or the display's own folder, is refused with exit 2 and
+// left as it was.
+TEST(InteropCli, LookupOfADisplayReplacesOnlyAnEarlierLookupFolder) {
+  test::ScratchFolder scratch("cli-lookup-folder");
+  const fs::path wall = scratch.path / "wall", lookups = scratch.path / "lookups";
+  ASSERT_EQ(run("display builtin:wall2x2 --out " + wall.string(), scratch.path).status, 0);
+  const std::string command = "lookup --display " + (wall / "display.json").string() + " --out ";
+  for (int round = 0; round < 2; ++round) {
+    const CliRun r = run(command + lookups.string(), scratch.path);
+    ASSERT_EQ(r.status, 0) << r.output;
+    std::size_t files = 0;
+    for (const auto& entry : fs::directory_iterator(lookups)) {
+      EXPECT_TRUE(entry.path().filename().string().ends_with(".lookup.exr")) << entry.path();
+      ++files;
+    }
+    EXPECT_EQ(files, 4u);
+  }
+  const fs::path mine = scratch.path / "mine";
+  fs::create_directories(mine);
+  std::ofstream(mine / "notes.txt") << "keep me";
+  const CliRun foreign = run(command + mine.string(), scratch.path);
+  EXPECT_EQ(foreign.status, 2) << foreign.output;
+  EXPECT_NE(foreign.output.find("--out"), std::string::npos) << foreign.output;
+  EXPECT_EQ(std::distance(fs::directory_iterator(mine), fs::directory_iterator{}), 1);
+  const CliRun over_input = run(command + wall.string(), scratch.path);
+  EXPECT_EQ(over_input.status, 2) << over_input.output;
+  EXPECT_TRUE(fs::exists(wall / "display.json"));
+}
+
 // A FIFO where a file is expected blocked the reader until killed; every reader now refuses a
 // path that is not a regular file (require_regular_file). Each run is limited to 20 s by
 // timeout(1), whose status 124 would fail the test.

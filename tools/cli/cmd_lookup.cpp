@@ -5,6 +5,7 @@
 #include "command.hpp"
 #include "facet/interop/lookup.hpp"
 #include "facet/projection/atomic_file.hpp"
+#include "facet/projection/atomic_folder.hpp"
 #include "facet/projection/errors.hpp"
 #include "facet/projection_io/display_config.hpp"
 #include "facet/projection_io/warp_file.hpp"
@@ -46,13 +47,37 @@ const Registration registration{
         std::vector<Warp> warps;
         for (const auto& projector : config.projectors)
           warps.push_back(read_warp(config.resolve(projector.warp).string()));
-        std::filesystem::create_directories(options->out);
-        for (std::size_t i = 0; i < warps.size(); ++i) {
-          const std::filesystem::path path =
-              std::filesystem::path(options->out) / (config.projectors[i].name + ".lookup.exr");
-          interop::write_lookup(warps[i], path);
-          std::cout << "wrote " << path.string() << "\n";
-        }
+        // The folder is written whole or not at all, and replaces only an earlier lookup folder.
+        OutputFolderRules rules;
+        rules.flag = "--out";
+        rules.expected =
+            "a new path, an empty folder, or a folder of earlier lookups (*.lookup.exr only)";
+        rules.is_own_output = [](const std::filesystem::path& folder) {
+          std::error_code error;
+          for (const auto& entry : std::filesystem::directory_iterator(folder, error)) {
+            const std::string name = entry.path().filename().string();
+            if (!name.ends_with(".lookup.exr") || entry.is_symlink(error) ||
+                !entry.is_regular_file(error))
+              return false;
+          }
+          return !error;
+        };
+        rules.inputs.push_back(options->display);
+        for (const auto& projector : config.projectors)
+          rules.inputs.push_back(config.resolve(projector.warp));
+        write_folder_atomically(
+            options->out,
+            [&](const std::filesystem::path& temporary) {
+              for (std::size_t i = 0; i < warps.size(); ++i)
+                interop::write_lookup(warps[i],
+                                      temporary / (config.projectors[i].name + ".lookup.exr"));
+            },
+            rules);
+        for (const auto& projector : config.projectors)
+          std::cout
+              << "wrote "
+              << (std::filesystem::path(options->out) / (projector.name + ".lookup.exr")).string()
+              << "\n";
       });
     }};
 

@@ -1,8 +1,11 @@
 // facet play: a dome master, panorama or cube map (still or video) on a display, through its
 // exact warp and blend; windows per projector, or headless frames to files.
+#include <unistd.h>
+
 #include <chrono>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <memory>
 #include <optional>
@@ -28,6 +31,25 @@
 
 namespace facet::cli {
 namespace {
+
+// A cache folder given with --direction-cache must be one facet can use: made now when missing,
+// then probed with a file. The default cache, which the user did not name, is skipped quietly
+// when it cannot be used.
+std::filesystem::path usable_cache_folder(const std::string& folder) {
+  namespace fs = std::filesystem;
+  const auto refuse = [&](const std::string& why) {
+    throw InputError("command line", "--direction-cache",
+                     "a folder facet may create and write files in; '" + folder + "' " + why);
+  };
+  std::error_code error;
+  fs::create_directories(folder, error);
+  if (error) refuse("cannot be made (" + error.message() + ")");
+  if (!fs::is_directory(folder, error)) refuse("is not a folder");
+  const fs::path probe = fs::path(folder) / (".facet-probe-" + std::to_string(::getpid()));
+  if (!std::ofstream(probe)) refuse("takes no new file");
+  fs::remove(probe, error);
+  return folder;
+}
 
 struct PlayOptions {
   std::string file;
@@ -114,7 +136,7 @@ void play(const PlayOptions& options) {
   if (!options.no_direction_cache) {
     playback.resample.direction_cache = options.direction_cache.empty()
                                             ? driver::default_direction_cache()
-                                            : std::filesystem::path(options.direction_cache);
+                                            : usable_cache_folder(options.direction_cache);
   }
   if (options.start_frame < 0 || options.start_frame >= media->frame_count())
     throw InputError("command line", "--start-frame",
