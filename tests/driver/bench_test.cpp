@@ -269,6 +269,13 @@ TEST(BenchCli, BadFlagsExitTwoAndWriteNothing) {
       << slurp(folder / "log.txt");
   EXPECT_EQ(names_in(foreign), std::vector<std::string>{"notes.txt"});
   EXPECT_EQ(slurp(foreign / "notes.txt"), "mine");
+  // So is the cluster scenario's, before any node starts.
+  EXPECT_EQ(run("bench --quick --scenario cluster --out " + foreign.string(), folder / "log.txt"),
+            2)
+      << slurp(folder / "log.txt");
+  EXPECT_NE(slurp(folder / "log.txt").find("--out"), std::string::npos)
+      << slurp(folder / "log.txt");
+  EXPECT_EQ(names_in(foreign), std::vector<std::string>{"notes.txt"});
 }
 
 // Every scenario's outputs and settings, without rendering: the quick and the full sweeps name

@@ -3,6 +3,7 @@
 // bench.png (facet/driver/bench.hpp).
 #include <cstdint>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -14,7 +15,6 @@
 #include "facet/driver/cluster.hpp"
 #include "facet/driver/gl_context.hpp"
 #include "facet/driver/scene_names.hpp"
-#include "facet/projection/atomic_file.hpp"
 #include "facet/projection/atomic_folder.hpp"
 #include "facet/projection/errors.hpp"
 #include "facet/projection/interrupt.hpp"
@@ -44,8 +44,36 @@ void run_cluster(const BenchCommandOptions& command) {
     options.frames = 50;
     options.node_counts = {2, 3};
   }
-  std::filesystem::create_directories(command.out);
-  options.folder = std::filesystem::absolute(command.out);
+  if (command.out.empty()) throw InputError("command line", "--out", "expected a folder");
+  // Before the run: --out is new, empty or an earlier cluster bench's (cluster.json alone).
+  OutputFolderRules out_rules;
+  out_rules.flag = "--out";
+  out_rules.expected =
+      "a new path, an empty folder, or a folder of an earlier cluster bench (cluster.json only)";
+  out_rules.is_own_output = [](const std::filesystem::path& folder) {
+    std::error_code error;
+    for (const auto& entry : std::filesystem::directory_iterator(folder, error)) {
+      if (entry.path().filename() != "cluster.json" || entry.is_symlink(error) ||
+          !entry.is_regular_file(error))
+        return false;
+    }
+    return !error;
+  };
+  check_output_folder(command.out, out_rules);
+  // The nodes' ipc:// sockets live in a private folder of the system's temporary folder.
+  std::string sockets =
+      (std::filesystem::temp_directory_path() / "facet-cluster-bench-XXXXXX").string();
+  if (!::mkdtemp(sockets.data()))
+    throw std::runtime_error("bench: cannot make a folder for the cluster's sockets in " +
+                             std::filesystem::temp_directory_path().string());
+  struct RemoveAtEnd {
+    std::filesystem::path folder;
+    ~RemoveAtEnd() {
+      std::error_code error;
+      std::filesystem::remove_all(folder, error);
+    }
+  } remove_sockets{sockets};
+  options.folder = sockets;
   watch_interrupts();
   const std::vector<ClusterBenchRow> rows = bench_cluster(options, [](const std::string& line) {
     std::printf("%s\n", line.c_str());
@@ -67,11 +95,16 @@ void run_cluster(const BenchCommandOptions& command) {
                     {"bare_nng_p99_ms", row.floor_p99_ms},
                     {"bare_nng_expired_frames", row.floor_expired},
                     {"frames_without_every_node", row.frames_short}});
-  const std::filesystem::path file = std::filesystem::path(command.out) / "cluster.json";
-  write_atomically(file, [&](const std::filesystem::path& temporary) {
-    std::ofstream(temporary) << json.dump(2) << '\n';
-  });
-  std::printf("wrote %s\n", file.string().c_str());
+  write_folder_atomically(
+      command.out,
+      [&](const std::filesystem::path& temporary) {
+        std::ofstream file(temporary / "cluster.json");
+        file << json.dump(2) << '\n';
+        if (!file.flush())
+          throw std::runtime_error("bench: writing " + (temporary / "cluster.json").string());
+      },
+      out_rules);
+  std::printf("wrote %s\n", (std::filesystem::path(command.out) / "cluster.json").string().c_str());
 }
 
 // The rules of bench's --out: a new path, an empty folder, or the folder of an earlier bench
