@@ -3,6 +3,7 @@
 // naming the file. The view of a scene (scene_view.hpp): the default eye leaves closed geometry,
 // --eye inside it warns, --look-at and --camera set the pose.
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
 #include <array>
 #include <cstring>
@@ -73,7 +74,7 @@ class TempDir {
 // A unit square in the x-y plane (two triangles, 16-bit indices, positions and texture
 // coordinates, no normals) instanced by two nodes: one at the origin, and one translated by
 // (10, 0, 0) under a parent scaled by 2. `index_override` replaces the index data when set.
-std::string square_gltf(std::array<std::uint16_t, 6> indices = {0, 1, 2, 0, 2, 3}) {
+std::vector<unsigned char> square_buffer(const std::array<std::uint16_t, 6>& indices) {
   std::vector<unsigned char> buffer;
   const float positions[4][3] = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}};
   const float uvs[4][2] = {{0, 1}, {1, 1}, {1, 0}, {0, 0}};
@@ -83,7 +84,15 @@ std::string square_gltf(std::array<std::uint16_t, 6> indices = {0, 1, 2, 0, 2, 3
     for (const float v : t) append(buffer, v);
   for (const auto i : indices) append(buffer, i);
   buffer.resize(buffer.size() + 2, 0);  // pad to a multiple of 4
-  const std::string uri = "data:application/octet-stream;base64," + base64(buffer);
+  return buffer;
+}
+
+// With `buffer_uri` empty, the buffer is embedded as a data URI.
+std::string square_gltf(std::array<std::uint16_t, 6> indices = {0, 1, 2, 0, 2, 3},
+                        const std::string& buffer_uri = {}) {
+  const std::vector<unsigned char> buffer = square_buffer(indices);
+  const std::string uri =
+      buffer_uri.empty() ? "data:application/octet-stream;base64," + base64(buffer) : buffer_uri;
   return R"({
   "asset": {"version": "2.0"},
   "scene": 0,
@@ -110,6 +119,41 @@ std::string square_gltf(std::array<std::uint16_t, 6> indices = {0, 1, 2, 0, 2, 3
   "buffers": [{"byteLength": )" +
          std::to_string(buffer.size()) + R"(, "uri": ")" + uri + R"("}]
 })";
+}
+
+// External buffers are read from the glTF file's folder or below it, as regular files, and URIs
+// are taken as written: a path leading out of the folder (by "..", an absolute path or a link),
+// a FIFO (which would block the reader) and "~" are refused, naming the URI.
+TEST(Gltf, ExternalFilesStayInTheGltfFilesFolder) {
+  TempDir dir;
+  const auto bytes = square_buffer({0, 1, 2, 0, 2, 3});
+  const fs::path folder = dir.write("outside.bin", "").parent_path() / "model";
+  fs::create_directories(folder);
+  std::ofstream(folder / "square.bin", std::ios::binary)
+      .write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
+  std::ofstream(folder.parent_path() / "outside.bin", std::ios::binary)
+      .write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
+  fs::create_directories(folder / "sub");
+  fs::copy_file(folder / "square.bin", folder / "sub" / "square.bin");
+  fs::create_symlink(folder.parent_path() / "outside.bin", folder / "link.bin");
+  ASSERT_EQ(::mkfifo((folder / "fifo.bin").c_str(), 0600), 0);
+  for (const std::string& uri :
+       std::vector<std::string>{"square.bin", "sub/square.bin", "./sub/../square.bin"}) {
+    const Scene scene = load_gltf(dir.write("model/" + std::to_string(uri.size()) + ".gltf",
+                                            square_gltf({0, 1, 2, 0, 2, 3}, uri)));
+    EXPECT_EQ(scene.indices.size(), 6u) << uri;
+  }
+  const std::string outside = (folder.parent_path() / "outside.bin").string();
+  for (const std::string& uri : {std::string("../outside.bin"), outside, std::string("link.bin"),
+                                 std::string("fifo.bin"), std::string("~/square.bin")}) {
+    const fs::path file = dir.write("model/bad.gltf", square_gltf({0, 1, 2, 0, 2, 3}, uri));
+    try {
+      load_gltf(file);
+      ADD_FAILURE() << uri << " was read";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(uri), std::string::npos) << e.what();
+    }
+  }
 }
 
 TEST(Gltf, LoadsCountsTransformsAndBounds) {

@@ -13,6 +13,7 @@
 #include <glm/gtc/type_ptr.hpp>
 #include <glm/mat4x4.hpp>
 #include <map>
+#include <optional>
 #include <string>
 
 #include "facet/driver/material_shader.hpp"
@@ -534,6 +535,41 @@ std::string lower(std::string s) {
   return s;
 }
 
+// External buffers and images are read only from the glTF file's own folder or below it, and only
+// as regular files: a URI such as ../../etc/passwd, a link leading out, or a FIFO is refused, and
+// tinygltf's error names it.
+struct UriFolder {
+  std::filesystem::path folder;  // canonical
+
+  std::optional<std::string> refusal(const std::string& path) const {
+    std::error_code error;
+    const std::filesystem::path file = std::filesystem::weakly_canonical(path, error);
+    if (error) return "'" + path + "' cannot be resolved (" + error.message() + ")";
+    const std::filesystem::path relative = file.lexically_relative(folder);
+    if (relative.empty() || relative.is_absolute() || *relative.begin() == "..")
+      return "'" + path + "' lies outside the glTF file's folder";
+    if (!std::filesystem::is_regular_file(file, error))
+      return "'" + path + "' is not a regular file";
+    return std::nullopt;
+  }
+};
+
+// URIs are paths as written: no `~` or `$VAR` expansion (tinygltf's default runs wordexp).
+std::string uri_as_written(const std::string& path, void*) { return path; }
+
+bool uri_exists(const std::string& path, void* user) {
+  return !static_cast<const UriFolder*>(user)->refusal(path);
+}
+
+bool read_uri(std::vector<unsigned char>* out, std::string* err, const std::string& path,
+              void* user) {
+  if (const auto refused = static_cast<const UriFolder*>(user)->refusal(path)) {
+    if (err) *err += *refused + "\n";
+    return false;
+  }
+  return tinygltf::ReadWholeFile(out, err, path, nullptr);
+}
+
 }  // namespace
 
 Scene load_gltf(const std::filesystem::path& path) {
@@ -546,6 +582,11 @@ Scene load_gltf(const std::filesystem::path& path) {
   if (!std::filesystem::is_regular_file(path, ec))
     throw InputError(source, "", "an existing, readable glTF file");
   tinygltf::TinyGLTF loader;
+  UriFolder uri_folder{
+      std::filesystem::weakly_canonical(std::filesystem::absolute(path), ec).parent_path()};
+  tinygltf::FsCallbacks callbacks{&uri_exists, &uri_as_written, &read_uri,
+                                  &tinygltf::WriteWholeFile, &uri_folder};
+  loader.SetFsCallbacks(callbacks);
   tinygltf::Model model;
   std::string error, warning;
   const bool ok = extension == ".glb" ? loader.LoadBinaryFromFile(&model, &error, &warning, source)

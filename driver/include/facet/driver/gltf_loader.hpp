@@ -13,6 +13,9 @@ namespace facet::driver {
 //   mesh's frame and is shared between nodes that instance the same mesh.
 // - The default scene is loaded (the first one when none is marked; every root node when the
 //   file has no scenes).
+// - External buffers and images are read only from the glTF file's folder or below it, as
+//   regular files, with URIs taken as written (no `~` or `$VAR` expansion): a URI leading out of
+//   the folder (by "..", an absolute path or a link) or naming a FIFO is an InputError naming it.
 // - Triangles, triangle strips and fans are loaded (strips and fans become lists); points and
 //   lines are skipped. Missing normals are computed (area-weighted); missing texture
 //   coordinates are 0.
