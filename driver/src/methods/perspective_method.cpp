@@ -219,7 +219,7 @@ class PerspectiveMethod final : public RenderMethod {
     planes[1] = M[3] - M[0];
     planes[2] = M[3] + M[1];
     planes[3] = M[3] - M[1];
-    planes[4] = glm::dvec4(0, 0, -1, -settings_.z_near);
+    planes[4] = M[3] - glm::dvec4(0, 0, 0, settings_.z_near);  // w = distance along the axis
     std::uint64_t drawn = 0;
     const Program* in_use = nullptr;
     for (std::size_t o = 0; o < scene.objects.size(); ++o) {
