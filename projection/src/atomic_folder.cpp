@@ -47,6 +47,17 @@ void create_folders(const fs::path& path, const std::string& flag) {
 
 }  // namespace
 
+bool holds_only_files_named(const fs::path& folder,
+                            const std::function<bool(const std::string& name)>& own_name) {
+  std::error_code error;
+  for (const fs::directory_entry& entry : fs::directory_iterator(folder, error)) {
+    if (!own_name(entry.path().filename().string()) || entry.is_symlink(error) ||
+        !entry.is_regular_file(error))
+      return false;
+  }
+  return !error;
+}
+
 fs::path check_output_folder(const fs::path& folder, const OutputFolderRules& rules) {
   fs::path out = folder.lexically_normal();
   if (!out.has_filename()) out = out.parent_path();

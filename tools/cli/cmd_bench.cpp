@@ -51,13 +51,8 @@ void run_cluster(const BenchCommandOptions& command) {
   out_rules.expected =
       "a new path, an empty folder, or a folder of an earlier cluster bench (cluster.json only)";
   out_rules.is_own_output = [](const std::filesystem::path& folder) {
-    std::error_code error;
-    for (const auto& entry : std::filesystem::directory_iterator(folder, error)) {
-      if (entry.path().filename() != "cluster.json" || entry.is_symlink(error) ||
-          !entry.is_regular_file(error))
-        return false;
-    }
-    return !error;
+    return holds_only_files_named(folder,
+                                  [](const std::string& name) { return name == "cluster.json"; });
   };
   check_output_folder(command.out, out_rules);
   // The nodes' ipc:// sockets live in a private folder of the system's temporary folder.

@@ -53,14 +53,8 @@ const Registration registration{
         rules.expected =
             "a new path, an empty folder, or a folder of earlier lookups (*.lookup.exr only)";
         rules.is_own_output = [](const std::filesystem::path& folder) {
-          std::error_code error;
-          for (const auto& entry : std::filesystem::directory_iterator(folder, error)) {
-            const std::string name = entry.path().filename().string();
-            if (!name.ends_with(".lookup.exr") || entry.is_symlink(error) ||
-                !entry.is_regular_file(error))
-              return false;
-          }
-          return !error;
+          return holds_only_files_named(
+              folder, [](const std::string& name) { return name.ends_with(".lookup.exr"); });
         };
         rules.inputs.push_back(options->display);
         for (const auto& projector : config.projectors)

@@ -139,14 +139,9 @@ OutputFolderRules render_out_rules(const RenderOptions& options) {
       "a new path, an empty folder, or a folder of an earlier facet render (<output>.png, "
       ".ids.exr and .depth.exr files, nothing else)";
   rules.is_own_output = [](const fs::path& folder) {
-    std::error_code error;
-    for (const fs::directory_entry& entry : fs::directory_iterator(folder, error)) {
-      const std::string name = entry.path().filename().string();
-      const bool own =
-          name.ends_with(".png") || name.ends_with(".ids.exr") || name.ends_with(".depth.exr");
-      if (!own || !entry.is_regular_file(error) || entry.is_symlink(error)) return false;
-    }
-    return !error;
+    return holds_only_files_named(folder, [](const std::string& name) {
+      return name.ends_with(".png") || name.ends_with(".ids.exr") || name.ends_with(".depth.exr");
+    });
   };
   for (const std::string& input :
        {options.display, options.scene, options.material, options.reference_scene}) {

@@ -135,14 +135,13 @@ std::vector<BenchSetting> sweep(const std::vector<FacetLayout>& layouts,
   return settings;
 }
 
-// Largest displacement, in output pixels, that a nearest-texel lookup in a cube map of face edge
-// `face` can cause, sampled over the output pixels (the half-diagonal of the texel holding each
-// pixel's exact direction, mapped through the warp). Faces are the eye frame's axes, as in the
-// cube-map method.
-std::pair<double, double> cube_texel_error(const Warp& warp, const WarpInverse& inverse, int face) {
+// Worst and RMS, in output pixels, of `displacement(q, preimage)` over the output's pixels
+// (about 256² of them, evenly strided) that the warp covers.
+template <class Displacement>
+std::pair<double, double> over_output_pixels(const Warp& warp, const WarpInverse& inverse,
+                                             const Displacement& displacement) {
   const glm::ivec2 size = warp.output_size;
   const int stride = std::max(1, int(std::sqrt(double(size.x) * size.y / 65536.0)));
-  const double half_texel = 1.0 / face;  // face coordinates span [-1, 1]
   double max_px = 0, sum_sq = 0;
   std::size_t n = 0;
   for (int y = stride / 2; y < size.y; y += stride) {
@@ -150,27 +149,39 @@ std::pair<double, double> cube_texel_error(const Warp& warp, const WarpInverse& 
       const glm::dvec2 q(x + 0.5, y + 0.5);
       const auto inverted = inverse.invert(q);
       if (!inverted) continue;
-      const glm::dvec3 v = inverted->v_eye;
-      int m = 0;
-      for (int k = 1; k < 3; ++k) {
-        if (std::abs(v[k]) > std::abs(v[m])) m = k;
-      }
-      const int a = (m + 1) % 3, b = (m + 2) % 3;
-      const glm::dvec3 on_face = v / std::abs(v[m]);
-      double worst = 0;
-      for (const double sb : {-1.0, 1.0}) {
-        glm::dvec3 moved = on_face;
-        moved[a] += half_texel;
-        moved[b] += sb * half_texel;
-        const auto projected = warp.project(moved, inverted->st.x);
-        if (projected) worst = std::max(worst, glm::length(projected->q - q));
-      }
+      const double worst = displacement(q, *inverted);
       max_px = std::max(max_px, worst);
       sum_sq += worst * worst;
       ++n;
     }
   }
   return {max_px, n ? std::sqrt(sum_sq / double(n)) : 0.0};
+}
+
+// Largest displacement, in output pixels, that a nearest-texel lookup in a cube map of face edge
+// `face` can cause, sampled over the output pixels (the half-diagonal of the texel holding each
+// pixel's exact direction, mapped through the warp). Faces are the eye frame's axes, as in the
+// cube-map method.
+std::pair<double, double> cube_texel_error(const Warp& warp, const WarpInverse& inverse, int face) {
+  const double half_texel = 1.0 / face;  // face coordinates span [-1, 1]
+  return over_output_pixels(warp, inverse, [&](const glm::dvec2& q, const auto& inverted) {
+    const glm::dvec3 v = inverted.v_eye;
+    int m = 0;
+    for (int k = 1; k < 3; ++k) {
+      if (std::abs(v[k]) > std::abs(v[m])) m = k;
+    }
+    const int a = (m + 1) % 3, b = (m + 2) % 3;
+    const glm::dvec3 on_face = v / std::abs(v[m]);
+    double worst = 0;
+    for (const double sb : {-1.0, 1.0}) {
+      glm::dvec3 moved = on_face;
+      moved[a] += half_texel;
+      moved[b] += sb * half_texel;
+      const auto projected = warp.project(moved, inverted.st.x);
+      if (projected) worst = std::max(worst, glm::length(projected->q - q));
+    }
+    return worst;
+  });
 }
 
 // The perspective baseline's rows ("perspective", the seed's IB row), one per image size,
@@ -200,31 +211,19 @@ std::pair<double, double> perspective_texel_error(const Warp& warp, const WarpIn
   const glm::ivec2 image = perspective_image_size(frustum, larger_side);
   const double half_u = (frustum.tan_extent[1] - frustum.tan_extent[0]) / (2.0 * image.x);
   const double half_v = (frustum.tan_extent[2] - frustum.tan_extent[3]) / (2.0 * image.y);
-  const glm::ivec2 size = warp.output_size;
-  const int stride = std::max(1, int(std::sqrt(double(size.x) * size.y / 65536.0)));
-  double max_px = 0, sum_sq = 0;
-  std::size_t n = 0;
-  for (int y = stride / 2; y < size.y; y += stride) {
-    for (int x = stride / 2; x < size.x; x += stride) {
-      const glm::dvec2 q(x + 0.5, y + 0.5);
-      const auto inverted = inverse.invert(q);
-      if (!inverted) continue;
-      const glm::dvec3 v_view = glm::transpose(frustum.R_eye_frustum) * inverted->v_eye;
-      if (!(v_view.z < 0)) continue;
-      const glm::dvec2 tangent = glm::dvec2(v_view) / -v_view.z;
-      double worst = 0;
-      for (const double su : {-1.0, 1.0})
-        for (const double sv : {-1.0, 1.0}) {
-          const glm::dvec3 moved(tangent.x + su * half_u, tangent.y + sv * half_v, -1.0);
-          const auto projected = warp.project(frustum.R_eye_frustum * moved, inverted->st.x);
-          if (projected) worst = std::max(worst, glm::length(projected->q - q));
-        }
-      max_px = std::max(max_px, worst);
-      sum_sq += worst * worst;
-      ++n;
-    }
-  }
-  return {max_px, n ? std::sqrt(sum_sq / double(n)) : 0.0};
+  return over_output_pixels(warp, inverse, [&](const glm::dvec2& q, const auto& inverted) {
+    const glm::dvec3 v_view = glm::transpose(frustum.R_eye_frustum) * inverted.v_eye;
+    if (!(v_view.z < 0)) return 0.0;
+    const glm::dvec2 tangent = glm::dvec2(v_view) / -v_view.z;
+    double worst = 0;
+    for (const double su : {-1.0, 1.0})
+      for (const double sv : {-1.0, 1.0}) {
+        const glm::dvec3 moved(tangent.x + su * half_u, tangent.y + sv * half_v, -1.0);
+        const auto projected = warp.project(frustum.R_eye_frustum * moved, inverted.st.x);
+        if (projected) worst = std::max(worst, glm::length(projected->q - q));
+      }
+    return worst;
+  });
 }
 
 struct Runner {

@@ -601,17 +601,13 @@ std::vector<std::string> bench_notes(const std::vector<BenchRow>& rows,
 }
 
 bool is_bench_output(const std::filesystem::path& folder) {
-  namespace fs = std::filesystem;
   std::error_code error;
-  bool holds_json = false;
-  for (const fs::directory_entry& entry : fs::directory_iterator(folder, error)) {
-    const std::string name = entry.path().filename().string();
-    const bool own =
-        name == "bench.json" || name == "bench.csv" || name == "bench.png" || name == "bench.log";
-    if (!own || entry.is_symlink(error) || !entry.is_regular_file(error)) return false;
-    holds_json = holds_json || name == "bench.json";
-  }
-  return !error && holds_json;
+  return holds_only_files_named(folder,
+                                [](const std::string& name) {
+                                  return name == "bench.json" || name == "bench.csv" ||
+                                         name == "bench.png" || name == "bench.log";
+                                }) &&
+         std::filesystem::is_regular_file(folder / "bench.json", error);
 }
 
 void write_bench_files(const BenchReport& report, const std::filesystem::path& folder,

@@ -21,8 +21,8 @@
 #include "facet/driver/shader_library.hpp"
 #include "facet/projection/content_projection.hpp"
 #include "facet/projection/errors.hpp"
-#include "facet/projection/warp_inverse.hpp"
 #include "material_programs.hpp"
+#include "pixel_lookup.hpp"
 #include "render_methods_internal.hpp"
 
 namespace facet::driver::detail {
@@ -85,25 +85,10 @@ class CubemapMethod final : public RenderMethod {
     face_needed_.fill(false);
     lookups_.clear();
     for (const OutputSpec& output : outputs) {
-      const WarpInverse inverse(output.warp);
-      const glm::ivec2 size = output.warp.output_size;
-      const auto st = inverse.st_at_pixel_centres();
-      // GL rows start at the bottom.
-      std::vector<glm::vec4> lookup(st.size(), glm::vec4(0));
-      for (int y = 0; y < size.y; ++y) {
-        for (int x = 0; x < size.x; ++x) {
-          const glm::dvec2 s = st[std::size_t(y) * size.x + x];
-          if (std::isnan(s.x)) continue;
-          const glm::dvec3 v_eye = output.warp.v_eye_from_st(s);
-          face_needed_[cube_face_of(v_eye)] = true;
-          lookup[std::size_t(size.y - 1 - y) * size.x + x] = glm::vec4(glm::vec3(v_eye), 1.0f);
-        }
-      }
-      Texture texture = Texture::create_2d(GL_RGBA32F, size.x, size.y);
-      glTextureParameteri(texture.id(), GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-      glTextureParameteri(texture.id(), GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-      glTextureSubImage2D(texture.id(), 0, 0, 0, size.x, size.y, GL_RGBA, GL_FLOAT, lookup.data());
-      lookups_.push_back(std::move(texture));
+      lookups_.push_back(pixel_lookup_texture(output.warp, [&](const glm::dvec3& v_eye) {
+        face_needed_[cube_face_of(v_eye)] = true;
+        return std::optional<glm::vec4>(glm::vec4(glm::vec3(v_eye), 1.0f));
+      }));
     }
 
     const int n = settings.cube_face_size;

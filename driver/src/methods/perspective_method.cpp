@@ -16,8 +16,8 @@
 #include "facet/driver/program.hpp"
 #include "facet/projection/content_projection.hpp"
 #include "facet/projection/errors.hpp"
-#include "facet/projection/warp_inverse.hpp"
 #include "material_programs.hpp"
+#include "pixel_lookup.hpp"
 #include "render_methods_internal.hpp"
 
 namespace facet::driver {
@@ -79,26 +79,13 @@ class PerspectiveMethod final : public RenderMethod {
       OutputState out;
       out.frustum = covering_frustum(output.warp, output.name);
       out.image_size = perspective_image_size(out.frustum, settings.cube_face_size);
-      const WarpInverse inverse(output.warp);
       const glm::ivec2 size = output.warp.output_size;
-      const auto st = inverse.st_at_pixel_centres();
-      std::vector<glm::vec4> lookup(st.size(), glm::vec4(0));
-      for (int y = 0; y < size.y; ++y) {
-        for (int x = 0; x < size.x; ++x) {
-          const glm::dvec2 s = st[std::size_t(y) * size.x + x];
-          if (std::isnan(s.x)) continue;
-          const auto image_st = perspective_image_st(out.frustum, output.warp.v_eye_from_st(s));
-          if (!image_st) continue;
-          // GL rows start at the bottom.
-          lookup[std::size_t(size.y - 1 - y) * size.x + x] =
-              glm::vec4(float(image_st->x), float(image_st->y), 0.0f, 1.0f);
-        }
-      }
-      out.lookup = Texture::create_2d(GL_RGBA32F, size.x, size.y);
-      glTextureParameteri(out.lookup.id(), GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-      glTextureParameteri(out.lookup.id(), GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-      glTextureSubImage2D(out.lookup.id(), 0, 0, 0, size.x, size.y, GL_RGBA, GL_FLOAT,
-                          lookup.data());
+      out.lookup = pixel_lookup_texture(output.warp, [&](const glm::dvec3& v_eye) {
+        const auto image_st = perspective_image_st(out.frustum, v_eye);
+        return image_st ? std::optional<glm::vec4>(
+                              glm::vec4(float(image_st->x), float(image_st->y), 0.0f, 1.0f))
+                        : std::nullopt;
+      });
       const glm::ivec2 n = out.image_size;
       out.colour = Texture::create_2d(GL_SRGB8_ALPHA8, n.x, n.y);
       glTextureParameteri(out.colour.id(), GL_TEXTURE_MIN_FILTER, GL_LINEAR);

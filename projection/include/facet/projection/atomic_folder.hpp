@@ -21,6 +21,12 @@ struct OutputFolderRules {
   std::vector<std::filesystem::path> inputs;
 };
 
+// True when every entry of `folder` is a regular file, not a link, whose name `own_name` accepts
+// (an empty folder is): the usual OutputFolderRules::is_own_output of a command that writes a
+// flat folder of files.
+bool holds_only_files_named(const std::filesystem::path& folder,
+                            const std::function<bool(const std::string& name)>& own_name);
+
 // `folder` as written ("out/" is "out") once it passes the checks write_folder_atomically makes
 // before writing anything. InputError naming the folder and rules.flag when it is empty, is the
 // current folder or one of its parents, is or holds one of rules.inputs, or exists and is not an
