@@ -106,8 +106,8 @@ double percentile(std::vector<double> values, double p) {
 
 // The floor under the protocol: NNG's own exchange, the one the protocol makes, on the same
 // transport between the same number of nodes. Per frame the master publishes a message of
-// `state_bytes` and then a question on the same pub socket; every other node, on a thread of its
-// own, receives both from its sub socket and answers at once on a pub socket of its own, which
+// `state_bytes`; every other node, on a thread of its own, receives it from its sub socket and
+// answers at once on a pub socket of its own, which
 // the master's one sub socket dials; the master waits for every answer, until the deadline by its
 // own clock. None of facet's protocol: no heartbeat, no hand-off between threads, no swap message,
 // no digests. Sets row.floor_*.
@@ -150,17 +150,15 @@ void bench_bare_nng(const projection_io::DisplayCluster& cluster, int frames,
     check(nng_dial(publisher, address.c_str(), nullptr, NNG_FLAG_NONBLOCK), address.c_str());
     check(nng_dial(answers, barrier.c_str(), nullptr, NNG_FLAG_NONBLOCK), barrier.c_str());
   }
-  // A message is a kind byte (1: frame state, 2: question, answer) and a frame number, then the
-  // frame state's bytes.
-  constexpr std::uint8_t kState = 1, kQuestion = 2;
+  // A message is a kind byte (1: frame state, 2: answer) and a frame number, then (for a frame
+  // state) the frame state's bytes.
+  constexpr std::uint8_t kState = 1, kAnswer = 2;
   constexpr std::size_t kHeader = 1 + sizeof(std::uint64_t);
   std::atomic<bool> stop{false};
   std::vector<std::thread> threads;
   for (const auto& [subscriber, answerer] : node_sockets) {
-    // Each question is answered when the frame state of its frame came before it; questions
-    // heard without their state (this node connected between the two) are passed over.
+    // Each frame state is answered with its kind byte and frame number.
     threads.emplace_back([subscriber = subscriber, answerer = answerer, &stop] {
-      std::uint64_t newest_state = 0;
       while (!stop.load()) {
         void* message = nullptr;
         std::size_t size = 0;
@@ -169,22 +167,16 @@ void bench_bare_nng(const projection_io::DisplayCluster& cluster, int frames,
           nng_free(message, size);
           continue;
         }
-        const std::uint8_t kind = *static_cast<const std::uint8_t*>(message);
-        std::uint64_t frame = 0;
-        std::memcpy(&frame, static_cast<const std::uint8_t*>(message) + 1, sizeof frame);
-        if (kind == kState) {
-          newest_state = frame;
-          nng_free(message, size);
-        } else if (kind == kQuestion && newest_state == frame) {
-          nng_send(answerer, message, size, NNG_FLAG_ALLOC);  // NNG frees it
-        } else {
-          nng_free(message, size);
-        }
+        const bool is_state = *static_cast<const std::uint8_t*>(message) == kState;
+        std::uint8_t answer[kHeader] = {kAnswer};
+        std::memcpy(answer + 1, static_cast<const std::uint8_t*>(message) + 1,
+                    sizeof(std::uint64_t));
+        nng_free(message, size);
+        if (is_state) nng_send(answerer, answer, sizeof answer, 0);
       }
     });
   }
   std::vector<std::uint8_t> state(std::max(state_bytes, kHeader), 0);
-  std::uint8_t question[kHeader] = {kQuestion};
   // One exchange: the time until every node answered, or nullopt when the deadline passed first.
   auto exchange = [&](std::uint64_t frame) -> std::optional<double> {
     const Clock::time_point start = Clock::now();
@@ -193,9 +185,7 @@ void bench_bare_nng(const projection_io::DisplayCluster& cluster, int frames,
                     std::chrono::duration<double, std::milli>(deadline_ms));
     state[0] = kState;
     std::memcpy(state.data() + 1, &frame, sizeof frame);
-    std::memcpy(question + 1, &frame, sizeof frame);
     nng_send(publisher, state.data(), state.size(), 0);
-    nng_send(publisher, question, sizeof question, 0);
     for (std::size_t answered = 0; answered + 1 < nodes;) {
       const double left =
           std::chrono::duration<double, std::milli>(deadline - Clock::now()).count();

@@ -1,8 +1,8 @@
 // The cluster protocol over NNG: the master's frame-state broadcast and swap barrier, and the
-// secondaries' side of both, all over pub/sub. The master publishes frame states and the barrier's
-// questions ("joined?", "frame N rendered?") on one pub socket; every secondary answers on a pub
-// socket of its own, at its barrier address, which the master's one sub socket dials. The
-// master's deadline is its own timer. See cluster.hpp.
+// secondaries' side of both, all over pub/sub. The master publishes frame states, swaps and the
+// question "joined?" on one pub socket; every secondary says "frame N rendered" and answers
+// "joined?" on a pub socket of its own, at its barrier address, which the master's one sub socket
+// dials. The master's deadline is its own timer. See cluster.hpp.
 //
 // No surveyor/respondent: NNG 1.5.2's respondent keeps a closed surveyor pipe in its list of pipes
 // to receive from and later uses it freed (nanomsg/nng#1959, fixed in NNG 1.10), which aborted a
@@ -55,9 +55,10 @@ const ClusterNode& find_cluster_node(const projection_io::DisplayCluster& cluste
 namespace {
 
 // Message kinds. Every message the master publishes starts with its kind and its content digest.
-// join and ready are the barrier's questions, followed by a frame number (0 for join); a
-// secondary answers one on its own pub socket with the question's kind and frame, its content
-// digest and its name.
+// join is the question "joined?", followed by the frame number 0. A secondary publishes on its
+// own pub socket a kind and a frame number, its content digest and its name: join and 0 to
+// answer the question, ready and N once its outputs of frame N are rendered, unasked: frame N's
+// state is the question.
 enum class Published : std::uint8_t {
   heartbeat = 1,
   frame = 2,
@@ -68,8 +69,7 @@ enum class Published : std::uint8_t {
   ready = 7
 };
 
-constexpr auto kPoll = std::chrono::milliseconds(20);  // how often blocked threads look up
-constexpr auto kCloseWait = std::chrono::seconds(2);   // Socket::close
+constexpr auto kCloseWait = std::chrono::seconds(2);  // Socket::close
 
 Clock::duration period(double seconds) {
   return std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(seconds));
@@ -341,8 +341,8 @@ class Master final : public FrameSync {
     const Clock::time_point deadline =
         start +
         std::chrono::ceil<Clock::duration>(std::chrono::duration<double, std::milli>(deadline_ms_));
-    // After the frame state on the same socket: a node that hears the question heard the state.
-    publish(Published::ready, Bytes().put(state.frame).data);
+    // A node says "rendered" once it has rendered the frame state published in next_frame: it
+    // heard the state. Earlier frames' words wait in the queue and are passed over.
     std::set<std::string> answered;
     std::vector<std::string> rejoined;
     while (answered.size() < active_.size() + rejoined.size()) {
@@ -430,10 +430,11 @@ class Master final : public FrameSync {
     }
   }
 
-  // The node that answered question `kind` for `frame`, when it runs our display and scene; the
-  // others are reported once each and ignored. Answers to other questions (an earlier frame's,
-  // given after its deadline) are ignored. A node that answers heard the question, and so every
-  // message published before it: it needs no more to join.
+  // The node that said `kind` for `frame` (join for 0: it heard "joined?"; ready for N: it
+  // rendered frame N's state), when it runs our display and scene; the others are reported once
+  // each and ignored. Words about other frames (an earlier frame's, said after its deadline) are
+  // ignored. A node that says either heard every message published before what it answers: it
+  // needs no more to join.
   std::optional<std::string> parse_answer(const std::vector<std::uint8_t>& reply, Published kind,
                                           std::uint64_t frame) {
     Parse in(reply);
@@ -554,7 +555,6 @@ class Secondary final : public FrameSync {
     answers_.open(nng_pub0_open, "pub");
     nng_socket_set(subscriber_.get(), NNG_OPT_SUB_SUBSCRIBE, "", 0);
     nng_socket_set_int(subscriber_.get(), NNG_OPT_RECVBUF, 1024);
-    subscriber_.set_ms(NNG_OPT_RECVTIMEO, double(kPoll.count()));
     const std::string field = address_field(options_.cluster, self_.name);
     subscriber_.listen(self_.address, options_.source, field, self_.name, nng_pub0_open);
     answers_.listen(projection_io::cluster_barrier_address(self_.address), options_.source, field,
@@ -562,22 +562,17 @@ class Secondary final : public FrameSync {
     say_no_swap_group_once(options_.report);
     options_.report("node " + self_.name + ": listening on " + self_.address + " for master " +
                     master_);
-    listener_ = std::thread([this] { listen(); });
-    responder_ = std::thread([this] { respond(); });
+    if (const int error = nng_aio_alloc(&receiving_, on_received, this))
+      throw std::runtime_error(std::string("cannot make an NNG aio: ") + nng_strerror(error));
+    nng_aio_set_timeout(receiving_, NNG_DURATION_INFINITE);
+    nng_recv_aio(subscriber_.get(), receiving_);
   }
 
-  // The threads end first, then the sockets close: no thread uses a socket after its close.
-  // The listener sees stopping_ within a receive timeout (kPoll), the responder at once.
+  // Receiving stops first (nng_aio_stop waits for a running callback), then the sockets close:
+  // nothing uses a socket after its close.
   ~Secondary() override {
-    {
-      std::lock_guard lock(mutex_);
-      stopping_ = true;
-    }
-    inbox_changed_.notify_all();
-    rendered_changed_.notify_all();
-    question_asked_.notify_all();
-    listener_.join();
-    responder_.join();
+    nng_aio_stop(receiving_);
+    nng_aio_free(receiving_);
     for (Socket* socket : {&subscriber_, &answers_}) {
       if (!socket->close())
         options_.report("node " + self_.name +
@@ -610,9 +605,11 @@ class Secondary final : public FrameSync {
   }
 
   bool ready_to_swap(const FrameState& state, nlohmann::json& stats) override {
+    // Said from this thread as soon as the outputs are rendered: no question to wait for, no
+    // other thread to wake.
+    answer(Published::ready, state.frame);
     std::unique_lock lock(mutex_);
     rendered_ = state.frame;
-    rendered_changed_.notify_all();
     for (;;) {
       check();
       while (!inbox_.empty()) {
@@ -664,7 +661,7 @@ class Secondary final : public FrameSync {
       options_.report("node " + node.get<std::string>() + " rejoined");
   }
 
-  // Throws for what the listener has seen: the master's stop, another display, silence.
+  // Throws for what the receive callback has seen: the master's stop, another display, silence.
   void check() {
     if (const int signal = interrupt_signal())
       throw Interrupted(signal, "stopped as a node of the cluster");
@@ -696,89 +693,68 @@ class Secondary final : public FrameSync {
     inbox_changed_.wait_until(lock, until);
   }
 
-  void listen() {
-    for (;;) {
-      {
-        std::lock_guard lock(mutex_);
-        if (stopping_) return;
-      }
-      const auto message = subscriber_.receive();
-      if (!message) continue;
-      Parse in(*message);
-      const auto kind = in.get<Published>();
-      const auto digest = in.get<std::uint64_t>();
-      if (!in.ok) continue;
-      std::lock_guard lock(mutex_);
-      last_heard_ = Clock::now();
-      if (digest != options_.content_digest) foreign_digest_ = digest;
-      if (kind == Published::stop) stop_reason_ = in.rest_text();
-      if (kind == Published::join || kind == Published::ready) {
-        // For the responder; the main thread waits for frame states and swaps only.
-        const auto frame = in.get<std::uint64_t>();
-        if (in.ok) {
-          questions_.emplace_back(kind, frame);
-          question_asked_.notify_one();
-        }
-        if (foreign_digest_) inbox_changed_.notify_one();
-      } else if (kind != Published::heartbeat) {
-        inbox_.emplace_back(kind, std::vector<std::uint8_t>(in.rest().begin(), in.rest().end()));
-        inbox_changed_.notify_one();
-      } else if (foreign_digest_) {
-        inbox_changed_.notify_one();
-      }
-      // A plain heartbeat wakes nobody: it moves last_heard_, which check() reads when the main
-      // thread wakes, at the latest when the old silence would have passed the deadline.
+  // NNG's callback for a message on subscriber_ (or an error), on one of NNG's own threads:
+  // the message is taken in there, so that nothing but the thread it is for wakes.
+  static void on_received(void* self) { static_cast<Secondary*>(self)->received(); }
+  void received() {
+    const int error = nng_aio_result(receiving_);
+    if (error == NNG_ECANCELED || error == NNG_ECLOSED) return;  // stopping
+    if (error == 0) {
+      nng_msg* message = nng_aio_get_msg(receiving_);
+      take(
+          std::span(static_cast<const std::uint8_t*>(nng_msg_body(message)), nng_msg_len(message)));
+      nng_msg_free(message);
     }
+    nng_recv_aio(subscriber_.get(), receiving_);
   }
 
-  // Answers the master's questions in the order the listener heard them, on this node's own
-  // pub socket (which only this thread uses).
-  void respond() {
-    for (;;) {
-      Published kind{};
-      std::uint64_t frame = 0;
-      bool answer = false;
-      {
-        std::unique_lock lock(mutex_);
-        question_asked_.wait(lock, [&] { return stopping_ || !questions_.empty(); });
-        if (stopping_) return;
-        std::tie(kind, frame) = questions_.front();
-        questions_.pop_front();
-        answer = kind == Published::join;
-        if (kind == Published::ready) {
-          // Answered once this node's outputs of `frame` are rendered; not when it skipped it.
-          rendered_changed_.wait(lock,
-                                 [&] { return stopping_ || (rendered_ && *rendered_ >= frame); });
-          if (stopping_) return;
-          answer = rendered_ && *rendered_ == frame;
-        }
-      }
-      if (answer)
-        answers_.send(
-            Bytes().put(kind).put(frame).put(options_.content_digest).put_text(self_.name).data);
+  void take(std::span<const std::uint8_t> message) {
+    Parse in(message);
+    const auto kind = in.get<Published>();
+    const auto digest = in.get<std::uint64_t>();
+    if (!in.ok) return;
+    std::lock_guard lock(mutex_);
+    last_heard_ = Clock::now();
+    if (digest != options_.content_digest) foreign_digest_ = digest;
+    if (kind == Published::stop) stop_reason_ = in.rest_text();
+    if (kind == Published::join) {
+      // Answered here at once; the main thread waits for frame states and swaps only.
+      if (in.get<std::uint64_t>() == 0 && in.ok) answer(Published::join, 0);
+      if (foreign_digest_) inbox_changed_.notify_one();
+    } else if (kind != Published::heartbeat) {
+      inbox_.emplace_back(kind, std::vector<std::uint8_t>(in.rest().begin(), in.rest().end()));
+      inbox_changed_.notify_one();
+    } else if (foreign_digest_) {
+      inbox_changed_.notify_one();
     }
+    // A plain heartbeat wakes nobody: it moves last_heard_, which check() reads when the main
+    // thread wakes, at the latest when the old silence would have passed the deadline.
+  }
+
+  // On this node's own pub socket: the receive callback answers "joined?", the main thread says
+  // "rendered" (NNG sockets may be shared between threads).
+  void answer(Published kind, std::uint64_t frame) {
+    answers_.send(
+        Bytes().put(kind).put(frame).put(options_.content_digest).put_text(self_.name).data);
   }
 
   ClusterNodeOptions options_;
   double deadline_ms_;
   const ClusterNode& self_;
   std::string master_;
-  // The listener receives on subscriber_, the responder sends on answers_; both close after the
-  // threads have ended.
+  // receiving_ takes subscriber_'s messages; its callback and the main thread send on answers_;
+  // both close after receiving has stopped.
   Socket subscriber_, answers_;
+  nng_aio* receiving_ = nullptr;
   std::mutex mutex_;
-  // The main thread waits for the inbox (and the master's silence), the responder for a question
-  // and for rendered_.
-  std::condition_variable inbox_changed_, rendered_changed_, question_asked_;
+  // The main thread waits for the inbox (and the master's silence).
+  std::condition_variable inbox_changed_;
   std::deque<std::pair<Published, std::vector<std::uint8_t>>> inbox_;
-  std::deque<std::pair<Published, std::uint64_t>> questions_;  // join or ready, and the frame
   std::optional<Clock::time_point> last_heard_;
   Clock::time_point started_ = Clock::now();
   std::optional<std::uint64_t> rendered_;
   std::optional<std::uint64_t> foreign_digest_;
   std::string stop_reason_;
-  bool stopping_ = false;
-  std::thread listener_, responder_;
 };
 
 }  // namespace

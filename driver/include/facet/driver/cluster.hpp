@@ -5,10 +5,10 @@
 // Everything is pub/sub. The master owns the frame state. Every frame it
 //   1. publishes FrameState N, together with the digest of the display and scene it runs; every
 //      node renders its own projectors from it;
-//   2. publishes the question "frame N rendered?" after it on the same socket, and waits up to
-//      the cluster's deadline (its own timer) for the answers; each node answers on a pub socket
-//      of its own, which the master subscribes to, when its outputs are rendered and about to
-//      swap;
+//   2. waits up to the cluster's deadline (its own timer, from when its own outputs are
+//      rendered) for every node to say "frame N rendered", which each node publishes unasked on a
+//      pub socket of its own, which the master subscribes to, from the thread that rendered, once
+//      its outputs are rendered and about to swap;
 //   3. publishes "swap N" with the nodes that missed the deadline, which are dropped from the
 //      barrier, and the nodes that answered again, which rejoin it. Then every node swaps.
 // Joining is the same exchange: the master asks "joined?" every 100 ms until every node answered
@@ -17,9 +17,9 @@
 // that a secondary that hears nothing for a deadline knows the master is gone, whatever the
 // frames cost to render.
 //
-// Addresses: every node listens on its address (frame states and questions: a sub socket) and
-// on cluster_barrier_address(address) (its answers: a pub socket); the master dials both of every
-// other node, so nodes may start in any order, and a restarted node is found again by the
+// Addresses: every node listens on its address (frame states, swaps and "joined?": a sub socket)
+// and on cluster_barrier_address(address) (its answers: a pub socket); the master dials both of
+// every other node, so nodes may start in any order, and a restarted node is found again by the
 // master's dialers.
 //
 // No hardware swap lock: GLX_NV_swap_group is not used; the barrier is the software one above.
@@ -153,8 +153,8 @@ struct ClusterBenchRow {
   double secondary_loss_ms = 0;  // a secondary falls silent: the master's wait until it drops it
   double master_loss_ms = 0;     // the master falls silent: until the last secondary gives up
   // The floor under the protocol, measured before it on the same transport and node count:
-  // NNG's exchange alone, per frame: the master publishes a frame state and a question, each
-  // node answers at once on its own pub socket from a thread of its own, the master's sub socket
+  // NNG's exchange alone, per frame: the master publishes a frame state, each node answers it at
+  // once on its own pub socket from a thread of its own, the master's sub socket
   // collects the answers; floor_expired frames whose deadline passed before every node answered
   // (not timed).
   double floor_median_ms = 0, floor_p99_ms = 0;
