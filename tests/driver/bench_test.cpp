@@ -1,7 +1,7 @@
-// facet bench from the command line: --quick writes bench.json, bench.csv and bench.png with every
-// render method, the same rows in JSON and CSV, a readable plot, and facets-gs IDs identical to
-// facets. Bad flags exit 2 and write nothing; --out replaces only an earlier bench. No timing
-// assertions: times only have to exist.
+// facet bench from the command line: --quick writes bench.json, bench.csv, bench.md and bench.png
+// with every render method, the same rows in JSON, CSV and the tables, a readable plot, and
+// facets-gs IDs identical to facets. Bad flags exit 2 and write nothing; --out replaces only an
+// earlier bench. No timing assertions: times only have to exist.
 #include "facet/driver/bench.hpp"
 
 #include <OpenImageIO/imageio.h>
@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -157,6 +158,18 @@ TEST(BenchCli, QuickWritesJsonCsvAndPlotWithEveryMethod) {
   }
   EXPECT_EQ(rows, json["rows"].size());
 
+  // The tables: a heading per scenario and a line per row, with its method, setting and frame
+  // time as the JSON has them.
+  const std::string tables = slurp(out / "bench.md");
+  for (const auto& row : json["rows"]) {
+    char frame[32];
+    std::snprintf(frame, sizeof frame, "%.1f", row["frame_ms"].get<double>());
+    const std::string table_line = "| " + row["method"].get<std::string>() + " | " +
+                                   row["setting"].get<std::string>() + " | " + frame + " |";
+    EXPECT_NE(tables.find(table_line), std::string::npos) << table_line;
+    EXPECT_NE(tables.find("**" + row["scenario"].get<std::string>() + "**"), std::string::npos);
+  }
+
   // The plot: a PNG that decodes, two panels wide, not blank.
   auto png = OIIO::ImageInput::open((out / "bench.png").string());
   ASSERT_TRUE(png) << OIIO::geterror();
@@ -204,7 +217,7 @@ TEST(BenchFiles, ReplaceOnlyAnEarlierBenchAndLeaveNothingOnFailure) {
   const fs::path folder = fresh_folder("files");
   const fs::path out = folder / "bench";
   driver::write_bench_files(small_report("first"), out, bench_rules());
-  const std::vector<std::string> files = {"bench.csv", "bench.json", "bench.png"};
+  const std::vector<std::string> files = {"bench.csv", "bench.json", "bench.md", "bench.png"};
   EXPECT_EQ(names_in(out), files);
   EXPECT_TRUE(driver::is_bench_output(out));
   std::ofstream(out / "bench.log") << "log";

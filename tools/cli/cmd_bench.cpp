@@ -110,7 +110,7 @@ OutputFolderRules bench_out_rules(const BenchCommandOptions& command) {
   rules.flag = "--out";
   rules.expected =
       "a new path, an empty folder, or a folder of an earlier facet bench (bench.json, bench.csv, "
-      "bench.png, bench.log, nothing else)";
+      "bench.md, bench.png, bench.log, nothing else)";
   rules.is_own_output = is_bench_output;
   for (const std::string& input : {command.rig, command.scene}) {
     std::error_code error;
@@ -155,8 +155,9 @@ void run(const BenchCommandOptions& command) {
   std::printf("\n");
   for (const std::string& note : report.notes) std::printf("%s\n\n", note.c_str());
   const std::filesystem::path out(command.out);
-  std::printf("wrote %s, %s, %s\n", (out / "bench.json").string().c_str(),
-              (out / "bench.csv").string().c_str(), (out / "bench.png").string().c_str());
+  std::printf("wrote %s, %s, %s, %s\n", (out / "bench.json").string().c_str(),
+              (out / "bench.csv").string().c_str(), (out / "bench.md").string().c_str(),
+              (out / "bench.png").string().c_str());
 }
 
 const Registration registration{
@@ -180,7 +181,9 @@ const Registration registration{
           ->capture_default_str();
       command->add_option("--size-scale", options->size_scale, "Scale every output size by this")
           ->capture_default_str();
-      command->add_option("--out", options->out, "Folder for bench.json, bench.csv, bench.png")
+      command
+          ->add_option("--out", options->out,
+                       "Folder for bench.json, bench.csv, bench.md, bench.png")
           ->capture_default_str();
       command
           ->add_option("--rig", options->rig,

@@ -1,4 +1,4 @@
-// bench.json, bench.csv, bench.png and the closing note of `facet bench`.
+// bench.json, bench.csv, bench.md, bench.png and the closing note of `facet bench`.
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -190,6 +190,61 @@ std::string csv_text(const BenchReport& report) {
         row.error};
     for (std::size_t k = 0; k < fields.size(); ++k) text += (k ? "," : "") + csv_field(fields[k]);
     text += "\n";
+  }
+  return text;
+}
+
+// --- The tables ---------------------------------------------------------------------------------
+
+// One markdown table per scenario, in the rows' order, then the closing notes: what
+// driver/README.md's "Measured" section shows.
+std::string markdown_text(const BenchReport& report) {
+  std::string text =
+      "Renderer: " + report.renderer + "; medians of " + std::to_string(report.frames) +
+      " frame(s) per row" +
+      (report.size_scale != 1 ? format(", outputs at %g of full size", report.size_scale)
+                              : std::string()) +
+      ".\n";
+  std::vector<std::string> scenarios;
+  for (const BenchRow& row : report.rows)
+    if (std::find(scenarios.begin(), scenarios.end(), row.scenario) == scenarios.end())
+      scenarios.push_back(row.scenario);
+  for (const std::string& scenario : scenarios) {
+    const auto first = std::find_if(report.rows.begin(), report.rows.end(),
+                                    [&](const BenchRow& row) { return row.scenario == scenario; });
+    text += "\n**" + scenario + "** (" + std::to_string(first->outputs) + " output(s) at " +
+            first->output_size + ", " + first->scene + ")\n\n";
+    text +=
+        "| method | setting | frame ms | passes 1+2 (wall / timer) | facets | repl. ratio | "
+        "id_mismatch | edge max / p99 px | geometric max / RMS px |\n"
+        "|---|---|---:|---:|---:|---:|---:|---:|---:|\n";
+    for (const BenchRow& row : report.rows) {
+      if (row.scenario != scenario) continue;
+      if (!row.error.empty()) {
+        text += "| " + row.method + " | " + row.setting + " | not run: " + row.error +
+                " | | | | | | |\n";
+        continue;
+      }
+      const std::string share =
+          row.passes12_share
+              ? format("%.0f%% / ", 100 * *row.passes12_share) +
+                    (row.passes12_share_gpu ? format("%.0f%%", 100 * *row.passes12_share_gpu)
+                                            : std::string("–"))
+              : std::string();
+      const std::string geometric =
+          row.geometric_source == "reference edges"
+              ? std::string("(edges)")
+              : format("%.3f / %.3f", row.geometric_max_px, row.geometric_rms_px);
+      text += "| " + row.method + " | " + row.setting + " | " + format("%.1f", row.frame_ms) +
+              " | " + share + " | " + std::to_string(row.facets) + " | " +
+              format("%.2f", row.replication_ratio) + " | " + format("%.5f", row.id_mismatch) +
+              " | " + format("%.2f / %.2f", row.max_edge_px, row.p99_edge_px) + " | " + geometric +
+              " |\n";
+    }
+  }
+  if (!report.notes.empty()) {
+    text += "\n";
+    for (const std::string& note : report.notes) text += "- " + note + "\n";
   }
   return text;
 }
@@ -605,7 +660,8 @@ bool is_bench_output(const std::filesystem::path& folder) {
   return holds_only_files_named(folder,
                                 [](const std::string& name) {
                                   return name == "bench.json" || name == "bench.csv" ||
-                                         name == "bench.png" || name == "bench.log";
+                                         name == "bench.md" || name == "bench.png" ||
+                                         name == "bench.log";
                                 }) &&
          std::filesystem::is_regular_file(folder / "bench.json", error);
 }
@@ -632,6 +688,7 @@ void write_bench_files(const BenchReport& report, const std::filesystem::path& f
                                      {"notes", report.notes}};
         write_text(temporary / "bench.json", json.dump(2) + "\n");
         write_text(temporary / "bench.csv", csv_text(report));
+        write_text(temporary / "bench.md", markdown_text(report));
         if (!cv::imwrite((temporary / "bench.png").string(), plot_image(report))) {
           throw InputError((folder / "bench.png").string(), "", "could not be written");
         }
