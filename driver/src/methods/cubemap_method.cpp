@@ -143,14 +143,7 @@ class CubemapMethod final : public RenderMethod {
     if (linked_gs_ != use_gs_) face_programs_.clear();
     linked_gs_ = use_gs_;
     face_programs_.prepare(scene, settings.material, [this](const MaterialShader& shader) {
-      ProgramBuilder face;
-      face.define("WRITE_TRIANGLE_ID", "1")
-          .define("CUBE_GS", use_gs_ ? "1" : "0")
-          .shader("baselines/cube_face.vert")
-          .shader("baselines/pull_scene.vert");
-      if (use_gs_) face.shader("baselines/cube_face.geom");
-      add_material_stages(face, shader);
-      return link_with_material(face, shader);
+      return link_perspective_scene_program(shader, use_gs_);
     });
     if (!lookup_program_) {
       lookup_program_ = ProgramBuilder()
@@ -173,15 +166,7 @@ class CubemapMethod final : public RenderMethod {
     if (timer) timer->begin("faces");
     glEnable(GL_TEXTURE_CUBE_MAP_SEAMLESS);
     glEnable(GL_FRAMEBUFFER_SRGB);
-    glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE);
-    glEnable(GL_DEPTH_TEST);
-    glDepthFunc(GL_GREATER);
-    if (settings_.cull_back_faces) {
-      glEnable(GL_CULL_FACE);
-      glCullFace(GL_BACK);
-    } else {
-      glDisable(GL_CULL_FACE);
-    }
+    begin_reversed_z_scene(settings_.cull_back_faces);
     // Every face of GL's cube keeps the same handedness, so one winding serves all (layered).
     const CubeFaceAxes& first = kCubeFaces[0];
     const bool mirrored = glm::dot(glm::cross(first.a_s, first.a_t), first.a_m) > 0;
@@ -197,16 +182,15 @@ class CubemapMethod final : public RenderMethod {
     // projection onto each.
     object_faces_.assign(scene.objects.size(), 0u);
     object_clip_.resize(scene.objects.size());
+    const std::vector<BoundingSphere> eye_spheres = object_spheres(scene, T_eye_world);
     for (std::size_t o = 0; o < scene.objects.size(); ++o) {
       const Object& object = scene.objects[o];
-      if (object.bounds_world.empty()) continue;
-      const glm::dvec3 lo(object.bounds_world.p_min), hi(object.bounds_world.p_max);
-      const glm::dvec3 centre(T_eye_world * glm::dvec4(0.5 * (lo + hi), 1.0));
-      // T_eye_world is rigid: the radius stays.
-      const double radius = 0.5 * glm::length(hi - lo);
-      object_faces_[o] = settings_.cube_culling == RenderSettings::CubeCulling::none
-                             ? needed_mask
-                             : faces_of_sphere(centre, radius, settings_.z_near) & needed_mask;
+      const BoundingSphere& sphere = eye_spheres[o];
+      if (sphere.radius < 0) continue;
+      object_faces_[o] =
+          settings_.cube_culling == RenderSettings::CubeCulling::none
+              ? needed_mask
+              : faces_of_sphere(sphere.centre, sphere.radius, settings_.z_near) & needed_mask;
       for (int f = 0; f < 6; ++f) {
         if (object_faces_[o] & (1u << f)) {
           const glm::dmat4 T_clip_eye = clip_from_eye(kCubeFaces[std::size_t(f)], settings_.z_near);

@@ -67,4 +67,27 @@ std::uint64_t draw_object_primitives(const Scene& scene, const GpuScene& gpu, st
   return id - first_id;
 }
 
+void begin_reversed_z_scene(bool cull_back_faces) {
+  glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE);
+  glEnable(GL_DEPTH_TEST);
+  glDepthFunc(GL_GREATER);
+  if (cull_back_faces) {
+    glEnable(GL_CULL_FACE);
+    glCullFace(GL_BACK);
+  } else {
+    glDisable(GL_CULL_FACE);
+  }
+}
+
+Program link_perspective_scene_program(const MaterialShader& shader, bool layered_cube) {
+  ProgramBuilder builder;
+  builder.define("WRITE_TRIANGLE_ID", "1")
+      .define("CUBE_GS", layered_cube ? "1" : "0")
+      .shader("baselines/cube_face.vert")
+      .shader("baselines/pull_scene.vert");
+  if (layered_cube) builder.shader("baselines/cube_face.geom");
+  add_material_stages(builder, shader);
+  return link_with_material(builder, shader);
+}
+
 }  // namespace facet::driver::detail

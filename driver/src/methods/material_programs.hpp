@@ -52,4 +52,14 @@ std::uint64_t draw_object_primitives(const Scene& scene, const GpuScene& gpu, st
                                      const Program*& in_use, GLenum mode,
                                      const std::function<void()>& send_object);
 
+// The depth convention of every scene pass: clip z in [0, 1] with the origin at the lower left,
+// reversed Z (GL_GREATER against depth cleared to 0), and GL's back-face culling on exactly when
+// `cull_back_faces` (the caller sets glFrontFace).
+void begin_reversed_z_scene(bool cull_back_faces);
+
+// A perspective image of the scene shaded by `shader` (baselines/cube_face.vert pulling the
+// scene's vertices, WRITE_TRIANGLE_ID 1): the cube map's faces, in one layered pass through
+// baselines/cube_face.geom when `layered_cube`, and the perspective baseline's image.
+Program link_perspective_scene_program(const MaterialShader& shader, bool layered_cube);
+
 }  // namespace facet::driver::detail

@@ -29,17 +29,6 @@ class NaiveMethod final : public FacetMethodBase {
                      GpuTimer* timer) override {
     FACET_ASSERT(targets.size() == outputs_.size());
     update_view(T_eye_world);
-    const Scene& scene = *scene_;
-    // Eye-frame bounding spheres of the objects, for the per-facet culling.
-    std::vector<glm::dvec3> centre(scene.objects.size());
-    std::vector<double> radius(scene.objects.size(), -1);
-    for (std::size_t o = 0; o < scene.objects.size(); ++o) {
-      const Aabb& box = scene.objects[o].bounds_world;
-      if (box.empty()) continue;
-      const glm::dvec3 p_min(box.p_min), p_max(box.p_max);
-      centre[o] = glm::dvec3(T_eye_world * glm::dvec4(0.5 * (p_min + p_max), 1.0));
-      radius[o] = 0.5 * glm::length(p_max - p_min) * 1.0001;
-    }
     RenderStats stats;
     // The record table and object frames, shared by the outputs.
     stats.gpu_buffer_bytes = records_buffer_.size() + object_frames_.size();
@@ -66,7 +55,8 @@ class NaiveMethod final : public FacetMethodBase {
           for (std::uint32_t r : records_by_material_[m]) {
             const GpuRecord& record = records_[r];
             if (!out.object_visible[record.object]) continue;
-            if (!sphere_may_meet_cone(centre[record.object], radius[record.object],
+            const BoundingSphere& sphere = eye_spheres_[record.object];
+            if (!sphere_may_meet_cone(sphere.centre, sphere.radius * 1.0001,
                                       pieces.planes[f].data(), 4)) {
               continue;
             }

@@ -111,13 +111,7 @@ class PerspectiveMethod final : public RenderMethod {
     }
     if (!empty_vao_) empty_vao_ = VertexArray::create();
     scene_programs_.prepare(scene, settings.material, [](const MaterialShader& shader) {
-      ProgramBuilder builder;
-      builder.define("WRITE_TRIANGLE_ID", "1")
-          .define("CUBE_GS", "0")
-          .shader("baselines/cube_face.vert")
-          .shader("baselines/pull_scene.vert");
-      add_material_stages(builder, shader);
-      return link_with_material(builder, shader);
+      return link_perspective_scene_program(shader, false);
     });
     if (!lookup_program_) {
       lookup_program_ = ProgramBuilder()
@@ -138,15 +132,7 @@ class PerspectiveMethod final : public RenderMethod {
     stats.gpu_buffer_bytes = buffer_bytes_;
     if (timer) timer->begin("image");
     glEnable(GL_FRAMEBUFFER_SRGB);
-    glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE);
-    glEnable(GL_DEPTH_TEST);
-    glDepthFunc(GL_GREATER);
-    if (settings_.cull_back_faces) {
-      glEnable(GL_CULL_FACE);
-      glCullFace(GL_BACK);
-    } else {
-      glDisable(GL_CULL_FACE);
-    }
+    begin_reversed_z_scene(settings_.cull_back_faces);
     glBindVertexArray(empty_vao_.id());
     gpu_scene_->bind_for_pulling();
     const float background[4] = {0, 0, 0, 1};
@@ -209,16 +195,16 @@ class PerspectiveMethod final : public RenderMethod {
     planes[4] = M[3] - glm::dvec4(0, 0, 0, settings_.z_near);  // w = distance along the axis
     std::uint64_t drawn = 0;
     const Program* in_use = nullptr;
+    const std::vector<BoundingSphere> eye_spheres = object_spheres(scene, T_eye_world);
     for (std::size_t o = 0; o < scene.objects.size(); ++o) {
       const Object& object = scene.objects[o];
-      if (object.bounds_world.empty()) continue;
-      const glm::dvec3 lo(object.bounds_world.p_min), hi(object.bounds_world.p_max);
-      const glm::dvec3 centre(T_eye_world * glm::dvec4(0.5 * (lo + hi), 1.0));
-      const double radius = 0.5 * glm::length(hi - lo);  // T_eye_world is rigid
+      const BoundingSphere& sphere = eye_spheres[o];
+      if (sphere.radius < 0) continue;
       bool outside = false;
       for (const glm::dvec4& plane : planes) {
         const double length = glm::length(glm::dvec3(plane));
-        outside = outside || glm::dot(glm::dvec3(plane), centre) + plane.w < -radius * length;
+        outside = outside ||
+                  glm::dot(glm::dvec3(plane), sphere.centre) + plane.w < -sphere.radius * length;
       }
       if (outside) continue;
       const glm::dmat4 T_eye_object = T_eye_world * glm::dmat4(object.T_world_object);

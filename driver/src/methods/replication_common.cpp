@@ -149,28 +149,23 @@ bool FacetMethodBase::update_view(const glm::dmat4& T_eye_world) {
   for (std::size_t o = 0; o < scene.objects.size(); ++o)
     last_T_world_object_[o] = scene.objects[o].T_world_object;
   std::vector<GpuObjectFrame> frames(std::max<std::size_t>(scene.objects.size(), 1));
-  std::vector<glm::dvec3> centre(scene.objects.size());
-  std::vector<double> radius(scene.objects.size(), -1);
   for (std::size_t o = 0; o < scene.objects.size(); ++o) {
     const Object& object = scene.objects[o];
-    const glm::dmat4 T_world_object(object.T_world_object);
-    const glm::mat4 T_eye_object(T_eye_world * T_world_object);
+    const glm::mat4 T_eye_object(T_eye_world * glm::dmat4(object.T_world_object));
     std::copy_n(glm::value_ptr(T_eye_object), 16, frames[o].T_eye_object);
     std::copy_n(glm::value_ptr(object.T_world_object), 16, frames[o].T_world_object);
-    if (object.bounds_world.empty()) continue;
-    // The box's bounding sphere; T_eye_world is rigid, so the radius carries over.
-    const glm::dvec3 p_min(object.bounds_world.p_min), p_max(object.bounds_world.p_max);
-    centre[o] = glm::dvec3(T_eye_world * glm::dvec4(0.5 * (p_min + p_max), 1.0));
-    radius[o] = 0.5 * glm::length(p_max - p_min);
   }
+  eye_spheres_ = object_spheres(scene, T_eye_world);
   object_frames_.sub_data(0, frames.size() * sizeof(GpuObjectFrame), frames.data());
 
   for (OutputState& out : outputs_) {
     out.replication_valid = false;
     out.object_visible.assign(scene.objects.size(), 0);
     for (std::size_t o = 0; o < scene.objects.size(); ++o) {
+      const BoundingSphere& sphere = eye_spheres_[o];
       out.object_visible[o] =
-          radius[o] >= 0 && sphere_may_meet_facets(out.facets, centre[o], radius[o] * 1.0001);
+          sphere.radius >= 0 &&
+          sphere_may_meet_facets(out.facets, sphere.centre, sphere.radius * 1.0001);
     }
     // Objects inside one piece and clear of the others: pass 1 gives their triangles that piece
     // without the grid (the walk, the reference, always walks).
@@ -178,7 +173,8 @@ bool FacetMethodBase::update_view(const glm::dmat4& T_eye_world) {
     if (settings_.coverage == FacetCoverage::grid) {
       for (std::size_t o = 0; o < scene.objects.size(); ++o) {
         if (out.object_visible[o])
-          sole_piece[o] = sole_piece_of_sphere(out.facets, centre[o], radius[o] * 1.0001);
+          sole_piece[o] = sole_piece_of_sphere(out.facets, eye_spheres_[o].centre,
+                                               eye_spheres_[o].radius * 1.0001);
       }
     }
     out.list.clear();
@@ -346,18 +342,10 @@ void FacetMethodBase::draw_replicas(std::size_t i, const OutputTarget& target,
 }
 
 void FacetMethodBase::begin_facet_drawing(bool cull_back_faces) {
-  glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE);
-  glEnable(GL_DEPTH_TEST);
-  glDepthFunc(GL_GREATER);
+  begin_reversed_z_scene(cull_back_faces);
+  glFrontFace(GL_CCW);
   glDepthMask(GL_TRUE);
   for (int k = 0; k < 4; ++k) glEnable(GL_CLIP_DISTANCE0 + k);
-  if (cull_back_faces) {
-    glEnable(GL_CULL_FACE);
-    glCullFace(GL_BACK);
-    glFrontFace(GL_CCW);
-  } else {
-    glDisable(GL_CULL_FACE);
-  }
 }
 
 void FacetMethodBase::end_facet_drawing() {

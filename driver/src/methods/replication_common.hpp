@@ -176,6 +176,7 @@ class FacetMethodBase : public RenderMethod {
   glm::dmat4 last_T_eye_world_{0.0};
   bool have_view_ = false;
   std::vector<glm::mat4> last_T_world_object_;  // the transforms of the last update_view
+  std::vector<BoundingSphere> eye_spheres_;     // the objects' spheres at the last update_view
 };
 
 // The pipelines that replicate into a pair buffer (facets, facets-gs). A frame queues every

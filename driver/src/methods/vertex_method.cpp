@@ -226,26 +226,15 @@ class VertexMethod final : public RenderMethod {
     const bool tessellated = settings_.max_tessellation > 1;
     const MaterialPrograms& draw = tessellated ? tess_programs_ : plain_programs_;
 
-    // Eye-frame bounding spheres of the objects.
-    std::vector<glm::dvec3> centre(scene.objects.size());
-    std::vector<double> radius(scene.objects.size(), -1);
-    for (std::size_t o = 0; o < scene.objects.size(); ++o) {
-      const Aabb& box = scene.objects[o].bounds_world;
-      if (box.empty()) continue;
-      const glm::dvec3 p_min(box.p_min), p_max(box.p_max);
-      centre[o] = glm::dvec3(T_eye_world * glm::dvec4(0.5 * (p_min + p_max), 1.0));
-      radius[o] = 0.5 * glm::length(p_max - p_min) * 1.0001;
-    }
+    const std::vector<BoundingSphere> eye_spheres = object_spheres(scene, T_eye_world);
 
     if (timer) timer->begin("draw");
     glClearNamedBufferData(counters_.id(), GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, counters_.id());
     gpu_scene_->bind_for_pulling();
-    glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE);
-    glEnable(GL_DEPTH_TEST);
     // Back faces are culled in 3D by the shaders: a large triangle's projected winding is not
     // reliable.
-    glDisable(GL_CULL_FACE);
+    begin_reversed_z_scene(false);
     glBindVertexArray(empty_vao_.id());
     if (tessellated) glPatchParameteri(GL_PATCH_VERTICES, 3);
 
@@ -278,7 +267,7 @@ class VertexMethod final : public RenderMethod {
 
       const Program* in_use = nullptr;
       for (std::size_t o = 0; o < scene.objects.size(); ++o) {
-        if (!may_be_seen(out, centre[o], radius[o])) continue;
+        if (!may_be_seen(out, eye_spheres[o].centre, eye_spheres[o].radius * 1.0001)) continue;
         const Object& object = scene.objects[o];
         const glm::mat4 T_eye_object(T_eye_world * glm::dmat4(object.T_world_object));
         draw_object_primitives(scene, *gpu_scene_, o, triangle_base_[o] + 1, draw, in_use,

@@ -39,6 +39,18 @@ Aabb Scene::bounds_world() const {
   return box;
 }
 
+std::vector<BoundingSphere> object_spheres(const Scene& scene, const glm::dmat4& T_frame_world) {
+  std::vector<BoundingSphere> spheres(scene.objects.size());
+  for (std::size_t o = 0; o < scene.objects.size(); ++o) {
+    const Aabb& box = scene.objects[o].bounds_world;
+    if (box.empty()) continue;
+    const glm::dvec3 p_min(box.p_min), p_max(box.p_max);
+    spheres[o].centre = glm::dvec3(T_frame_world * glm::dvec4(0.5 * (p_min + p_max), 1.0));
+    spheres[o].radius = 0.5 * glm::length(p_max - p_min);
+  }
+  return spheres;
+}
+
 void Scene::update_bounds() {
   for (auto& object : objects) {
     Aabb box;

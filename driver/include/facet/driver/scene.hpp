@@ -107,6 +107,15 @@ struct Scene {
   void update_bounds();
 };
 
+// An object's bounding sphere about its world box (the box's centre, half its diagonal), carried
+// into another frame by a rigid transform; radius < 0 for an object without vertices.
+struct BoundingSphere {
+  glm::dvec3 centre{0.0};
+  double radius = -1;
+};
+// Every object's BoundingSphere in the frame T_frame_world (rigid) leads to, in the objects' order.
+std::vector<BoundingSphere> object_spheres(const Scene& scene, const glm::dmat4& T_frame_world);
+
 // The scene with every triangle cut into n² (regular subdivision: each edge in n equal parts,
 // the pieces of one triangle sharing their vertices), positions, texture coordinates and normals
 // interpolated linearly (normals renormalised). Primitives, objects, materials and images keep
