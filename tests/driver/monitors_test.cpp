@@ -83,5 +83,41 @@ TEST(PlaceOutput, WindowOutputsKeepTheirRectangle) {
   EXPECT_EQ(placement.rect, glm::ivec4(10, 20, 300, 200));
 }
 
+// Spanning: one borderless window over the outputs' bounding rectangle, each output's viewport at
+// its place in it with GL's rows (y up from the bottom). Otherwise a window per output where its
+// placement says, with the whole framebuffer as its viewport.
+TEST(OutputWindows, OneSpanningWindowOrOneWindowPerOutput) {
+  std::vector<OutputPlacement> placements(3);
+  placements[0].rect = {100, 50, 1024, 768};
+  placements[1].rect = {1124, 50, 1024, 768};
+  placements[2].rect = {100, 818, 1024, 768};
+  placements[2].kind = OutputPlacement::Kind::fullscreen;
+  placements[2].monitor = 2;
+
+  const std::vector<OutputWindow> spanning = output_windows(placements, true);
+  ASSERT_EQ(spanning.size(), 1u);
+  const OutputWindow& all = spanning[0];
+  EXPECT_EQ(all.options.position, glm::ivec2(100, 50));
+  EXPECT_EQ(all.options.width, 2048);
+  EXPECT_EQ(all.options.height, 1536);
+  EXPECT_FALSE(all.options.decorated);
+  EXPECT_EQ(all.options.monitor, -1);
+  EXPECT_EQ(all.outputs, (std::vector<std::size_t>{0, 1, 2}));
+  EXPECT_EQ(all.viewports, (std::vector<glm::ivec4>{
+                               {0, 768, 1024, 768}, {1024, 768, 1024, 768}, {0, 0, 1024, 768}}));
+
+  const std::vector<OutputWindow> each = output_windows(placements, false);
+  ASSERT_EQ(each.size(), 3u);
+  for (std::size_t i = 0; i < each.size(); ++i) {
+    EXPECT_EQ(each[i].outputs, std::vector<std::size_t>{i});
+    EXPECT_EQ(each[i].viewports, std::vector<glm::ivec4>{glm::ivec4(0)});
+  }
+  EXPECT_EQ(each[1].options.position, glm::ivec2(1124, 50));
+  EXPECT_EQ(each[1].options.width, 1024);
+  EXPECT_EQ(each[1].options.monitor, -1);
+  EXPECT_EQ(each[2].options.monitor, 2);
+  EXPECT_TRUE(output_windows({}, true).empty());
+}
+
 }  // namespace
 }  // namespace facet::driver

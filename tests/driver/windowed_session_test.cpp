@@ -141,6 +141,29 @@ TEST_F(XorgDummy, WindowsLandOnTheirMonitorsAndShowTheirOutputs) {
   EXPECT_GT(report["last_frame"]["replicas"].get<double>(), 0.0);
 }
 
+// --span: one borderless window over all three monitors, each output read back from its own
+// viewport byte for byte.
+TEST_F(XorgDummy, OneSpanningWindowShowsEveryOutputInItsPlace) {
+  const fs::path display = write_display("spanned");
+  const fs::path report_path = folder_ / "spanned_report.json";
+  ASSERT_EQ(run_shell(run_command(display, "--span --frames 3 --report " + report_path.string())),
+            0);
+  const nlohmann::json report = nlohmann::json::parse(std::ifstream(report_path));
+  ASSERT_EQ(report["windows"].size(), 1u);
+  const nlohmann::json& window = report["windows"][0];
+  EXPECT_EQ(window["position"][0], 0);
+  EXPECT_EQ(window["position"][1], 0);
+  EXPECT_EQ(window["framebuffer"][0], kMonitors * kWidth);
+  EXPECT_EQ(window["framebuffer"][1], kHeight);
+  ASSERT_EQ(window["outputs"].size(), std::size_t(kMonitors));
+  for (int i = 0; i < kMonitors; ++i) {
+    const nlohmann::json& output = window["outputs"][i];
+    SCOPED_TRACE("output " + std::to_string(i));
+    EXPECT_EQ(output["monitor"], "DUMMY" + std::to_string(i));
+    EXPECT_EQ(output["mismatched_bytes"], 0) << "the viewport does not show its output exactly";
+  }
+}
+
 TEST_F(XorgDummy, SurvivesAMonitorUnpluggedDuringTheSession) {
   const fs::path display = write_display("unplug");
   const fs::path report_path = folder_ / "unplug_report.json";

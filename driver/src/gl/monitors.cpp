@@ -1,5 +1,8 @@
 #include "facet/driver/monitors.hpp"
 
+#include <glm/common.hpp>
+#include <limits>
+
 #include "facet/projection/errors.hpp"
 
 namespace facet::driver {
@@ -46,6 +49,36 @@ void apply_placement(const OutputPlacement& placement, WindowOptions& options) {
     options.width = placement.rect.z;
     options.height = placement.rect.w;
   }
+}
+
+std::vector<OutputWindow> output_windows(std::span<const OutputPlacement> placements, bool span) {
+  std::vector<OutputWindow> windows;
+  if (span && !placements.empty()) {
+    glm::ivec2 low(std::numeric_limits<int>::max()), high(std::numeric_limits<int>::min());
+    for (const OutputPlacement& p : placements) {
+      low = glm::min(low, glm::ivec2(p.rect.x, p.rect.y));
+      high = glm::max(high, glm::ivec2(p.rect.x + p.rect.z, p.rect.y + p.rect.w));
+    }
+    OutputWindow& window = windows.emplace_back();
+    window.options.position = low;
+    window.options.width = high.x - low.x;
+    window.options.height = high.y - low.y;
+    window.options.decorated = false;
+    for (std::size_t i = 0; i < placements.size(); ++i) {
+      const glm::ivec4& r = placements[i].rect;
+      window.outputs.push_back(i);
+      // Desktop y grows down, GL viewports up from the bottom.
+      window.viewports.emplace_back(r.x - low.x, high.y - (r.y + r.w), r.z, r.w);
+    }
+    return windows;
+  }
+  for (std::size_t i = 0; i < placements.size(); ++i) {
+    OutputWindow& window = windows.emplace_back();
+    apply_placement(placements[i], window.options);
+    window.outputs.push_back(i);
+    window.viewports.emplace_back(0, 0, 0, 0);
+  }
+  return windows;
 }
 
 }  // namespace facet::driver

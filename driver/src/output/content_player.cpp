@@ -206,34 +206,14 @@ void run_windowed_play(const SessionDisplay& display, std::unique_ptr<ContentMed
     glfwSetKeyCallback(native, on_play_key);
     return window;
   };
-  if (window_options.span) {
-    glm::ivec2 low(std::numeric_limits<int>::max()), high(std::numeric_limits<int>::min());
-    for (const OutputPlacement& p : placements) {
-      low = glm::min(low, glm::ivec2(p.rect.x, p.rect.y));
-      high = glm::max(high, glm::ivec2(p.rect.x + p.rect.z, p.rect.y + p.rect.w));
-    }
-    WindowOptions spanning;
-    spanning.position = low;
-    spanning.width = high.x - low.x;
-    spanning.height = high.y - low.y;
-    spanning.decorated = false;
-    PlayWindow window = open_window(spanning);
-    for (std::size_t i = 0; i < placements.size(); ++i) {
-      const glm::ivec4& r = placements[i].rect;
-      window.outputs.push_back(i);
-      window.viewports.emplace_back(r.x - low.x, high.y - (r.y + r.w), r.z, r.w);
+  for (const OutputWindow& layout : output_windows(placements, window_options.span)) {
+    PlayWindow window = open_window(layout.options);
+    window.outputs = layout.outputs;
+    for (glm::ivec4 viewport : layout.viewports) {
+      if (viewport.z == 0) viewport = glm::ivec4(0, 0, window.context->framebuffer_size());
+      window.viewports.push_back(viewport);
     }
     windows.push_back(std::move(window));
-  } else {
-    for (const OutputPlacement& placement : placements) {
-      WindowOptions one;
-      apply_placement(placement, one);
-      PlayWindow window = open_window(one);
-      const glm::ivec2 size = window.context->framebuffer_size();
-      window.outputs.push_back(windows.size());
-      window.viewports.emplace_back(0, 0, size.x, size.y);
-      windows.push_back(std::move(window));
-    }
   }
 
   windows.front().context->make_current();

@@ -362,38 +362,16 @@ void run_windowed_session(const SessionDisplay& display, const Scene& scene, con
     glfwSetMouseButtonCallback(native, on_mouse_button);
     return window;
   };
-  if (options.span) {
-    glm::ivec2 low(std::numeric_limits<int>::max()), high(std::numeric_limits<int>::min());
-    for (const OutputPlacement& p : placements) {
-      low = glm::min(low, glm::ivec2(p.rect.x, p.rect.y));
-      high = glm::max(high, glm::ivec2(p.rect.x + p.rect.z, p.rect.y + p.rect.w));
-    }
-    WindowOptions spanning;
-    spanning.position = low;
-    spanning.width = high.x - low.x;
-    spanning.height = high.y - low.y;
-    spanning.decorated = false;
-    Window window = open_window(spanning);
-    for (std::size_t i = 0; i < placements.size(); ++i) {
-      const glm::ivec4& r = placements[i].rect;
-      window.outputs.push_back(i);
-      // Desktop y grows down, GL viewports up from the bottom.
-      window.viewports.emplace_back(r.x - low.x, high.y - (r.y + r.w), r.z, r.w);
-      window.placements.push_back(placements[i]);
+  for (const OutputWindow& layout : output_windows(placements, options.span)) {
+    Window window = open_window(layout.options);
+    window.outputs = layout.outputs;
+    for (std::size_t k = 0; k < layout.outputs.size(); ++k) {
+      glm::ivec4 viewport = layout.viewports[k];
+      if (viewport.z == 0) viewport = glm::ivec4(0, 0, window.context->framebuffer_size());
+      window.viewports.push_back(viewport);
+      window.placements.push_back(placements[layout.outputs[k]]);
     }
     windows.push_back(std::move(window));
-  } else {
-    for (std::size_t i = 0; i < placements.size(); ++i) {
-      WindowOptions one;
-      const OutputPlacement& p = placements[i];
-      apply_placement(p, one);
-      Window window = open_window(one);
-      const glm::ivec2 size = window.context->framebuffer_size();
-      window.outputs.push_back(i);
-      window.viewports.emplace_back(0, 0, size.x, size.y);
-      window.placements.push_back(p);
-      windows.push_back(std::move(window));
-    }
   }
   glfwSetMonitorCallback(on_monitor);
   if (options.log) {

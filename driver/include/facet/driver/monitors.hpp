@@ -44,4 +44,17 @@ OutputPlacement place_output(const projection_io::DisplayOutput& output,
 // Sets where a window goes: full screen on the placement's monitor, or at its desktop rectangle.
 void apply_placement(const OutputPlacement& placement, WindowOptions& options);
 
+// One window of a windowed session and the outputs it shows, each in a viewport of its own
+// (x, y, width, height in framebuffer pixels, y up from the bottom as GL has it); a viewport of
+// zero size is the window's whole framebuffer, whose size is known once the window is open.
+struct OutputWindow {
+  WindowOptions options;
+  std::vector<std::size_t> outputs;  // indices into `placements`
+  std::vector<glm::ivec4> viewports;
+};
+// The windows that show outputs placed at `placements`: with `span`, one borderless window over
+// the bounding rectangle of them all, each output in its own rectangle of it; otherwise one window
+// per output, where apply_placement puts it.
+std::vector<OutputWindow> output_windows(std::span<const OutputPlacement> placements, bool span);
+
 }  // namespace facet::driver
