@@ -63,11 +63,9 @@ struct PlayOptions {
   std::optional<std::int64_t> frames;
   std::int64_t start_frame = 0;
   std::string out = "out/play";
-  std::string stats;  // windowed: the statistics file
-  std::string node;   // a cluster node of the display
-  double join_timeout_s = 60;
-  std::optional<double> rate_hz;
-  std::string direction_cache;  // empty: driver::default_direction_cache()
+  std::string stats;               // windowed: the statistics file
+  driver::ClusterRequest cluster;  // --node, --join-timeout, --rate
+  std::string direction_cache;     // empty: driver::default_direction_cache()
   bool no_direction_cache = false;
 };
 
@@ -108,8 +106,8 @@ void play(const PlayOptions& options) {
     throw InputError("command line", "--fov", "a field of view for --format fisheye only");
 
   // A cluster node shows its own projectors only.
-  const driver::ClusterRequest cluster_request{options.node, options.frames.has_value(),
-                                               options.rate_hz, options.join_timeout_s};
+  driver::ClusterRequest cluster_request = options.cluster;
+  cluster_request.frames_given = options.frames.has_value();
   auto [display, cluster_share] =
       driver::load_node_display(options.display, size, options.scale, cluster_request);
 
@@ -257,18 +255,7 @@ const Registration registration{
           ->capture_default_str();
       command->add_option("--stats", options->stats,
                           "Windowed: write per-frame statistics (stats.jsonl lines) to this file");
-      command
-          ->add_option("--node", options->node,
-                       "Play as this node of the display.json's cluster: its projectors only, "
-                       "frame-locked with the others (the master's show clock)")
-          ->check(cluster_node_name());
-      command
-          ->add_option("--join-timeout", options->join_timeout_s,
-                       "Cluster: seconds the master waits for the nodes to join, and a node "
-                       "for the master's first word")
-          ->capture_default_str();
-      command->add_option("--rate", options->rate_hz,
-                          "Cluster master: at most this many frames per second");
+      add_cluster_flags(*command, options->cluster, "Play");
       command->callback([options] { play(*options); });
     }};
 

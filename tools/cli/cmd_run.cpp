@@ -46,9 +46,7 @@ struct RunOptions {
   std::string report;
   bool monitors = false;
   ViewFlags view;
-  std::string node;               // a cluster node of the display
-  double join_timeout_s = 60;     // cluster: how long nodes wait for each other at the start
-  std::optional<double> rate_hz;  // cluster master: at most this many frames a second
+  driver::ClusterRequest cluster;  // --node, --join-timeout, --rate
 };
 
 // The command-line settings that change a node's pictures, for the cluster's content digest.
@@ -109,8 +107,8 @@ void run(const RunOptions& options) {
   if (!options.size.empty()) size = parse_size(options.size, "--size");
   const auto orientation = builtin_dome_orientation(options.orientation, options.display);
   // A cluster node renders its own projectors only.
-  const driver::ClusterRequest cluster_request{options.node, options.frames.has_value(),
-                                               options.rate_hz, options.join_timeout_s};
+  driver::ClusterRequest cluster_request = options.cluster;
+  cluster_request.frames_given = options.frames.has_value();
   auto [display, cluster_share] =
       driver::load_node_display(options.display, size, options.scale, cluster_request);
   for (auto& output : display.outputs) {
@@ -260,19 +258,7 @@ const Registration registration{
       command->add_flag("--no-path", options->no_path, "Start still instead of on the path");
       command->add_option("--report", options->report,
                           "Windowed: write window placement and shown-pixel checks to this JSON");
-      command
-          ->add_option("--node", options->node,
-                       "Run as this node of the display.json's cluster: its projectors only, "
-                       "frame-locked with the others (see README: Clusters)")
-          ->check(cluster_node_name());
-      command
-          ->add_option("--join-timeout", options->join_timeout_s,
-                       "Cluster: seconds the master waits for the nodes to join, and a node "
-                       "for the master's first word")
-          ->capture_default_str();
-      command->add_option("--rate", options->rate_hz,
-                          "Cluster master: at most this many frames per second (default: as "
-                          "fast as the slowest node)");
+      add_cluster_flags(*command, options->cluster, "Run");
       command->add_flag("--monitors", options->monitors,
                         "List the connected monitors (name, size+x+y, refresh) and exit");
       command->callback([options] { run(*options); });
