@@ -9,13 +9,13 @@
 namespace facet::detail {
 
 // Loops shorter than min_parallel run on the calling thread: starting threads costs more.
+// `workers` threads share the loop (0: one per hardware thread).
 template <typename Body>
-void parallel_for(std::size_t count, Body&& body, std::size_t min_parallel = 8) {
+void parallel_for(std::size_t count, Body&& body, std::size_t min_parallel = 8,
+                  std::size_t workers = 0) {
+  if (workers == 0) workers = std::max<std::size_t>(1, std::thread::hardware_concurrency());
   const std::size_t threads =
-      count < min_parallel
-          ? 1
-          : std::max<std::size_t>(
-                1, std::min<std::size_t>(std::thread::hardware_concurrency(), count));
+      count < min_parallel ? 1 : std::max<std::size_t>(1, std::min<std::size_t>(workers, count));
   if (threads <= 1) {
     for (std::size_t k = 0; k < count; ++k) body(k, std::size_t{0});
     return;

@@ -243,15 +243,15 @@ std::optional<glm::dvec2> WarpInverse::walk_from(glm::ivec2 cell, glm::dvec2 q) 
   return std::nullopt;
 }
 
-void WarpInverse::for_each_pixel_centre(
-    const std::function<void(std::size_t, glm::dvec2)>& found) const {
+void WarpInverse::for_each_pixel_centre(const std::function<void(std::size_t, glm::dvec2)>& found,
+                                        std::size_t threads) const {
   const glm::ivec2 size = warp_.output_size;
   // Along a row, consecutive pixel centres mostly lie in the same cell: Newton starts there from
   // the previous pixel's cell-local solution, a pixel away, and converges in a step or two
   // instead of four or five from the cell's middle. It still stops only within kTolerancePx, so
   // the answer is the same point to that tolerance; anything else (another cell, a solution
   // outside this one, no convergence) takes st_from_q's path.
-  detail::parallel_for(std::size_t(std::max(size.y, 0)), [&](std::size_t y, std::size_t) {
+  const auto row = [&](std::size_t y, std::size_t) {
     const std::int32_t* cells = cell_of_pixel_.data() + y * std::size_t(size.x);
     std::int32_t previous = -1;  // the cell of the previous pixel's solution, or −1
     glm::dvec2 f(0.5), q00(0.0), q10(0.0), q01(0.0), q11(0.0);
@@ -288,22 +288,25 @@ void WarpInverse::for_each_pixel_centre(
         q11 = q_node(c.x + 1, c.y + 1);
       }
     }
-  });
+  };
+  detail::parallel_for(std::size_t(std::max(size.y, 0)), row, 8, threads);
 }
 
-std::vector<glm::dvec2> WarpInverse::st_at_pixel_centres() const {
+std::vector<glm::dvec2> WarpInverse::st_at_pixel_centres(std::size_t threads) const {
   std::vector<glm::dvec2> st(cell_of_pixel_.size(),
                              glm::dvec2(std::numeric_limits<double>::quiet_NaN()));
-  for_each_pixel_centre([&](std::size_t pixel, glm::dvec2 found) { st[pixel] = found; });
+  for_each_pixel_centre([&](std::size_t pixel, glm::dvec2 found) { st[pixel] = found; }, threads);
   return st;
 }
 
-std::vector<glm::vec3> WarpInverse::v_eye_at_pixel_centres() const {
+std::vector<glm::vec3> WarpInverse::v_eye_at_pixel_centres(std::size_t threads) const {
   std::vector<glm::vec3> v_eye(cell_of_pixel_.size(),
                                glm::vec3(std::numeric_limits<float>::quiet_NaN()));
-  for_each_pixel_centre([&](std::size_t pixel, glm::dvec2 found) {
-    v_eye[pixel] = glm::vec3(glm::normalize(warp_.v_eye_from_st(found)));
-  });
+  for_each_pixel_centre(
+      [&](std::size_t pixel, glm::dvec2 found) {
+        v_eye[pixel] = glm::vec3(glm::normalize(warp_.v_eye_from_st(found)));
+      },
+      threads);
   return v_eye;
 }
 

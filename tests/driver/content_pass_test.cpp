@@ -8,10 +8,12 @@
 
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <numbers>
 #include <vector>
 
@@ -295,6 +297,108 @@ TEST(DirectionCache, ReadsBackTheComputedLookupAndIgnoresADamagedFile) {
   // No folder: computed, nothing written.
   EXPECT_FALSE(direction_lookup(warp, {}).from_cache);
   std::filesystem::remove_all(folder);
+}
+
+namespace fs = std::filesystem;
+
+void write_bytes(const fs::path& path, std::size_t size) {
+  std::ofstream(path, std::ios::binary) << std::string(size, 'x');
+}
+
+void set_age(const fs::path& path, int seconds_ago) {
+  fs::last_write_time(path, fs::file_time_type::clock::now() - std::chrono::seconds(seconds_ago));
+}
+
+// The folder is trimmed to its budget by removing the least recently modified cache files, and
+// nothing that is not one: other names, other kinds of entries and links are neither counted nor
+// removed.
+TEST(DirectionCache, TrimRemovesTheOldestCacheFilesBeyondTheBudgetAndNothingElse) {
+  const fs::path folder = test_paths::scratch_path("facet_direction_cache_trim");
+  fs::remove_all(folder);
+  fs::create_directories(folder / "0000000000000000.dirs");  // a folder named like a file
+  write_bytes(folder / "0000000000000000.dirs" / "inner", 10);
+  const std::vector<std::string> cache = {"00000000000000a1.dirs", "00000000000000a2.dirs",
+                                          "00000000000000a3.dirs", "00000000000000a4.dirs",
+                                          "00000000000000a5.dirs"};
+  for (std::size_t k = 0; k < cache.size(); ++k) {
+    write_bytes(folder / cache[k], 1000);
+    set_age(folder / cache[k], 100 - 10 * int(k));  // a5 the newest
+  }
+  const std::vector<std::string> others = {"notes.txt",
+                                           "00000000000000A1.dirs",
+                                           "00000000000000a1.dirs.bak",
+                                           "0000000000000a1.dirs",
+                                           ".00000000000000a6.tmp42-0.dirs",
+                                           "00000000000000a7.dir"};
+  for (const std::string& name : others) {
+    write_bytes(folder / name, 5000);
+    set_age(folder / name, 1000);
+  }
+  write_bytes(folder.parent_path() / "facet_direction_cache_trim_target", 5000);
+  fs::create_symlink(folder.parent_path() / "facet_direction_cache_trim_target",
+                     folder / "00000000000000b1.dirs");
+
+  // 2500 bytes: the two newest cache files (2000 bytes) stay, the third would exceed it.
+  EXPECT_EQ(trim_direction_cache(folder, 2500), 3u);
+  for (std::size_t k = 0; k < cache.size(); ++k)
+    EXPECT_EQ(fs::exists(folder / cache[k]), k >= 3) << cache[k];
+  for (const std::string& name : others) EXPECT_TRUE(fs::exists(folder / name)) << name;
+  EXPECT_TRUE(fs::exists(folder / "0000000000000000.dirs" / "inner"));
+  EXPECT_TRUE(fs::is_symlink(folder / "00000000000000b1.dirs"));
+  EXPECT_TRUE(fs::exists(folder.parent_path() / "facet_direction_cache_trim_target"));
+
+  // The kept file stays whatever its age, and counts first.
+  EXPECT_EQ(trim_direction_cache(folder, 1500, folder / cache[3]), 1u);
+  EXPECT_TRUE(fs::exists(folder / cache[3]));
+  EXPECT_FALSE(fs::exists(folder / cache[4]));
+  // A missing folder: nothing to do.
+  EXPECT_EQ(trim_direction_cache(folder / "missing", 0), 0u);
+  fs::remove_all(folder);
+  fs::remove(folder.parent_path() / "facet_direction_cache_trim_target");
+}
+
+// Through direction_lookup: writing a lookup trims the folder; reading one marks it used, so the
+// lookup read last outlives one written earlier; and a reader that has the file open when it is
+// removed still reads every byte of it.
+TEST(DirectionCache, WritingTrimsToTheBudgetAndReadingCountsAsUse) {
+  const fs::path folder = test_paths::scratch_path("facet_direction_cache_budget");
+  fs::remove_all(folder);
+  const std::vector<OutputSpec> outputs = dome4_outputs();
+  const Warp& a = outputs.at(0).warp;
+  const Warp& b = outputs.at(1).warp;
+  const Warp& c = outputs.at(2).warp;
+  const fs::path file_a = folder / direction_cache_file_name(direction_cache_key(a));
+  const fs::path file_b = folder / direction_cache_file_name(direction_cache_key(b));
+  const fs::path file_c = folder / direction_cache_file_name(direction_cache_key(c));
+  const std::uint64_t unlimited = std::uint64_t(1) << 40;
+
+  EXPECT_FALSE(direction_lookup(a, folder, unlimited).from_cache);
+  EXPECT_FALSE(direction_lookup(b, folder, unlimited).from_cache);
+  const std::uintmax_t file_size = fs::file_size(file_a);
+  ASSERT_EQ(fs::file_size(file_b), file_size);  // outputs of one size
+  // a written first, then b; reading a makes it the most recently used.
+  set_age(file_a, 200);
+  set_age(file_b, 100);
+  const DirectionLookup reread = direction_lookup(a, folder, unlimited);
+  EXPECT_TRUE(reread.from_cache);
+  EXPECT_GT(fs::last_write_time(file_a), fs::last_write_time(file_b));
+
+  // A reader holding b open while c's write removes it (room for two files: c and a).
+  std::ifstream reader(file_b, std::ios::binary);
+  ASSERT_TRUE(reader.is_open());
+  EXPECT_FALSE(direction_lookup(c, folder, 2 * file_size).from_cache);
+  EXPECT_TRUE(fs::exists(file_c));
+  EXPECT_TRUE(fs::exists(file_a));
+  EXPECT_FALSE(fs::exists(file_b));
+  std::string bytes((std::istreambuf_iterator<char>(reader)), std::istreambuf_iterator<char>());
+  EXPECT_EQ(bytes.size(), file_size);
+
+  // A budget smaller than one file keeps the one just written.
+  EXPECT_FALSE(direction_lookup(b, folder, 1).from_cache);
+  EXPECT_TRUE(fs::exists(file_b));
+  EXPECT_FALSE(fs::exists(file_a));
+  EXPECT_FALSE(fs::exists(file_c));
+  fs::remove_all(folder);
 }
 
 }  // namespace

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <fstream>
 #include <random>
 #include <sstream>
@@ -214,6 +215,33 @@ TEST(WarpInverse, RealSimcadDomeWarpsRoundTrip) {
     EXPECT_GT(trip.covered, std::size_t(640 * 400) / 2);
     EXPECT_LE(trip.worst_px, 1e-6);  // worst case, output px
     EXPECT_LE(worst_forward_then_inverse(inverse, 4000, 10 + channel), 1e-9);
+  }
+}
+
+// The pixel-centre inverse shares its rows among threads. Direction lookups cached on disk stay
+// valid only if the answer does not depend on how many threads shared them: every thread count
+// gives the serial answer to the bit, covered or not (NaN has one bit pattern here).
+TEST(WarpInverse, PixelCentresAreTheSameBitsOnAnyNumberOfThreads) {
+  for (int channel : {1, 4}) {
+    const std::string path = std::string(FACET_SHARED_DATA_DIR) +
+                             "/warps/sgct-dome/simcad/channel" + std::to_string(channel) +
+                             "_warp_mesh.csv";
+    SCOPED_TRACE(path);
+    const WarpInverse inverse(simcad_warp(path, {1280, 800}));
+    const std::vector<glm::dvec2> serial_st = inverse.st_at_pixel_centres(1);
+    const std::vector<glm::vec3> serial_v = inverse.v_eye_at_pixel_centres(1);
+    std::size_t covered = 0;
+    for (const glm::vec3& v : serial_v) covered += std::isnan(v.x) ? 0 : 1;
+    EXPECT_GT(covered, serial_v.size() / 2);
+    for (std::size_t threads : {2, 3, 8, 0}) {
+      SCOPED_TRACE(threads);
+      const std::vector<glm::dvec2> st = inverse.st_at_pixel_centres(threads);
+      const std::vector<glm::vec3> v = inverse.v_eye_at_pixel_centres(threads);
+      ASSERT_EQ(st.size(), serial_st.size());
+      ASSERT_EQ(v.size(), serial_v.size());
+      EXPECT_EQ(std::memcmp(st.data(), serial_st.data(), st.size() * sizeof(glm::dvec2)), 0);
+      EXPECT_EQ(std::memcmp(v.data(), serial_v.data(), v.size() * sizeof(glm::vec3)), 0);
+    }
   }
 }
 

@@ -6,6 +6,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <future>
 #include <iostream>
 #include <memory>
 #include <optional>
@@ -111,9 +112,22 @@ void play(const PlayOptions& options) {
   auto [display, cluster_share] =
       driver::load_node_display(options.display, size, options.scale, cluster_request);
 
+  driver::PlaybackOptions playback;
+  if (options.no_direction_cache && !options.direction_cache.empty())
+    throw InputError("command line", "--no-direction-cache",
+                     "either --direction-cache DIR or --no-direction-cache, not both");
+  if (!options.no_direction_cache) {
+    playback.resample.direction_cache = options.direction_cache.empty()
+                                            ? driver::default_direction_cache()
+                                            : usable_cache_folder(options.direction_cache);
+  }
+  // The direction lookups (the warp inverse at every output pixel, or the cache read) on a
+  // thread of their own while FFmpeg opens the file and the GL starts.
+  std::future<driver::ContentLookups> lookups =
+      driver::start_content_lookups(display, playback.resample);
+
   auto media = driver::ContentMedia::open(options.file);
   const ContentFormat chosen = driver::check_content_format(media->size(), format, options.file);
-  driver::PlaybackOptions playback;
   switch (chosen) {
     case ContentFormat::fisheye:
       playback.projection = fisheye_content(options.fov.value_or(180), orientation);
@@ -128,14 +142,6 @@ void play(const PlayOptions& options) {
   playback.projection.validate("command line");
   playback.loop = options.loop;
   playback.start_frame = options.start_frame;
-  if (options.no_direction_cache && !options.direction_cache.empty())
-    throw InputError("command line", "--no-direction-cache",
-                     "either --direction-cache DIR or --no-direction-cache, not both");
-  if (!options.no_direction_cache) {
-    playback.resample.direction_cache = options.direction_cache.empty()
-                                            ? driver::default_direction_cache()
-                                            : usable_cache_folder(options.direction_cache);
-  }
   if (options.start_frame < 0 || options.start_frame >= media->frame_count())
     throw InputError("command line", "--start-frame",
                      "a frame from 0 to " + std::to_string(media->frame_count() - 1) + " of " +
@@ -181,13 +187,14 @@ void play(const PlayOptions& options) {
     if (!options.stats.empty()) window_options.stats = options.stats;
     window_options.sync = sync.get();
     window_options.log = console_log("facet play: ");
-    driver::run_windowed_play(display, std::move(media), playback, window_options);
+    driver::run_windowed_play(display, std::move(media), playback, window_options,
+                              std::move(lookups));
     return;
   }
   if (!options.headless)
     std::cerr << "facet play: no display server (DISPLAY is not set): playing headless\n";
   auto context = driver::create_headless_context();
-  driver::ContentPlayer player(std::move(display), std::move(media), playback);
+  driver::ContentPlayer player(std::move(display), std::move(media), playback, std::move(lookups));
   driver::HeadlessRunOptions headless_options;
   headless_options.frames = frames.value_or(driver::frames_for_one_pass(player.clock()));
   headless_options.out_dir = options.out;

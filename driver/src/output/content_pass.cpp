@@ -101,26 +101,45 @@ void ContentTexture::upload(const ContentImage& image) {
   check_gl_error("content upload");
 }
 
-ContentPass::ContentPass(std::span<const OutputSpec> outputs, ResampleOptions options)
-    : options_(options) {
+ContentLookups prepare_content_lookups(std::span<const OutputSpec> outputs,
+                                       const ResampleOptions& options) {
+  ContentLookups lookups;
   for (const OutputSpec& output : outputs) {
     const glm::ivec2 size = output.warp.output_size;
-    const DirectionLookup directions = direction_lookup(output.warp, options.direction_cache);
-    lookups_from_cache_ += directions.from_cache ? 1 : 0;
+    const DirectionLookup directions =
+        direction_lookup(output.warp, options.direction_cache, options.direction_cache_budget);
+    lookups.from_cache += directions.from_cache ? 1 : 0;
     const std::vector<glm::vec3>& v_eye = directions.v_eye;
     // GL rows start at the bottom.
-    std::vector<glm::vec4> lookup(v_eye.size(), glm::vec4(0));
+    std::vector<glm::vec4> texels(v_eye.size(), glm::vec4(0));
     for (int y = 0; y < size.y; ++y) {
-      for (int x = 0; x < size.x; ++x) {
-        const glm::vec3 v = v_eye[std::size_t(y) * size.x + x];
-        if (std::isnan(v.x)) continue;
-        lookup[std::size_t(size.y - 1 - y) * size.x + x] = glm::vec4(v, 1.0f);
-      }
+      const glm::vec3* from = v_eye.data() + std::size_t(y) * size.x;
+      glm::vec4* to = texels.data() + std::size_t(size.y - 1 - y) * size.x;
+      for (int x = 0; x < size.x; ++x)
+        if (!std::isnan(from[x].x)) to[x] = glm::vec4(from[x], 1.0f);
     }
+    lookups.sizes.push_back(size);
+    lookups.texels.push_back(std::move(texels));
+  }
+  return lookups;
+}
+
+ContentPass::ContentPass(std::span<const OutputSpec> outputs, ResampleOptions options)
+    : ContentPass(prepare_content_lookups(outputs, options), options) {}
+
+ContentPass::ContentPass(ContentLookups lookups, ResampleOptions options) : options_(options) {
+  FACET_ASSERT(lookups.sizes.size() == lookups.texels.size());
+  lookups_from_cache_ = lookups.from_cache;
+  for (std::size_t i = 0; i < lookups.sizes.size(); ++i) {
+    const glm::ivec2 size = lookups.sizes[i];
+    FACET_ASSERT(lookups.texels[i].size() == std::size_t(size.x) * size.y);
     Texture texture = Texture::create_2d(GL_RGBA32F, size.x, size.y);
     glTextureParameteri(texture.id(), GL_TEXTURE_MIN_FILTER, GL_NEAREST);
     glTextureParameteri(texture.id(), GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-    glTextureSubImage2D(texture.id(), 0, 0, 0, size.x, size.y, GL_RGBA, GL_FLOAT, lookup.data());
+    glTextureSubImage2D(texture.id(), 0, 0, 0, size.x, size.y, GL_RGBA, GL_FLOAT,
+                        lookups.texels[i].data());
+    // The GL has its copy.
+    std::vector<glm::vec4>().swap(lookups.texels[i]);
     lookups_.push_back(std::move(texture));
     sizes_.push_back(size);
   }

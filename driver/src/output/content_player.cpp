@@ -79,7 +79,7 @@ nlohmann::json play_frame_stats_to_json(const PlayFrameStats& stats) {
 }
 
 ContentPlayer::ContentPlayer(SessionDisplay display, std::unique_ptr<ContentMedia> media,
-                             PlaybackOptions options)
+                             PlaybackOptions options, std::future<ContentLookups> lookups)
     : display_(std::move(display)), media_(std::move(media)), options_(std::move(options)) {
   FACET_ASSERT(media_ != nullptr);
   const std::string source = media_->path().string();
@@ -95,14 +95,29 @@ ContentPlayer::ContentPlayer(SessionDisplay display, std::unique_ptr<ContentMedi
                      "a frame from 0 to " + std::to_string(media_->frame_count() - 1) + " of " +
                          source + "; got " + std::to_string(options_.start_frame));
 
-  std::vector<OutputSpec> specs;
-  for (const SessionOutput& output : display_.outputs) specs.push_back(output.spec);
-  pass_ = ContentPass(specs, options_.resample);
+  // The GL work that needs no lookup first, while they may still be on their way.
   texture_ = ContentTexture(options_.projection.format, media_->size(), media_->pixels(), source);
   for (const SessionOutput& output : display_.outputs) {
     targets_.push_back(OutputTarget::create(output.spec.warp.output_size));
     blends_.emplace_back(output.spec.warp.output_size, output.blend, output.encoding);
   }
+  if (lookups.valid()) {
+    pass_ = ContentPass(lookups.get(), options_.resample);
+  } else {
+    std::vector<OutputSpec> specs;
+    for (const SessionOutput& output : display_.outputs) specs.push_back(output.spec);
+    pass_ = ContentPass(specs, options_.resample);
+  }
+  FACET_ASSERT(pass_.output_count() == display_.outputs.size());
+}
+
+std::future<ContentLookups> start_content_lookups(const SessionDisplay& display,
+                                                  const ResampleOptions& options) {
+  std::vector<OutputSpec> specs;
+  for (const SessionOutput& output : display.outputs) specs.push_back(output.spec);
+  return std::async(std::launch::async, [specs = std::move(specs), options] {
+    return prepare_content_lookups(specs, options);
+  });
 }
 
 PlayFrameStats ContentPlayer::render(const FrameState& state, bool finish) {
@@ -185,7 +200,8 @@ struct PlayWindow {
 }  // namespace
 
 void run_windowed_play(const SessionDisplay& display, std::unique_ptr<ContentMedia> media,
-                       const PlaybackOptions& options, const WindowPlayOptions& window_options) {
+                       const PlaybackOptions& options, const WindowPlayOptions& window_options,
+                       std::future<ContentLookups> lookups) {
   const auto entered = std::chrono::steady_clock::now();
   const std::vector<MonitorInfo> monitors = list_monitors();
   std::vector<OutputPlacement> placements;
@@ -217,7 +233,7 @@ void run_windowed_play(const SessionDisplay& display, std::unique_ptr<ContentMed
   }
 
   windows.front().context->make_current();
-  ContentPlayer player(display, std::move(media), options);
+  ContentPlayer player(display, std::move(media), options, std::move(lookups));
   std::vector<Texture> raw_views;
   for (const OutputTarget& target : player.targets())
     raw_views.push_back(Texture::create_view(target.colour(), GL_RGBA8));

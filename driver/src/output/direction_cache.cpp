@@ -1,5 +1,6 @@
 #include "facet/driver/direction_cache.hpp"
 
+#include <algorithm>
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
@@ -56,11 +57,11 @@ std::uint64_t payload_digest(const std::vector<glm::vec3>& v_eye) {
   return state;
 }
 
-std::string file_name(std::uint64_t key) {
-  static const char* hex = "0123456789abcdef";
-  std::string name(16, '0');
-  for (int k = 0; k < 16; ++k) name[15 - k] = hex[(key >> (4 * k)) & 15];
-  return name + ".dirs";
+// A name direction_cache_file_name gives: 16 lower-case hex digits, ".dirs".
+bool is_cache_file_name(const std::string& name) {
+  if (name.size() != 21 || name.compare(16, 5, ".dirs") != 0) return false;
+  return std::all_of(name.begin(), name.begin() + 16,
+                     [](char c) { return (c >= '0' && c <= '9') || (c >= 'a' && c <= 'f'); });
 }
 
 bool read_cached(const std::filesystem::path& path, const Warp& warp, std::uint64_t key,
@@ -77,7 +78,11 @@ bool read_cached(const std::filesystem::path& path, const Warp& warp, std::uint6
   v_eye.resize(std::size_t(warp.output_size.x) * std::size_t(warp.output_size.y));
   const auto size = std::streamsize(v_eye.size() * sizeof(glm::vec3));
   if (!in.read(reinterpret_cast<char*>(v_eye.data()), size) || in.peek() != EOF) return false;
-  return payload_digest(v_eye) == header.payload_digest;
+  if (payload_digest(v_eye) != header.payload_digest) return false;
+  // Used now: the last file trim_direction_cache removes. A read-only folder keeps the old time.
+  std::error_code ignored;
+  std::filesystem::last_write_time(path, std::filesystem::file_time_type::clock::now(), ignored);
+  return true;
 }
 
 void write_cached(const std::filesystem::path& path, const Warp& warp, std::uint64_t key,
@@ -125,10 +130,57 @@ std::uint64_t direction_cache_key(const Warp& warp) {
   return hash.state;
 }
 
-DirectionLookup direction_lookup(const Warp& warp, const std::filesystem::path& folder) {
+std::string direction_cache_file_name(std::uint64_t key) {
+  static const char* hex = "0123456789abcdef";
+  std::string name(16, '0');
+  for (int k = 0; k < 16; ++k) name[15 - k] = hex[(key >> (4 * k)) & 15];
+  return name + ".dirs";
+}
+
+std::size_t trim_direction_cache(const std::filesystem::path& folder, std::uint64_t budget_bytes,
+                                 const std::filesystem::path& keep) {
+  namespace fs = std::filesystem;
+  struct Entry {
+    fs::path path;
+    fs::file_time_type time;
+    std::uintmax_t size;
+    bool kept;
+  };
+  std::vector<Entry> entries;
+  std::error_code error;
+  for (fs::directory_iterator it(folder, error), end; !error && it != end; it.increment(error)) {
+    const std::string name = it->path().filename().string();
+    std::error_code entry_error;
+    // symlink_status: a link named like a cache file is not the cache's and is left alone.
+    if (!is_cache_file_name(name) || !fs::is_regular_file(it->symlink_status(entry_error)))
+      continue;
+    Entry entry{it->path(), it->last_write_time(entry_error), it->file_size(entry_error),
+                !keep.empty() && name == keep.filename().string()};
+    if (!entry_error) entries.push_back(std::move(entry));
+  }
+  // The kept file first, then the most recently used; ties by name, for the same order every time.
+  std::sort(entries.begin(), entries.end(), [](const Entry& a, const Entry& b) {
+    if (a.kept != b.kept) return a.kept;
+    if (a.time != b.time) return a.time > b.time;
+    return a.path < b.path;
+  });
+  std::uint64_t total = 0;
+  std::size_t removed = 0;
+  for (const Entry& entry : entries) {
+    total += entry.size;
+    if (entry.kept || total <= budget_bytes) continue;
+    std::error_code ignored;
+    if (fs::remove(entry.path, ignored)) ++removed;
+  }
+  return removed;
+}
+
+DirectionLookup direction_lookup(const Warp& warp, const std::filesystem::path& folder,
+                                 std::uint64_t budget_bytes) {
   DirectionLookup lookup;
   const std::uint64_t key = direction_cache_key(warp);
-  const std::filesystem::path path = folder.empty() ? folder : folder / file_name(key);
+  const std::filesystem::path path =
+      folder.empty() ? folder : folder / direction_cache_file_name(key);
   if (!folder.empty() && read_cached(path, warp, key, lookup.v_eye)) {
     lookup.from_cache = true;
     return lookup;
@@ -139,6 +191,7 @@ DirectionLookup direction_lookup(const Warp& warp, const std::filesystem::path& 
       std::error_code ignored;
       std::filesystem::create_directories(folder, ignored);
       write_cached(path, warp, key, lookup.v_eye);
+      trim_direction_cache(folder, budget_bytes, path);
     } catch (const std::exception&) {
       // A read-only or full disk: the next start computes the directions again.
     }

@@ -13,6 +13,7 @@
 #include <span>
 #include <vector>
 
+#include "facet/driver/direction_cache.hpp"
 #include "facet/driver/gl_objects.hpp"
 #include "facet/driver/render_method.hpp"
 #include "facet/projection/content_projection.hpp"
@@ -69,7 +70,23 @@ struct ResampleOptions {
   // back when it holds one for the same warp, else computed and written there. Empty: always
   // computed, nothing written.
   std::filesystem::path direction_cache;
+  // The most bytes of lookups the folder keeps; the least recently used beyond are removed.
+  std::uint64_t direction_cache_budget = kDefaultDirectionCacheBudget;
 };
+
+// Every output's direction lookup as its texture holds it: GL rows from the bottom, the unit eye
+// direction and 1 where the warp covers the pixel, 0 elsewhere. The CPU half of ContentPass,
+// without GL, so that it can run on another thread while the content opens.
+struct ContentLookups {
+  std::vector<glm::ivec2> sizes;
+  std::vector<std::vector<glm::vec4>> texels;
+  std::size_t from_cache = 0;  // outputs read from the cache folder rather than computed
+};
+// Inverts every output's warp at its pixel centres (WarpInverse, all hardware threads), or reads
+// the directions from options.direction_cache. Thread-safe: touches no GL and no shared state
+// besides the cache folder, whose files are written atomically.
+ContentLookups prepare_content_lookups(std::span<const OutputSpec> outputs,
+                                       const ResampleOptions& options);
 
 class ContentPass {
  public:
@@ -78,6 +95,8 @@ class ContentPass {
   // direction lookup texture per output, or reads them from options.direction_cache. Needs a
   // current context.
   explicit ContentPass(std::span<const OutputSpec> outputs, ResampleOptions options = {});
+  // The same from lookups already prepared (prepare_content_lookups with these options).
+  ContentPass(ContentLookups lookups, ResampleOptions options);
 
   // Draws output `output`'s pixels into the bound framebuffer (its size the output's; the
   // viewport is set here). Pixels the warp does not cover are left as they are, and covered

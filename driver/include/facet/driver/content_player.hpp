@@ -8,6 +8,7 @@
 // and counted.
 #include <cstdint>
 #include <filesystem>
+#include <future>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <span>
@@ -67,8 +68,10 @@ class ContentPlayer {
   // Opens nothing: `media` is the opened file. Builds the direction lookups and blend passes of
   // every output. Needs a current GL context for the player's life. InputError for a content
   // format that does not fit the media (check_content_format) or a start frame beyond its end.
+  // `lookups`, when valid, brings the direction lookups start_content_lookups began (with this
+  // display and options.resample); else they are prepared here.
   ContentPlayer(SessionDisplay display, std::unique_ptr<ContentMedia> media,
-                PlaybackOptions options);
+                PlaybackOptions options, std::future<ContentLookups> lookups = {});
 
   // Shows the source frame for `state.time_s` on every output: decode if it changed, upload,
   // resample through the warp, blend. With `finish`, waits for the GPU (for timings).
@@ -93,6 +96,12 @@ class ContentPlayer {
   std::optional<double> previous_time_s_;
   std::int64_t dropped_total_ = 0;
 };
+
+// Starts preparing the direction lookups of every output of `display` (prepare_content_lookups)
+// on a thread of its own, so that opening the content and the GL overlap them; the result goes
+// to ContentPlayer or run_windowed_play. They need the CPU, not the GL.
+std::future<ContentLookups> start_content_lookups(const SessionDisplay& display,
+                                                  const ResampleOptions& options);
 
 struct HeadlessPlayResult {
   std::vector<PlayFrameStats> frames;
@@ -128,6 +137,7 @@ struct WindowPlayOptions {
 // wall clock from the first frame; Space pauses, Escape quits. GlContextError without a display
 // server; Interrupted after watch_interrupts().
 void run_windowed_play(const SessionDisplay& display, std::unique_ptr<ContentMedia> media,
-                       const PlaybackOptions& options, const WindowPlayOptions& window_options);
+                       const PlaybackOptions& options, const WindowPlayOptions& window_options,
+                       std::future<ContentLookups> lookups = {});
 
 }  // namespace facet::driver

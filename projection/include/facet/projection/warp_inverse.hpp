@@ -45,13 +45,15 @@ class WarpInverse {
   std::optional<glm::dvec2> st_from_q(glm::dvec2 q) const;
 
   // invert() at every output pixel centre (x + 0.5, y + 0.5), row 0 at the top, row-major;
-  // uncovered pixels hold NaN in every component. Runs on all hardware threads. Newton starts
-  // from the neighbouring pixel's solution where both lie in one cell, so an answer may differ
-  // from st_from_q's in the last bits, never by more than kTolerancePx in output pixels.
-  std::vector<glm::dvec2> st_at_pixel_centres() const;
+  // uncovered pixels hold NaN in every component. Rows are shared among `threads` threads (0:
+  // one per hardware thread); each row is solved on its own, so the answer is the same to the
+  // bit for any count. Newton starts from the neighbouring pixel's solution where both lie in
+  // one cell, so an answer may differ from st_from_q's in the last bits, never by more than
+  // kTolerancePx in output pixels.
+  std::vector<glm::dvec2> st_at_pixel_centres(std::size_t threads = 0) const;
   // The same pixel centres' unit eye directions, normalize(Warp::v_eye_from_st(st)) rounded to
   // float (as a direction lookup texture holds them); NaN where uncovered.
-  std::vector<glm::vec3> v_eye_at_pixel_centres() const;
+  std::vector<glm::vec3> v_eye_at_pixel_centres(std::size_t threads = 0) const;
 
   // The cell (i + j·(Gw − 1)) stored for the pixel holding q's centre, or −1: for tests.
   std::int32_t cell_at_pixel(glm::ivec2 pixel) const;
@@ -65,8 +67,10 @@ class WarpInverse {
   // Moves from cell to neighbouring cell towards q until the solution lies inside the cell.
   std::optional<glm::dvec2> walk_from(glm::ivec2 cell, glm::dvec2 q) const;
   glm::dvec2 q_node(int i, int j) const;
-  // Calls found(y · width + x, st) for every covered pixel centre, rows in parallel.
-  void for_each_pixel_centre(const std::function<void(std::size_t, glm::dvec2)>& found) const;
+  // Calls found(y · width + x, st) for every covered pixel centre, rows in parallel on
+  // `threads` threads (0: every hardware thread).
+  void for_each_pixel_centre(const std::function<void(std::size_t, glm::dvec2)>& found,
+                             std::size_t threads) const;
   void build_bins();
 
   Warp warp_;
