@@ -7,7 +7,8 @@
 // folder, removed afterwards): a 4096×4096 dome master and a 3840×1920 panorama, each frame a
 // moving pattern with fine detail; then decodes every frame in order and shows them on dome4
 // (four 1024×768 projectors with their blends) headless. Prints the median per frame, and how
-// long the first frame took: the dome master computes the direction lookups (the warp inverse
+// long the first frame took, started as facet play starts (the direction lookups on a thread of
+// their own while FFmpeg opens the file): the dome master computes the lookups (the warp inverse
 // at every output pixel) into FOLDER/directions, the panorama reads them back from there.
 #include <unistd.h>
 

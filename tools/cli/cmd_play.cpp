@@ -250,7 +250,8 @@ const Registration registration{
       command->add_flag("--loop", options->loop, "Loop the video");
       command->add_option("--direction-cache", options->direction_cache,
                           "Folder keeping each output's direction lookup (the warp inverse at "
-                          "every pixel) between starts, keyed by the warp's content (default "
+                          "every pixel) between starts, keyed by the warp's content, the least "
+                          "recently used beyond 1 GiB removed (default "
                           "$XDG_CACHE_HOME/facet/directions or ~/.cache/facet/directions)");
       command->add_flag("--no-direction-cache", options->no_direction_cache,
                         "Compute the direction lookups at every start and write none");
