@@ -27,6 +27,23 @@ Activity::~Activity() {
   if (failed_activity.empty()) failed_activity = std::move(what_);
 }
 
+const std::string& InputError::option() const {
+  static const std::string none;
+  return option_ == Option::source ? source_ : option_ == Option::field ? field_ : none;
+}
+
+InputError InputError::with_option_shown_as(const std::string& shown) const {
+  switch (option_) {
+    case Option::source:
+      return InputError(shown, field_, expected_);
+    case Option::field:
+      return InputError(source_, shown, expected_);
+    case Option::none:
+      break;
+  }
+  return *this;
+}
+
 std::string Activity::failed() {
   const std::lock_guard lock(failed_mutex);
   return failed_activity;

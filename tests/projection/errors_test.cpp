@@ -19,6 +19,32 @@ void fail_inside(const char* outer, const char* inner) {
   throw std::bad_alloc();
 }
 
+TEST(InputError, NamesAnOptionByItsLibraryNameUntilItIsShownAsAFlag) {
+  const InputError plain("d.json", "render.tolerance_px", "a positive number");
+  EXPECT_EQ(plain.option(), "");
+  EXPECT_STREQ(plain.with_option_shown_as("--tolerance").what(),
+               "d.json: field 'render.tolerance_px': a positive number");
+
+  const InputError field("command line", OptionName{"fov_deg"}, "degrees in (0, 360]");
+  EXPECT_EQ(field.option(), "fov_deg");
+  EXPECT_STREQ(field.what(), "command line: field 'fov_deg': degrees in (0, 360]");
+  const InputError shown = field.with_option_shown_as("--fov");
+  EXPECT_STREQ(shown.what(), "command line: field '--fov': degrees in (0, 360]");
+  EXPECT_EQ(shown.option(), "");  // a flag is no library name
+  EXPECT_EQ(shown.source(), "command line");
+
+  const InputError alone(OptionName{"average"}, "a number of exposures >= 1");
+  EXPECT_EQ(alone.option(), "average");
+  EXPECT_STREQ(alone.what(), "average: a number of exposures >= 1");
+  EXPECT_STREQ(alone.with_option_shown_as("--average").what(),
+               "--average: a number of exposures >= 1");
+
+  // A helper's field argument carries the option through (InputField).
+  const InputField out = OptionName{"out"};
+  EXPECT_EQ(InputError("out/", out, "an empty folder").option(), "out");
+  EXPECT_EQ(InputError("out/", "--out", "an empty folder").option(), "");
+}
+
 TEST(Activity, NamesTheInnermostStepAnExceptionLeft) {
   EXPECT_THROW(fail_inside("reading the display d.json", "reading the warp p0.warp.exr"),
                std::bad_alloc);
