@@ -19,6 +19,7 @@
 #include "facet/projection/errors.hpp"
 #include "facet/projection/interrupt.hpp"
 #include "frames_flag.hpp"
+#include "option_flags.hpp"
 
 namespace facet::cli {
 namespace {
@@ -159,6 +160,22 @@ void run(const BenchCommandOptions& command) {
               (out / "bench.csv").string().c_str(), (out / "bench.md").string().c_str(),
               (out / "bench.png").string().c_str());
 }
+
+// The library options this command's flags set, for errors that name them (option_flags.hpp).
+const OptionFlags option_flags{"bench",
+                               {{"scenarios", "--scenario"},
+                                {"size_scale", "--size-scale"},
+                                {"frames", "--frames"},
+                                {"out", "--out"},
+                                {"display", "--display"},
+                                {"size", "--size"},
+                                {"method", "--method"},
+                                {"material", "--material"},
+                                {"scene", "--scene"},
+                                {"step", "--scene"},
+                                {"camera", "--camera"},
+                                {"eye_world", "--eye"},
+                                {"look_at_world", "--look-at"}}};
 
 const Registration registration{
     35, [](CLI::App& app) {

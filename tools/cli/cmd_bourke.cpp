@@ -9,9 +9,13 @@
 #include "facet/interop/display_folder.hpp"
 #include "facet/projection/errors.hpp"
 #include "facet/projection/input_file.hpp"
+#include "option_flags.hpp"
 
 namespace facet::cli {
 namespace {
+
+// The library options this command's flags set, for errors that name them (option_flags.hpp).
+const OptionFlags option_flags{"bourke", {{"out", "--out"}}};
 
 const Registration registration{
     61, [](CLI::App& app) {

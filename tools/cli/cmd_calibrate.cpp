@@ -13,6 +13,7 @@
 #include "facet/projection/interrupt.hpp"
 #include "facet/projection/progress.hpp"
 #include "facet/projection_io/display_config.hpp"
+#include "option_flags.hpp"
 
 namespace {
 
@@ -39,6 +40,9 @@ glm::ivec2 parse_grid(const std::string& text) {
   }
   return {width, height};
 }
+
+// The library options this command's flags set, for errors that name them (option_flags.hpp).
+const facet::cli::OptionFlags option_flags{"calibrate", {{"out", "--out"}}};
 
 const facet::cli::Registration registration{
     40, [](CLI::App& app) {

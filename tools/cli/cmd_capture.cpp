@@ -22,6 +22,7 @@
 #include "facet/projection/interrupt.hpp"
 #include "facet/projection_io/display_config.hpp"
 #include "facet/projection_io/rig_file.hpp"
+#include "option_flags.hpp"
 #if __has_include("facet/interop/usb_devices.hpp")
 #include "facet/interop/usb_devices.hpp"
 #include "facet/projection/input_file.hpp"
@@ -289,6 +290,17 @@ int run_capture(const CaptureArgs& args) {
   std::fflush(stdout);
   return report.complete ? 0 : 3;
 }
+
+// The library options this command's flags set, for errors that name them (option_flags.hpp).
+const OptionFlags option_flags{"capture",
+                               {{"device", "--camera"},
+                                {"size", "--camera-size"},
+                                {"discard", "--discard"},
+                                {"average", "--average"},
+                                {"bits", "--bits"},
+                                {"camera_gamma", "--camera-gamma"},
+                                {"max_clipped_fraction", "--max-clipped"},
+                                {"out", "--out"}}};
 
 const Registration registration{
     28, [](CLI::App& app) {

@@ -7,6 +7,7 @@
 #include "facet/driver/depth_image.hpp"
 #include "facet/driver/scene_names.hpp"
 #include "facet/driver/scene_view.hpp"
+#include "option_flags.hpp"
 
 namespace facet::cli {
 namespace {
@@ -14,6 +15,19 @@ namespace {
 struct DepthImageFlags {
   std::string scene = "builtin:city", out, kind = "dpci", size, eye;
 };
+
+// The library options this command's flags set, for errors that name them (option_flags.hpp).
+const OptionFlags option_flags{"depth-image",
+                               {{"kind", "--kind"},
+                                {"size", "--size"},
+                                {"out", "--out"},
+                                {"method", "--method"},
+                                {"material", "--material"},
+                                {"scene", "--scene"},
+                                {"step", "--scene"},
+                                {"camera", "--camera"},
+                                {"eye_world", "--eye"},
+                                {"look_at_world", "--look-at"}}};
 
 const Registration registration{
     32, [](CLI::App& app) {

@@ -8,6 +8,7 @@
 #include "command.hpp"
 #include "display_flags.hpp"
 #include "facet/driver/session.hpp"
+#include "option_flags.hpp"
 
 namespace facet::cli {
 namespace {
@@ -20,6 +21,10 @@ struct DisplayOptions {
   std::string out;
   DomeOrientationFlags orientation;
 };
+
+// The library options this command's flags set, for errors that name them (option_flags.hpp).
+const OptionFlags option_flags{"display",
+                               {{"display", "--display"}, {"size", "--size"}, {"out", "--out"}}};
 
 const Registration registration{
     45, [](CLI::App& app) {

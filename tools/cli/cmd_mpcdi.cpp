@@ -9,9 +9,13 @@
 #include "facet/interop/mpcdi.hpp"
 #include "facet/projection/atomic_file.hpp"
 #include "facet/projection/errors.hpp"
+#include "option_flags.hpp"
 
 namespace facet::cli {
 namespace {
+
+// The library options this command's flags set, for errors that name them (option_flags.hpp).
+const OptionFlags option_flags{"mpcdi", {{"out", "--out"}}};
 
 const Registration registration{
     60, [](CLI::App& app) {

@@ -10,6 +10,7 @@
 #include "facet/calibration/patterns.hpp"
 #include "facet/projection/errors.hpp"
 #include "facet/projection/rig.hpp"
+#include "option_flags.hpp"
 
 namespace {
 
@@ -23,6 +24,9 @@ struct PatternsArgs {
   int phase_steps = 4;
   int bit_depth = 8;
 };
+
+// The library options this command's flags set, for errors that name them (option_flags.hpp).
+const facet::cli::OptionFlags option_flags{"patterns", {{"out", "--out"}}};
 
 const facet::cli::Registration registration{
     20, [](CLI::App& app) {

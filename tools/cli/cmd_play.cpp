@@ -29,6 +29,7 @@
 #include "facet/projection/interrupt.hpp"
 #include "facet/projection/progress.hpp"
 #include "frames_flag.hpp"
+#include "option_flags.hpp"
 
 namespace facet::cli {
 namespace {
@@ -214,6 +215,21 @@ void play(const PlayOptions& options) {
             << ") written to " << options.out << "/<output>/<frame>.png; statistics in "
             << options.out << "/stats.jsonl; " << dropped << " source frames dropped\n";
 }
+
+// The library options this command's flags set, for errors that name them (option_flags.hpp).
+const OptionFlags option_flags{"play",
+                               {{"display", "--display"},
+                                {"size", "--size"},
+                                {"factor", "--scale"},
+                                {"format", "--format"},
+                                {"fov_deg", "--fov"},
+                                {"frames", "--frames"},
+                                {"start_frame", "--start-frame"},
+                                {"out", "--out"},
+                                {"stats", "--stats"},
+                                {"node", "--node"},
+                                {"join_timeout_s", "--join-timeout"},
+                                {"rate_hz", "--rate"}}};
 
 const Registration registration{
     42, [](CLI::App& app) {

@@ -17,6 +17,7 @@
 #include "facet/projection/display_preview.hpp"
 #include "facet/projection/errors.hpp"
 #include "facet/projection_io/display_config.hpp"
+#include "option_flags.hpp"
 
 namespace facet::cli {
 namespace {
@@ -129,6 +130,15 @@ void preview(const PreviewCommandOptions& options) {
   std::cout << "facet preview: wrote " << options.out << " (" << to_string(show) << ", "
             << result.size.x << "x" << result.size.y << ")\n";
 }
+
+// The library options this command's flags set, for errors that name them (option_flags.hpp).
+const OptionFlags option_flags{"preview",
+                               {{"display", "--display"},
+                                {"size", "--size"},
+                                {"view", "--view"},
+                                {"fov_deg", "--fov"},
+                                {"height_px", "--preview-size"},
+                                {"out", "--out"}}};
 
 const Registration registration{
     45, [](CLI::App& app) {

@@ -28,6 +28,7 @@
 #include "facet/projection/errors.hpp"
 #include "facet/projection/interrupt.hpp"
 #include "frames_flag.hpp"
+#include "option_flags.hpp"
 #include "view_flags.hpp"
 
 namespace facet::cli {
@@ -360,6 +361,20 @@ void run(const RenderOptions& options) {
     }
   }
 }
+
+// The library options this command's flags set, for errors that name them (option_flags.hpp).
+const OptionFlags option_flags{"render",
+                               {{"display", "--display"},
+                                {"size", "--size"},
+                                {"method", "--method"},
+                                {"material", "--material"},
+                                {"frames", "--frames"},
+                                {"out", "--out"},
+                                {"scene", "--scene"},
+                                {"step", "--scene"},
+                                {"camera", "--camera"},
+                                {"eye_world", "--eye"},
+                                {"look_at_world", "--look-at"}}};
 
 const Registration registration{
     30, [](CLI::App& app) {

@@ -23,6 +23,7 @@
 #include "facet/projection/test_pattern.hpp"
 #include "facet/projection/warp.hpp"
 #include "frames_flag.hpp"
+#include "option_flags.hpp"
 #include "view_flags.hpp"
 
 namespace facet::cli {
@@ -211,6 +212,25 @@ void run(const RunOptions& options) {
             << result.last.replication_ratio() << "; resident set " << result.rss_first_kib / 1024
             << " MiB after the first frame, at most " << result.rss_peak_kib / 1024 << " MiB\n";
 }
+
+// The library options this command's flags set, for errors that name them (option_flags.hpp).
+const OptionFlags option_flags{"run",
+                               {{"display", "--display"},
+                                {"size", "--size"},
+                                {"factor", "--scale"},
+                                {"method", "--method"},
+                                {"material", "--material"},
+                                {"frames", "--frames"},
+                                {"save_every", "--save-every"},
+                                {"out", "--out"},
+                                {"node", "--node"},
+                                {"join_timeout_s", "--join-timeout"},
+                                {"rate_hz", "--rate"},
+                                {"scene", "--scene"},
+                                {"step", "--scene"},
+                                {"camera", "--camera"},
+                                {"eye_world", "--eye"},
+                                {"look_at_world", "--look-at"}}};
 
 const Registration registration{
     40, [](CLI::App& app) {

@@ -10,6 +10,7 @@
 #include "facet/interop/sgct_cluster.hpp"
 #include "facet/projection/errors.hpp"
 #include "facet/projection_io/display_config.hpp"
+#include "option_flags.hpp"
 
 namespace facet::cli {
 namespace {
@@ -20,6 +21,9 @@ std::string lowercase_extension(const std::string& file) {
   for (char& c : extension) c = char(std::tolower(static_cast<unsigned char>(c)));
   return extension;
 }
+
+// The library options this command's flags set, for errors that name them (option_flags.hpp).
+const OptionFlags option_flags{"sgct", {{"out", "--out"}}};
 
 const Registration registration{
     61, [](CLI::App& app) {

@@ -14,6 +14,7 @@
 #include "facet/projection/interrupt.hpp"
 #include "facet/projection/progress.hpp"
 #include "facet/projection_io/rig_file.hpp"
+#include "option_flags.hpp"
 
 namespace {
 
@@ -91,6 +92,9 @@ void apply_overrides(const SimulateArgs& args, facet::Rig& rig) {
     rig.camera.size = parse_size(*args.camera_size);
   }
 }
+
+// The library options this command's flags set, for errors that name them (option_flags.hpp).
+const facet::cli::OptionFlags option_flags{"simulate", {{"out", "--out"}}};
 
 const facet::cli::Registration registration{
     25, [](CLI::App& app) {

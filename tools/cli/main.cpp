@@ -19,6 +19,7 @@
 #include "command.hpp"
 #include "facet/projection/errors.hpp"
 #include "facet/projection/interrupt.hpp"
+#include "option_flags.hpp"
 
 namespace facet::cli {
 
@@ -92,7 +93,8 @@ int report_failure(std::exception_ptr failure, const std::string& command, int a
               << "\n";
     return e.exit_status();
   } catch (const facet::InputError& e) {
-    std::cerr << "facet: error: " << e.what() << "\n";
+    // A library names the option it refuses by its library name: shown here by its flag.
+    std::cerr << "facet: error: " << shown_with_flags(e, command).what() << "\n";
     return 2;
   } catch (const facet::PeerLost& e) {
     std::cerr << "facet: stopped: " << e.what() << "\n";
