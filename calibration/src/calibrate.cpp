@@ -401,7 +401,7 @@ CalibrationReport calibrate(const fs::path& capture_path, const fs::path& out,
   const std::string capture_json = (capture.folder / "capture.json").string();
   // Checked before any heavy work, and again when written.
   OutputFolderRules out_rules;
-  out_rules.flag = "--out";
+  out_rules.field = OptionName{"out"};
   out_rules.inputs = {capture.folder};
   check_output_folder(out, out_rules);
   // Polled between projectors and stages; write_folder_atomically then removes the temporary.

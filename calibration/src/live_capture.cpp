@@ -161,17 +161,17 @@ std::vector<CaptureFrame> standard_frames(const std::string& projector_name, glm
 }
 
 void check_live_capture_options(const LiveCaptureOptions& options) {
-  if (options.average < 1) throw InputError("--average", "", "a number of exposures >= 1");
-  if (options.bits != 8 && options.bits != 16) throw InputError("--bits", "", "8 or 16");
+  if (options.average < 1) throw InputError(OptionName{"average"}, "a number of exposures >= 1");
+  if (options.bits != 8 && options.bits != 16) throw InputError(OptionName{"bits"}, "8 or 16");
   if (!(options.camera_gamma > 0 && options.camera_gamma <= kMaxGamma)) {
-    throw InputError("--camera-gamma", "", "a gamma in (0, 10]");
+    throw InputError(OptionName{"camera_gamma"}, "a gamma in (0, 10]");
   }
   if (!(options.max_clipped_fraction >= 0 && options.max_clipped_fraction <= 1)) {
-    throw InputError("--max-clipped", "", "a fraction of camera pixels from 0 to 1");
+    throw InputError(OptionName{"max_clipped_fraction"}, "a fraction of camera pixels from 0 to 1");
   }
-  if (options.out.empty()) throw InputError("--out", "", "a capture folder");
+  if (options.out.empty()) throw InputError(OptionName{"out"}, "a capture folder");
   OutputFolderRules rules;
-  rules.flag = "--out";
+  rules.field = OptionName{"out"};
   rules.expected = std::string(
                        "a new or empty folder, or the folder of an interrupted 'facet capture' (it "
                        "has no ") +
@@ -244,7 +244,7 @@ LiveCaptureReport run_live_capture(PatternOutputs& outputs, LiveCamera& camera,
     newline_needed = !journal.ends_with_newline;
   } else if (fs::exists(out, error) &&
              (!fs::is_directory(out, error) || !fs::is_empty(out, error))) {
-    throw InputError(out.string(), "--out",
+    throw InputError(out.string(), OptionName{"out"},
                      std::string("a new or empty folder, or the folder of an interrupted 'facet "
                                  "capture' (it has no ") +
                          kCaptureJournalFile + ")");

@@ -169,7 +169,7 @@ void write_pattern_folder(const std::filesystem::path& out_dir, glm::ivec2 size,
   FACET_ASSERT(bit_depth == 8 || bit_depth == 16);
   // Checked first naming the flag, and again when written.
   OutputFolderRules out_rules;
-  out_rules.flag = "--out";
+  out_rules.field = OptionName{"out"};
   check_output_folder(out_dir, out_rules);
   write_folder_atomically(out_dir, [&](const std::filesystem::path& folder) {
     nlohmann::json frames = nlohmann::json::array();

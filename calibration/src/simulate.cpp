@@ -274,7 +274,7 @@ SimulationReport simulate_capture(const Rig& rig, const std::filesystem::path& o
   rig.validate(source);
   // Checked before any work (naming the flag), and again when written.
   OutputFolderRules out_rules;
-  out_rules.flag = "--out";
+  out_rules.field = OptionName{"out"};
   check_output_folder(out, out_rules);
   const CameraModel camera = rig_camera_model(rig.camera, source);
 

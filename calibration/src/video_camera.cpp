@@ -67,14 +67,14 @@ class VideoCaptureCamera : public LiveCamera {
   VideoCaptureCamera(const std::string& device, std::string identity,
                      const VideoCameraOptions& options)
       : device_(device), identity_(std::move(identity)), discard_(options.discard) {
-    if (discard_ < 0) throw InputError("--discard", "", "a number of frames >= 0");
+    if (discard_ < 0) throw InputError(OptionName{"discard"}, "a number of frames >= 0");
     const auto index = parse_int(device);
     if (index) {
       capture_.open(*index, cv::CAP_V4L2);
     } else {
       std::error_code error;
       if (!fs::exists(device, error)) {
-        throw InputError("--camera", "",
+        throw InputError(OptionName{"device"},
                          "a camera device: '" + device +
                              "' does not exist (give /dev/videoN, an index, a usb: stable id "
                              "from 'facet devices', or fake:RIG.json)");
@@ -82,10 +82,9 @@ class VideoCaptureCamera : public LiveCamera {
       capture_.open(device, cv::CAP_V4L2);
     }
     if (!capture_.isOpened()) {
-      throw InputError("--camera", "",
-                       "a V4L2 camera that opens, but '" + device +
-                           "' does not (busy or not a "
-                           "capture device?)");
+      throw InputError(OptionName{"device"}, "a V4L2 camera that opens, but '" + device +
+                                                 "' does not (busy or not a "
+                                                 "capture device?)");
     }
     capture_.set(cv::CAP_PROP_BUFFERSIZE, 1);
     if (options.size) {
@@ -95,7 +94,7 @@ class VideoCaptureCamera : public LiveCamera {
     const cv::Mat first = read_grey();
     size_ = {first.cols, first.rows};
     if (options.size && size_ != *options.size) {
-      throw InputError("--camera-size", "",
+      throw InputError(OptionName{"size"},
                        std::to_string(options.size->x) + "x" + std::to_string(options.size->y) +
                            ", a size '" + device + "' offers; it delivers " +
                            std::to_string(size_.x) + "x" + std::to_string(size_.y));
@@ -108,7 +107,7 @@ class VideoCaptureCamera : public LiveCamera {
     for (int k = 0; k < discard_; ++k) capture_.grab();
     cv::Mat frame = read_grey();
     if (frame.cols != size_.x || frame.rows != size_.y) {
-      throw InputError("--camera", "", "frames of one size from '" + device_ + "'");
+      throw InputError(OptionName{"device"}, "frames of one size from '" + device_ + "'");
     }
     return frame;
   }
@@ -121,7 +120,8 @@ class VideoCaptureCamera : public LiveCamera {
   cv::Mat read_grey() {
     cv::Mat frame;
     if (!capture_.read(frame) || frame.empty()) {
-      throw InputError("--camera", "", "frames from '" + device_ + "', but reading one failed");
+      throw InputError(OptionName{"device"},
+                       "frames from '" + device_ + "', but reading one failed");
     }
     cv::Mat grey;
     if (frame.channels() == 3) {

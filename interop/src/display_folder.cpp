@@ -13,7 +13,7 @@ namespace {
 // The imports and exports write a new or empty --out folder.
 OutputFolderRules out_folder_rules() {
   OutputFolderRules rules;
-  rules.flag = "--out";
+  rules.field = OptionName{"out"};
   rules.expected = "expected a folder that does not exist or is empty";
   return rules;
 }

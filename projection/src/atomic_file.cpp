@@ -37,9 +37,8 @@ void write_atomically(const std::filesystem::path& path,
   }
 }
 
-void check_output_file(const std::filesystem::path& path, std::string_view flag) {
+void check_output_file(const std::filesystem::path& path, const InputField& field) {
   namespace fs = std::filesystem;
-  const std::string field(flag);
   if (path.empty()) throw InputError("command line", field, "expected a file to write");
   const std::string name = path.filename().string();
   if (name.empty() || name == "." || name == "..")
@@ -65,13 +64,12 @@ void check_output_file(const std::filesystem::path& path, std::string_view flag)
   }
 }
 
-void refuse_output_over_inputs(const std::filesystem::path& out, std::string_view flag,
+void refuse_output_over_inputs(const std::filesystem::path& out, const InputField& field,
                                std::initializer_list<std::filesystem::path> inputs) {
   for (const std::filesystem::path& input : inputs) {
     std::error_code error;
     if (std::filesystem::equivalent(out, input, error) && !error)
-      throw InputError(out.string(), std::string(flag),
-                       "a path other than the input " + input.string());
+      throw InputError(out.string(), field, "a path other than the input " + input.string());
   }
 }
 

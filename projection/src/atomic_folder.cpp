@@ -38,11 +38,11 @@ fs::path sibling(const fs::path& folder, const char* tag) {
   return folder.parent_path() / name;
 }
 
-void create_folders(const fs::path& path, const std::string& flag) {
+void create_folders(const fs::path& path, const InputField& field) {
   std::error_code error;
   fs::create_directories(path, error);
   if (error)
-    throw InputError(path.string(), flag, "a folder that can be created: " + error.message());
+    throw InputError(path.string(), field, "a folder that can be created: " + error.message());
 }
 
 }  // namespace
@@ -61,19 +61,19 @@ bool holds_only_files_named(const fs::path& folder,
 fs::path check_output_folder(const fs::path& folder, const OutputFolderRules& rules) {
   fs::path out = folder.lexically_normal();
   if (!out.has_filename()) out = out.parent_path();
-  if (out.empty()) throw InputError("command line", rules.flag, "expected an output folder");
+  if (out.empty()) throw InputError("command line", rules.field, "expected an output folder");
   std::error_code error;
   const fs::path current = fs::current_path(error);
   if (!error && is_or_holds(out, current))
-    throw InputError(out.string(), rules.flag,
+    throw InputError(out.string(), rules.field,
                      "a folder other than the current folder and its parents");
   for (const fs::path& input : rules.inputs) {
     if (is_or_holds(out, input))
-      throw InputError(out.string(), rules.flag,
+      throw InputError(out.string(), rules.field,
                        "a folder that neither is nor holds the input " + input.string());
   }
   if (out.filename().string().size() > 255)
-    throw InputError(out.string(), rules.flag, "a folder name of at most 255 bytes");
+    throw InputError(out.string(), rules.field, "a folder name of at most 255 bytes");
   const fs::file_status status = fs::symlink_status(out, error);
   if (!fs::exists(status)) {
     // Created later, in its nearest existing ancestor: which must be a folder (not a file, nor a
@@ -84,13 +84,13 @@ fs::path check_output_folder(const fs::path& folder, const OutputFolderRules& ru
       above = above.parent_path();
     if (above.empty()) above = ".";
     if (!fs::is_directory(fs::status(above, error)))
-      throw InputError(out.string(), rules.flag,
+      throw InputError(out.string(), rules.field,
                        "a folder that can be created: " + above.string() + " is no folder");
     const fs::path probe = above / (".facet-probe" + std::to_string(::getpid()));
     if (::mkdir(probe.c_str(), 0700) == 0) {
       ::rmdir(probe.c_str());
     } else if (errno != EEXIST) {
-      throw InputError(out.string(), rules.flag,
+      throw InputError(out.string(), rules.field,
                        "a folder that can be created: " + std::generic_category().message(errno));
     }
     return out;
@@ -98,7 +98,7 @@ fs::path check_output_folder(const fs::path& folder, const OutputFolderRules& ru
   bool replaceable = fs::is_directory(status);
   if (replaceable && !fs::is_empty(out, error))
     replaceable = !error && rules.is_own_output && rules.is_own_output(out);
-  if (!replaceable) throw InputError(out.string(), rules.flag, rules.expected);
+  if (!replaceable) throw InputError(out.string(), rules.field, rules.expected);
   return out;
 }
 
@@ -108,11 +108,11 @@ void write_folder_atomically(const fs::path& folder,
   fs::path out = check_output_folder(folder, rules);
   // A bare name lives in the current folder: give it one so that its siblings do too.
   if (!out.has_parent_path()) out = fs::path(".") / out;
-  create_folders(out.parent_path(), rules.flag);
+  create_folders(out.parent_path(), rules.field);
   const fs::path temporary = sibling(out, ".tmp");
   std::error_code error;
   fs::remove_all(temporary, error);
-  create_folders(temporary, rules.flag);
+  create_folders(temporary, rules.field);
   try {
     fill(temporary);
     const bool replacing = fs::exists(fs::symlink_status(out, error));

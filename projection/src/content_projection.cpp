@@ -56,7 +56,7 @@ ContentFormat content_format_from_string(const std::string& name, const std::str
 
 void ContentProjection::validate(const std::string& source) const {
   if (format == ContentFormat::fisheye && !(fov_deg > 0 && fov_deg <= 360)) {
-    throw InputError(source, "--fov",
+    throw InputError(source, OptionName{"fov_deg"},
                      "expected the dome master's full field of view in degrees within (0, 360]; "
                      "got " +
                          detail::degrees_text(fov_deg));

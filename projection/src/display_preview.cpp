@@ -197,11 +197,11 @@ DisplayPreview preview_display(std::span<const PreviewProjector> projectors,
                                const PreviewOptions& options, const std::string& source) {
   const ContentProjection& view = options.view;
   if (view.format != ContentFormat::fisheye && view.format != ContentFormat::equirect)
-    throw InputError(source, "--view", "fisheye or equirect");
+    throw InputError(source, OptionName{"view"}, "fisheye or equirect");
   view.validate(source);
   if (options.height_px < 8 || options.height_px > 8192)
     throw InputError(
-        source, "--preview-size",
+        source, OptionName{"height_px"},
         "a preview height from 8 to 8192 pixels, got " + std::to_string(options.height_px));
   if (projectors.size() > 32767)
     throw InputError(source, "projectors", "at most 32767 projectors in a preview");
@@ -237,7 +237,7 @@ DisplayPreview preview_display(std::span<const PreviewProjector> projectors,
   // The maps below take 32 bytes a pixel; the image drawn from them and its encoding about as
   // much again.
   require_memory(
-      std::uint64_t(pixels) * 64, source, "--preview-size",
+      std::uint64_t(pixels) * 64, source, OptionName{"height_px"},
       "a " + std::to_string(preview.size.x) + "x" + std::to_string(preview.size.y) + " preview");
   for (const PreviewProjector& projector : projectors) preview.names.push_back(projector.name);
   preview.in_view.assign(pixels, 0);

@@ -57,7 +57,7 @@ std::uint64_t allocatable_bytes() {
   return system_available_bytes();
 }
 
-void require_memory(std::uint64_t bytes, const std::string& source, const std::string& field,
+void require_memory(std::uint64_t bytes, const std::string& source, const InputField& field,
                     const std::string& what) {
   const std::uint64_t budget = allocatable_bytes();
   if (bytes <= budget) return;

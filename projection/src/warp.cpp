@@ -16,7 +16,7 @@ double cross(glm::dvec2 a, glm::dvec2 b) { return a.x * b.y - a.y * b.x; }
 
 }  // namespace
 
-void check_image_size(glm::ivec2 size, const std::string& source, const std::string& field) {
+void check_image_size(glm::ivec2 size, const std::string& source, const InputField& field) {
   if (size.x < 1 || size.y < 1 || size.x > kMaxImageSide || size.y > kMaxImageSide ||
       std::int64_t(size.x) * size.y > kMaxImagePixels) {
     throw InputError(source, field,

@@ -205,7 +205,7 @@ driver::BenchReport small_report(const std::string& renderer) {
 
 OutputFolderRules bench_rules() {
   OutputFolderRules rules;
-  rules.flag = "--out";
+  rules.field = "--out";
   rules.is_own_output = driver::is_bench_output;
   return rules;
 }

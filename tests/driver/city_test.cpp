@@ -333,7 +333,7 @@ TEST(SceneNames, RefuseUnknownNamesAndAbsurdSizes) {
       parse_scene_name(bad);
       ADD_FAILURE() << bad << " was accepted";
     } catch (const InputError& e) {
-      EXPECT_EQ(e.field(), "--scene") << bad;
+      EXPECT_EQ(e.field(), "scene") << bad;
       EXPECT_NE(e.expected().find("builtin:city:K"), std::string::npos) << bad;
     }
   }

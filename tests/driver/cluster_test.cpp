@@ -154,12 +154,12 @@ TEST(NodeDisplay, ANodeKeepsItsProjectorsAndItsRoleIsChecked) {
     }
     return std::string("no error");
   };
-  EXPECT_EQ(field_of("builtin:wall2x2", {"a", false, std::nullopt, 60}), "--node");
-  EXPECT_EQ(field_of("builtin:wall2x2", {"", false, 30.0, 60}), "--rate");
-  EXPECT_EQ(field_of(json.string(), {"b", true, std::nullopt, 60}), "--frames");
-  EXPECT_EQ(field_of(json.string(), {"b", false, 30.0, 60}), "--rate");
-  EXPECT_EQ(field_of(json.string(), {"a", false, 0.0, 60}), "--rate");
-  EXPECT_EQ(field_of(json.string(), {"a", false, std::nullopt, 0}), "--join-timeout");
+  EXPECT_EQ(field_of("builtin:wall2x2", {"a", false, std::nullopt, 60}), "node");
+  EXPECT_EQ(field_of("builtin:wall2x2", {"", false, 30.0, 60}), "rate_hz");
+  EXPECT_EQ(field_of(json.string(), {"b", true, std::nullopt, 60}), "frames");
+  EXPECT_EQ(field_of(json.string(), {"b", false, 30.0, 60}), "rate_hz");
+  EXPECT_EQ(field_of(json.string(), {"a", false, 0.0, 60}), "rate_hz");
+  EXPECT_EQ(field_of(json.string(), {"a", false, std::nullopt, 0}), "join_timeout_s");
 
   const NodeDisplay secondary =
       load_node_display(json.string(), std::nullopt, 0.5, {"b", false, std::nullopt, 5});

@@ -562,7 +562,7 @@ TEST(SceneView, CameraByName) {
     choose_scene_view(scene, request, false);
     ADD_FAILURE();
   } catch (const InputError& e) {
-    EXPECT_EQ(e.field(), "--camera");
+    EXPECT_EQ(e.field(), "camera");
     EXPECT_NE(e.expected().find("'Front', 'Side'"), std::string::npos) << e.what();
   }
   request.camera = "Side";

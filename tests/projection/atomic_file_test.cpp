@@ -143,7 +143,7 @@ std::vector<std::string> names_in(const fs::path& folder) {
 // A command whose output is a folder holding run.txt, and nothing else.
 OutputFolderRules own_run_rules() {
   OutputFolderRules rules;
-  rules.flag = "--out";
+  rules.field = "--out";
   rules.is_own_output = [](const fs::path& folder) {
     return names_in(folder) == std::vector<std::string>{"run.txt"};
   };

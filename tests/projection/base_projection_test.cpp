@@ -165,7 +165,7 @@ TEST(DomeOrientation, PlacesAFisheyeMastersCentreAndFront) {
       bad.validate("command line");
       ADD_FAILURE() << "no error for " << bad.tilt_deg << ", " << bad.orientation_deg;
     } catch (const InputError& e) {
-      EXPECT_EQ(e.field(), bad.orientation_deg == 361 ? "--orientation" : "--tilt");
+      EXPECT_EQ(e.field(), bad.orientation_deg == 361 ? "orientation_deg" : "tilt_deg");
     }
   }
   EXPECT_EQ(fisheye_zenith_from_string("center", "s", "--zenith"), FisheyeZenith::centre);

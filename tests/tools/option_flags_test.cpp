@@ -4,11 +4,115 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <iterator>
+#include <regex>
 #include <string>
+#include <vector>
 
+#include "../driver/cli_process.hpp"
+#include "facet/projection/content_projection.hpp"
 #include "facet/projection/errors.hpp"
 
 namespace {
+
+namespace fs = std::filesystem;
+
+// The arguments of each `InputError(...)` call in `text`, with the line it starts on: from the
+// opening parenthesis to its match, string and character literals skipped whole.
+std::vector<std::pair<int, std::string>> input_error_calls(const std::string& text) {
+  std::vector<std::pair<int, std::string>> calls;
+  const std::string opening = "InputError(";
+  for (std::size_t at = text.find(opening); at != std::string::npos;
+       at = text.find(opening, at + 1)) {
+    std::size_t i = at + opening.size();
+    int depth = 1;
+    while (i < text.size() && depth > 0) {
+      const char c = text[i];
+      if (c == '"' || c == '\'') {
+        for (++i; i < text.size() && text[i] != c; ++i) {
+          if (text[i] == '\\') ++i;
+        }
+      } else if (c == '(') {
+        ++depth;
+      } else if (c == ')') {
+        --depth;
+      }
+      ++i;
+    }
+    const int line = 1 + int(std::count(text.begin(), text.begin() + long(at), '\n'));
+    calls.emplace_back(line, text.substr(at, i - at));
+  }
+  return calls;
+}
+
+// The string literals of `call` that are a flag and nothing else ("--fov"): a source or a field
+// named by a flag.
+std::vector<std::string> flags_named(const std::string& call) {
+  static const std::regex flag(R"re("(--[a-z][a-z0-9-]*)")re");
+  std::vector<std::string> flags;
+  for (std::sregex_iterator it(call.begin(), call.end(), flag), end; it != end; ++it) {
+    flags.push_back((*it)[1]);
+  }
+  return flags;
+}
+
+TEST(LibrarySources, TheScanFindsAFlagNamedInAnInputError) {
+  const auto calls = input_error_calls(
+      "throw InputError(\"command line\", \"--fov\", \"a (field) of view\");\n"
+      "throw InputError(\n    source, \"--preview-size\",\n    \"8 to 8192\");\n"
+      "throw InputError(source, OptionName{\"fov_deg\"}, \"expected --fov's range\");\n");
+  ASSERT_EQ(calls.size(), 3u);
+  EXPECT_EQ(calls[1].first, 2);
+  EXPECT_EQ(flags_named(calls[0].second), std::vector<std::string>{"--fov"});
+  EXPECT_EQ(flags_named(calls[1].second), std::vector<std::string>{"--preview-size"});
+  EXPECT_TRUE(flags_named(calls[2].second).empty());
+}
+
+// No library error names a command-line flag as its source or field: libraries name options by
+// their library names (OptionName), and the CLI maps them onto flags.
+TEST(LibrarySources, NoInputErrorNamesACommandLineFlag) {
+  std::size_t calls = 0;
+  std::vector<std::string> found;
+  for (const char* library : {"projection", "calibration", "interop", "driver", "api"}) {
+    const fs::path folder = fs::path(FACET_SOURCE_DIR) / library;
+    ASSERT_TRUE(fs::is_directory(folder)) << folder;
+    for (const auto& entry : fs::recursive_directory_iterator(folder)) {
+      const std::string extension = entry.path().extension().string();
+      if (!entry.is_regular_file() || (extension != ".cpp" && extension != ".hpp")) continue;
+      std::ifstream stream(entry.path(), std::ios::binary);
+      const std::string text{std::istreambuf_iterator<char>(stream),
+                             std::istreambuf_iterator<char>()};
+      for (const auto& [line, call] : input_error_calls(text)) {
+        ++calls;
+        for (const std::string& flag : flags_named(call)) {
+          found.push_back(fs::relative(entry.path(), FACET_SOURCE_DIR).string() + ":" +
+                          std::to_string(line) + " " + flag);
+        }
+      }
+    }
+  }
+  std::cout << calls << " InputError calls in the libraries, " << found.size()
+            << " naming a flag\n";
+  EXPECT_GT(calls, 300u) << "the scan found too few InputError calls to mean anything";
+  std::string list;
+  for (const std::string& site : found) list += "\n  " + site;
+  EXPECT_TRUE(found.empty()) << found.size() << " library errors name a flag:" << list;
+}
+
+TEST(OptionFlags, ALibraryErrorNamesItsOptionByItsLibraryName) {
+  try {
+    facet::fisheye_content(400).validate("command line");
+    FAIL() << "a 400° dome master was accepted";
+  } catch (const facet::InputError& e) {
+    EXPECT_EQ(e.option(), "fov_deg");
+    EXPECT_EQ(e.field(), "fov_deg");
+    EXPECT_EQ(std::string(e.what()).find("--"), std::string::npos) << e.what();
+  }
+}
 
 TEST(OptionFlags, TheCliShowsALibraryOptionUnderItsCommandsFlag) {
   using facet::InputError;
@@ -30,6 +134,40 @@ TEST(OptionFlags, TheCliShowsALibraryOptionUnderItsCommandsFlag) {
   EXPECT_EQ(std::string(facet::cli::shown_with_flags(file, "run").what()), file.what());
   EXPECT_EQ(facet::cli::flag_of_option("run", "factor"), "--scale");
   EXPECT_EQ(facet::cli::flag_of_option("run", "no_such_option"), "");
+}
+
+// What the user of the facet executable reads when a library refuses an option: its flag.
+TEST(OptionFlags, TheFacetExecutableNamesTheFlagOfALibrarysOption) {
+#ifndef FACET_TEST_HAS_DRIVER
+  GTEST_SKIP() << "a build without the driver has no depth-image command";
+#else
+  const fs::path out = facet::test_paths::scratch_path("option_flags") / "depth.exr";
+  std::string output;
+  EXPECT_EQ(facet::test::run_facet("depth-image --kind sphere --out " + out.string(), &output), 2);
+  EXPECT_EQ(output,
+            "facet: error: command line: field '--kind': expected planar or dpci; got 'sphere'\n");
+  EXPECT_FALSE(fs::exists(out));
+#endif
+}
+
+// The same for an option a library names as the error's source.
+TEST(OptionFlags, TheFacetExecutableNamesTheFlagOfALibrarysOptionAsTheSource) {
+#if !defined(FACET_TEST_HAS_DRIVER) || !defined(FACET_TEST_HAS_CALIBRATION)
+  GTEST_SKIP() << "a build without the driver or calibration has no capture command";
+#else
+  const fs::path display =
+      fs::path(FACET_SOURCE_DIR) / "configs/displays/sample_two_projectors.display.json";
+  const fs::path out = facet::test_paths::scratch_path("option_flags") / "capture";
+  std::string output;
+  EXPECT_EQ(facet::test::run_facet("capture --display " + display.string() +
+                                       " --camera fake:builtin:wall2x2 --quiet --max-clipped 2"
+                                       " --out " +
+                                       out.string(),
+                                   &output),
+            2);
+  EXPECT_EQ(output, "facet: error: --max-clipped: a fraction of camera pixels from 0 to 1\n");
+  EXPECT_FALSE(fs::exists(out));
+#endif
 }
 
 }  // namespace

@@ -48,7 +48,7 @@ void run_cluster(const BenchCommandOptions& command) {
   if (command.out.empty()) throw InputError("command line", "--out", "expected a folder");
   // Before the run: --out is new, empty or an earlier cluster bench's (cluster.json alone).
   OutputFolderRules out_rules;
-  out_rules.flag = "--out";
+  out_rules.field = "--out";
   out_rules.expected =
       "a new path, an empty folder, or a folder of an earlier cluster bench (cluster.json only)";
   out_rules.is_own_output = [](const std::filesystem::path& folder) {
@@ -108,7 +108,7 @@ void run_cluster(const BenchCommandOptions& command) {
 // folder that is or holds the rig or scene file read.
 OutputFolderRules bench_out_rules(const BenchCommandOptions& command) {
   OutputFolderRules rules;
-  rules.flag = "--out";
+  rules.field = "--out";
   rules.expected =
       "a new path, an empty folder, or a folder of an earlier facet bench (bench.json, bench.csv, "
       "bench.md, bench.png, bench.log, nothing else)";

@@ -49,7 +49,7 @@ const Registration registration{
           warps.push_back(read_warp(config.resolve(projector.warp).string()));
         // The folder is written whole or not at all, and replaces only an earlier lookup folder.
         OutputFolderRules rules;
-        rules.flag = "--out";
+        rules.field = "--out";
         rules.expected =
             "a new path, an empty folder, or a folder of earlier lookups (*.lookup.exr only)";
         rules.is_own_output = [](const std::filesystem::path& folder) {

@@ -135,7 +135,7 @@ nlohmann::json compare_with_reference(const Scene& scene, const std::vector<Outp
 OutputFolderRules render_out_rules(const RenderOptions& options) {
   namespace fs = std::filesystem;
   OutputFolderRules rules;
-  rules.flag = "--out";
+  rules.field = "--out";
   rules.expected =
       "a new path, an empty folder, or a folder of an earlier facet render (<output>.png, "
       ".ids.exr and .depth.exr files, nothing else)";
@@ -205,8 +205,8 @@ void run(const RenderOptions& options) {
     try {
       return step();
     } catch (const InputError& error) {
-      if (error.field() != "--scene") throw;
-      throw InputError(error.source(), "--reference-scene", error.expected());
+      if (error.option() != "scene" && error.option() != "step") throw;
+      throw error.with_option_shown_as("--reference-scene");
     }
   };
   std::optional<SceneName> reference_scene_name;

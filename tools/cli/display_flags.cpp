@@ -136,7 +136,12 @@ DomeOrientation DomeOrientationFlags::value() const {
   if (!orientation.empty()) {
     result.orientation_deg = parse_numbers(orientation, "--orientation", 1, 1)[0];
   }
-  result.validate("command line");
+  try {
+    result.validate("command line");
+  } catch (const InputError& error) {
+    // DomeOrientation names its fields; these flags set them.
+    throw error.with_option_shown_as(error.option() == "tilt_deg" ? "--tilt" : "--orientation");
+  }
   return result;
 }
 

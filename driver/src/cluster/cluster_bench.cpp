@@ -229,7 +229,8 @@ void bench_bare_nng(const projection_io::DisplayCluster& cluster, int frames,
 
 std::vector<ClusterBenchRow> bench_cluster(
     const ClusterBenchOptions& options, const std::function<void(const std::string&)>& progress) {
-  if (options.frames < 10) throw InputError("command line", "--frames", "at least 10 frames");
+  if (options.frames < 10)
+    throw InputError("command line", OptionName{"frames"}, "at least 10 frames");
   std::vector<ClusterBenchRow> rows;
   for (const std::string& transport : options.transports) {
     for (const int nodes : options.node_counts) {

@@ -48,7 +48,7 @@ const ClusterNode& find_cluster_node(const projection_io::DisplayCluster& cluste
     if (candidate.name == node) return candidate;
     names += (names.empty() ? "" : ", ") + candidate.name;
   }
-  throw InputError(source, "--node",
+  throw InputError(source, OptionName{"node"},
                    "the name of one of the cluster's nodes (" + names + "), got '" + node + "'");
 }
 
@@ -791,21 +791,23 @@ NodeDisplay load_node_display(const std::string& display, std::optional<glm::ive
   if (scale) scale_session_display(loaded.display, *scale);
   if (!request.node.empty()) {
     if (!display.ends_with(".json"))
-      throw InputError("command line", "--node", "a display.json with a cluster section");
+      throw InputError("command line", OptionName{"node"}, "a display.json with a cluster section");
     loaded.cluster = keep_cluster_node_outputs(loaded.display, display, request.node);
     if (!loaded.cluster->master && request.frames_given)
-      throw InputError("command line", "--frames",
+      throw InputError("command line", OptionName{"frames"},
                        "no --frames on a secondary node: the master's --frames ends the run on "
                        "every node");
     if (!loaded.cluster->master && request.rate_hz)
-      throw InputError("command line", "--rate", "no --rate on a secondary: the master paces");
+      throw InputError("command line", OptionName{"rate_hz"},
+                       "no --rate on a secondary: the master paces");
     if (!(request.join_timeout_s > 0 && request.join_timeout_s <= 86400))
-      throw InputError("command line", "--join-timeout", "seconds in (0, 86400]");
+      throw InputError("command line", OptionName{"join_timeout_s"}, "seconds in (0, 86400]");
   } else if (request.rate_hz) {
-    throw InputError("command line", "--rate", "--node: --rate paces a cluster's master");
+    throw InputError("command line", OptionName{"rate_hz"},
+                     "--node: --rate paces a cluster's master");
   }
   if (request.rate_hz && !(*request.rate_hz > 0 && *request.rate_hz <= 10000))
-    throw InputError("command line", "--rate", "frames per second in (0, 10000]");
+    throw InputError("command line", OptionName{"rate_hz"}, "frames per second in (0, 10000]");
   return loaded;
 }
 

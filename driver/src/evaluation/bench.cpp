@@ -287,7 +287,7 @@ std::vector<BenchScenario> make_bench_scenarios(const BenchOptions& options) {
   if (names.empty()) names = {"cylinder", "deformation", "dome"};
   for (const std::string& name : names) {
     if (!known.contains(name)) {
-      throw InputError("command line", "--scenario",
+      throw InputError("command line", OptionName{"scenarios"},
                        "expected cylinder, deformation, deformation-80x60, deformation-128x128, "
                        "dome, dome-master, dome4, scale (scale-scenes, scale-facets, scale-width) "
                        "or all; got '" +
@@ -296,9 +296,10 @@ std::vector<BenchScenario> make_bench_scenarios(const BenchOptions& options) {
   }
   parse_scene_name(options.scene);  // InputError for a bad --scene before any work
   if (!(options.size_scale >= 1.0 / 64) || options.size_scale > 4) {
-    throw InputError("command line", "--size-scale", "expected a scale in [1/64, 4]");
+    throw InputError("command line", OptionName{"size_scale"}, "expected a scale in [1/64, 4]");
   }
-  if (options.frames < 1) throw InputError("command line", "--frames", "expected at least 1");
+  if (options.frames < 1)
+    throw InputError("command line", OptionName{"frames"}, "expected at least 1");
   const double scale = options.size_scale * (options.quick ? 0.125 : 1.0);
   const bool quick = options.quick;
   auto faces = [&](std::vector<int> edges) {

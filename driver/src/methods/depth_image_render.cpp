@@ -49,18 +49,18 @@ glm::vec3 sample_texture(const Image& image, glm::vec2 uv, bool repeat,
 }  // namespace
 
 DepthImage render_depth_image(const Scene& scene, const DepthImageRequest& request) {
-  check_image_size(request.size, "command line", "--size");
+  check_image_size(request.size, "command line", OptionName{"size"});
   DepthImage image = request.kind == DepthImageKind::dpci
                          ? make_dpci(request.size)
                          : make_planar(request.size, request.fov_x_deg);
   image.T_world_image = request.T_world_image;
   std::int64_t pixels = 0;
   for (const DepthImagePart& part : image.parts) {
-    check_image_size(part.size, "command line", "--size");
+    check_image_size(part.size, "command line", OptionName{"size"});
     pixels += std::int64_t(part.size.x) * part.size.y;
   }
   if (pixels > kMaxDepthImagePixels)
-    throw InputError("command line", "--size",
+    throw InputError("command line", OptionName{"size"},
                      "expected at most " + std::to_string(kMaxDepthImagePixels) +
                          " pixels in all parts together");
 
@@ -175,22 +175,22 @@ DepthImage run_depth_image_command(const DepthImageCommand& command) {
   } else if (command.kind == "planar") {
     request.kind = DepthImageKind::planar;
   } else {
-    throw InputError("command line", "--kind",
+    throw InputError("command line", OptionName{"kind"},
                      "expected planar or dpci; got '" + command.kind + "'");
   }
   if (command.out.empty() || command.out.extension() != ".exr")
-    throw InputError("command line", "--out",
+    throw InputError("command line", OptionName{"out"},
                      "expected a FILE.exr to write; got '" + command.out.string() + "'");
-  check_output_file(command.out, "--out");  // before any work
+  check_output_file(command.out, OptionName{"out"});  // before any work
   if (command.size) request.size = *command.size;
-  check_image_size(request.size, "command line", "--size");
+  check_image_size(request.size, "command line", OptionName{"size"});
   const SceneName name = parse_scene_name(command.scene);
   {
     std::vector<std::filesystem::path> inputs;
     for (const DepthImageName& image : name.depth_images) inputs.push_back(image.file);
     if (name.kind == SceneName::Kind::file) inputs.push_back(name.file);
     for (const std::filesystem::path& input : inputs)
-      refuse_output_over_inputs(command.out, "--out", {input});
+      refuse_output_over_inputs(command.out, OptionName{"out"}, {input});
   }
   const Scene scene = load_scene(name);
   request.T_world_image =

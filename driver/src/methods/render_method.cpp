@@ -45,11 +45,11 @@ void check_render_method(std::string_view name) {
   }
   for (std::string_view known : kNames) {
     if (known == name) {
-      throw InputError("command line", "--method",
+      throw InputError("command line", OptionName{"method"},
                        "method '" + std::string(name) + "' is not available in this build");
     }
   }
-  throw InputError("command line", "--method",
+  throw InputError("command line", OptionName{"method"},
                    "expected one of " + joined_names() + "; got '" + std::string(name) + "'");
 }
 

@@ -233,7 +233,7 @@ ContentFormat check_content_format(glm::ivec2 size, std::optional<ContentFormat>
                              size_text(size));
       break;
     case ContentFormat::perspective:
-      throw InputError(source, "--format",
+      throw InputError(source, OptionName{"format"},
                        "fisheye, equirect or cubemap (a perspective image is per projector, "
                        "for applications)");
   }

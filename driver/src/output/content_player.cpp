@@ -91,7 +91,7 @@ ContentPlayer::ContentPlayer(SessionDisplay display, std::unique_ptr<ContentMedi
   clock_.loop = options_.loop;
   clock_.start_frame = options_.start_frame;
   if (options_.start_frame < 0 || options_.start_frame >= media_->frame_count())
-    throw InputError("command line", "--start-frame",
+    throw InputError("command line", OptionName{"start_frame"},
                      "a frame from 0 to " + std::to_string(media_->frame_count() - 1) + " of " +
                          source + "; got " + std::to_string(options_.start_frame));
 
@@ -254,7 +254,8 @@ void run_windowed_play(const SessionDisplay& display, std::unique_ptr<ContentMed
   if (window_options.stats) {
     stats_file.open(stats_temporary);
     if (!stats_file)
-      throw InputError(window_options.stats->string(), "--stats", "a file that can be written");
+      throw InputError(window_options.stats->string(), OptionName{"stats"},
+                       "a file that can be written");
   }
 
   const auto start = std::chrono::steady_clock::now();

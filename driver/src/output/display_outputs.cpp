@@ -31,7 +31,7 @@ std::vector<OutputSpec> display_config_outputs(const projection_io::DisplayConfi
 
 LoadedDisplay load_display(std::string_view display, std::optional<glm::ivec2> size) {
   if (size && (size->x < 1 || size->y < 1)) {
-    throw InputError("command line", "--size", "expected a positive output size");
+    throw InputError("command line", OptionName{"size"}, "expected a positive output size");
   }
   LoadedDisplay loaded;
   std::vector<OutputSpec>& outputs = loaded.outputs;
@@ -63,7 +63,7 @@ LoadedDisplay load_display(std::string_view display, std::optional<glm::ivec2> s
     const std::string path(display);
     Warp warp = read_warp(path);
     if (size && *size != warp.output_size) {
-      throw InputError("command line", "--size",
+      throw InputError("command line", OptionName{"size"},
                        "expected the size of " + path + " (" + std::to_string(warp.output_size.x) +
                            "x" + std::to_string(warp.output_size.y) + ") or no --size");
     }
@@ -74,14 +74,14 @@ LoadedDisplay load_display(std::string_view display, std::optional<glm::ivec2> s
     projection_io::DisplayConfig config =
         projection_io::read_display_config(std::filesystem::path(display));
     if (size) {
-      throw InputError("command line", "--size",
+      throw InputError("command line", OptionName{"size"},
                        "expected no --size with a display.json (each projector has its own)");
     }
     outputs = display_config_outputs(config, std::string(display));
     loaded.config = std::move(config);
   } else {
     throw InputError(
-        "command line", "--display",
+        "command line", OptionName{"display"},
         "expected builtin:cylinder360, builtin:dome180, builtin:wall2x2, a .warp.exr file or a "
         "display.json; got '" +
             std::string(display) + "'");

@@ -418,7 +418,7 @@ std::uint8_t srgb_encode(float linear) {
 DepthMesh depth_image_mesh(const DepthImage& image, const DepthMeshOptions& options) {
   if (options.step < 1 || options.step > 64)
     throw InputError(
-        "command line", "--scene",
+        "command line", OptionName{"step"},
         "expected a depth image grid step in 1..64; got " + std::to_string(options.step));
   image.validate();
   DepthMesh mesh;

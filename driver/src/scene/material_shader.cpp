@@ -50,7 +50,7 @@ void refuse_forbidden_words(const std::string& file, std::string_view text) {
   std::smatch match;
   if (!std::regex_search(code, match, forbidden)) return;
   const auto line = 1 + std::count(code.begin(), code.begin() + match.position(0), '\n');
-  throw InputError(file, "--material",
+  throw InputError(file, OptionName{"material"},
                    "line " + std::to_string(line) + " uses '" + match[1].str() +
                        "': a material only returns a colour from shade(), so that the triangle "
                        "IDs and depth stay the renderer's");
@@ -64,7 +64,7 @@ void refuse_non_text(const std::string& file, std::string_view text) {
     const auto byte = static_cast<unsigned char>(text[i]);
     if (byte == '\n') ++line;
     if (byte == 0) {
-      throw InputError(file, "--material",
+      throw InputError(file, OptionName{"material"},
                        "line " + std::to_string(line) + " holds a NUL byte: expected GLSL text");
     }
     // The length of the UTF-8 sequence this byte starts (0: not a valid start byte).
@@ -78,7 +78,7 @@ void refuse_non_text(const std::string& file, std::string_view text) {
       valid = (static_cast<unsigned char>(text[i + k]) & 0xc0) == 0x80;
     }
     if (!valid) {
-      throw InputError(file, "--material",
+      throw InputError(file, OptionName{"material"},
                        "line " + std::to_string(line) + " is not valid UTF-8: expected GLSL text");
     }
     i += length;
@@ -127,7 +127,7 @@ MaterialShader load_material_shader(std::string_view name_or_file) {
   }
   const std::string file(name_or_file);
   if (!file.ends_with(".frag")) {
-    throw InputError("command line", "--material",
+    throw InputError("command line", OptionName{"material"},
                      "expected lit, solid-wireframe, pen-and-ink, procedural or a GLSL file "
                      "FILE.frag; got '" +
                          file + "'");
@@ -136,12 +136,13 @@ MaterialShader load_material_shader(std::string_view name_or_file) {
   std::error_code error;
   const auto bytes = std::filesystem::file_size(file, error);
   if (error || bytes > kMaxMaterialBytes) {
-    throw InputError(file, "--material", "expected a GLSL file of at most 1 MiB");
+    throw InputError(file, OptionName{"material"}, "expected a GLSL file of at most 1 MiB");
   }
   std::ifstream in(file, std::ios::binary);
   std::ostringstream text;
   text << in.rdbuf();
-  if (!in && !in.eof()) throw InputError(file, "--material", "expected a readable GLSL file");
+  if (!in && !in.eof())
+    throw InputError(file, OptionName{"material"}, "expected a readable GLSL file");
   MaterialShader material;
   material.name = file;
   material.file = file;
@@ -188,7 +189,7 @@ Program link_with_material(const ProgramBuilder& builder, const MaterialShader& 
     if (first.empty()) first = e.what();
     const bool compile = e.file() == file;
     throw InputError(
-        file, "--material",
+        file, OptionName{"material"},
         std::string(compile ? "GLSL compile error" : "GLSL link error") +
             (compile && e.line() > 0 ? " at line " + std::to_string(e.line()) : std::string()) +
             ": " + first +

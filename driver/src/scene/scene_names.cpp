@@ -16,7 +16,7 @@ constexpr const char* kExpected =
     "+depth:FILE.exr depth images, or depth:FILE.exr alone";
 
 [[noreturn]] void refuse(std::string_view text, const std::string& why) {
-  throw InputError("command line", "--scene",
+  throw InputError("command line", OptionName{"scene"},
                    "expected " + std::string(kExpected) + "; got '" + std::string(text) + "'" +
                        (why.empty() ? "" : " (" + why + ")"));
 }

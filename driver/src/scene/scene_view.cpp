@@ -136,10 +136,10 @@ SceneView choose_scene_view(const Scene& scene, const ViewRequest& request, bool
 
   if (!request.camera.empty()) {
     if (request.eye_world || request.look_at_world)
-      throw InputError("command line", "--camera",
+      throw InputError("command line", OptionName{"camera"},
                        "expected either --camera or --eye/--look-at, not both");
     if (scene.cameras.empty())
-      throw InputError("command line", "--camera",
+      throw InputError("command line", OptionName{"camera"},
                        "expected the name of one of the scene's cameras; " +
                            (scene.name.empty() ? std::string("the scene") : scene.name) +
                            " has none");
@@ -156,7 +156,7 @@ SceneView choose_scene_view(const Scene& scene, const ViewRequest& request, bool
       for (const SceneCamera& camera : scene.cameras)
         names += (names.empty() ? "'" : ", '") + camera.name + "'";
       throw InputError(
-          "command line", "--camera",
+          "command line", OptionName{"camera"},
           "expected one of the scene's cameras: " + names + "; got '" + request.camera + "'");
     }
     view.T_world_eye = found->T_world_camera;
@@ -169,7 +169,7 @@ SceneView choose_scene_view(const Scene& scene, const ViewRequest& request, bool
     const glm::dvec3 target = request.look_at_world.value_or(centre);
     if (glm::length(target - *request.eye_world) < 1e-9)
       throw InputError(
-          "command line", request.look_at_world ? "--look-at" : "--eye",
+          "command line", OptionName{request.look_at_world ? "look_at_world" : "eye_world"},
           "expected an --eye apart from the point looked at (--look-at, by default the "
           "scene bounds' centre " +
               format_point(centre) + "); both are " + format_point(target));
@@ -179,7 +179,8 @@ SceneView choose_scene_view(const Scene& scene, const ViewRequest& request, bool
     return view;
   }
   if (request.look_at_world)
-    throw InputError("command line", "--look-at", "expected --eye as well: the point to look from");
+    throw InputError("command line", OptionName{"look_at_world"},
+                     "expected --eye as well: the point to look from");
 
   const auto depth_eye =
       std::find_if(scene.cameras.begin(), scene.cameras.end(),

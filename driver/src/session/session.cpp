@@ -121,14 +121,14 @@ SessionDisplay load_session_display(std::string_view display, std::optional<glm:
 
 void scale_session_display(SessionDisplay& display, double factor) {
   if (!(factor > 0 && factor <= 1))
-    throw InputError("command line", "--scale", "a factor in (0, 1]");
+    throw InputError("command line", OptionName{"factor"}, "a factor in (0, 1]");
   // Every output keeps at least 8 pixels a side: below that (--scale 1e-9 made 1x1 outputs)
   // there is nothing to preview.
   for (const SessionOutput& output : display.outputs) {
     const glm::dvec2 scaled = glm::round(glm::dvec2(output.spec.warp.output_size) * factor);
     if (scaled.x < 8 || scaled.y < 8) {
       throw InputError(
-          "command line", "--scale",
+          "command line", OptionName{"factor"},
           "a factor in (0, 1] that leaves every output at least 8 pixels a side, but " +
               std::to_string(factor) + " makes " + output.spec.name + " " +
               std::to_string(int(scaled.x)) + "x" + std::to_string(int(scaled.y)));
@@ -170,7 +170,7 @@ void write_session_display(const SessionDisplay& display, const std::string& nam
                            const std::filesystem::path& folder) {
   namespace fs = std::filesystem;
   OutputFolderRules rules;
-  rules.flag = "--out";
+  rules.field = OptionName{"out"};
   write_folder_atomically(
       folder,
       [&](const fs::path& temporary) {

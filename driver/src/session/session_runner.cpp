@@ -103,7 +103,7 @@ std::string frame_file_name(std::uint64_t frame) {
 OutputFolderRules headless_out_rules(const HeadlessRunOptions& options,
                                      const std::string& earlier) {
   OutputFolderRules rules;
-  rules.flag = "--out";
+  rules.field = OptionName{"out"};
   rules.expected = "a new path, an empty folder, or a folder from an earlier " + earlier +
                    " (stats.jsonl and folders of NNNNN.png, nothing else)";
   rules.is_own_output = holds_earlier_run;
@@ -123,10 +123,10 @@ void write_headless_frames(const HeadlessRunOptions& options, const std::string&
                            const HeadlessFrameDone& done_frame) {
   FACET_ASSERT(targets.size() == display.outputs.size());
   if (options.frames < 1 || options.frames > kMaxFrames)
-    throw InputError("command line", "--frames",
+    throw InputError("command line", OptionName{"frames"},
                      "from 1 to " + std::to_string(kMaxFrames) + " frames");
   if (options.save_every < 1)
-    throw InputError("command line", "--save-every", "a frame interval of at least 1");
+    throw InputError("command line", OptionName{"save_every"}, "a frame interval of at least 1");
   const OutputFolderRules rules = headless_out_rules(options, earlier);
   const fs::path out_dir = check_output_folder(options.out_dir, rules);
   const bool replacing = fs::exists(fs::symlink_status(out_dir));

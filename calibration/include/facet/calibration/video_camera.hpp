@@ -43,8 +43,8 @@ struct VideoCameraOptions {
 // A camera opened through OpenCV VideoCapture with the V4L2 backend: `device` is a device node
 // (/dev/videoN) or an index ("0"). `identity` names it in the capture journal (the stable USB id
 // when the config gave one, else the node). Frames become grey (BT.601 luma of colour frames),
-// scaled so that full scale is 1. Throws InputError("--camera", ...) when the device does not
-// open or delivers no frame, and when a grab later fails.
+// scaled so that full scale is 1. Throws InputError(OptionName "device", ...) when the device does
+// not open or delivers no frame, and when a grab later fails.
 std::unique_ptr<LiveCamera> open_video_camera(const std::string& device,
                                               const std::string& identity,
                                               const VideoCameraOptions& options = {});

@@ -98,7 +98,7 @@ struct ClusterNodeOptions {
 // The cluster's deadline in ms: its deadline_ms, or kDefaultClusterDeadlineFrames frame periods.
 double cluster_deadline_ms(const projection_io::DisplayCluster& cluster, double frame_period_s);
 
-// The node named `node`, or InputError(source, "--node", the names there are).
+// The node named `node`, or InputError(source, OptionName "node", the names there are).
 const projection_io::ClusterNode& find_cluster_node(const projection_io::DisplayCluster& cluster,
                                                     const std::string& node,
                                                     const std::string& source);

@@ -44,7 +44,7 @@ struct PlayClock {
 struct PlaybackOptions {
   ContentProjection projection;  // fisheye_content() by default
   bool loop = false;
-  std::int64_t start_frame = 0;  // InputError("command line", "--start-frame") beyond the video
+  std::int64_t start_frame = 0;  // InputError(OptionName "start_frame") beyond the video
   ResampleOptions resample;
 };
 

@@ -122,7 +122,7 @@ struct DepthMesh {
 // world frame; per vertex the stored normal (world frame) and the colour image's texel centre as
 // uv. The cylinder's last column joins its first. Triangles face the eye (counter-clockwise seen
 // from it). The scene also holds a SceneCamera named kDepthImageEyeCamera at T_world_image.
-// InputError naming "--scene" for a step outside [1, 64].
+// InputError naming the option "step" for a step outside [1, 64].
 DepthMesh depth_image_mesh(const DepthImage& image, const DepthMeshOptions& options = {});
 
 // Several scenes in one: objects, primitives, materials, images and cameras appended in order

@@ -24,7 +24,7 @@ namespace facet::driver {
 //   FILE.json            a display.json (FORMATS.md §4): one output per projector, named and
 //                        sized as there.
 // `size` overrides a built-in's default output size; for a file it must equal the file's size.
-// Throws InputError("command line", "--display" or "--size", ...) for anything else, and the
+// Throws InputError("command line", OptionName "display" or "size", ...) for anything else, and the
 // file's own InputError for a bad file.
 std::vector<OutputSpec> load_display_outputs(std::string_view display,
                                              std::optional<glm::ivec2> size = std::nullopt);

@@ -171,8 +171,8 @@ class RenderMethod {
 
 // Every method name make_render_method accepts, in the order `facet bench` lists them.
 std::span<const std::string_view> render_method_names();
-// Throws InputError("--method", ...) for an unknown name. Methods may make GL objects from the
-// start: call with a current context (check_render_method checks a name without one).
+// Throws InputError(OptionName "method", ...) for an unknown name. Methods may make GL objects from
+// the start: call with a current context (check_render_method checks a name without one).
 std::unique_ptr<RenderMethod> make_render_method(std::string_view name);
 // Throws make_render_method's InputError for a name it would reject; needs no GL context.
 void check_render_method(std::string_view name);

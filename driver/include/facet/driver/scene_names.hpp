@@ -55,9 +55,10 @@ struct SceneName {
   bool builtin_city() const { return kind != Kind::file && kind != Kind::depth_images; }
 };
 
-// Parses a --scene value. InputError("command line", "--scene", what was expected) for an unknown
-// builtin: name, a count that is not a whole number in range, a file that is not .gltf/.glb, a
-// depth image that is not .exr, or a built-in scene of more than kMaxSceneTriangles triangles.
+// Parses a scene name (the CLI's --scene value). InputError("command line", OptionName "scene",
+// what was expected) for an unknown builtin: name, a count that is not a whole number in range, a
+// file that is not .gltf/.glb, a depth image that is not .exr, or a built-in scene of more than
+// kMaxSceneTriangles triangles.
 SceneName parse_scene_name(std::string_view text);
 
 // Triangles of a built-in scene, counted without building it (0 for files).

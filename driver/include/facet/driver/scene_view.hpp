@@ -47,8 +47,8 @@ struct SceneView {
 
 // The view of `scene`:
 // - camera: the SceneCamera of that name (its name, else its camera_name), turning on the spot.
-//   InputError("command line", "--camera", ...) listing the cameras when none has that name, or
-//   saying the scene has none. Not together with eye_world.
+//   InputError("command line", OptionName "camera", ...) listing the cameras when none has that
+//   name, or saying the scene has none. Not together with eye_world.
 // - eye_world: the eye there, looking at look_at_world (default: the bounds' centre), circling
 //   the point looked at. InputError naming --eye / --look-at when the two coincide, and naming
 //   --look-at when it comes without --eye.

@@ -6,12 +6,15 @@
 #include <string>
 #include <vector>
 
+#include "facet/projection/errors.hpp"
+
 namespace facet {
 
 // What an output folder may replace, and how a refusal is worded.
 struct OutputFolderRules {
-  // The option that names the folder, for errors ("--out"); "" when none does.
-  std::string flag;
+  // What names the folder in errors: in a library the option of its call (OptionName{"out"}), in
+  // the CLI the flag ("--out"); empty when nothing does.
+  InputField field;
   // The error's "expected" text when an existing path may not be replaced.
   std::string expected = "a folder that does not exist yet or is empty";
   // True for an existing folder that holds this command's own earlier output, which may be
@@ -28,7 +31,7 @@ bool holds_only_files_named(const std::filesystem::path& folder,
                             const std::function<bool(const std::string& name)>& own_name);
 
 // `folder` as written ("out/" is "out") once it passes the checks write_folder_atomically makes
-// before writing anything. InputError naming the folder and rules.flag when it is empty, is the
+// before writing anything. InputError naming the folder and rules.field when it is empty, is the
 // current folder or one of its parents, is or holds one of rules.inputs, or exists and is not an
 // empty folder or one that rules.is_own_output accepts (a symbolic link is not a folder here); or
 // when it does not exist and could not be created: a name longer than 255 bytes, or a nearest

@@ -65,8 +65,8 @@ struct ContentProjection {
   // DomeOrientation::R_eye_dome() · R_dome_fisheye(centre) (fisheye_content).
   glm::dmat3 R_eye_content{1.0};
 
-  // InputError(source, "--fov", ...) for a field of view outside (0, 360]; perspective extents
-  // must be finite with left < right and top > bottom ("tan_extent").
+  // InputError(source, OptionName "fov_deg", ...) for a field of view outside (0, 360]; perspective
+  // extents must be finite with left < right and top > bottom ("tan_extent").
   void validate(const std::string& source) const;
 
   // The image point that shows eye direction v_eye (any length > 0); nullopt where the content

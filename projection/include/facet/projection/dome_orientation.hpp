@@ -42,15 +42,16 @@ struct DomeOrientation {
     return R_turn * R_tilt;
   }
 
-  // InputError(source, "--tilt" or "--orientation", ...) for a value out of range or not finite.
+  // InputError(source, OptionName "tilt_deg" or "orientation_deg", ...) for a value out of range
+  // or not finite.
   void validate(const std::string& source) const {
     if (!(std::isfinite(tilt_deg) && std::abs(tilt_deg) <= 90)) {
-      throw InputError(source, "--tilt",
+      throw InputError(source, OptionName{"tilt_deg"},
                        "expected the dome's forward tilt in degrees within [−90, 90]; got " +
                            detail::degrees_text(tilt_deg));
     }
     if (!(std::isfinite(orientation_deg) && std::abs(orientation_deg) <= 360)) {
-      throw InputError(source, "--orientation",
+      throw InputError(source, OptionName{"orientation_deg"},
                        "expected the dome's azimuth turn in degrees within [−360, 360]; got " +
                            detail::degrees_text(orientation_deg));
     }

@@ -4,6 +4,8 @@
 #include <cstdint>
 #include <string>
 
+#include "facet/projection/errors.hpp"
+
 namespace facet {
 
 // Bytes this process can still allocate: its address-space limit (RLIMIT_AS, as `ulimit -v`
@@ -13,7 +15,7 @@ std::uint64_t allocatable_bytes();
 
 // InputError(source, field, ...) naming `what`, the estimate and the budget when `bytes` is more
 // than allocatable_bytes().
-void require_memory(std::uint64_t bytes, const std::string& source, const std::string& field,
+void require_memory(std::uint64_t bytes, const std::string& source, const InputField& field,
                     const std::string& what);
 
 }  // namespace facet

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "facet/projection/base_projection.hpp"
+#include "facet/projection/errors.hpp"
 
 namespace facet {
 
@@ -19,7 +20,7 @@ inline constexpr std::int64_t kMaxImagePixels = std::int64_t(1) << 26;
 
 // InputError naming `source` and `field` unless both sides are at least 1 and the size is within
 // kMaxImageSide and kMaxImagePixels.
-void check_image_size(glm::ivec2 size, const std::string& source, const std::string& field);
+void check_image_size(glm::ivec2 size, const std::string& source, const InputField& field);
 
 struct Warp {
   BaseProjection base;
