@@ -171,14 +171,15 @@ std::vector<std::string> bench_notes(const std::vector<BenchRow>& rows,
                                      const std::string& renderer);
 
 // True for a folder of an earlier bench: bench.json, and otherwise only bench.csv, bench.md,
-// bench.png and bench.log (the log tools/gpu-bench keeps beside them), all regular files. write_bench_files may
-// replace such a folder whole.
+// bench.png and bench.log (the log tools/gpu-bench keeps beside them), all regular files.
+// write_bench_files may replace such a folder whole.
 bool is_bench_output(const std::filesystem::path& folder);
 
 // Writes folder/bench.json, folder/bench.csv, folder/bench.md (a markdown table per scenario,
 // then the notes) and folder/bench.png (median frame time against id_mismatch and against
-// geometric error, one series per method, one row of panels per scenario) through write_folder_atomically, under `rules` (the CLI's take is_bench_output as
-// the command's own output): a failure leaves `folder` as it was and no temporary behind.
+// geometric error, one series per method, one row of panels per scenario) through
+// write_folder_atomically, under `rules` (the CLI's take is_bench_output as the command's own
+// output): a failure leaves `folder` as it was and no temporary behind.
 void write_bench_files(const BenchReport& report, const std::filesystem::path& folder,
                        const OutputFolderRules& rules);
 
