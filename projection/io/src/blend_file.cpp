@@ -9,6 +9,7 @@
 #include "facet/projection/atomic_file.hpp"
 #include "facet/projection/errors.hpp"
 #include "facet/projection/input_file.hpp"
+#include "facet/projection/warp.hpp"
 #include "facet/projection_io/exr_header.hpp"
 
 namespace facet::projection_io {
@@ -89,17 +90,30 @@ BlendMap read_blend_map(const std::string& path, std::optional<glm::ivec2> expec
                          " pixels (the projector's output size), got " +
                          std::to_string(spec.width) + "x" + std::to_string(spec.height));
   }
-  std::vector<float> pixels(std::size_t(spec.width) * spec.height * spec.nchannels);
-  if (!input->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, pixels.data())) {
-    throw InputError(path, "pixels", "readable image data: " + input->geterror());
-  }
+  // An output's size at most (kMaxImagePixels), and only the channels the map keeps are read:
+  // a header may claim any size and any number of channels.
+  check_image_size({spec.width, spec.height}, path, "size");
+  const int first = *std::min_element(wanted.begin(), wanted.end());
+  const int end = *std::max_element(wanted.begin(), wanted.end()) + 1;
+  const std::size_t pixel_count = std::size_t(spec.width) * std::size_t(spec.height);
   BlendMap map;
   map.size = {spec.width, spec.height};
   map.channels = int(wanted.size());
-  map.values.resize(std::size_t(spec.width) * spec.height * map.channels);
-  for (std::size_t k = 0; k < std::size_t(spec.width) * spec.height; ++k) {
-    for (int c = 0; c < map.channels; ++c) {
-      map.values[k * map.channels + c] = pixels[k * spec.nchannels + wanted[std::size_t(c)]];
+  bool in_order = end - first == map.channels;
+  for (int c = 0; c < map.channels; ++c) in_order = in_order && wanted[std::size_t(c)] == first + c;
+  std::vector<float> read(in_order ? 0 : pixel_count * std::size_t(end - first));
+  map.values.resize(pixel_count * std::size_t(map.channels));
+  float* into = in_order ? map.values.data() : read.data();
+  if (!input->read_image(0, 0, first, end, OIIO::TypeDesc::FLOAT, into)) {
+    throw InputError(path, "pixels", "readable image data: " + input->geterror());
+  }
+  if (!in_order) {
+    const std::size_t span = std::size_t(end - first);
+    for (std::size_t k = 0; k < pixel_count; ++k) {
+      for (int c = 0; c < map.channels; ++c) {
+        map.values[k * map.channels + c] =
+            read[k * span + std::size_t(wanted[std::size_t(c)] - first)];
+      }
     }
   }
   map.validate(path);
