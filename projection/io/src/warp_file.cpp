@@ -3,11 +3,13 @@
 #include <OpenImageIO/imagebuf.h>
 #include <OpenImageIO/imageio.h>
 
+#include <algorithm>
 #include <nlohmann/json.hpp>
 
 #include "facet/projection/atomic_file.hpp"
 #include "facet/projection/errors.hpp"
 #include "facet/projection/input_file.hpp"
+#include "facet/projection/warp.hpp"
 #include "facet/projection_io/exr_header.hpp"
 #include "json_fields.hpp"
 
@@ -136,17 +138,23 @@ Warp read_warp(const std::string& path) {
   Warp warp;
   base_from_json(meta, path, warp);
   warp.grid_size = {spec.width, spec.height};
-  std::vector<float> pixels(std::size_t(spec.width) * spec.height * spec.nchannels);
-  if (!input->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, pixels.data())) {
+  // A node grid no larger than an image (kMaxImagePixels), and only R, G and A read: a header may
+  // claim any size and any number of channels.
+  check_image_size(warp.grid_size, path, "grid size");
+  const int first = std::min({channel_r, channel_g, channel_a});
+  const int end = std::max({channel_r, channel_g, channel_a}) + 1;
+  const std::size_t span = std::size_t(end - first);
+  const std::size_t nodes = std::size_t(spec.width) * std::size_t(spec.height);
+  std::vector<float> pixels(nodes * span);
+  if (!input->read_image(0, 0, first, end, OIIO::TypeDesc::FLOAT, pixels.data())) {
     throw InputError(path, "pixels", "cannot read the image data: " + input->geterror());
   }
-  const std::size_t nodes = std::size_t(spec.width) * spec.height;
   warp.offset_px.resize(nodes);
   warp.coverage.resize(nodes);
   for (std::size_t k = 0; k < nodes; ++k) {
-    const float* pixel = &pixels[k * spec.nchannels];
-    warp.offset_px[k] = {pixel[channel_r], pixel[channel_g]};
-    warp.coverage[k] = pixel[channel_a];
+    const float* pixel = &pixels[k * span];
+    warp.offset_px[k] = {pixel[channel_r - first], pixel[channel_g - first]};
+    warp.coverage[k] = pixel[channel_a - first];
   }
   warp.validate(path);
   return warp;
