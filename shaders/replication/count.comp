@@ -43,7 +43,6 @@ layout(std430, binding = 12) buffer Stats {
 };
 layout(std430, binding = 17) buffer Staged { uint staged[]; };
 layout(std430, binding = 18) writeonly buffer StageOffsets { uint stage_offset[]; };
-layout(location = 42) uniform uint triangle_count;
 layout(location = 45) uniform uint pair_capacity;
 layout(location = 48) uniform uint staged_capacity;  // words of Staged (staged_words in C++)
 // The walk pass's indirect dispatch, one work group per queued triangle in rows of
@@ -66,6 +65,7 @@ const uint kNoPiece = 0xffffffffu;  // ListEntry::sole_piece of an entry without
 uint triangle_eye(uint t, out vec3 p[3]);
 bool triangle_may_cover(vec3 p[3]);
 uvec4 list_entry(uint e);
+uint list_triangle_count();
 bool grid_coverage(vec3 p[3], uint t, uint pair_base, uint wanted, out uint wanted_facet,
                    out uint found);
 uint walk_coverage(vec3 p[3], uint t, uint pair_base, uint wanted, out uint wanted_facet);
@@ -105,6 +105,7 @@ void write_pair(uint at, uint t, uint facet) {
 shared uint group_pairs, group_staged, group_visible, group_base;
 
 void main() {
+  uint triangle_count = list_triangle_count();
 #if defined(WALK_PASS)
   uint queued = gl_WorkGroupID.y * kWalkRow + gl_WorkGroupID.x;
   uint t = queued < walk_count ? walk_queue[queued] : triangle_count + 1u;

@@ -11,10 +11,11 @@ layout(std430, binding = 12) buffer Stats {
   uint pair_total;
   uint overflow;
 };
-layout(location = 42) uniform uint triangle_count;
+uint list_triangle_count();
 layout(location = 45) uniform uint pair_capacity;
 
 void main() {
+  uint triangle_count = list_triangle_count();
   uint t = gl_GlobalInvocationID.x;
   uint total = scan[triangle_count];
   if (t == 0u) {

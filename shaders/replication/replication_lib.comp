@@ -40,13 +40,14 @@ struct Node {  // GpuCoverageNode
 layout(std430, binding = 7) readonly buffer Nodes { Node nodes[]; };
 layout(std430, binding = 8) readonly buffer Order { uint facet_order[]; };
 
-// The frame's triangle list (ListEntry in replication_common.hpp), an RGBA32UI texel per run of a
-// record: (record, list position of its first triangle, the one piece all its triangles take or
-// kNone, padding).
+// The frame's triangle list (ListEntry in replication_common.hpp), an RGBA32UI texel per record
+// in material order: (record, list position of its first triangle, the one piece all its
+// triangles take or kNone, padding). The entry of a record whose object is culled holds no
+// triangles: its first triangle is the next entry's.
 layout(binding = 14) uniform usamplerBuffer list_texels;
 uvec4 list_entry(uint e) { return texelFetch(list_texels, int(e)); }
 
-layout(location = 40) uniform uint list_entries;   // entries in the list
+layout(location = 40) uniform uint list_entries;   // entries in the list: every record
 layout(location = 41) uniform uint cull_back_faces;  // 1: front is counter-clockwise from the eye
 
 // Rounding slack of the coverage test, radians: every plane is moved outwards by this angle so
@@ -55,12 +56,14 @@ const float kCoverageSlack = 2e-6;
 const uint kNone = 0xffffffffu;
 const uint kCoverageLeafSize = 4u;  // CoverageIndex's leaf size, checked by pack_coverage_nodes
 
-// After the list_entries entries, the list's block table: entry k of the table, packed four to a
-// texel, is the entry holding list triangle kListBlockTriangles·k; one more ends it with the last
-// entry (FacetMethodBase::update_view). A lookup then searches only the entries of one block.
+// After the list_entries entries, the list's header: (its triangles, those of entries with a sole
+// piece, 0, 0). Then its block table: entry k of the table, packed four to a texel, is the entry
+// holding list triangle kListBlockTriangles·k; one more ends it with the last entry
+// (list_block_table, or list_build.comp). A lookup then searches only the entries of one block.
 const uint kListBlockTriangles = 64u;
+uint list_triangle_count() { return texelFetch(list_texels, int(list_entries)).x; }
 uint list_block_entry(uint block) {
-  return texelFetch(list_texels, int(list_entries + block / 4u))[block % 4u];
+  return texelFetch(list_texels, int(list_entries + 1u + block / 4u))[block % 4u];
 }
 
 // The list entry holding list triangle t (binary search on first_triangle within its block).
@@ -300,6 +303,39 @@ uint walk_coverage(vec3 p[3], uint t, uint pair_base, uint wanted, out uint want
     }
   }
   return found;
+}
+
+// Whether a sphere (eye frame: centre in metres, radius) may meet any facet's guarded pyramid,
+// for object culling on the GPU (list_build.comp): sphere_may_meet_facets (facet_gpu.hpp) with the
+// nodes' bounding pyramids in place of their cones. A sphere wholly outside one plane through the
+// eye misses that pyramid, so the answer is never false for a sphere that meets a facet. Needs a
+// hierarchy with at least one facet.
+bool sphere_may_meet_facets(vec3 centre, float radius) {
+  if (length(centre) <= radius) return true;  // the eye is inside: every direction
+  uint stack[64];
+  int top = 0;
+  stack[top++] = 0u;
+  while (top > 0) {
+    Node node = nodes[stack[--top]];
+    if (node.bounded != 0u) {
+      bool outside = false;
+      for (int k = 0; k < 4; ++k) outside = outside || dot(node.pyramid[k].xyz, centre) < -radius;
+      if (outside) continue;
+    }
+    if (node.count > 0u) {
+      for (uint m = 0u; m < kCoverageLeafSize; ++m) {
+        if (m >= node.count) break;
+        uint f = facet_order[node.first + m];
+        bool outside = false;
+        for (int k = 0; k < 3; ++k) outside = outside || dot(clip_plane(f, k).xyz, centre) < -radius;
+        if (!outside) return true;
+      }
+    } else if (top + 2 <= 64) {
+      stack[top++] = node.first;
+      stack[top++] = node.first + 1u;
+    }
+  }
+  return false;
 }
 
 // ---- Coverage grid (projection/coverage_grid.hpp, CoverageGrid: the same arithmetic in float,

@@ -22,7 +22,7 @@ layout(binding = 17) uniform usamplerBuffer staged_texels;
 layout(binding = 18) uniform usamplerBuffer stage_offset_texels;
 uint scan(uint t) { return texelFetch(scan_texels, int(t)).x; }
 uint staged(uint at) { return texelFetch(staged_texels, int(at)).x; }
-layout(location = 42) uniform uint triangle_count;
+uint list_triangle_count();
 
 const uint kKept = 8u;              // kStagedChunkFacets
 const uint kChained = 0x80000000u;  // kStagedChained
@@ -33,6 +33,7 @@ uint object_of(uint e);
 uint triangle_id(uint e, uint t);
 
 void main() {
+  uint triangle_count = list_triangle_count();
   uint t = gl_GlobalInvocationID.x;
   if (t >= triangle_count || overflow != 0u) return;
   uint first = scan(t), count = scan(t + 1u) - first;

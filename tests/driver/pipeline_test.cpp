@@ -628,9 +628,130 @@ TEST(Pipeline, GridCoverageGivesTheWalksIds) {
   }
 }
 
+// 300 small objects about the eye, 8 to 20 m away in every direction: fans of 1 to 130
+// triangles facing the eye, in three materials, so that the list's entries start at many
+// positions within its blocks of 64 triangles.
+Scene many_small_objects() {
+  Scene scene;
+  scene.materials.resize(3);
+  std::mt19937 random(7);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  for (std::uint32_t o = 0; o < 300; ++o) {
+    glm::dvec3 d;
+    do d = {unit(random), unit(random), unit(random)};
+    while (glm::length(d) < 0.1 || glm::length(d) > 1.0);
+    d = glm::normalize(d);
+    const glm::dvec3 centre = (14.0 + 6.0 * unit(random)) * d;
+    const glm::dvec3 u = glm::normalize(
+        glm::cross(d, std::abs(d.y) < 0.9 ? glm::dvec3(0, 1, 0) : glm::dvec3(1, 0, 0)));
+    const glm::dvec3 v = glm::cross(d, u);
+    const std::uint32_t triangles = 1 + (o * 37) % 130;
+    const std::uint32_t first_index = std::uint32_t(scene.indices.size());
+    for (std::uint32_t k = 0; k < triangles; ++k) {
+      const double a0 = 2 * M_PI * k / triangles, a1 = 2 * M_PI * (k + 1) / triangles;
+      // Counter-clockwise seen from the eye: front faces.
+      for (const glm::dvec3& p : {centre, centre + 1.5 * (std::cos(a1) * u + std::sin(a1) * v),
+                                  centre + 1.5 * (std::cos(a0) * u + std::sin(a0) * v)}) {
+        scene.indices.push_back(std::uint32_t(scene.positions.size()));
+        scene.positions.push_back(glm::vec3(p));
+        scene.normals.push_back(glm::vec3(-d));
+        scene.uvs.push_back({0, 0});
+      }
+    }
+    scene.primitives.push_back({first_index, 3 * triangles, o % 3});
+    Object object;
+    object.first_primitive = o;
+    object.primitive_count = 1;
+    scene.objects.push_back(object);
+  }
+  scene.update_bounds();
+  return scene;
+}
+
+// Object culling and the triangle list built on the GPU (list_build.comp) draw what the CPU's
+// list draws: the same IDs pixel for pixel, frame after frame of a moving view and with an object
+// moved between frames, for every facet pipeline, on strips and tolerance layouts of the
+// cylinder, a tilted dome and the 2 × 2 wall's four outputs, with the city and with 300 small
+// objects. The GPU's culling keeps every object the CPU's keeps (it tests the nodes' pyramids,
+// not their cones), and at most a tenth more triangles.
+TEST(Pipeline, GpuTriangleListGivesTheCpuListsIds) {
+  test::shared_context();
+  RenderSettings quarter_px;
+  quarter_px.facets.layout = FacetTolerance{0.25};
+  const glm::dmat4 tilt = glm::rotate(glm::dmat4(1.0), -1.2, glm::dvec3(1, 0, 0));
+  const auto wall = load_display_outputs("builtin:wall2x2", glm::ivec2(128, 80));
+  ASSERT_EQ(wall.size(), 4u);
+  Scene city = small_city(), small_objects = many_small_objects();
+  ASSERT_GT(city.objects.size(), 4u);
+  for (const auto& [name, scene_ptr, outputs, settings, T_view] :
+       {std::tuple{"cylinder strips", &city, cylinder(), strips(40), glm::dmat4(1.0)},
+        std::tuple{"cylinder 0.25 px", &city, cylinder(), quarter_px, glm::dmat4(1.0)},
+        std::tuple{"dome 0.25 px, tilted", &city, dome(), quarter_px, tilt},
+        std::tuple{"wall2x2 0.25 px", &city, wall, quarter_px, glm::dmat4(1.0)},
+        std::tuple{"small objects, cylinder", &small_objects, cylinder(), quarter_px,
+                   glm::dmat4(1.0)},
+        std::tuple{"small objects, dome", &small_objects, dome(), quarter_px, tilt}}) {
+    Scene& scene = *scene_ptr;
+    const glm::mat4 T_rest = scene.objects[3].T_world_object;
+    for (const char* method : {"facets", "facets-gs", "tessellated"}) {
+      SCOPED_TRACE(std::string(name) + ", " + method);
+      const GpuScene gpu = upload_scene(scene);
+      RenderSettings on_cpu = settings, on_gpu = settings;
+      on_cpu.triangle_list = TriangleListBuild::cpu;
+      on_gpu.triangle_list = TriangleListBuild::gpu;
+      auto cpu_renderer = make_render_method(method);
+      auto gpu_renderer = make_render_method(method);
+      cpu_renderer->prepare(scene, gpu, outputs, on_cpu);
+      gpu_renderer->prepare(scene, gpu, outputs, on_gpu);
+      std::vector<OutputTarget> cpu_targets, gpu_targets;
+      for (const auto& output : outputs) {
+        cpu_targets.push_back(OutputTarget::create(output.warp.output_size));
+        gpu_targets.push_back(OutputTarget::create(output.warp.output_size));
+      }
+      for (int frame = 0; frame < 3; ++frame) {
+        // The third frame keeps the view and moves an object 20 m sideways.
+        scene.objects[3].T_world_object =
+            frame == 2 ? glm::translate(glm::mat4(1.0f), glm::vec3(20, 0, 0)) * T_rest : T_rest;
+        scene.update_bounds();
+        const double step = std::min(frame, 1);
+        const glm::dmat4 view = &scene == &city ? T_view * city_view(1.0 + 2.0 * step)
+                                                : T_view * glm::rotate(glm::dmat4(1.0), 0.4 * step,
+                                                                       glm::dvec3(0, 1, 0));
+        const RenderStats cpu_stats = cpu_renderer->render(view, cpu_targets);
+        const RenderStats gpu_stats = gpu_renderer->render(view, gpu_targets);
+        check_gl_error("render");
+        EXPECT_FALSE(gpu_stats.reused_replication) << frame;
+        EXPECT_GE(gpu_stats.triangles_in, cpu_stats.triangles_in) << frame;
+        EXPECT_LE(gpu_stats.triangles_in, cpu_stats.triangles_in + cpu_stats.triangles_in / 10)
+            << frame;
+        EXPECT_GT(cpu_stats.triangles_in, 0u) << frame;
+        EXPECT_EQ(gpu_stats.triangles_sole_piece, 0u) << frame;
+        std::size_t drawn = 0;
+        for (std::size_t i = 0; i < outputs.size(); ++i) {
+          const auto cpu_ids = cpu_targets[i].read_ids();
+          const auto gpu_ids = gpu_targets[i].read_ids();
+          ASSERT_EQ(cpu_ids.size(), gpu_ids.size());
+          std::size_t differing = 0;
+          for (std::size_t k = 0; k < cpu_ids.size(); ++k) differing += cpu_ids[k] != gpu_ids[k];
+          EXPECT_EQ(differing, 0u) << "frame " << frame << ", output " << i;
+          drawn += cpu_ids.size() - count_value(cpu_ids, 0);
+        }
+        EXPECT_GT(drawn, 500u) << frame;
+        if (frame == 0)
+          std::printf("%s, %s: list triangles GPU/CPU %llu/%llu\n", name, method,
+                      static_cast<unsigned long long>(gpu_stats.triangles_in),
+                      static_cast<unsigned long long>(cpu_stats.triangles_in));
+      }
+      scene.objects[3].T_world_object = T_rest;
+      scene.update_bounds();
+    }
+  }
+}
+
 // The pair buffers start at one pair per triangle: a view that needs more overflows them, the
 // frame is replicated again with room, and its image is the one a roomy frame gives. Both pair
-// pipelines size their buffers this way, without reading the pair count back before drawing.
+// pipelines size their buffers this way, without reading the pair count back before drawing,
+// with the triangle list built on the CPU or on the GPU.
 TEST(Pipeline, AnOverflowingPairBufferRerunsToTheSameImage) {
   test::shared_context();
   const Scene scene = background_sphere(96, 48, 50.0f);  // 9,216 triangles, all in view
@@ -639,10 +760,15 @@ TEST(Pipeline, AnOverflowingPairBufferRerunsToTheSameImage) {
   const glm::dmat4 view_a(1.0);
   const glm::dmat4 view_b = glm::dmat4(glm::rotate(glm::dmat4(1.0), 0.3, glm::dvec3(0, 1, 0)));
   std::vector<std::uint32_t> ids_of_facets;
-  for (const char* method : {"facets", "facets-gs"}) {
-    SCOPED_TRACE(method);
+  for (const auto& [method, list] :
+       {std::pair{"facets", TriangleListBuild::cpu}, std::pair{"facets-gs", TriangleListBuild::cpu},
+        std::pair{"facets", TriangleListBuild::gpu},
+        std::pair{"facets-gs", TriangleListBuild::gpu}}) {
+    SCOPED_TRACE(std::string(method) + (list == TriangleListBuild::gpu ? ", GPU list" : ""));
     auto renderer = make_render_method(method);
-    renderer->prepare(scene, gpu, outputs, strips(160));
+    RenderSettings settings = strips(160);
+    settings.triangle_list = list;
+    renderer->prepare(scene, gpu, outputs, settings);
     std::vector<OutputTarget> targets;
     targets.push_back(OutputTarget::create(kCylinderSize));
     const RenderStats first = renderer->render(view_a, targets);

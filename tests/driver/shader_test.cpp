@@ -71,6 +71,9 @@ TEST(Shaders, ListAndScatterConstantsMatchTheCpp) {
   const std::string library(embedded_shader("replication/replication_lib.comp").text);
   ASSERT_TRUE(std::regex_search(library, match, std::regex(R"(kListBlockTriangles = (\d+)u)")));
   EXPECT_EQ(std::stoul(match[1]), kListBlockTriangles);
+  const std::string list_build(embedded_shader("replication/list_build.comp").text);
+  ASSERT_TRUE(std::regex_search(list_build, match, std::regex(R"(kTableBlockTriangles = (\d+)u)")));
+  EXPECT_EQ(std::stoul(match[1]), kListBlockTriangles);
   const std::string scatter(embedded_shader("replication/scatter.comp").text);
   for (const auto& [name, unit] :
        {std::pair<const char*, GLuint>{"scan_texels", texture_unit::scan},
@@ -88,20 +91,27 @@ TEST(Shaders, ListAndScatterConstantsMatchTheCpp) {
 // layout of every shader that declares the block. Each block is found somewhere, and wherever it
 // is declared its binding is the C++ one.
 TEST(Shaders, StorageBufferBindingsMatchTheCpp) {
-  const std::map<std::string, GLuint> bindings = {{"Indices", binding::indices},
-                                                  {"Nodes", binding::nodes},
-                                                  {"Order", binding::order},
-                                                  {"Scan", binding::scan},
-                                                  {"Pairs", binding::pairs},
-                                                  {"Stats", binding::stats},
-                                                  {"MaterialRanges", binding::material_ranges},
-                                                  {"DrawArgs", binding::draw_args},
-                                                  {"BlockSums", binding::block_sums},
-                                                  {"Staged", binding::staged},
-                                                  {"StageOffsets", binding::stage_offsets},
-                                                  {"DrawCounts", binding::draw_counts},
-                                                  {"WalkQueue", binding::walk_queue},
-                                                  {"GridQueue", binding::grid_queue}};
+  const std::map<std::string, GLuint> bindings = {
+      {"Indices", binding::indices},
+      {"Nodes", binding::nodes},
+      {"Order", binding::order},
+      {"Scan", binding::scan},
+      {"Pairs", binding::pairs},
+      {"Stats", binding::stats},
+      {"MaterialRanges", binding::material_ranges},
+      {"DrawArgs", binding::draw_args},
+      {"BlockSums", binding::block_sums},
+      {"Staged", binding::staged},
+      {"StageOffsets", binding::stage_offsets},
+      {"DrawCounts", binding::draw_counts},
+      {"WalkQueue", binding::walk_queue},
+      {"GridQueue", binding::grid_queue},
+      {"ListOut", binding::list_out},
+      {"ObjectSpheres", binding::object_spheres},
+      {"ObjectVisible", binding::object_visible},
+      {"ListArgs", binding::list_args},
+      {"EntryRecords", binding::entry_records},
+      {"MaterialFirstEntries", binding::material_first_entries}};
   std::map<std::string, int> found;
   const std::regex block(R"(layout\(std430, binding = (\d+)\) (?:[a-z]+ )*buffer (\w+))");
   for (const EmbeddedShader& shader : embedded_shaders()) {

@@ -2255,6 +2255,7 @@ void add_flags_render(std::vector<Variant>& out) {
   add_flag_values(out, "render", b, "--reference-scene", scenes(), {"--reference"});
   add_flag_values(out, "render", b, "--anisotropy", non_negatives({"1000"}));
   add_flag_values(out, "render", b, "--coverage", choices("grid"));
+  add_flag_values(out, "render", b, "--triangle-list", choices("auto"));
   add_flag_values(out, "render", b, "--pieces", counts({"100000000"}));
   add_flag_values(out, "render", b, "--grid", sizes({"65536x1", "1x65536"}));
   add_flag_values(out, "render", b, "--tolerance", positives({"1e-9", "1e-300"}));

@@ -49,6 +49,7 @@ struct RenderOptions {
   int msaa = 0;
   float anisotropy = kAutomaticAnisotropy;
   std::string coverage = "grid";
+  std::string triangle_list = "auto";
   std::string material = "lit";
   DomeOrientationFlags orientation;
   bool ids = false, depth = false, reference = false, json = false, static_view = false;
@@ -188,6 +189,14 @@ void run(const RenderOptions& options) {
   } else if (options.coverage != "grid") {
     throw InputError("command line", "--coverage",
                      "expected grid or walk; got '" + options.coverage + "'");
+  }
+  if (options.triangle_list == "cpu") {
+    settings.triangle_list = TriangleListBuild::cpu;
+  } else if (options.triangle_list == "gpu") {
+    settings.triangle_list = TriangleListBuild::gpu;
+  } else if (options.triangle_list != "auto") {
+    throw InputError("command line", "--triangle-list",
+                     "expected auto, cpu or gpu; got '" + options.triangle_list + "'");
   }
   // GL caps the level at GL_MAX_TEXTURE_MAX_ANISOTROPY, 16 on every GPU that has it: a larger
   // level (or infinity) would be clamped without a word.
@@ -423,6 +432,9 @@ const Registration registration{
       command->add_option("--coverage", options->coverage,
                           "Facet methods' pass 1: grid (default) or walk (the hierarchy "
                           "reference)");
+      command->add_option("--triangle-list", options->triangle_list,
+                          "Facet pipelines' object culling and triangle list: auto (default: "
+                          "the GPU on a hardware renderer, the CPU on a software one), cpu or gpu");
       command->add_flag("--json", options->json, "Print one JSON object");
       command->callback([options] { run(*options); });
     }};

@@ -24,7 +24,7 @@ class FacetGsPipeline final : public PairPipelineBase {
     if (!count_) {
       count_ =
           link_replication_program({"replication/triangle_index.vert", "replication/count.geom"});
-      replicate_ = build_program({"replication/replicate.comp"});
+      replicate_ = link_replication_program({"replication/replicate.comp"});
       args_ = build_program({"replication/draw_args.comp"}, {{"VERTICES_PER_REPLICA", "1"}});
       scan_.prepare();
       feedback_ = TransformFeedback::create();
@@ -44,7 +44,7 @@ class FacetGsPipeline final : public PairPipelineBase {
   // count and, beyond the pair capacity, the overflow flag that makes draw_args.comp draw nothing.
   void replicate(std::size_t i, OutputTarget& target, GpuTimer* timer) override {
     OutputState& out = outputs_[i];
-    const std::uint32_t n = out.triangles;
+    const std::uint32_t n = list_capacity(i);  // the list's triangles, or at most
     ensure_capacity(out.scan, (std::size_t(n) + 1) * sizeof(std::uint32_t));
     const std::uint32_t capacity = pair_capacity(i);
     ensure_capacity(out.pairs, std::size_t(capacity) * 2 * sizeof(std::uint32_t));
@@ -53,7 +53,11 @@ class FacetGsPipeline final : public PairPipelineBase {
       TimedPass scope(timer, "pass1 coverage");
       const std::uint32_t zero[4] = {0, 0, 0, 0};
       out.stats.sub_data(0, sizeof zero, zero);
-      out.scan.sub_data(std::size_t(n) * sizeof(std::uint32_t), sizeof(std::uint32_t), zero);
+      // Transform feedback writes the list's counts; the scan's end marker, past them, is 0.
+      const std::uint32_t no_count = 0;
+      glClearNamedBufferSubData(out.scan.id(), GL_R32UI, 0,
+                                (std::size_t(n) + 1) * sizeof(std::uint32_t), GL_RED_INTEGER,
+                                GL_UNSIGNED_INT, &no_count);
       // Pass 1 draws (with rasterizer discard), which needs a complete framebuffer bound.
       target.bind();
       bind_output(i);
@@ -64,7 +68,11 @@ class FacetGsPipeline final : public PairPipelineBase {
       glEnable(GL_RASTERIZER_DISCARD);
       glBindTransformFeedback(GL_TRANSFORM_FEEDBACK, feedback_.id());
       glBeginTransformFeedback(GL_POINTS);
-      glDrawArrays(GL_POINTS, 0, GLsizei(n));
+      glBindBuffer(GL_DRAW_INDIRECT_BUFFER, out.list_args.id());
+      glMemoryBarrier(GL_COMMAND_BARRIER_BIT);
+      glDrawArraysIndirect(GL_POINTS, reinterpret_cast<const void*>(std::uintptr_t(
+                                          kListArgsTriangleDraw * sizeof(std::uint32_t))));
+      glBindBuffer(GL_DRAW_INDIRECT_BUFFER, 0);
       glEndTransformFeedback();
       glBindTransformFeedback(GL_TRANSFORM_FEEDBACK, 0);
       glDisable(GL_RASTERIZER_DISCARD);
@@ -77,7 +85,9 @@ class FacetGsPipeline final : public PairPipelineBase {
     bind_output(i);
     set_list_uniforms(replicate_, i);
     replicate_.use();
-    glDispatchCompute((n + 63) / 64, 1, 1);
+    glBindBuffer(GL_DISPATCH_INDIRECT_BUFFER, out.list_args.id());
+    glDispatchComputeIndirect(kListArgsTriangleDispatch * sizeof(std::uint32_t));
+    glBindBuffer(GL_DISPATCH_INDIRECT_BUFFER, 0);
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
     write_draw_commands(i, args_);
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_COMMAND_BARRIER_BIT);

@@ -73,7 +73,7 @@ class FacetPipeline final : public PairPipelineBase {
   // indirect arguments, all without reading anything back.
   void replicate(std::size_t i, OutputTarget&, GpuTimer* timer) override {
     OutputState& out = outputs_[i];
-    const std::uint32_t n = out.triangles;
+    const std::uint32_t n = list_capacity(i);  // the list's triangles, or at most
     ensure_capacity(out.scan, (std::size_t(n) + 1) * sizeof(std::uint32_t));
     ensure_capacity(out.stage_offsets, std::max<std::size_t>(n, 1) * sizeof(std::uint32_t));
     for (Buffer* queue : {&out.grid_queue, &out.walk_queue})
@@ -93,7 +93,8 @@ class FacetPipeline final : public PairPipelineBase {
       const Program& first = settings_.coverage == FacetCoverage::walk ? count_walk_ : count_;
       set_list_uniforms(first, i);
       first.use();
-      glDispatchCompute((n + 1 + kLocalSize - 1) / kLocalSize, 1, 1);
+      glBindBuffer(GL_DISPATCH_INDIRECT_BUFFER, out.list_args.id());
+      glDispatchComputeIndirect(kListArgsCullDispatch * sizeof(std::uint32_t));
       glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_COMMAND_BARRIER_BIT);
       const Program& grid = grid_programs_.at(grid_kind(out.facets.grid));
       for (const auto& [program, queue] :
@@ -118,7 +119,9 @@ class FacetPipeline final : public PairPipelineBase {
     glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT);
     set_list_uniforms(scatter_, i);
     scatter_.use();
-    glDispatchCompute((n + kLocalSize - 1) / kLocalSize, 1, 1);
+    glBindBuffer(GL_DISPATCH_INDIRECT_BUFFER, out.list_args.id());
+    glDispatchComputeIndirect(kListArgsTriangleDispatch * sizeof(std::uint32_t));
+    glBindBuffer(GL_DISPATCH_INDIRECT_BUFFER, 0);
     write_draw_commands(i, args_);
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_COMMAND_BARRIER_BIT);
     out.replication_valid = true;
@@ -184,7 +187,7 @@ std::vector<std::vector<std::uint32_t>> gpu_triangle_coverage(
   pipeline.prepare(scene, gpu, std::span(&output, 1), settings);
   pipeline.update_view(glm::dmat4(1.0));
   auto& out = pipeline.outputs_[0];
-  if (out.triangles == 0 || out.facets.mesh.facets.empty()) return result;
+  if (!pipeline.may_draw(0)) return result;
   OutputTarget unused_target;
   pipeline.replicate(0, unused_target, nullptr);
   if (!pipeline.read_replication(0)) {

@@ -25,6 +25,9 @@ class NaiveMethod final : public FacetMethodBase {
     });
   }
 
+  // Draws per piece the objects the CPU culled.
+  bool lists_on_gpu_allowed() const override { return false; }
+
   RenderStats render(const glm::dmat4& T_eye_world, std::span<OutputTarget> targets,
                      GpuTimer* timer) override {
     FACET_ASSERT(targets.size() == outputs_.size());

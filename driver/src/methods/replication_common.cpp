@@ -115,6 +115,29 @@ void FacetMethodBase::prepare(const Scene& scene, const GpuScene& gpu_scene,
   for (std::uint32_t r = 0; r < records_.size(); ++r) {
     records_by_material_.at(records_[r].material).push_back(r);
   }
+  entry_records_.clear();
+  material_first_entries_.clear();
+  std::uint64_t scene_triangles = 0;
+  for (const auto& material_records : records_by_material_) {
+    material_first_entries_.push_back(std::uint32_t(entry_records_.size()));
+    for (std::uint32_t r : material_records) {
+      entry_records_.push_back(r);
+      scene_triangles += records_[r].triangle_count;
+    }
+  }
+  material_first_entries_.push_back(std::uint32_t(entry_records_.size()));
+  // One more triangle is the cull pass's end marker; the list positions are uint32.
+  if (scene_triangles >= UINT32_MAX)
+    throw InputError("scene", "triangles",
+                     "fewer than 2^32 - 1 triangles for the facet methods; it has " +
+                         std::to_string(scene_triangles));
+  scene_list_triangles_ = std::uint32_t(scene_triangles);
+  const std::uint32_t no_entry = 0;
+  entry_records_buffer_ = entry_records_.empty() ? Buffer::create(sizeof no_entry, &no_entry)
+                                                 : Buffer::create_from(entry_records_);
+  material_first_entries_buffer_ = Buffer::create_from(material_first_entries_);
+  object_spheres_buffer_ =
+      Buffer::create(std::max<std::size_t>(scene.objects.size(), 1) * sizeof(glm::vec4));
   const GpuRecord no_record{};
   records_buffer_ = records_.empty() ? Buffer::create(sizeof no_record, &no_record)
                                      : Buffer::create_from(records_);
@@ -126,18 +149,60 @@ void FacetMethodBase::prepare(const Scene& scene, const GpuScene& gpu_scene,
   if (!empty_vao_) empty_vao_ = VertexArray::create();
   chunked_draws_ = is_software_renderer() && (epoxy_gl_version() >= 46 ||
                                               epoxy_has_gl_extension("GL_ARB_indirect_parameters"));
+  const bool gpu_lists =
+      lists_on_gpu_allowed() &&
+      (settings.triangle_list == TriangleListBuild::gpu ||
+       (settings.triangle_list == TriangleListBuild::automatic && !is_software_renderer()));
+  if (gpu_lists && !list_write_) {
+    list_objects_ =
+        link_replication_program({"replication/list_build.comp"}, {{"OBJECT_PASS", "1"}});
+    list_counts_ = link_replication_program({"replication/list_build.comp"}, {{"COUNT_PASS", "1"}});
+    list_write_ = link_replication_program({"replication/list_build.comp"}, {{"WRITE_PASS", "1"}});
+    list_scan_.prepare();
+  }
+  // The list buffer: the entries, the header texel, and a block table for every triangle.
+  const std::size_t table_values = scene_list_triangles_ / kListBlockTriangles + 2;
+  const std::size_t list_texels = list_entries() + 1 + (table_values + 3) / 4;
+  const std::size_t args_words = kListArgsPatchDraws + 4 * std::size_t(material_count());
   outputs_.clear();
   for (const OutputSpec& output : outputs) {
     OutputState state(FacetSet::build(output.warp, settings.facets, settings.z_near,
                                       settings.merge_coplanar_facets));
-    const std::uint32_t no_stats[4] = {0, 0, 0, 0};
+    const std::uint32_t no_stats[6] = {0, 0, 0, 0, 0, 0};
     state.stats = Buffer::create(sizeof no_stats, no_stats);
+    state.list_on_gpu = gpu_lists && list_entries() > 0 && !state.facets.mesh.facets.empty();
+    state.list_buffer = Buffer::create(list_texels * sizeof(ListEntry));
+    state.list_texels =
+        Texture::create_buffer_view(state.list_buffer, GL_RGBA32UI, sizeof(ListEntry));
+    state.ranges_buffer = Buffer::create(2 * std::size_t(material_count()) * sizeof(std::uint32_t));
+    state.list_args = Buffer::create(args_words * sizeof(std::uint32_t));
+    if (state.list_on_gpu) {
+      state.object_visible_flags =
+          Buffer::create(std::max<std::size_t>(scene.objects.size(), 1) * sizeof(std::uint32_t));
+      state.list_offsets =
+          Buffer::create((std::size_t(list_entries()) + 1) * sizeof(std::uint32_t));
+    }
     outputs_.push_back(std::move(state));
   }
   have_view_ = false;
 }
 
-bool FacetMethodBase::update_view(const glm::dmat4& T_eye_world) {
+std::uint32_t FacetMethodBase::list_capacity(std::size_t i) const {
+  const OutputState& out = outputs_[i];
+  return out.list_on_gpu ? scene_list_triangles_ : out.triangles;
+}
+
+bool FacetMethodBase::may_draw(std::size_t i) const {
+  return list_capacity(i) != 0 && !outputs_[i].facets.mesh.facets.empty();
+}
+
+void FacetMethodBase::take_list_counts(std::size_t i, const std::uint32_t* stats) {
+  OutputState& out = outputs_[i];
+  out.triangles = stats[4];
+  out.triangles_sole_piece = stats[5];
+}
+
+bool FacetMethodBase::update_view(const glm::dmat4& T_eye_world, GpuTimer* timer) {
   const Scene& scene = *scene_;
   bool objects_moved = last_T_world_object_.size() != scene.objects.size();
   for (std::size_t o = 0; !objects_moved && o < scene.objects.size(); ++o)
@@ -157,58 +222,135 @@ bool FacetMethodBase::update_view(const glm::dmat4& T_eye_world) {
   }
   eye_spheres_ = object_spheres(scene, T_eye_world);
   object_frames_.sub_data(0, frames.size() * sizeof(GpuObjectFrame), frames.data());
-
-  for (OutputState& out : outputs_) {
-    out.replication_valid = false;
-    out.object_visible.assign(scene.objects.size(), 0);
-    for (std::size_t o = 0; o < scene.objects.size(); ++o) {
+  if (std::any_of(outputs_.begin(), outputs_.end(),
+                  [](const OutputState& out) { return out.list_on_gpu; })) {
+    // In float, grown by 1e-6 of the distance: more than the centre's rounding (about 1e-7 of it)
+    // and the plane tests' (a few ulps of the distance).
+    std::vector<glm::vec4> spheres(std::max<std::size_t>(eye_spheres_.size(), 1), glm::vec4(-1));
+    for (std::size_t o = 0; o < eye_spheres_.size(); ++o) {
       const BoundingSphere& sphere = eye_spheres_[o];
-      out.object_visible[o] =
-          sphere.radius >= 0 &&
-          sphere_may_meet_facets(out.facets, sphere.centre, sphere.radius * 1.0001);
+      if (sphere.radius < 0) continue;
+      const double grown = sphere.radius * 1.0001 + 1e-6 * glm::length(sphere.centre);
+      spheres[o] = glm::vec4(glm::vec3(sphere.centre), float(grown));
     }
-    // Objects inside one piece and clear of the others: pass 1 gives their triangles that piece
-    // without the grid (the walk, the reference, always walks).
-    std::vector<std::uint32_t> sole_piece(scene.objects.size(), kNoPiece);
-    if (settings_.coverage == FacetCoverage::grid) {
-      for (std::size_t o = 0; o < scene.objects.size(); ++o) {
-        if (out.object_visible[o])
-          sole_piece[o] = sole_piece_of_sphere(out.facets, eye_spheres_[o].centre,
-                                               eye_spheres_[o].radius * 1.0001);
-      }
+    object_spheres_buffer_.sub_data(0, spheres.size() * sizeof(glm::vec4), spheres.data());
+  }
+  for (std::size_t i = 0; i < outputs_.size(); ++i) {
+    outputs_[i].replication_valid = false;
+    TimedPass scope(timer, "pass1 coverage");
+    if (outputs_[i].list_on_gpu) {
+      build_list_on_gpu(i);
+    } else {
+      build_list_on_cpu(i);
     }
-    out.list.clear();
-    out.material_ranges.clear();
-    std::uint32_t triangles = 0;
-    out.triangles_sole_piece = 0;
-    for (const auto& material_records : records_by_material_) {
-      out.material_ranges.push_back(triangles);
-      for (std::uint32_t r : material_records) {
-        const std::uint32_t object = records_[r].object;
-        if (!out.object_visible[object]) continue;
-        out.list.push_back({r, triangles, sole_piece[object], 0});
-        triangles += records_[r].triangle_count;
-        if (sole_piece[object] != kNoPiece) out.triangles_sole_piece += records_[r].triangle_count;
-      }
-      out.material_ranges.push_back(triangles);
-    }
-    out.triangles = triangles;
-    if (out.list.empty()) out.list.push_back({0, 0});  // keeps the binding valid; never read
-    const std::vector<std::uint32_t> block_table = list_block_table(out.list, triangles);
-    const std::size_t list_bytes = out.list.size() * sizeof(ListEntry);
-    const std::size_t table_bytes = block_table.size() * sizeof(std::uint32_t);
-    const GLuint list_buffer_before = out.list_buffer.id();
-    ensure_capacity(out.list_buffer, list_bytes + table_bytes);
-    out.list_buffer.sub_data(0, list_bytes, out.list.data());
-    out.list_buffer.sub_data(list_bytes, table_bytes, block_table.data());
-    if (!out.list_texels || out.list_buffer.id() != list_buffer_before)
-      out.list_texels =
-          Texture::create_buffer_view(out.list_buffer, GL_RGBA32UI, sizeof(ListEntry));
-    ensure_capacity(out.ranges_buffer, out.material_ranges.size() * sizeof(std::uint32_t));
-    out.ranges_buffer.sub_data(0, out.material_ranges.size() * sizeof(std::uint32_t),
-                               out.material_ranges.data());
   }
   return true;
+}
+
+void FacetMethodBase::build_list_on_cpu(std::size_t i) {
+  const Scene& scene = *scene_;
+  OutputState& out = outputs_[i];
+  out.object_visible.assign(scene.objects.size(), 0);
+  for (std::size_t o = 0; o < scene.objects.size(); ++o) {
+    const BoundingSphere& sphere = eye_spheres_[o];
+    out.object_visible[o] = sphere.radius >= 0 && sphere_may_meet_facets(out.facets, sphere.centre,
+                                                                         sphere.radius * 1.0001);
+  }
+  // Objects inside one piece and clear of the others: pass 1 gives their triangles that piece
+  // without the grid (the walk, the reference, always walks).
+  std::vector<std::uint32_t> sole_piece(scene.objects.size(), kNoPiece);
+  if (settings_.coverage == FacetCoverage::grid) {
+    for (std::size_t o = 0; o < scene.objects.size(); ++o) {
+      if (out.object_visible[o])
+        sole_piece[o] = sole_piece_of_sphere(out.facets, eye_spheres_[o].centre,
+                                             eye_spheres_[o].radius * 1.0001);
+    }
+  }
+  out.list.clear();
+  out.material_ranges.clear();
+  std::uint32_t triangles = 0;
+  out.triangles_sole_piece = 0;
+  std::vector<std::uint32_t> args(kListArgsPatchDraws + 4 * std::size_t(material_count()), 0);
+  for (std::uint32_t m = 0; m < material_count(); ++m) {
+    out.material_ranges.push_back(triangles);
+    for (std::uint32_t k = material_first_entries_[m]; k < material_first_entries_[m + 1]; ++k) {
+      const std::uint32_t r = entry_records_[k], object = records_[r].object;
+      const bool seen = out.object_visible[object] != 0;
+      out.list.push_back({r, triangles, seen ? sole_piece[object] : kNoPiece, 0});
+      if (!seen) continue;
+      triangles += records_[r].triangle_count;
+      if (sole_piece[object] != kNoPiece) out.triangles_sole_piece += records_[r].triangle_count;
+    }
+    out.material_ranges.push_back(triangles);
+    const std::uint32_t begin = out.material_ranges[2 * m], end = out.material_ranges[2 * m + 1];
+    const std::size_t at = kListArgsPatchDraws + 4 * std::size_t(m);
+    args[at] = end - begin;
+    args[at + 1] = patch_instances(out);
+    args[at + 2] = begin;
+  }
+  out.triangles = triangles;
+  const std::uint32_t groups = triangles / 64 + 1, triangle_groups = (triangles + 63) / 64;
+  const std::uint32_t fixed_args[kListArgsPatchDraws] = {
+      groups, 1, 1, 0, triangle_groups, 1, 1, 0, triangles, 1, 0, 0, 0, 0, 0, 0};
+  std::copy_n(fixed_args, kListArgsPatchDraws, args.begin());
+  out.list_args.sub_data(0, args.size() * sizeof(std::uint32_t), args.data());
+  const std::uint32_t list_counts[2] = {triangles, out.triangles_sole_piece};
+  out.stats.sub_data(4 * sizeof(std::uint32_t), sizeof list_counts, list_counts);
+
+  const ListEntry header{triangles, out.triangles_sole_piece, 0, 0};
+  const std::size_t list_bytes = out.list.size() * sizeof(ListEntry);
+  if (!out.list.empty()) out.list_buffer.sub_data(0, list_bytes, out.list.data());
+  out.list_buffer.sub_data(list_bytes, sizeof header, &header);
+  if (!out.list.empty()) {
+    const std::vector<std::uint32_t> block_table = list_block_table(out.list, triangles);
+    out.list_buffer.sub_data(list_bytes + sizeof header, block_table.size() * sizeof(std::uint32_t),
+                             block_table.data());
+  }
+  if (!out.material_ranges.empty())
+    out.ranges_buffer.sub_data(0, out.material_ranges.size() * sizeof(std::uint32_t),
+                               out.material_ranges.data());
+}
+
+void FacetMethodBase::build_list_on_gpu(std::size_t i) {
+  OutputState& out = outputs_[i];
+  const auto groups = [](std::size_t invocations) { return GLuint((invocations + 63) / 64); };
+  out.facets.bind();
+  record_texels_.bind_unit(texture_unit::records);
+  object_spheres_buffer_.bind_base(GL_SHADER_STORAGE_BUFFER, binding::object_spheres);
+  out.object_visible_flags.bind_base(GL_SHADER_STORAGE_BUFFER, binding::object_visible);
+  entry_records_buffer_.bind_base(GL_SHADER_STORAGE_BUFFER, binding::entry_records);
+  const std::uint32_t objects = std::uint32_t(scene_->objects.size());
+  glProgramUniform1ui(list_objects_.id(), list_objects_.uniform_location("object_count"), objects);
+  list_objects_.use();
+  glDispatchCompute(groups(objects), 1, 1);
+  glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+
+  out.list_offsets.bind_base(GL_SHADER_STORAGE_BUFFER, binding::scan);
+  glProgramUniform1ui(list_counts_.id(), list_counts_.uniform_location("list_entries"),
+                      list_entries());
+  list_counts_.use();
+  glDispatchCompute(groups(std::size_t(list_entries()) + 1), 1, 1);
+  list_scan_.run(out.list_offsets, list_entries() + 1);
+
+  out.list_offsets.bind_base(GL_SHADER_STORAGE_BUFFER, binding::scan);
+  out.list_buffer.bind_base(GL_SHADER_STORAGE_BUFFER, binding::list_out);
+  out.ranges_buffer.bind_base(GL_SHADER_STORAGE_BUFFER, binding::material_ranges);
+  material_first_entries_buffer_.bind_base(GL_SHADER_STORAGE_BUFFER,
+                                           binding::material_first_entries);
+  out.list_args.bind_base(GL_SHADER_STORAGE_BUFFER, binding::list_args);
+  out.stats.bind_base(GL_SHADER_STORAGE_BUFFER, binding::stats);
+  const std::pair<const char*, std::uint32_t> uniforms[] = {
+      {"list_entries", list_entries()},
+      {"material_count", material_count()},
+      {"patch_instances", patch_instances(out)}};
+  for (const auto& [name, value] : uniforms)
+    glProgramUniform1ui(list_write_.id(), list_write_.uniform_location(name), value);
+  list_write_.use();
+  const std::size_t blocks = scene_list_triangles_ / kListBlockTriangles + 2;
+  glDispatchCompute(
+      groups(std::max({std::size_t(list_entries()), blocks, std::size_t(material_count())})), 1, 1);
+  glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT |
+                  GL_COMMAND_BARRIER_BIT);
 }
 
 void FacetMethodBase::bind_output(std::size_t i) const {
@@ -235,9 +377,8 @@ void FacetMethodBase::set_list_uniforms(const Program& program, std::size_t i) c
   const OutputState& out = outputs_[i];
   // By name: a location the linker dropped from this program must not be set.
   const std::pair<const char*, std::uint32_t> values[] = {
-      {"list_entries", std::uint32_t(out.list.size())},
+      {"list_entries", list_entries()},
       {"cull_back_faces", settings_.cull_back_faces ? 1u : 0u},
-      {"triangle_count", out.triangles},
       {"material_count", material_count()},
       {"coverage_by_grid", settings_.coverage == FacetCoverage::grid ? 1u : 0u},
       {"pair_capacity", out.pair_capacity},
@@ -253,18 +394,18 @@ std::uint64_t FacetMethodBase::buffer_bytes(const OutputState& out) const {
   std::uint64_t bytes =
       set.facets.size() + set.nodes.size() + set.order.size() + set.grid_words.size();
   for (const Buffer* b :
-       {&out.list_buffer, &out.ranges_buffer, &out.scan, &out.pairs, &out.stats, &out.draw_args,
-        &out.draw_counts, &out.staged, &out.stage_offsets, &out.grid_queue, &out.walk_queue})
+       {&out.list_buffer, &out.ranges_buffer, &out.list_args, &out.object_visible_flags,
+        &out.list_offsets, &out.scan, &out.pairs, &out.stats, &out.draw_args, &out.draw_counts,
+        &out.staged, &out.stage_offsets, &out.grid_queue, &out.walk_queue})
     bytes += b->size();
   return bytes;
 }
 
-bool FacetMethodBase::add_output_stats(const OutputState& out, RenderStats& stats) const {
+void FacetMethodBase::add_output_stats(const OutputState& out, RenderStats& stats) const {
   stats.facets += out.facets.mesh.facets.size();
   stats.triangles_in += out.triangles;
   stats.triangles_sole_piece += out.triangles_sole_piece;
   stats.gpu_buffer_bytes += buffer_bytes(out);
-  return out.triangles != 0 && !out.facets.mesh.facets.empty();
 }
 
 void FacetMethodBase::set_material(const Program& program, std::uint32_t m) const {
@@ -318,7 +459,7 @@ void FacetMethodBase::draw_replicas(std::size_t i, const OutputTarget& target,
   glMemoryBarrier(GL_COMMAND_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
   const Program* in_use = nullptr;
   for (std::uint32_t m = 0; m < material_count(); ++m) {
-    if (out.material_ranges[2 * m] == out.material_ranges[2 * m + 1]) continue;
+    if (!out.list_on_gpu && out.material_ranges[2 * m] == out.material_ranges[2 * m + 1]) continue;
     const Program& program = programs.program_of(m);
     if (&program != in_use) {
       program.use();
@@ -364,17 +505,14 @@ namespace facet::driver::detail {
 RenderStats PairPipelineBase::render(const glm::dmat4& T_eye_world, std::span<OutputTarget> targets,
                                      GpuTimer* timer) {
   FACET_ASSERT(targets.size() == outputs_.size());
-  const bool changed = update_view(T_eye_world);
+  const bool changed = update_view(T_eye_world, timer);
   RenderStats stats;
   stats.reused_replication = !outputs_.empty();
-  const auto has_work = [](const OutputState& out) {
-    return out.triangles != 0 && !out.facets.mesh.facets.empty();
-  };
   std::vector<std::size_t> replicated;
   for (std::size_t i = 0; i < outputs_.size(); ++i) {
     OutputState& out = outputs_[i];
     targets[i].clear();
-    if (!has_work(out)) continue;
+    if (!may_draw(i)) continue;
     if (changed || !out.replication_valid) {
       stats.reused_replication = false;
       replicate(i, targets[i], timer);
@@ -395,7 +533,8 @@ RenderStats PairPipelineBase::render(const glm::dmat4& T_eye_world, std::span<Ou
   for (std::size_t i = 0; i < outputs_.size(); ++i) {
     const OutputState& out = outputs_[i];
     targets[i].resolve();
-    if (!add_output_stats(out, stats)) continue;
+    add_output_stats(out, stats);
+    if (!may_draw(i)) continue;
     stats.replicas += out.replicas;
     stats.triangles_visible += out.visible;
   }
@@ -405,14 +544,16 @@ RenderStats PairPipelineBase::render(const glm::dmat4& T_eye_world, std::span<Ou
 
 std::uint32_t PairPipelineBase::pair_capacity(std::size_t i) {
   OutputState& out = outputs_[i];
-  if (out.pair_capacity == 0) out.pair_capacity = std::max(out.triangles, kFirstPairCapacity);
+  if (out.pair_capacity == 0) out.pair_capacity = std::max(list_capacity(i), kFirstPairCapacity);
   return out.pair_capacity;
 }
 
 bool PairPipelineBase::read_replication(std::size_t i) {
   OutputState& out = outputs_[i];
-  std::uint32_t values[3] = {0, 0, 0};  // visible triangles, pairs, overflow
+  // Visible triangles, pairs, overflow, staged pairs, list triangles, those with a sole piece.
+  std::uint32_t values[6] = {0, 0, 0, 0, 0, 0};
   out.stats.get_sub_data(0, sizeof values, values);
+  take_list_counts(i, values);
   out.visible = values[0];
   out.replicas = values[1];
   if (values[2] == 0) return true;

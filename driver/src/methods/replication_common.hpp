@@ -89,13 +89,21 @@ struct ListEntry {  // std430 ListEntry of replication_lib.comp's List
 };
 static_assert(sizeof(ListEntry) == 16);
 
-// The block table that follows a frame's list in its buffer: value b is the last entry whose
-// first_triangle is at most kListBlockTriangles·b, for b < ceil(triangles / kListBlockTriangles),
-// then the last entry; packed four values to a texel (ListEntry-sized, RGBA32UI). The entry
-// holding list triangle t lies between the values of t's block and the next. Padded with zeros
-// to whole texels.
+// The block table that follows a frame's list and its header in the list buffer: value b is the
+// last entry whose first_triangle is at most kListBlockTriangles·b, for b < ceil(triangles /
+// kListBlockTriangles), then the last entry; packed four values to a texel (ListEntry-sized,
+// RGBA32UI). The entry holding list triangle t lies between the values of t's block and the next.
+// Padded with zeros to whole texels.
 std::vector<std::uint32_t> list_block_table(std::span<const ListEntry> list,
                                             std::uint32_t triangles);
+
+// The list's indirect arguments (binding::list_args, uint words), written with the list: the cull
+// pass's dispatch (a work group per 64 list triangles and one more), the per-triangle dispatch
+// of the scatter and replicate.comp, facets-gs' pass-1 draw (DrawArraysIndirectCommand of the
+// list's triangles), then from kListArgsPatchDraws a patch draw of each material's triangles for
+// the tessellator form.
+inline constexpr std::uint32_t kListArgsCullDispatch = 0, kListArgsTriangleDispatch = 4,
+                               kListArgsTriangleDraw = 8, kListArgsPatchDraws = 16;
 
 class FacetMethodBase : public RenderMethod {
  public:
@@ -106,15 +114,23 @@ class FacetMethodBase : public RenderMethod {
   struct OutputState {
     explicit OutputState(FacetSet set) : facets(std::move(set)) {}
     FacetSet facets;
+    // Whether this output's list is built on the GPU (list_build.comp); else on the CPU, which
+    // fills object_visible, list and material_ranges.
+    bool list_on_gpu = false;
     std::vector<std::uint8_t> object_visible;
     std::vector<ListEntry> list;
     std::vector<std::uint32_t> material_ranges;  // (begin, end) list triangles per material
-    std::uint32_t triangles = 0;                 // list triangles
-    std::uint32_t triangles_sole_piece = 0;      // of those, in entries with a sole piece
-    Buffer list_buffer, ranges_buffer;
+    // List triangles, and of those the ones in entries with a sole piece: the CPU's, or on the
+    // GPU the last read of the statistics.
+    std::uint32_t triangles = 0;
+    std::uint32_t triangles_sole_piece = 0;
+    // The list: list_entries() entries, the header texel, the block table (sized for every
+    // triangle of the scene); its indirect arguments; the list build's object flags (GPU only).
+    Buffer list_buffer, ranges_buffer, list_args, object_visible_flags, list_offsets;
     Texture list_texels;  // list_buffer as a buffer texture
     // Replication results, reused while neither the view nor any object transform changes.
-    // stats: visible triangles, pairs, overflow (std430 uints, replication/count.comp).
+    // stats: visible triangles, pairs, overflow, staged pairs (std430 uints, count.comp), then
+    // the list's triangles and those with a sole piece (list_build.comp).
     Buffer scan, pairs, stats, draw_args;
     // Pass 3's commands: draws_per_material per material, each of at most replicas_per_draw
     // replicas, and how many of them each material uses (replication/draw_args.comp).
@@ -134,7 +150,24 @@ class FacetMethodBase : public RenderMethod {
   // Uploads the object transforms, culls objects per output and rebuilds the triangle lists when
   // T_eye_world or any object's T_world_object (read from the scene at every call: a moving
   // scene changes them between frames) differs from the last frame's; returns whether it did.
-  bool update_view(const glm::dmat4& T_eye_world);
+  // A list built on the GPU is queued, not read back. With `timer`, each output's culling and
+  // list count as its "pass1 coverage".
+  bool update_view(const glm::dmat4& T_eye_world, GpuTimer* timer = nullptr);
+  // Whether this method may build its lists on the GPU (naive draws from the CPU's culling).
+  virtual bool lists_on_gpu_allowed() const { return true; }
+  // Instances of the tessellator form's patch draws for output `out` (list_args).
+  virtual std::uint32_t patch_instances(const OutputState&) const { return 1; }
+  // Output i's list, culled and built on the CPU or queued on the GPU.
+  void build_list_on_cpu(std::size_t i);
+  void build_list_on_gpu(std::size_t i);
+  // Entries of every output's list: one per record.
+  std::uint32_t list_entries() const { return std::uint32_t(entry_records_.size()); }
+  // Triangles output i's list may hold this frame: the CPU's count, else every triangle.
+  std::uint32_t list_capacity(std::size_t i) const;
+  // Whether output i has facets and its list may hold triangles.
+  bool may_draw(std::size_t i) const;
+  // Sets output i's list triangles from statistics words 4 and 5 (`stats`, read by the caller).
+  void take_list_counts(std::size_t i, const std::uint32_t* stats);
   // Binds the scene, record and object-frame buffers, and output i's facets and triangle list.
   void bind_output(std::size_t i) const;
   // Sets scene/material.frag's uniforms and texture for material m on `program`.
@@ -156,8 +189,8 @@ class FacetMethodBase : public RenderMethod {
   // scan, staging, pairs, statistics and draw arguments.
   std::uint64_t buffer_bytes(const OutputState& out) const;
   // Adds output `out`'s fixed figures to `stats` (facets, list triangles, those on one facet,
-  // buffer_bytes); returns whether it has anything to draw (list triangles and facets).
-  bool add_output_stats(const OutputState& out, RenderStats& stats) const;
+  // buffer_bytes).
+  void add_output_stats(const OutputState& out, RenderStats& stats) const;
   // Program uniforms of replication_lib.comp for output i.
   void set_list_uniforms(const Program& program, std::size_t i) const;
 
@@ -166,7 +199,14 @@ class FacetMethodBase : public RenderMethod {
   RenderSettings settings_;
   std::vector<GpuRecord> records_;
   std::vector<std::vector<std::uint32_t>> records_by_material_;
-  Buffer records_buffer_, object_frames_;
+  // The lists' entries: every record in material order, and each material's first entry (and
+  // one past the last), as vectors and as the GPU list build's buffers.
+  std::vector<std::uint32_t> entry_records_, material_first_entries_;
+  std::uint32_t scene_list_triangles_ = 0;  // triangles of every record
+  Buffer records_buffer_, object_frames_, entry_records_buffer_, material_first_entries_buffer_,
+      object_spheres_buffer_;
+  Program list_objects_, list_counts_, list_write_;
+  PrefixScan list_scan_;
   Texture record_texels_,
       object_frame_texels_;  // records_buffer_, object_frames_ as buffer textures
   // Pass 3 splits each material's replicas into draws of kSoftwareReplicasPerDraw (see there).

@@ -59,7 +59,8 @@ class TessellatedPipeline final : public FacetMethodBase {
     for (std::size_t i = 0; i < outputs_.size(); ++i) {
       OutputState& out = outputs_[i];
       targets[i].clear();
-      if (!add_output_stats(out, stats)) {
+      if (!may_draw(i)) {
+        add_output_stats(out, stats);
         targets[i].resolve();
         continue;
       }
@@ -69,8 +70,11 @@ class TessellatedPipeline final : public FacetMethodBase {
       draw(i, targets[i]);
       targets[i].resolve();
       scope.end();
-      std::uint32_t counted[2] = {0, 0};
+      // Visible triangles, replicas, two unused words, list triangles, those with a sole piece.
+      std::uint32_t counted[6] = {0, 0, 0, 0, 0, 0};
       out.stats.get_sub_data(0, sizeof counted, counted);
+      take_list_counts(i, counted);
+      add_output_stats(out, stats);
       stats.triangles_visible += counted[0];
       stats.replicas += counted[1];
     }
@@ -82,10 +86,6 @@ class TessellatedPipeline final : public FacetMethodBase {
   void draw(std::size_t i, const OutputTarget& target) {
     const OutputState& out = outputs_[i];
     const MaterialPrograms& programs = programs_.at(grid_kind(out.facets.grid));
-    // The walk finds a facet at most once per triangle (a quad's two facets each count).
-    const std::uint64_t most_replicas = out.facets.mesh.facets.size();
-    const std::uint64_t per_patch = std::uint64_t(max_level_) * max_level_;
-    const auto instances = GLsizei((most_replicas + per_patch - 1) / per_patch);
     bind_output(i);
     target.bind();
     begin_facet_drawing(false);
@@ -96,21 +96,34 @@ class TessellatedPipeline final : public FacetMethodBase {
     }
     glPatchParameteri(GL_PATCH_VERTICES, 1);
     glBindVertexArray(empty_vao_.id());
+    glBindBuffer(GL_DRAW_INDIRECT_BUFFER, out.list_args.id());
+    glMemoryBarrier(GL_COMMAND_BARRIER_BIT);
     const Program* in_use = nullptr;
     for (std::uint32_t m = 0; m < material_count(); ++m) {
-      const std::uint32_t begin = out.material_ranges[2 * m], end = out.material_ranges[2 * m + 1];
-      if (begin == end) continue;
+      if (!out.list_on_gpu && out.material_ranges[2 * m] == out.material_ranges[2 * m + 1])
+        continue;
       const Program& program = programs.program_of(m);
       if (&program != in_use) {
         program.use();
         in_use = &program;
       }
       set_material(program, m);
-      glDrawArraysInstanced(GL_PATCHES, GLint(begin), GLsizei(end - begin), instances);
+      // list_args holds each material's patches as (count, instances, first, 0).
+      const std::uintptr_t command = (kListArgsPatchDraws + 4 * std::uintptr_t(m)) * 4;
+      glDrawArraysIndirect(GL_PATCHES, reinterpret_cast<const void*>(command));
     }
+    glBindBuffer(GL_DRAW_INDIRECT_BUFFER, 0);
     glBindVertexArray(0);
     end_facet_drawing();
     glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
+  }
+
+  // The walk finds a facet at most once per triangle (a quad's two facets each count); one patch
+  // makes at most max_level² replicas.
+  std::uint32_t patch_instances(const OutputState& out) const override {
+    const std::uint64_t most_replicas = out.facets.mesh.facets.size();
+    const std::uint64_t per_patch = std::uint64_t(max_level_) * max_level_;
+    return std::uint32_t(std::max<std::uint64_t>((most_replicas + per_patch - 1) / per_patch, 1));
   }
 
   static std::uint32_t grid_kind(const CoverageGrid& grid) {

@@ -45,6 +45,11 @@ inline constexpr GLuint indices = pulling::indices_binding, nodes = 7, order = 8
                         pairs = 11, stats = 12, material_ranges = 13, draw_args = 14,
                         block_sums = 15, staged = 17, stage_offsets = 18, draw_counts = 19,
                         walk_queue = 20, grid_queue = 21;
+// The triangle list built on the GPU (replication/list_build.comp): the list buffer written as
+// storage, the objects' eye-frame spheres and which may meet a facet, the list's indirect
+// arguments, and the static record of every entry and first entry of every material.
+inline constexpr GLuint list_out = 22, object_spheres = 23, object_visible = 24, list_args = 25,
+                        entry_records = 26, material_first_entries = 27;
 }  // namespace binding
 
 // What pass 3 draws: pieces. Piece f < F is facet f of the mesh (F facets); piece F + k, a quad,

@@ -38,10 +38,19 @@ struct OutputSpec {
 // (CoverageIndex), kept as the reference the grid is measured and tested against.
 enum class FacetCoverage { grid, walk };
 
+// Where the facet pipelines (facets, facets-gs, tessellated) cull objects against each output's
+// facets and build the frame's triangle list: on the CPU, uploaded when the view or an object
+// moves, or on the GPU (replication/list_build.comp), where only the objects' eye-frame spheres
+// are uploaded. automatic takes the GPU on a hardware renderer and the CPU on a software one,
+// where the CPU is the faster (driver/README.md). The images are the same; `naive` always culls
+// on the CPU.
+enum class TriangleListBuild { automatic, cpu, gpu };
+
 struct RenderSettings {
   // Facet methods: how the warp is cut into facets, and how pass 1 finds a triangle's facets.
   FacetBuildOptions facets;
   FacetCoverage coverage = FacetCoverage::grid;
+  TriangleListBuild triangle_list = TriangleListBuild::automatic;
   // Facet methods: draw the two facets of a tensor cell that share one projection as one quad
   // (FacetPieces); false draws every facet on its own, as the hierarchy walk lists them.
   bool merge_coplanar_facets = true;

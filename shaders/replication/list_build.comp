@@ -1,0 +1,118 @@
+// The frame's triangle list of one output, built on the GPU (RenderSettings::triangle_list), in
+// the layout FacetMethodBase builds on the CPU: an entry for every record, in material order (an
+// entry of a culled object holds no triangles), the list's header, then its block table. Three
+// programs, dispatched in order with the prefix scan between the second and the third:
+// - OBJECT_PASS, one invocation per object: whether its eye-frame bounding sphere may meet a
+//   facet's guarded pyramid (sphere_may_meet_facets in replication_lib.comp);
+// - COUNT_PASS, one per entry: its record's triangles when its object may be seen, else 0, into
+//   the scan buffer (and 0 after the last entry, so that the exclusive scan ends with the total);
+// - WRITE_PASS, one per entry, block and material: the entries, the block table, the material
+//   ranges, the header and the indirect arguments of the passes that follow (ListArgs), and the
+//   list's triangles into the statistics.
+#if defined(OBJECT_PASS) && (defined(COUNT_PASS) || defined(WRITE_PASS))
+#error one pass per program
+#endif
+#if defined(COUNT_PASS) && defined(WRITE_PASS)
+#error one pass per program
+#endif
+layout(local_size_x = 64) in;
+
+const uint kNoPiece = 0xffffffffu;  // ListEntry::sole_piece of an entry without one
+uvec4 record(uint r);
+
+#if defined(OBJECT_PASS)
+// Eye frame: centre (metres), radius grown to cover float rounding; radius < 0: no vertices.
+layout(std430, binding = 23) readonly buffer ObjectSpheres { vec4 object_spheres[]; };
+layout(std430, binding = 24) writeonly buffer ObjectVisible { uint object_visible[]; };
+layout(location = 50) uniform uint object_count;
+bool sphere_may_meet_facets(vec3 centre, float radius);
+
+void main() {
+  uint o = gl_GlobalInvocationID.x;
+  if (o >= object_count) return;
+  vec4 sphere = object_spheres[o];
+  object_visible[o] = sphere.w >= 0.0 && sphere_may_meet_facets(sphere.xyz, sphere.w) ? 1u : 0u;
+}
+
+#else
+layout(location = 40) uniform uint list_entries;  // replication_lib.comp: every record
+layout(std430, binding = 26) readonly buffer EntryRecords { uint entry_records[]; };
+
+#if defined(COUNT_PASS)
+layout(std430, binding = 10) writeonly buffer Scan { uint scan[]; };
+layout(std430, binding = 24) readonly buffer ObjectVisible { uint object_visible[]; };
+
+void main() {
+  uint k = gl_GlobalInvocationID.x;
+  if (k > list_entries) return;
+  if (k == list_entries) {
+    scan[k] = 0u;
+    return;
+  }
+  uvec4 entry_record = record(entry_records[k]);  // (first_index, triangles, object, material)
+  scan[k] = object_visible[entry_record.z] != 0u ? entry_record.y : 0u;
+}
+
+#else  // WRITE_PASS
+layout(std430, binding = 10) readonly buffer Scan { uint scan[]; };
+layout(std430, binding = 22) writeonly buffer ListOut { uvec4 list_out[]; };
+layout(std430, binding = 13) writeonly buffer MaterialRanges { uvec2 material_ranges[]; };
+layout(std430, binding = 27) readonly buffer MaterialFirstEntries { uint material_first_entry[]; };
+// The indirect arguments (kListArgs* in replication_common.hpp): the cull pass's dispatch (one
+// invocation per triangle and one more), the per-triangle dispatch (scatter, replicate.comp),
+// facets-gs' pass-1 draw, then a patch draw per material for the tessellator form.
+layout(std430, binding = 25) writeonly buffer ListArgs { uint list_args[]; };
+layout(std430, binding = 12) buffer Stats {
+  uint visible_triangles;
+  uint pair_total;
+  uint overflow;
+  uint staged_total;
+  uint list_triangles;
+  uint list_triangles_sole_piece;
+};
+layout(location = 43) uniform uint material_count;
+layout(location = 51) uniform uint patch_instances;  // the tessellator form's instances per draw
+const uint kTableBlockTriangles = 64u;  // kListBlockTriangles
+const uint kLocalSize = 64u;  // count.comp, scatter.comp and replicate.comp
+
+void set_block_entry(uint block, uint entry) {
+  list_out[list_entries + 1u + block / 4u][block % 4u] = entry;
+}
+
+// The last entry whose first triangle is at most t (the entries' first triangles ascend).
+uint last_entry_from(uint t) {
+  uint lo = 0u, hi = list_entries - 1u;
+  while (lo < hi) {
+    uint mid = (lo + hi + 1u) / 2u;
+    if (scan[mid] <= t) lo = mid; else hi = mid - 1u;
+  }
+  return lo;
+}
+
+void main() {
+  uint k = gl_GlobalInvocationID.x;
+  uint total = scan[list_entries];
+  if (k < list_entries) list_out[k] = uvec4(entry_records[k], scan[k], kNoPiece, 0u);
+  uint blocks = (total + kTableBlockTriangles - 1u) / kTableBlockTriangles;
+  if (k < blocks) set_block_entry(k, last_entry_from(k * kTableBlockTriangles));
+  if (k == blocks) set_block_entry(k, list_entries - 1u);
+  if (k < material_count) {
+    uint begin = scan[material_first_entry[k]], end = scan[material_first_entry[k + 1u]];
+    material_ranges[k] = uvec2(begin, end);
+    uint at = 16u + 4u * k;
+    list_args[at] = end - begin;
+    list_args[at + 1u] = patch_instances;
+    list_args[at + 2u] = begin;
+    list_args[at + 3u] = 0u;
+  }
+  if (k != 0u) return;
+  list_out[list_entries] = uvec4(total, 0u, 0u, 0u);
+  list_triangles = total;
+  list_triangles_sole_piece = 0u;
+  uint args[16] = uint[16]((total + kLocalSize) / kLocalSize, 1u, 1u, 0u,
+                           (total + kLocalSize - 1u) / kLocalSize, 1u, 1u, 0u,
+                           total, 1u, 0u, 0u, 0u, 0u, 0u, 0u);
+  for (uint a = 0u; a < 16u; ++a) list_args[a] = args[a];
+}
+#endif
+#endif
