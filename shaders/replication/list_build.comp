@@ -2,10 +2,12 @@
 // the layout FacetMethodBase builds on the CPU: an entry for every record, in material order (an
 // entry of a culled object holds no triangles), the list's header, then its block table. Three
 // programs, dispatched in order with the prefix scan between the second and the third:
-// - OBJECT_PASS, one invocation per object: whether its eye-frame bounding sphere may meet a
-//   facet's guarded pyramid (sphere_may_meet_facets in replication_lib.comp);
+// - OBJECT_PASS, one invocation per object: kCulled unless its eye-frame bounding sphere may meet
+//   a facet's guarded pyramid (sphere_may_meet_facets in replication_lib.comp), else its sole
+//   piece (sole_piece_of_sphere) or kNoPiece;
 // - COUNT_PASS, one per entry: its record's triangles when its object may be seen, else 0, into
-//   the scan buffer (and 0 after the last entry, so that the exclusive scan ends with the total);
+//   the scan buffer (and 0 after the last entry, so that the exclusive scan ends with the total),
+//   and the triangles with a sole piece into the statistics;
 // - WRITE_PASS, one per entry, block and material: the entries, the block table, the material
 //   ranges, the header and the indirect arguments of the passes that follow (ListArgs), and the
 //   list's triangles into the statistics.
@@ -18,20 +20,37 @@
 layout(local_size_x = 64) in;
 
 const uint kNoPiece = 0xffffffffu;  // ListEntry::sole_piece of an entry without one
+const uint kCulled = 0xfffffffeu;   // an object's state when it meets no facet
 uvec4 record(uint r);
+// Statistics words 4 and 5: the list's triangles, and those of entries with a sole piece.
+layout(std430, binding = 12) buffer Stats {
+  uint visible_triangles;
+  uint pair_total;
+  uint overflow;
+  uint staged_total;
+  uint list_triangles;
+  uint list_triangles_sole_piece;
+};
 
 #if defined(OBJECT_PASS)
 // Eye frame: centre (metres), radius grown to cover float rounding; radius < 0: no vertices.
 layout(std430, binding = 23) readonly buffer ObjectSpheres { vec4 object_spheres[]; };
-layout(std430, binding = 24) writeonly buffer ObjectVisible { uint object_visible[]; };
+layout(std430, binding = 24) writeonly buffer ObjectVisible { uint object_state[]; };
 layout(location = 50) uniform uint object_count;
+// 1: objects may take a sole piece (grid coverage, cell buckets whose pads are under a cell).
+layout(location = 52) uniform uint sole_pieces;
 bool sphere_may_meet_facets(vec3 centre, float radius);
+uint sole_piece_of_sphere(vec3 centre, float radius);
 
 void main() {
   uint o = gl_GlobalInvocationID.x;
+  if (o == 0u) list_triangles_sole_piece = 0u;
   if (o >= object_count) return;
   vec4 sphere = object_spheres[o];
-  object_visible[o] = sphere.w >= 0.0 && sphere_may_meet_facets(sphere.xyz, sphere.w) ? 1u : 0u;
+  uint state = kCulled;
+  if (sphere.w >= 0.0 && sphere_may_meet_facets(sphere.xyz, sphere.w))
+    state = sole_pieces != 0u ? sole_piece_of_sphere(sphere.xyz, sphere.w) : kNoPiece;
+  object_state[o] = state;
 }
 
 #else
@@ -40,7 +59,7 @@ layout(std430, binding = 26) readonly buffer EntryRecords { uint entry_records[]
 
 #if defined(COUNT_PASS)
 layout(std430, binding = 10) writeonly buffer Scan { uint scan[]; };
-layout(std430, binding = 24) readonly buffer ObjectVisible { uint object_visible[]; };
+layout(std430, binding = 24) readonly buffer ObjectVisible { uint object_state[]; };
 
 void main() {
   uint k = gl_GlobalInvocationID.x;
@@ -50,7 +69,9 @@ void main() {
     return;
   }
   uvec4 entry_record = record(entry_records[k]);  // (first_index, triangles, object, material)
-  scan[k] = object_visible[entry_record.z] != 0u ? entry_record.y : 0u;
+  uint state = object_state[entry_record.z];
+  scan[k] = state != kCulled ? entry_record.y : 0u;
+  if (state != kCulled && state != kNoPiece) atomicAdd(list_triangles_sole_piece, entry_record.y);
 }
 
 #else  // WRITE_PASS
@@ -62,14 +83,7 @@ layout(std430, binding = 27) readonly buffer MaterialFirstEntries { uint materia
 // invocation per triangle and one more), the per-triangle dispatch (scatter, replicate.comp),
 // facets-gs' pass-1 draw, then a patch draw per material for the tessellator form.
 layout(std430, binding = 25) writeonly buffer ListArgs { uint list_args[]; };
-layout(std430, binding = 12) buffer Stats {
-  uint visible_triangles;
-  uint pair_total;
-  uint overflow;
-  uint staged_total;
-  uint list_triangles;
-  uint list_triangles_sole_piece;
-};
+layout(std430, binding = 24) readonly buffer ObjectVisible { uint object_state[]; };
 layout(location = 43) uniform uint material_count;
 layout(location = 51) uniform uint patch_instances;  // the tessellator form's instances per draw
 const uint kTableBlockTriangles = 64u;  // kListBlockTriangles
@@ -92,7 +106,10 @@ uint last_entry_from(uint t) {
 void main() {
   uint k = gl_GlobalInvocationID.x;
   uint total = scan[list_entries];
-  if (k < list_entries) list_out[k] = uvec4(entry_records[k], scan[k], kNoPiece, 0u);
+  if (k < list_entries) {
+    uint state = object_state[record(entry_records[k]).z];
+    list_out[k] = uvec4(entry_records[k], scan[k], state == kCulled ? kNoPiece : state, 0u);
+  }
   uint blocks = (total + kTableBlockTriangles - 1u) / kTableBlockTriangles;
   if (k < blocks) set_block_entry(k, last_entry_from(k * kTableBlockTriangles));
   if (k == blocks) set_block_entry(k, list_entries - 1u);
@@ -106,9 +123,8 @@ void main() {
     list_args[at + 3u] = 0u;
   }
   if (k != 0u) return;
-  list_out[list_entries] = uvec4(total, 0u, 0u, 0u);
+  list_out[list_entries] = uvec4(total, list_triangles_sole_piece, 0u, 0u);
   list_triangles = total;
-  list_triangles_sole_piece = 0u;
   uint args[16] = uint[16]((total + kLocalSize) / kLocalSize, 1u, 1u, 0u,
                            (total + kLocalSize - 1u) / kLocalSize, 1u, 1u, 0u,
                            total, 1u, 0u, 0u, 0u, 0u, 0u, 0u);

@@ -581,6 +581,68 @@ bool bucket_range(vec4 box, bool full_p, out uvec4 range) {
   return true;
 }
 
+// The one piece whose guarded pyramid holds a sphere (eye frame: centre in metres, radius) while
+// no other piece's may meet it, else kNone: sole_piece_of_sphere (facet_gpu.hpp) in float, for
+// the GPU's triangle list. Only for cell buckets whose pads are under a cell (the caller knows);
+// the pieces of the cells within two of those about the centre are tested. A sphere is inside a
+// plane only by 1e-6 of its distance beyond its radius, more than float rounding (about 3e-7 of
+// it), and meets another piece unless it lies that far beyond its radius outside one of its
+// planes' (the radius is grown by the caller), so float never claims a sole piece that double
+// precision would not. Near boxes of more than 4 cells a side answer kNone at once.
+uint sole_piece_of_sphere(vec3 centre, float radius) {
+  float distance = length(centre);
+  if (!(distance > radius)) return kNone;
+  mat3 R_base_eye = mat3(grid_float(12u), grid_float(13u), grid_float(14u), grid_float(15u),
+                         grid_float(16u), grid_float(17u), grid_float(18u), grid_float(19u),
+                         grid_float(20u));
+  vec3 b = R_base_eye * (centre / distance);
+  vec3 corners[3] = vec3[3](b, b, b);
+  uint chart = grid_chart();
+  vec4 angles, box;
+  bool full_phi = false;
+  if (!direction_box(corners, chart, angles, full_phi)) return kNone;
+  if (!chart_box(chart, angles, full_phi, box)) return kNone;
+  uvec4 near;
+  if (!bucket_range(box, full_phi && chart <= kChartEquirectangular, near)) return kNone;
+  if (near.z > 4u || near.w > 4u) return kNone;
+  uint columns = grid_word(2), rows = grid_word(3);
+  bool periodic = grid_periodic();
+  if (periodic && near.z + 4u > columns) return kNone;
+  uint first_offset = grid_word(9), pieces_offset = grid_word(10);
+  uint row_lo = near.y >= 2u ? near.y - 2u : 0u;
+  uint row_hi = min(near.y + near.w + 1u, rows - 1u);
+  float margin = 1e-6 * distance;
+  uint sole = kNone;
+  for (uint j = row_lo; j <= row_hi; ++j) {
+    for (uint k = 0u; k < near.z + 4u; ++k) {
+      // Column near.x + k - 2; GLSL's % is undefined for negative operands.
+      uint i = near.x + k;
+      if (periodic) {
+        i = (i + columns - 2u) % columns;
+      } else if (i < 2u || i - 2u >= columns) {
+        continue;
+      } else {
+        i -= 2u;
+      }
+      uint bucket = first_offset + j * columns + i;
+      for (uint m = grid_word(bucket); m < grid_word(bucket + 1u); ++m) {
+        uint p = grid_word(pieces_offset + m);
+        if (p == sole) continue;
+        bool may_meet_piece = true, inside = true;
+        for (int n = 0; n < 4; ++n) {
+          float d = dot(clip_plane(p, n).xyz, centre);
+          may_meet_piece = may_meet_piece && !(d < -radius - margin);
+          inside = inside && d >= radius + margin;
+        }
+        if (!may_meet_piece) continue;
+        if (sole != kNone || !inside) return kNone;
+        sole = p;
+      }
+    }
+  }
+  return sole;
+}
+
 // Whether candidate piece f and the triangle with unit corners u may meet: false when one of the
 // piece's four guarded planes or one of the triangle's three edge planes (edge[k], with their
 // rounding slack in w) has all corners of the other outside it. Either is a separating plane of

@@ -319,8 +319,14 @@ void FacetMethodBase::build_list_on_gpu(std::size_t i) {
   object_spheres_buffer_.bind_base(GL_SHADER_STORAGE_BUFFER, binding::object_spheres);
   out.object_visible_flags.bind_base(GL_SHADER_STORAGE_BUFFER, binding::object_visible);
   entry_records_buffer_.bind_base(GL_SHADER_STORAGE_BUFFER, binding::entry_records);
+  out.stats.bind_base(GL_SHADER_STORAGE_BUFFER, binding::stats);
   const std::uint32_t objects = std::uint32_t(scene_->objects.size());
+  const CoverageGrid& grid = out.facets.grid;
+  const bool sole_pieces =
+      settings_.coverage == FacetCoverage::grid && grid.cell_buckets() && grid.pads_under_a_cell();
   glProgramUniform1ui(list_objects_.id(), list_objects_.uniform_location("object_count"), objects);
+  glProgramUniform1ui(list_objects_.id(), list_objects_.uniform_location("sole_pieces"),
+                      sole_pieces ? 1u : 0u);
   list_objects_.use();
   glDispatchCompute(groups(objects), 1, 1);
   glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
@@ -331,6 +337,7 @@ void FacetMethodBase::build_list_on_gpu(std::size_t i) {
   list_counts_.use();
   glDispatchCompute(groups(std::size_t(list_entries()) + 1), 1, 1);
   list_scan_.run(out.list_offsets, list_entries() + 1);
+  out.object_visible_flags.bind_base(GL_SHADER_STORAGE_BUFFER, binding::object_visible);
 
   out.list_offsets.bind_base(GL_SHADER_STORAGE_BUFFER, binding::scan);
   out.list_buffer.bind_base(GL_SHADER_STORAGE_BUFFER, binding::list_out);
