@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "../../tools/cli/command.hpp"
 #include "../driver/cli_process.hpp"
 #include "facet/projection/content_projection.hpp"
 #include "facet/projection/errors.hpp"
@@ -134,6 +135,32 @@ TEST(OptionFlags, TheCliShowsALibraryOptionUnderItsCommandsFlag) {
   EXPECT_EQ(std::string(facet::cli::shown_with_flags(file, "run").what()), file.what());
   EXPECT_EQ(facet::cli::flag_of_option("run", "factor"), "--scale");
   EXPECT_EQ(facet::cli::flag_of_option("run", "no_such_option"), "");
+}
+
+// The scene-view rows (view_flags.hpp) are one list shared by render, run, bench and depth-image;
+// once the commands have declared their options, each keeps only the rows of flags it has.
+TEST(OptionFlags, ACommandKeepsOnlyTheSharedRowsOfTheFlagsItDeclares) {
+#ifndef FACET_TEST_HAS_DRIVER
+  GTEST_SKIP() << "a build without the driver has none of the commands that render a scene";
+#else
+  using facet::cli::flag_of_option;
+  CLI::App app;
+  for (auto& [order, setup] : facet::cli::CommandRegistry::commands()) setup(app);
+  facet::cli::keep_declared_flags(app);
+  for (const char* command : {"render", "run"}) {
+    EXPECT_EQ(flag_of_option(command, "material"), "--material") << command;
+    EXPECT_EQ(flag_of_option(command, "step"), "--scene") << command;
+    EXPECT_EQ(flag_of_option(command, "camera"), "--camera") << command;
+    EXPECT_EQ(flag_of_option(command, "look_at_world"), "--look-at") << command;
+  }
+  EXPECT_EQ(flag_of_option("depth-image", "eye_world"), "--eye");
+  EXPECT_EQ(flag_of_option("depth-image", "scene"), "--scene");
+  EXPECT_EQ(flag_of_option("depth-image", "camera"), "");
+  EXPECT_EQ(flag_of_option("bench", "scene"), "--scene");
+  EXPECT_EQ(flag_of_option("bench", "frames"), "--frames");
+  for (const char* option : {"material", "camera", "eye_world", "look_at_world", "size"})
+    EXPECT_EQ(flag_of_option("bench", option), "") << option;
+#endif
 }
 
 // What the user of the facet executable reads when a library refuses an option: its flag.

@@ -20,6 +20,7 @@
 #include "facet/projection/interrupt.hpp"
 #include "frames_flag.hpp"
 #include "option_flags.hpp"
+#include "view_flags.hpp"
 
 namespace facet::cli {
 namespace {
@@ -166,16 +167,8 @@ const OptionFlags option_flags{"bench",
                                {{"scenarios", "--scenario"},
                                 {"size_scale", "--size-scale"},
                                 {"frames", "--frames"},
-                                {"out", "--out"},
-                                {"display", "--display"},
-                                {"size", "--size"},
-                                {"method", "--method"},
-                                {"material", "--material"},
-                                {"scene", "--scene"},
-                                {"step", "--scene"},
-                                {"camera", "--camera"},
-                                {"eye_world", "--eye"},
-                                {"look_at_world", "--look-at"}}};
+                                {"out", "--out"}},
+                               ViewFlags::option_flags()};
 
 const Registration registration{
     35, [](CLI::App& app) {

@@ -8,6 +8,7 @@
 #include "facet/driver/scene_names.hpp"
 #include "facet/driver/scene_view.hpp"
 #include "option_flags.hpp"
+#include "view_flags.hpp"
 
 namespace facet::cli {
 namespace {
@@ -18,16 +19,8 @@ struct DepthImageFlags {
 
 // The library options this command's flags set, for errors that name them (option_flags.hpp).
 const OptionFlags option_flags{"depth-image",
-                               {{"kind", "--kind"},
-                                {"size", "--size"},
-                                {"out", "--out"},
-                                {"method", "--method"},
-                                {"material", "--material"},
-                                {"scene", "--scene"},
-                                {"step", "--scene"},
-                                {"camera", "--camera"},
-                                {"eye_world", "--eye"},
-                                {"look_at_world", "--look-at"}}};
+                               {{"kind", "--kind"}, {"size", "--size"}, {"out", "--out"}},
+                               ViewFlags::option_flags()};
 
 const Registration registration{
     32, [](CLI::App& app) {

@@ -376,14 +376,9 @@ const OptionFlags option_flags{"render",
                                {{"display", "--display"},
                                 {"size", "--size"},
                                 {"method", "--method"},
-                                {"material", "--material"},
                                 {"frames", "--frames"},
-                                {"out", "--out"},
-                                {"scene", "--scene"},
-                                {"step", "--scene"},
-                                {"camera", "--camera"},
-                                {"eye_world", "--eye"},
-                                {"look_at_world", "--look-at"}}};
+                                {"out", "--out"}},
+                               ViewFlags::option_flags()};
 
 const Registration registration{
     30, [](CLI::App& app) {

@@ -219,18 +219,13 @@ const OptionFlags option_flags{"run",
                                 {"size", "--size"},
                                 {"factor", "--scale"},
                                 {"method", "--method"},
-                                {"material", "--material"},
                                 {"frames", "--frames"},
                                 {"save_every", "--save-every"},
                                 {"out", "--out"},
                                 {"node", "--node"},
                                 {"join_timeout_s", "--join-timeout"},
-                                {"rate_hz", "--rate"},
-                                {"scene", "--scene"},
-                                {"step", "--scene"},
-                                {"camera", "--camera"},
-                                {"eye_world", "--eye"},
-                                {"look_at_world", "--look-at"}}};
+                                {"rate_hz", "--rate"}},
+                               ViewFlags::option_flags()};
 
 const Registration registration{
     40, [](CLI::App& app) {

@@ -209,6 +209,7 @@ int run(int argc, char** argv) {
   std::stable_sort(commands.begin(), commands.end(),
                    [](const auto& a, const auto& b) { return a.first < b.first; });
   for (auto& [order, setup] : commands) setup(app);
+  keep_declared_flags(app);
   refuse_empty_values(app);
   try {
     app.parse(argc, argv);

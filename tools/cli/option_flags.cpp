@@ -11,12 +11,31 @@ std::map<std::string, std::map<std::string, std::string>>& tables() {
   return by_command;
 }
 
+// Whether `command` or a subcommand nested in it declares `flag`.
+bool declares(const CLI::App& command, const std::string& flag) {
+  if (command.get_option_no_throw(flag) != nullptr) return true;
+  for (const CLI::App* sub : command.get_subcommands([](const CLI::App*) { return true; })) {
+    if (declares(*sub, flag)) return true;
+  }
+  return false;
+}
+
 }  // namespace
 
+void keep_declared_flags(const CLI::App& app) {
+  for (const CLI::App* command : app.get_subcommands([](const CLI::App*) { return true; })) {
+    const auto table = tables().find(command->get_name());
+    if (table == tables().end()) continue;
+    std::erase_if(table->second, [&](const auto& row) { return !declares(*command, row.second); });
+  }
+}
+
 OptionFlags::OptionFlags(const std::string& command,
-                         std::initializer_list<std::pair<std::string, std::string>> option_flags) {
+                         std::initializer_list<std::pair<std::string, std::string>> option_flags,
+                         const OptionFlagList& shared) {
   std::map<std::string, std::string>& table = tables()[command];
   for (const auto& [option, flag] : option_flags) table[option] = flag;
+  for (const auto& [option, flag] : shared) table[option] = flag;
 }
 
 std::string flag_of_option(const std::string& command, const std::string& option) {

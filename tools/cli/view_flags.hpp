@@ -6,6 +6,7 @@
 #include <string>
 
 #include "facet/driver/scene_view.hpp"
+#include "option_flags.hpp"
 
 namespace facet::cli {
 
@@ -19,6 +20,18 @@ struct ViewFlags {
     command.add_option("--look-at", look_at,
                        "Point X,Y,Z the eye looks at (needs --eye; default: the bounds' centre)");
     command.add_option("--camera", camera, "Start at the scene file's camera of this name");
+  }
+
+  // The library options of the scene and its view and the flags that set them, for the
+  // OptionFlags table of every command that renders a scene (render, run, bench, depth-image):
+  // the three above, and --scene and --material, which each command declares with its own help.
+  // "step" is the scene name's step (builtin:city:STEP), set by --scene. A command keeps the rows
+  // of the flags it declares (keep_declared_flags): bench has --scene alone, depth-image --eye.
+  static const OptionFlagList& option_flags() {
+    static const OptionFlagList flags{{"material", "--material"}, {"scene", "--scene"},
+                                      {"step", "--scene"},        {"camera", "--camera"},
+                                      {"eye_world", "--eye"},     {"look_at_world", "--look-at"}};
+    return flags;
   }
 
   driver::ViewRequest request() const {
