@@ -13,9 +13,9 @@
 namespace facet::calibration {
 namespace {
 
+using json_fields::FieldPath;
 using json_fields::Fields;
 using json_fields::Json;
-using JsonContext = json_fields::FieldPath;
 
 bool valid_name(const std::string& name) {
   if (name.empty() || name.front() == '.' || name.size() > 128) return false;
@@ -27,11 +27,11 @@ bool valid_name(const std::string& name) {
   return true;
 }
 
-void check_relative_path(const std::filesystem::path& path, const JsonContext& at) {
+void check_relative_path(const std::filesystem::path& path, const FieldPath& at) {
   if (path.empty() || path.is_absolute()) at.fail("a file path relative to the capture folder");
 }
 
-void check_rotation(const glm::dmat3& R, const JsonContext& at) {
+void check_rotation(const glm::dmat3& R, const FieldPath& at) {
   const glm::dmat3 error = glm::transpose(R) * R - glm::dmat3(1.0);
   double worst = 0;
   for (int i = 0; i < 3; ++i) {
@@ -44,7 +44,7 @@ void check_rotation(const glm::dmat3& R, const JsonContext& at) {
 
 bool is_unit(const glm::dvec3& v) { return std::abs(glm::length(v) - 1.0) <= 1e-6; }
 
-Screen screen_from_json(const Json& object, const JsonContext& at) {
+Screen screen_from_json(const Json& object, const FieldPath& at) {
   using namespace json_fields;
   Fields fields(object, at);
   const std::string expected_type = "\"sphere\", \"cylinder\" or \"plane\"";
@@ -103,7 +103,7 @@ nlohmann::json screen_to_json(const Screen& screen) {
   FACET_ASSERT(false);
 }
 
-CaptureProjector projector_from_json(const Json& object, const JsonContext& at) {
+CaptureProjector projector_from_json(const Json& object, const FieldPath& at) {
   using namespace json_fields;
   Fields fields(object, at);
   CaptureProjector projector;
@@ -114,7 +114,7 @@ CaptureProjector projector_from_json(const Json& object, const JsonContext& at) 
   const Json& frames = fields.required("frames", "a list of frames");
   if (!frames.is_array()) at["frames"].fail("a list of frames", frames);
   for (std::size_t k = 0; k < frames.size(); ++k) {
-    const JsonContext frame_at = at["frames"][k];
+    const FieldPath frame_at = at["frames"][k];
     Fields frame_fields(frames[k], frame_at);
     CaptureFrame frame;
     frame.file = to_string(frame_fields.required("file", "an image file name"), frame_at["file"]);
@@ -130,7 +130,7 @@ CaptureProjector projector_from_json(const Json& object, const JsonContext& at) 
 }  // namespace
 
 void validate_capture(const Capture& capture, const std::string& source) {
-  const JsonContext root(source);
+  const FieldPath root(source);
   check_relative_path(capture.camera.model, root["camera"]["model"]);
   check_rotation(capture.camera.R_eye_camera, root["camera"]["R_eye_camera"]);
   for (int i = 0; i < 3; ++i) {
@@ -148,7 +148,7 @@ void validate_capture(const Capture& capture, const std::string& source) {
   }
   if (capture.screen) {
     const Screen& screen = *capture.screen;
-    const JsonContext at = root["screen"];
+    const FieldPath at = root["screen"];
     if (screen.type != Screen::Type::plane && !(screen.radius > 0)) {
       at["radius"].fail("a positive number of metres");
     }
@@ -163,7 +163,7 @@ void validate_capture(const Capture& capture, const std::string& source) {
   std::set<std::string> names;
   for (std::size_t p = 0; p < capture.projectors.size(); ++p) {
     const CaptureProjector& projector = capture.projectors[p];
-    const JsonContext at = root["projectors"][p];
+    const FieldPath at = root["projectors"][p];
     if (!valid_name(projector.name)) {
       at["name"].fail(
           "a name of letters, digits, '_', '-' and '.' that does not start with '.' (it names "
@@ -183,7 +183,7 @@ void validate_capture(const Capture& capture, const std::string& source) {
     std::set<std::string> seen;
     for (std::size_t k = 0; k < projector.frames.size(); ++k) {
       const CaptureFrame& frame = projector.frames[k];
-      const JsonContext frame_at = at["frames"][k];
+      const FieldPath frame_at = at["frames"][k];
       check_relative_path(frame.file, frame_at["file"]);
       const Pattern& pattern = frame.pattern;
       if (pattern.type == PatternType::gray) {
@@ -217,7 +217,7 @@ Capture read_capture(const std::filesystem::path& path) {
       std::filesystem::is_directory(path, error) ? path / "capture.json" : path;
   const std::string source = file.string();
   const Json root = parse_file(file);
-  const JsonContext at(source);
+  const FieldPath at(source);
   Fields fields(root, at);
   const std::string expected_format = std::string("\"") + kCaptureFormat + "\"";
   const Json& format = fields.required("format", expected_format);
@@ -227,7 +227,7 @@ Capture read_capture(const std::filesystem::path& path) {
 
   Capture capture;
   capture.folder = file.parent_path();
-  const JsonContext camera_at = at["camera"];
+  const FieldPath camera_at = at["camera"];
   Fields camera(fields.required("camera", "a camera object"), camera_at);
   capture.camera.model =
       to_string(camera.required("model", "an mrcal .cameramodel file"), camera_at["model"]);
@@ -267,7 +267,7 @@ Capture read_capture(const std::filesystem::path& path) {
 void read_camera_pose(const std::filesystem::path& path, CaptureCamera& camera) {
   using namespace json_fields;
   const Json root = parse_file(path);
-  const JsonContext at(path.string());
+  const FieldPath at(path.string());
   Fields fields(root, at);
   if (const Json* R = fields.present("R_eye_camera")) {
     camera.R_eye_camera = to_dmat3(*R, at["R_eye_camera"]);

@@ -238,7 +238,7 @@ LiveCaptureReport run_live_capture(PatternOutputs& outputs, LiveCamera& camera,
                            (was ? shorten(*was) : std::string("absent")) + "), but this run has " +
                            (now ? shorten(*now) : std::string("none")) +
                            ": resume with the same display, camera and settings, or capture into a "
-                           "new --out folder");
+                           "new output folder");
     }
     journaled = journal.done;
     newline_needed = !journal.ends_with_newline;
@@ -354,9 +354,11 @@ LiveCaptureReport run_live_capture(PatternOutputs& outputs, LiveCamera& camera,
           std::snprintf(expected, sizeof expected,
                         "a white frame with at most %.3f%% of camera pixels at full scale, but "
                         "%.3f%% are clipped: lower the camera's exposure time or gain (or the "
-                        "projector's brightness) and run again, or pass --allow-clipping",
+                        "projector's brightness) and run again, raise this limit, or allow "
+                        "clipping",
                         100 * options.max_clipped_fraction, 100 * fraction);
-          throw InputError("projector '" + projector.name + "'", "", expected);
+          throw InputError("projector '" + projector.name + "'", OptionName{"max_clipped_fraction"},
+                           expected);
         }
       }
       write_grey_image(out / frame.file, average, options.bits);

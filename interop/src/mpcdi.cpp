@@ -116,11 +116,11 @@ Warp region_warp(const RegionWarpInput& in, MpcdiWarpValues values, const std::s
     const bool offset_ok =
         offset_score >= 0.9 && offset_score > absolute_score + 0.05 - (absolute_score < 0.9);
     if (absolute_ok == offset_ok) {
-      throw InputError(source, "warp values",
+      throw InputError(source, OptionName{"values"},
                        "expected a warp that reads as either absolute positions or offsets "
                        "(cells keeping their orientation: absolute " +
                            std::to_string(absolute_score) + ", offset " +
-                           std::to_string(offset_score) + "); say which with --warp-values");
+                           std::to_string(offset_score) + "); say which it is");
     }
     values = absolute_ok ? MpcdiWarpValues::absolute : MpcdiWarpValues::offset;
   }
@@ -410,11 +410,12 @@ ImportedDisplay import_mpcdi(const MpcdiFiles& files, const std::string& source,
       display.notes.push_back(std::string("profile a3 with originOf3DData ") +
                               to_string(first.origin) +
                               ": the eye is taken at the origin of the file's frame; give the "
-                              "real eye point with --eye x,y,z (file frame, geometricUnit)");
+                              "real eye point as the import's eye (x,y,z in the file's frame "
+                              "and geometricUnit)");
     }
     if (!metres && eye_file != glm::dvec3(0.0)) {
       display.notes.push_back(
-          "geometricUnit unknown: display.json's eye is the --eye point read as metres");
+          "geometricUnit unknown: display.json's eye is the given eye point read as metres");
     }
     for (const MpcdiRegion& region : document.regions) {
       if (region.unit != first.unit) {

@@ -486,8 +486,8 @@ ImportedDisplay import_sgct_cluster(const std::filesystem::path& config,
     if (addresses_ok) {
       display.notes.push_back("a cluster section maps the " +
                               std::to_string(facet_cluster.nodes.size()) +
-                              " nodes with projectors to facet run --node node<k>, on ports "
-                              "7400 + 2k of their addresses");
+                              " nodes with projectors to facet's cluster nodes node<k>, on "
+                              "ports 7400 + 2k of their addresses");
       display.cluster = std::move(facet_cluster);
     } else {
       display.notes.push_back(

@@ -586,7 +586,8 @@ FacetMesh build_to_tolerance(const Warp& warp, const FacetBuildOptions& options)
                     "%s: field '%s': %s%g px not met: the facets reach %.3g px (%.1f%% over, "
                     "within the %g%% accepted) at output pixel %s; rendering with them (they meet "
                     "%g px)",
-                    origin.source.empty() ? "input" : origin.source.c_str(), origin.field.c_str(),
+                    origin.source.empty() ? "input" : origin.source.c_str(),
+                    origin.field.name().c_str(),
                     origin.output.empty() ? "" : ("output '" + origin.output + "': ").c_str(),
                     tolerance, reached, 100 * (reached / tolerance - 1), 100 * options.near_miss,
                     where.c_str(), round_up_2(reached));

@@ -292,7 +292,7 @@ TEST(CaptureCli, BadInputExitsTwoAndFinishesNothing) {
   const RigFiles clipped(bright);
   const fs::path clipped_out = clipped.temp.path() / "capture";
   EXPECT_EQ(run_cli(clipped.command(clipped_out), &output), 2) << output;
-  EXPECT_NE(output.find("projector 'left'"), std::string::npos) << output;
+  EXPECT_NE(output.find("projector 'left': field '--max-clipped'"), std::string::npos) << output;
   EXPECT_FALSE(fs::exists(clipped_out / "capture.json"));
   // ... unless accepted.
   EXPECT_EQ(run_cli(clipped.command(clipped_out, "--allow-clipping --stop-after 2"), &output), 3)

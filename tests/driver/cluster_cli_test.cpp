@@ -435,7 +435,7 @@ TEST(ClusterCli, BadInputIsStatusTwoWithAClearMessage) {
                                 (scratch.path / "p").string(),
                             &output),
             2);
-  EXPECT_NE(output.find("field 'cluster': a cluster section for --node"), std::string::npos)
+  EXPECT_NE(output.find("field 'cluster': a cluster section for a cluster node"), std::string::npos)
       << output;
   // A bad address, and a node named twice, in display.json.
   json cluster = dome4_cluster(scratch.path);

@@ -517,7 +517,7 @@ TEST(SceneView, EyeAndLookAt) {
   request.eye_world = glm::dvec3(0.2, 0.1, 0);
   const SceneView inside = choose_scene_view(scene, request, false);
   EXPECT_TRUE(inside.eye_inside);
-  EXPECT_EQ(inside.message.rfind("warning: --eye", 0), 0u) << inside.message;
+  EXPECT_EQ(inside.message.rfind("warning: the eye point", 0), 0u) << inside.message;
   request.eye_world = glm::dvec3(4, 3, 0);
   request.look_at_world = glm::dvec3(0, 3, 0);
   const SceneView outside = choose_scene_view(scene, request, false);

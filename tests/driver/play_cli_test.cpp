@@ -178,7 +178,8 @@ TEST_F(PlayCli, BadInputExitsTwoWithAClearMessage) {
       2);
   EXPECT_NE(log().find("twice as wide as high"), std::string::npos) << log();
   EXPECT_EQ(play((dir_ / "wide.png").string() + " --headless --out " + out.string()), 2);
-  EXPECT_NE(log().find("give --format"), std::string::npos) << log();
+  EXPECT_NE(log().find("field '--format': a square dome master (fisheye)"), std::string::npos)
+      << log();
 
   EXPECT_EQ(play(video.string() + " --start-frame 40 --headless --out " + out.string()), 2);
   EXPECT_NE(log().find("--start-frame"), std::string::npos) << log();

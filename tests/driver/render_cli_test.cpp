@@ -130,8 +130,9 @@ TEST(RenderCli, GltfViewLeavesClosedGeometryAndTakesEyeAndCamera) {
 
   const Result inside = run_cli(common + " --eye 0.1,0,0 --out " + (folder / "inside").string());
   ASSERT_EQ(inside.status, 0) << inside.output;
-  EXPECT_NE(inside.output.find("facet render: warning: --eye (0.1, 0, 0) is inside geometry"),
-            std::string::npos)
+  EXPECT_NE(
+      inside.output.find("facet render: warning: the eye point (0.1, 0, 0) is inside geometry"),
+      std::string::npos)
       << inside.output;
   EXPECT_EQ(non_black_pixels(folder / "inside" / "cylinder360.png"), 0);
 

@@ -349,7 +349,7 @@ TEST(MpcdiCrafted, BadContainersGiveInputErrorsNamingTheField) {
   all_nan.values.assign(27, std::numeric_limits<float>::quiet_NaN());
   EXPECT_EQ(field_of_error({{"mpcdi.xml", frustum_xml(kRegion, kFrustum, kFileset)},
                             {"w.pfm", format_pfm(all_nan)}}),
-            "warp values");
+            "values");
   // A mirrored warp reads neither as absolute positions nor as offsets.
   PfmImage mirrored = parse_pfm(pfm, "m");
   for (std::size_t k = 0; k < mirrored.values.size(); k += 3) {
@@ -357,7 +357,7 @@ TEST(MpcdiCrafted, BadContainersGiveInputErrorsNamingTheField) {
   }
   EXPECT_EQ(field_of_error({{"mpcdi.xml", frustum_xml(kRegion, kFrustum, kFileset)},
                             {"w.pfm", format_pfm(mirrored)}}),
-            "warp values");
+            "values");
   const std::string alpha_fileset =
       "<fileset region=\"r\"><geometryWarpFile><path>w.pfm</path></geometryWarpFile>"
       "<alphaMap><path>a.png</path></alphaMap></fileset>";

@@ -5,8 +5,10 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cctype>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <iostream>
 #include <iterator>
 #include <regex>
@@ -61,6 +63,123 @@ std::vector<std::string> flags_named(const std::string& call) {
   return flags;
 }
 
+// The string literals of C++ source `text` with the line each starts on; comments, character
+// literals and the code between literals are skipped. A raw string is taken whole.
+std::vector<std::pair<int, std::string>> string_literals(const std::string& text) {
+  std::vector<std::pair<int, std::string>> literals;
+  int line = 1;
+  std::size_t i = 0;
+  const auto skip_to = [&](std::size_t end) {
+    line += int(std::count(text.begin() + long(i), text.begin() + long(end), '\n'));
+    i = end;
+  };
+  while (i < text.size()) {
+    if (text.compare(i, 2, "//") == 0) {
+      skip_to(std::min(text.find('\n', i), text.size()));
+    } else if (text.compare(i, 2, "/*") == 0) {
+      const std::size_t end = text.find("*/", i + 2);
+      skip_to(end == std::string::npos ? text.size() : end + 2);
+    } else if (text.compare(i, 2, "R\"") == 0 &&
+               (i == 0 ||
+                !(std::isalnum(static_cast<unsigned char>(text[i - 1])) || text[i - 1] == '_'))) {
+      const std::size_t open = text.find('(', i + 2);
+      if (open == std::string::npos) break;
+      const std::string close = ")" + text.substr(i + 2, open - i - 2) + "\"";
+      const std::size_t end = std::min(text.find(close, open), text.size());
+      literals.emplace_back(line, text.substr(open + 1, end - open - 1));
+      skip_to(std::min(end + close.size(), text.size()));
+    } else if (text[i] == '"' || text[i] == '\'') {
+      const char quote = text[i];
+      std::size_t end = i + 1;
+      while (end < text.size() && text[end] != quote && text[end] != '\n')
+        end += text[end] == '\\' ? 2 : 1;
+      if (quote == '"') literals.emplace_back(line, text.substr(i + 1, end - i - 1));
+      skip_to(std::min(end + 1, text.size()));
+    } else {
+      skip_to(i + 1);
+    }
+  }
+  return literals;
+}
+
+// The command-line flags ("--fov") a text mentions anywhere in its wording: "--" at the start of
+// a word, then a lower-case letter.
+std::vector<std::string> flags_mentioned(const std::string& text) {
+  static const std::regex flag(R"re((?:^|[^-\w])(--[a-z][a-z0-9-]*))re");
+  std::vector<std::string> flags;
+  for (std::sregex_iterator it(text.begin(), text.end(), flag), end; it != end; ++it) {
+    flags.push_back((*it)[1]);
+  }
+  return flags;
+}
+
+// What a scan of the libraries' sources found: the pieces `pieces_of` cut from them, and
+// "file:line flag" for every flag `flags_of` finds in a piece.
+struct LibraryScan {
+  std::size_t pieces = 0;
+  std::vector<std::string> found;
+  std::string list() const {
+    std::string text;
+    for (const std::string& site : found) text += "\n  " + site;
+    return text;
+  }
+};
+LibraryScan scan_libraries(
+    const std::function<std::vector<std::pair<int, std::string>>(const std::string&)>& pieces_of,
+    const std::function<std::vector<std::string>(const std::string&)>& flags_of) {
+  LibraryScan scan;
+  for (const char* library : {"projection", "calibration", "interop", "driver", "api"}) {
+    const fs::path folder = fs::path(FACET_SOURCE_DIR) / library;
+    EXPECT_TRUE(fs::is_directory(folder)) << folder;
+    if (!fs::is_directory(folder)) continue;
+    for (const auto& entry : fs::recursive_directory_iterator(folder)) {
+      const std::string extension = entry.path().extension().string();
+      if (!entry.is_regular_file() || (extension != ".cpp" && extension != ".hpp")) continue;
+      std::ifstream stream(entry.path(), std::ios::binary);
+      const std::string text{std::istreambuf_iterator<char>(stream),
+                             std::istreambuf_iterator<char>()};
+      for (const auto& [line, piece] : pieces_of(text)) {
+        ++scan.pieces;
+        for (const std::string& flag : flags_of(piece)) {
+          scan.found.push_back(fs::relative(entry.path(), FACET_SOURCE_DIR).string() + ":" +
+                               std::to_string(line) + " " + flag);
+        }
+      }
+    }
+  }
+  return scan;
+}
+
+TEST(LibrarySources, TheScanFindsAFlagInTheWordingOfAnyLibraryText) {
+  const auto literals = string_literals(
+      "throw InputError(\"command line\", OptionName{\"eye_world\"},\n"
+      "                 \"expected --eye as well\");  // a comment on --eye is no text\n"
+      "notes.push_back(\"give the real eye point \"\n  \"with --eye x,y,z\");\n"
+      "/* --camera in a block comment */ char c = '\"'; int top = stack[--top];\n"
+      "const char* s = R\"(raw \"--look-at\" text)\"; const char* t = \"a -- b, x--y\";\n");
+  std::vector<std::string> flags;
+  std::vector<int> lines;
+  for (const auto& [line, literal] : literals) {
+    for (const std::string& flag : flags_mentioned(literal)) {
+      flags.push_back(flag);
+      lines.push_back(line);
+    }
+  }
+  EXPECT_EQ(flags, (std::vector<std::string>{"--eye", "--eye", "--look-at"}));
+  EXPECT_EQ(lines, (std::vector<int>{2, 4, 6}));
+}
+
+// No library text names a command-line flag in its wording: not an error's expectation, a note
+// or a warning. A library names an option by its OptionName and words the rest without flags.
+TEST(LibrarySources, NoLibraryTextMentionsACommandLineFlag) {
+  const LibraryScan scan = scan_libraries(string_literals, flags_mentioned);
+  std::cout << scan.pieces << " string literals in the libraries, " << scan.found.size()
+            << " mentioning a flag\n";
+  EXPECT_GT(scan.pieces, 3000u) << "the scan found too few string literals to mean anything";
+  EXPECT_TRUE(scan.found.empty()) << scan.found.size()
+                                  << " library texts mention a flag:" << scan.list();
+}
+
 TEST(LibrarySources, TheScanFindsAFlagNamedInAnInputError) {
   const auto calls = input_error_calls(
       "throw InputError(\"command line\", \"--fov\", \"a (field) of view\");\n"
@@ -76,32 +195,12 @@ TEST(LibrarySources, TheScanFindsAFlagNamedInAnInputError) {
 // No library error names a command-line flag as its source or field: libraries name options by
 // their library names (OptionName), and the CLI maps them onto flags.
 TEST(LibrarySources, NoInputErrorNamesACommandLineFlag) {
-  std::size_t calls = 0;
-  std::vector<std::string> found;
-  for (const char* library : {"projection", "calibration", "interop", "driver", "api"}) {
-    const fs::path folder = fs::path(FACET_SOURCE_DIR) / library;
-    ASSERT_TRUE(fs::is_directory(folder)) << folder;
-    for (const auto& entry : fs::recursive_directory_iterator(folder)) {
-      const std::string extension = entry.path().extension().string();
-      if (!entry.is_regular_file() || (extension != ".cpp" && extension != ".hpp")) continue;
-      std::ifstream stream(entry.path(), std::ios::binary);
-      const std::string text{std::istreambuf_iterator<char>(stream),
-                             std::istreambuf_iterator<char>()};
-      for (const auto& [line, call] : input_error_calls(text)) {
-        ++calls;
-        for (const std::string& flag : flags_named(call)) {
-          found.push_back(fs::relative(entry.path(), FACET_SOURCE_DIR).string() + ":" +
-                          std::to_string(line) + " " + flag);
-        }
-      }
-    }
-  }
-  std::cout << calls << " InputError calls in the libraries, " << found.size()
+  const LibraryScan scan = scan_libraries(input_error_calls, flags_named);
+  std::cout << scan.pieces << " InputError calls in the libraries, " << scan.found.size()
             << " naming a flag\n";
-  EXPECT_GT(calls, 300u) << "the scan found too few InputError calls to mean anything";
-  std::string list;
-  for (const std::string& site : found) list += "\n  " + site;
-  EXPECT_TRUE(found.empty()) << found.size() << " library errors name a flag:" << list;
+  EXPECT_GT(scan.pieces, 300u) << "the scan found too few InputError calls to mean anything";
+  EXPECT_TRUE(scan.found.empty()) << scan.found.size()
+                                  << " library errors name a flag:" << scan.list();
 }
 
 TEST(OptionFlags, ALibraryErrorNamesItsOptionByItsLibraryName) {
@@ -134,6 +233,10 @@ TEST(OptionFlags, TheCliShowsALibraryOptionUnderItsCommandsFlag) {
   const InputError file("display.json", "render.tolerance_px", "a positive number");
   EXPECT_EQ(std::string(facet::cli::shown_with_flags(file, "run").what()), file.what());
   EXPECT_EQ(facet::cli::flag_of_option("run", "factor"), "--scale");
+  // The session's default tolerance, and the content format play checks the image against.
+  EXPECT_EQ(facet::cli::flag_of_option("run", "tolerance_px"), "--tolerance");
+  EXPECT_EQ(facet::cli::flag_of_option("play", "format"), "--format");
+  EXPECT_EQ(facet::cli::flag_of_option("mpcdi", "values"), "--warp-values");
   EXPECT_EQ(facet::cli::flag_of_option("run", "no_such_option"), "");
 }
 

@@ -15,7 +15,7 @@ namespace facet::cli {
 namespace {
 
 // The library options this command's flags set, for errors that name them (option_flags.hpp).
-const OptionFlags option_flags{"mpcdi", {{"out", "--out"}}};
+const OptionFlags option_flags{"mpcdi", {{"out", "--out"}, {"values", "--warp-values"}}};
 
 const Registration registration{
     60, [](CLI::App& app) {

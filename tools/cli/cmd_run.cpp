@@ -123,6 +123,9 @@ void run(const RunOptions& options) {
     display.settings.facets.origin.source = "command line";
     display.settings.facets.origin.field = "--tolerance";
   }
+  // A default tolerance is named by its library option: shown as its flag in the warnings too.
+  if (FacetToleranceOrigin& origin = display.settings.facets.origin; origin.field.is_option())
+    origin.field = flag_of_option("run", origin.field.name());
   display.settings.facets.warn = [](const std::string& line) {
     std::cerr << "facet run: warning: " << line << "\n";
   };
@@ -224,7 +227,8 @@ const OptionFlags option_flags{"run",
                                 {"out", "--out"},
                                 {"node", "--node"},
                                 {"join_timeout_s", "--join-timeout"},
-                                {"rate_hz", "--rate"}},
+                                {"rate_hz", "--rate"},
+                                {"tolerance_px", "--tolerance"}},
                                ViewFlags::option_flags()};
 
 const Registration registration{

@@ -771,7 +771,8 @@ ClusterNodeShare keep_cluster_node_outputs(SessionDisplay& display,
       display.config ? *display.config : projection_io::read_display_config(display_file);
   if (!share.config.cluster)
     throw InputError(display_file.string(), "cluster",
-                     "a cluster section for --node (nodes, their projectors and the master)");
+                     "a cluster section for a cluster node (nodes, their projectors and the "
+                     "master)");
   const ClusterNode& self = find_cluster_node(*share.config.cluster, node, display_file.string());
   share.node = self.name;
   share.master = share.config.cluster->master == self.name;
@@ -795,16 +796,16 @@ NodeDisplay load_node_display(const std::string& display, std::optional<glm::ive
     loaded.cluster = keep_cluster_node_outputs(loaded.display, display, request.node);
     if (!loaded.cluster->master && request.frames_given)
       throw InputError("command line", OptionName{"frames"},
-                       "no --frames on a secondary node: the master's --frames ends the run on "
+                       "none on a secondary node: the master's frame count ends the run on "
                        "every node");
     if (!loaded.cluster->master && request.rate_hz)
       throw InputError("command line", OptionName{"rate_hz"},
-                       "no --rate on a secondary: the master paces");
+                       "none on a secondary node: the master paces");
     if (!(request.join_timeout_s > 0 && request.join_timeout_s <= 86400))
       throw InputError("command line", OptionName{"join_timeout_s"}, "seconds in (0, 86400]");
   } else if (request.rate_hz) {
     throw InputError("command line", OptionName{"rate_hz"},
-                     "--node: --rate paces a cluster's master");
+                     "only on a cluster's master node, which it paces");
   }
   if (request.rate_hz && !(*request.rate_hz > 0 && *request.rate_hz <= 10000))
     throw InputError("command line", OptionName{"rate_hz"}, "frames per second in (0, 10000]");

@@ -205,31 +205,30 @@ ContentFormat check_content_format(glm::ivec2 size, std::optional<ContentFormat>
     if (square) return ContentFormat::fisheye;
     if (two_to_one) return ContentFormat::equirect;
     if (strip) return ContentFormat::cubemap;
-    throw InputError(source, "image",
+    throw InputError(source, OptionName{"format"},
                      "a square dome master (fisheye), a 2:1 equirectangular panorama or a 6:1 "
                      "cube-map strip; got " +
-                         size_text(size) + " (give --format to say which it is)");
+                         size_text(size) + " (give the format to say which it is)");
   }
   switch (*requested) {
     case ContentFormat::fisheye:
       if (!square)
-        throw InputError(source, "image",
-                         "a square dome master for --format fisheye (the circle of the field "
+        throw InputError(source, OptionName{"format"},
+                         "a square dome master for fisheye (the circle of the field "
                          "of view inscribed); got " +
                              size_text(size));
       break;
     case ContentFormat::equirect:
       if (!two_to_one)
-        throw InputError(source, "image",
+        throw InputError(source, OptionName{"format"},
                          "an equirectangular panorama twice as wide as high (360° × 180°, to "
-                         "the pixel) for --format equirect; got " +
+                         "the pixel) for equirect; got " +
                              size_text(size));
       break;
     case ContentFormat::cubemap:
       if (!strip)
-        throw InputError(source, "image",
-                         "a cube map as six square faces side by side (6:1) for --format "
-                         "cubemap; got " +
+        throw InputError(source, OptionName{"format"},
+                         "a cube map as six square faces side by side (6:1) for cubemap; got " +
                              size_text(size));
       break;
     case ContentFormat::perspective:

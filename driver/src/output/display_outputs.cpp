@@ -65,7 +65,7 @@ LoadedDisplay load_display(std::string_view display, std::optional<glm::ivec2> s
     if (size && *size != warp.output_size) {
       throw InputError("command line", OptionName{"size"},
                        "expected the size of " + path + " (" + std::to_string(warp.output_size.x) +
-                           "x" + std::to_string(warp.output_size.y) + ") or no --size");
+                           "x" + std::to_string(warp.output_size.y) + ") or none");
     }
     std::string name = std::filesystem::path(path).filename().string();
     name = name.substr(0, name.size() - std::string_view(".warp.exr").size());
@@ -75,7 +75,7 @@ LoadedDisplay load_display(std::string_view display, std::optional<glm::ivec2> s
         projection_io::read_display_config(std::filesystem::path(display));
     if (size) {
       throw InputError("command line", OptionName{"size"},
-                       "expected no --size with a display.json (each projector has its own)");
+                       "expected none with a display.json (each projector has its own size)");
     }
     outputs = display_config_outputs(config, std::string(display));
     loaded.config = std::move(config);

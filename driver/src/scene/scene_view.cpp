@@ -137,7 +137,8 @@ SceneView choose_scene_view(const Scene& scene, const ViewRequest& request, bool
   if (!request.camera.empty()) {
     if (request.eye_world || request.look_at_world)
       throw InputError("command line", OptionName{"camera"},
-                       "expected either --camera or --eye/--look-at, not both");
+                       "expected either a scene camera or an eye point (and a point to look at), "
+                       "not both");
     if (scene.cameras.empty())
       throw InputError("command line", OptionName{"camera"},
                        "expected the name of one of the scene's cameras; " +
@@ -168,19 +169,19 @@ SceneView choose_scene_view(const Scene& scene, const ViewRequest& request, bool
   if (request.eye_world) {
     const glm::dvec3 target = request.look_at_world.value_or(centre);
     if (glm::length(target - *request.eye_world) < 1e-9)
-      throw InputError(
-          "command line", OptionName{request.look_at_world ? "look_at_world" : "eye_world"},
-          "expected an --eye apart from the point looked at (--look-at, by default the "
-          "scene bounds' centre " +
-              format_point(centre) + "); both are " + format_point(target));
+      throw InputError("command line",
+                       OptionName{request.look_at_world ? "look_at_world" : "eye_world"},
+                       "expected an eye point apart from the point looked at (by default the scene "
+                       "bounds' centre " +
+                           format_point(centre) + "); both are " + format_point(target));
     view.T_world_eye = look_at(*request.eye_world, target);
     view.pivot_world = target;
-    warn_if_inside("--eye", *request.eye_world);
+    warn_if_inside("the eye point", *request.eye_world);
     return view;
   }
   if (request.look_at_world)
     throw InputError("command line", OptionName{"look_at_world"},
-                     "expected --eye as well: the point to look from");
+                     "expected an eye point as well: the point to look from");
 
   const auto depth_eye =
       std::find_if(scene.cameras.begin(), scene.cameras.end(),
@@ -205,8 +206,8 @@ SceneView choose_scene_view(const Scene& scene, const ViewRequest& request, bool
                    ", outside and above the model, looking at its bounds' centre " +
                    format_point(centre) + ", which is inside geometry (" + std::to_string(hits) +
                    " of " + std::to_string(kInsideTestRays) +
-                   " rays from it hit a back face first); --eye, --look-at or --camera choose "
-                   "another view";
+                   " rays from it hit a back face first); an eye point, a point to look at or a "
+                   "scene camera chooses another view";
   }
   return view;
 }

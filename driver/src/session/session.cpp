@@ -77,9 +77,10 @@ SessionDisplay load_session_display(std::string_view display, std::optional<glm:
   SessionDisplay result;
   result.source = std::string(display);
   // A show goes on when its facets miss the tolerance by a near miss (with a warning, when the
-  // caller gives facets.warn); the tolerance is the display's own, or --tolerance's default.
+  // caller gives facets.warn); the tolerance is the display's own, or the default of the
+  // caller's tolerance option.
   result.settings.facets.near_miss = kRunNearMiss;
-  result.settings.facets.origin = {"command line", "--tolerance", {}};
+  result.settings.facets.origin = {"command line", OptionName{"tolerance_px"}, {}};
   // A display.json is read once: its outputs, settings and (for a cluster node) its cluster
   // section all come from this one value.
   LoadedDisplay loaded = load_display(display, size);

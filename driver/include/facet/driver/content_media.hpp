@@ -65,9 +65,9 @@ class ContentMedia {
 };
 
 // The content format an image of `size` is for, checked: `requested`, or from the aspect ratio
-// when none is given (square: fisheye, 2:1: equirect, 6:1: cubemap). InputError(source, "image",
-// ...) when the size does not fit: a dome master must be square, an equirectangular panorama
-// twice as wide as high (to the pixel), a cube strip six times.
+// when none is given (square: fisheye, 2:1: equirect, 6:1: cubemap). InputError(source,
+// OptionName{"format"}, ...) when the size does not fit: a dome master must be square, an
+// equirectangular panorama twice as wide as high (to the pixel), a cube strip six times.
 ContentFormat check_content_format(glm::ivec2 size, std::optional<ContentFormat> requested,
                                    const std::string& source);
 

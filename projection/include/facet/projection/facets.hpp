@@ -15,6 +15,7 @@
 #include <variant>
 #include <vector>
 
+#include "facet/projection/errors.hpp"
 #include "facet/projection/warp.hpp"
 
 namespace facet {
@@ -99,9 +100,9 @@ inline constexpr double kRunNearMiss = 0.10;
 // Where a tolerance was set and what the facets are for, so that the errors and warnings of a
 // tolerance build name them: InputError(source, field, ...) and "<source>: field '<field>': ...".
 struct FacetToleranceOrigin {
-  std::string source;               // a display.json's path, "command line"; empty: "input"
-  std::string field = "tolerance";  // "render.tolerance_px", "--tolerance"
-  std::string output;               // the projector the facets are for; empty: not named
+  std::string source;              // a display.json's path, "command line"; empty: "input"
+  InputField field = "tolerance";  // "render.tolerance_px", OptionName{"tolerance_px"}
+  std::string output;              // the projector the facets are for; empty: not named
 };
 
 struct FacetBuildOptions {
