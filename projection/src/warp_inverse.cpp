@@ -244,7 +244,7 @@ std::optional<glm::dvec2> WarpInverse::walk_from(glm::ivec2 cell, glm::dvec2 q) 
 }
 
 void WarpInverse::for_each_pixel_centre(const std::function<void(std::size_t, glm::dvec2)>& found,
-                                        std::size_t threads) const {
+                                        std::size_t threads, std::stop_token stop) const {
   const glm::ivec2 size = warp_.output_size;
   // Along a row, consecutive pixel centres mostly lie in the same cell: Newton starts there from
   // the previous pixel's cell-local solution, a pixel away, and converges in a step or two
@@ -252,6 +252,7 @@ void WarpInverse::for_each_pixel_centre(const std::function<void(std::size_t, gl
   // the answer is the same point to that tolerance; anything else (another cell, a solution
   // outside this one, no convergence) takes st_from_q's path.
   const auto row = [&](std::size_t y, std::size_t) {
+    if (stop.stop_requested()) return;
     const std::int32_t* cells = cell_of_pixel_.data() + y * std::size_t(size.x);
     std::int32_t previous = -1;  // the cell of the previous pixel's solution, or −1
     glm::dvec2 f(0.5), q00(0.0), q10(0.0), q01(0.0), q11(0.0);
@@ -299,14 +300,15 @@ std::vector<glm::dvec2> WarpInverse::st_at_pixel_centres(std::size_t threads) co
   return st;
 }
 
-std::vector<glm::vec3> WarpInverse::v_eye_at_pixel_centres(std::size_t threads) const {
+std::vector<glm::vec3> WarpInverse::v_eye_at_pixel_centres(std::size_t threads,
+                                                           std::stop_token stop) const {
   std::vector<glm::vec3> v_eye(cell_of_pixel_.size(),
                                glm::vec3(std::numeric_limits<float>::quiet_NaN()));
   for_each_pixel_centre(
       [&](std::size_t pixel, glm::dvec2 found) {
         v_eye[pixel] = glm::vec3(glm::normalize(warp_.v_eye_from_st(found)));
       },
-      threads);
+      threads, stop);
   return v_eye;
 }
 

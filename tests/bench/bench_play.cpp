@@ -91,8 +91,7 @@ void measure(const fs::path& video, ContentProjection projection, int frames,
   // As facet play starts: the direction lookups on a thread of their own while FFmpeg opens the
   // file.
   const auto start = std::chrono::steady_clock::now();
-  std::future<driver::ContentLookups> lookups =
-      driver::start_content_lookups(display, options.resample);
+  driver::PendingLookups lookups = driver::start_content_lookups(display, options.resample);
   std::unique_ptr<driver::ContentMedia> media = driver::ContentMedia::open(video);
   driver::ContentPlayer player(display, std::move(media), options, std::move(lookups));
   const double prepare_ms =

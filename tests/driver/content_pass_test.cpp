@@ -15,6 +15,7 @@
 #include <fstream>
 #include <iterator>
 #include <numbers>
+#include <stop_token>
 #include <vector>
 
 #include "facet/driver/direction_cache.hpp"
@@ -312,6 +313,47 @@ void set_age(const fs::path& path, int seconds_ago) {
 // The folder is trimmed to its budget by removing the least recently modified cache files, and
 // nothing that is not one: other names, other kinds of entries and links are neither counted nor
 // removed.
+// Asked to stop, the lookups return nothing and cache nothing: an incomplete inverse never
+// reaches a texture or the cache folder (facet play stops them when the content cannot play).
+TEST(DirectionCache, AStoppedLookupReturnsNothingAndWritesNoFile) {
+  const std::filesystem::path folder = test_paths::scratch_path("facet_direction_cache_stop");
+  std::filesystem::remove_all(folder);
+  const std::vector<OutputSpec> outputs = dome4_outputs();
+  const Warp& warp = outputs.at(1).warp;
+  std::stop_source stop;
+  stop.request_stop();
+
+  const std::vector<glm::vec3> inverse =
+      WarpInverse(warp).v_eye_at_pixel_centres(0, stop.get_token());
+  ASSERT_EQ(inverse.size(), std::size_t(warp.output_size.x) * warp.output_size.y);
+  std::size_t solved = 0;
+  for (const glm::vec3& v : inverse) solved += std::isnan(v.x) ? 0 : 1;
+  EXPECT_EQ(solved, 0u) << "rows were solved after the stop";
+
+  const DirectionLookup stopped =
+      direction_lookup(warp, folder, kDefaultDirectionCacheBudget, stop.get_token());
+  EXPECT_TRUE(stopped.stopped);
+  EXPECT_TRUE(stopped.v_eye.empty());
+  EXPECT_FALSE(std::filesystem::exists(folder)) << "a stopped lookup wrote into the cache";
+
+  ResampleOptions options;
+  options.direction_cache = folder;
+  const ContentLookups none = prepare_content_lookups(outputs, options, stop.get_token());
+  EXPECT_TRUE(none.stopped);
+  EXPECT_TRUE(none.sizes.empty() && none.texels.empty());
+  EXPECT_FALSE(std::filesystem::exists(folder));
+
+  // Not stopped: every output, each written to the cache.
+  const ContentLookups all =
+      prepare_content_lookups(outputs, options, std::stop_source().get_token());
+  EXPECT_FALSE(all.stopped);
+  EXPECT_EQ(all.sizes.size(), outputs.size());
+  EXPECT_EQ(std::distance(std::filesystem::directory_iterator(folder),
+                          std::filesystem::directory_iterator()),
+            std::ptrdiff_t(outputs.size()));
+  std::filesystem::remove_all(folder);
+}
+
 TEST(DirectionCache, TrimRemovesTheOldestCacheFilesBeyondTheBudgetAndNothingElse) {
   const fs::path folder = test_paths::scratch_path("facet_direction_cache_trim");
   fs::remove_all(folder);

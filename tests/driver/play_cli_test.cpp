@@ -213,6 +213,52 @@ TEST_F(PlayCli, DirectionCacheGivesTheSamePictures) {
   EXPECT_NE(log().find("--no-direction-cache"), std::string::npos) << log();
 }
 
+// --direction-cache-budget bounds the cache folder: after writing its lookup, play removes the
+// least recently used files beyond the budget (here a stale 2 MiB file against 1 MiB), and the
+// default budget (1 GiB) keeps them.
+TEST_F(PlayCli, DirectionCacheBudgetBoundsTheFolder) {
+  cv::Mat dome(96, 96, CV_8UC3, cv::Scalar(90, 120, 150));
+  cv::imwrite((dir_ / "dome.png").string(), dome);
+  const std::string still = (dir_ / "dome.png").string() + " --headless";
+  const auto stale_cache = [&](const std::string& name) {
+    const fs::path cache = dir_ / name;
+    fs::create_directories(cache);
+    const fs::path stale = cache / "0123456789abcdef.dirs";
+    std::ofstream(stale, std::ios::binary) << std::string(2 << 20, '\0');
+    fs::last_write_time(stale, fs::file_time_type::clock::now() - std::chrono::hours(24));
+    return stale;
+  };
+  const fs::path kept = stale_cache("default");
+  ASSERT_EQ(play(still + " --direction-cache " + kept.parent_path().string() + " --out " +
+                 (dir_ / "a").string()),
+            0)
+      << log();
+  EXPECT_TRUE(fs::exists(kept));
+  EXPECT_EQ(std::distance(fs::directory_iterator(kept.parent_path()), fs::directory_iterator()), 2);
+
+  const fs::path trimmed = stale_cache("small");
+  ASSERT_EQ(play(still + " --direction-cache " + trimmed.parent_path().string() +
+                 " --direction-cache-budget 1 --out " + (dir_ / "b").string()),
+            0)
+      << log();
+  EXPECT_FALSE(fs::exists(trimmed));
+  EXPECT_EQ(std::distance(fs::directory_iterator(trimmed.parent_path()), fs::directory_iterator()),
+            1);
+
+  // Bad budgets exit 2 naming the flag, before any work.
+  for (const char* bad : {"0", "-1", "1048577", "lots"}) {
+    EXPECT_EQ(play(still + " --direction-cache-budget " + bad + " --out " + (dir_ / "c").string()),
+              2)
+        << bad;
+    EXPECT_NE(log().find("--direction-cache-budget"), std::string::npos) << log();
+    EXPECT_FALSE(fs::exists(dir_ / "c"));
+  }
+  EXPECT_EQ(play(still + " --no-direction-cache --direction-cache-budget 64 --out " +
+                 (dir_ / "c").string()),
+            2);
+  EXPECT_NE(log().find("field '--direction-cache-budget'"), std::string::npos) << log();
+}
+
 TEST_F(PlayCli, StillEquirectOnACylinder) {
   // A 2:1 panorama, white above the horizon and black below: the cylinder's top half is lit.
   cv::Mat panorama(64, 128, CV_8UC3, cv::Scalar(0, 0, 0));

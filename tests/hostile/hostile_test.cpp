@@ -2351,6 +2351,8 @@ void add_flags_play(std::vector<Variant>& out) {
                    "/sys/facet_hostile_out",
                    "/sys/facet_hostile_out/x"});
   add_flag_values(out, "play", b, "--direction-cache", {"{dir}/cache"}, {"--no-direction-cache"});
+  add_flag_values(out, "play", b, "--direction-cache-budget", counts({"1048577", "1e12"}));
+  add_flag_values(out, "play", b, "--direction-cache-budget", {"64"}, {"--no-direction-cache"});
   Base cluster = b;
   cluster.args = {"play",     "@x.png", "--display", "@display.json", "--headless",
                   "--frames", "1",      "--out",     "@out"};

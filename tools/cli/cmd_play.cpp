@@ -6,7 +6,6 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
-#include <future>
 #include <iostream>
 #include <memory>
 #include <optional>
@@ -69,7 +68,12 @@ struct PlayOptions {
   driver::ClusterRequest cluster;  // --node, --join-timeout, --rate
   std::string direction_cache;     // empty: driver::default_direction_cache()
   bool no_direction_cache = false;
+  std::optional<std::int64_t> direction_cache_budget_mib;  // empty: the library's default
 };
+
+// The most the direction cache may keep: 1 TiB, far beyond any display's lookups (dome4's four
+// outputs take 37.7 MB), so that a typo's 10^12 MiB is refused rather than meaning "never trim".
+constexpr std::int64_t kMaxDirectionCacheBudgetMib = std::int64_t(1) << 20;
 
 // What changes a node's pictures besides the display, for the cluster's content digest: the
 // content file by name and size (not its bytes: a show's video may be gigabytes) and the flags.
@@ -106,6 +110,15 @@ void play(const PlayOptions& options) {
   const DomeOrientation orientation = options.orientation.value();
   if (options.fov && format && *format != ContentFormat::fisheye)
     throw InputError("command line", "--fov", "a field of view for --format fisheye only");
+  if (const auto& mib = options.direction_cache_budget_mib) {
+    if (options.no_direction_cache)
+      throw InputError("command line", "--direction-cache-budget",
+                       "a budget for a direction cache, not with --no-direction-cache");
+    if (*mib < 1 || *mib > kMaxDirectionCacheBudgetMib)
+      throw InputError("command line", "--direction-cache-budget",
+                       "a number of MiB from 1 to " + std::to_string(kMaxDirectionCacheBudgetMib) +
+                           " (1 TiB), got " + std::to_string(*mib));
+  }
 
   // A cluster node shows its own projectors only.
   driver::ClusterRequest cluster_request = options.cluster;
@@ -122,10 +135,13 @@ void play(const PlayOptions& options) {
                                             ? driver::default_direction_cache()
                                             : usable_cache_folder(options.direction_cache);
   }
+  if (options.direction_cache_budget_mib)
+    playback.resample.direction_cache_budget = std::uint64_t(*options.direction_cache_budget_mib)
+                                               << 20;
   // The direction lookups (the warp inverse at every output pixel, or the cache read) on a
-  // thread of their own while FFmpeg opens the file and the GL starts.
-  std::future<driver::ContentLookups> lookups =
-      driver::start_content_lookups(display, playback.resample);
+  // thread of their own while FFmpeg opens the file and the GL starts. An error before the
+  // player takes them (a content file that cannot be played) stops them on its way out.
+  driver::PendingLookups lookups = driver::start_content_lookups(display, playback.resample);
 
   auto media = driver::ContentMedia::open(options.file);
   const ContentFormat chosen = driver::check_content_format(media->size(), format, options.file);
@@ -267,8 +283,11 @@ const Registration registration{
       command->add_option("--direction-cache", options->direction_cache,
                           "Folder keeping each output's direction lookup (the warp inverse at "
                           "every pixel) between starts, keyed by the warp's content, the least "
-                          "recently used beyond 1 GiB removed (default "
+                          "recently used beyond --direction-cache-budget removed (default "
                           "$XDG_CACHE_HOME/facet/directions or ~/.cache/facet/directions)");
+      command->add_option("--direction-cache-budget", options->direction_cache_budget_mib,
+                          "MiB of direction lookups the cache folder keeps, 1 to 1048576 "
+                          "(default 1024)");
       command->add_flag("--no-direction-cache", options->no_direction_cache,
                         "Compute the direction lookups at every start and write none");
       command->add_option("--start-frame", options->start_frame,

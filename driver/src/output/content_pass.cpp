@@ -102,12 +102,17 @@ void ContentTexture::upload(const ContentImage& image) {
 }
 
 ContentLookups prepare_content_lookups(std::span<const OutputSpec> outputs,
-                                       const ResampleOptions& options) {
+                                       const ResampleOptions& options, std::stop_token stop) {
   ContentLookups lookups;
   for (const OutputSpec& output : outputs) {
     const glm::ivec2 size = output.warp.output_size;
-    const DirectionLookup directions =
-        direction_lookup(output.warp, options.direction_cache, options.direction_cache_budget);
+    const DirectionLookup directions = direction_lookup(output.warp, options.direction_cache,
+                                                        options.direction_cache_budget, stop);
+    if (directions.stopped) {
+      ContentLookups none;
+      none.stopped = true;
+      return none;
+    }
     lookups.from_cache += directions.from_cache ? 1 : 0;
     const std::vector<glm::vec3>& v_eye = directions.v_eye;
     // GL rows start at the bottom.

@@ -79,7 +79,7 @@ nlohmann::json play_frame_stats_to_json(const PlayFrameStats& stats) {
 }
 
 ContentPlayer::ContentPlayer(SessionDisplay display, std::unique_ptr<ContentMedia> media,
-                             PlaybackOptions options, std::future<ContentLookups> lookups)
+                             PlaybackOptions options, PendingLookups lookups)
     : display_(std::move(display)), media_(std::move(media)), options_(std::move(options)) {
   FACET_ASSERT(media_ != nullptr);
   const std::string source = media_->path().string();
@@ -111,13 +111,16 @@ ContentPlayer::ContentPlayer(SessionDisplay display, std::unique_ptr<ContentMedi
   FACET_ASSERT(pass_.output_count() == display_.outputs.size());
 }
 
-std::future<ContentLookups> start_content_lookups(const SessionDisplay& display,
-                                                  const ResampleOptions& options) {
+PendingLookups start_content_lookups(const SessionDisplay& display,
+                                     const ResampleOptions& options) {
   std::vector<OutputSpec> specs;
   for (const SessionOutput& output : display.outputs) specs.push_back(output.spec);
-  return std::async(std::launch::async, [specs = std::move(specs), options] {
-    return prepare_content_lookups(specs, options);
-  });
+  std::packaged_task<ContentLookups(std::stop_token)> task(
+      [specs = std::move(specs), options](std::stop_token stop) {
+        return prepare_content_lookups(specs, options, stop);
+      });
+  std::future<ContentLookups> result = task.get_future();
+  return PendingLookups(std::move(result), std::jthread(std::move(task)));
 }
 
 PlayFrameStats ContentPlayer::render(const FrameState& state, bool finish) {
@@ -201,7 +204,7 @@ struct PlayWindow {
 
 void run_windowed_play(const SessionDisplay& display, std::unique_ptr<ContentMedia> media,
                        const PlaybackOptions& options, const WindowPlayOptions& window_options,
-                       std::future<ContentLookups> lookups) {
+                       PendingLookups lookups) {
   const auto entered = std::chrono::steady_clock::now();
   const std::vector<MonitorInfo> monitors = list_monitors();
   std::vector<OutputPlacement> placements;

@@ -176,7 +176,7 @@ std::size_t trim_direction_cache(const std::filesystem::path& folder, std::uint6
 }
 
 DirectionLookup direction_lookup(const Warp& warp, const std::filesystem::path& folder,
-                                 std::uint64_t budget_bytes) {
+                                 std::uint64_t budget_bytes, std::stop_token stop) {
   DirectionLookup lookup;
   const std::uint64_t key = direction_cache_key(warp);
   const std::filesystem::path path =
@@ -185,7 +185,10 @@ DirectionLookup direction_lookup(const Warp& warp, const std::filesystem::path& 
     lookup.from_cache = true;
     return lookup;
   }
-  lookup.v_eye = WarpInverse(warp).v_eye_at_pixel_centres();
+  if (stop.stop_requested()) return {{}, false, true};
+  lookup.v_eye = WarpInverse(warp).v_eye_at_pixel_centres(0, stop);
+  // An inverse stopped part-way is incomplete: neither returned nor cached.
+  if (stop.stop_requested()) return {{}, false, true};
   if (!folder.empty()) {
     try {
       std::error_code ignored;

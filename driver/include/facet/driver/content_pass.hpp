@@ -11,6 +11,7 @@
 #include <filesystem>
 #include <glm/glm.hpp>
 #include <span>
+#include <stop_token>
 #include <vector>
 
 #include "facet/driver/direction_cache.hpp"
@@ -81,12 +82,15 @@ struct ContentLookups {
   std::vector<glm::ivec2> sizes;
   std::vector<std::vector<glm::vec4>> texels;
   std::size_t from_cache = 0;  // outputs read from the cache folder rather than computed
+  bool stopped = false;        // stopped on request: no sizes or texels, for no output
 };
 // Inverts every output's warp at its pixel centres (WarpInverse, all hardware threads), or reads
 // the directions from options.direction_cache. Thread-safe: touches no GL and no shared state
-// besides the cache folder, whose files are written atomically.
+// besides the cache folder, whose files are written atomically. Once `stop` is requested it
+// returns within a row of the inverse under way, `stopped`, writing no cache file for the
+// output it stopped in.
 ContentLookups prepare_content_lookups(std::span<const OutputSpec> outputs,
-                                       const ResampleOptions& options);
+                                       const ResampleOptions& options, std::stop_token stop = {});
 
 class ContentPass {
  public:

@@ -12,7 +12,9 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <span>
+#include <stop_token>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "facet/driver/blend_pass.hpp"
@@ -63,6 +65,25 @@ struct PlayFrameStats {
 };
 nlohmann::json play_frame_stats_to_json(const PlayFrameStats& stats);
 
+// The direction lookups start_content_lookups prepares on a thread of its own. Letting it go
+// without get() (a bad content file, any error before the player takes it) stops the work within
+// a row of the warp inverse and waits only for that, so that an early exit does not wait for
+// lookups nobody will use; a stopped output writes no cache file.
+class PendingLookups {
+ public:
+  PendingLookups() = default;
+  PendingLookups(std::future<ContentLookups> result, std::jthread worker)
+      : result_(std::move(result)), worker_(std::move(worker)) {}
+
+  bool valid() const { return result_.valid(); }
+  // Waits for the lookups; rethrows what preparing them threw.
+  ContentLookups get() { return result_.get(); }
+
+ private:
+  std::future<ContentLookups> result_;
+  std::jthread worker_;  // destroyed first: asks the work to stop, then joins it
+};
+
 class ContentPlayer {
  public:
   // Opens nothing: `media` is the opened file. Builds the direction lookups and blend passes of
@@ -71,7 +92,7 @@ class ContentPlayer {
   // `lookups`, when valid, brings the direction lookups start_content_lookups began (with this
   // display and options.resample); else they are prepared here.
   ContentPlayer(SessionDisplay display, std::unique_ptr<ContentMedia> media,
-                PlaybackOptions options, std::future<ContentLookups> lookups = {});
+                PlaybackOptions options, PendingLookups lookups = {});
 
   // Shows the source frame for `state.time_s` on every output: decode if it changed, upload,
   // resample through the warp, blend. With `finish`, waits for the GPU (for timings).
@@ -100,8 +121,7 @@ class ContentPlayer {
 // Starts preparing the direction lookups of every output of `display` (prepare_content_lookups)
 // on a thread of its own, so that opening the content and the GL overlap them; the result goes
 // to ContentPlayer or run_windowed_play. They need the CPU, not the GL.
-std::future<ContentLookups> start_content_lookups(const SessionDisplay& display,
-                                                  const ResampleOptions& options);
+PendingLookups start_content_lookups(const SessionDisplay& display, const ResampleOptions& options);
 
 struct HeadlessPlayResult {
   std::vector<PlayFrameStats> frames;
@@ -138,6 +158,6 @@ struct WindowPlayOptions {
 // server; Interrupted after watch_interrupts().
 void run_windowed_play(const SessionDisplay& display, std::unique_ptr<ContentMedia> media,
                        const PlaybackOptions& options, const WindowPlayOptions& window_options,
-                       std::future<ContentLookups> lookups = {});
+                       PendingLookups lookups = {});
 
 }  // namespace facet::driver

@@ -20,6 +20,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <glm/glm.hpp>
+#include <stop_token>
 #include <string>
 #include <vector>
 
@@ -30,6 +31,7 @@ namespace facet::driver {
 struct DirectionLookup {
   std::vector<glm::vec3> v_eye;  // WarpInverse::v_eye_at_pixel_centres()
   bool from_cache = false;       // read from the cache folder, not computed
+  bool stopped = false;          // stopped on request: v_eye is empty, nothing was written
 };
 
 // 1 GiB: 28 displays of four 1024×768 outputs (37.7 MB each).
@@ -43,9 +45,12 @@ std::string direction_cache_file_name(std::uint64_t key);
 // The directions of `warp`'s output pixel centres: read from `folder` when it holds a valid file
 // for this warp, else computed and (when `folder` is not empty) written there, then the folder
 // trimmed to `budget_bytes` (trim_direction_cache). Failing to create the folder or write the
-// file only costs the next start the time: the result is the same.
+// file only costs the next start the time: the result is the same. Once `stop` is requested the
+// inverse stops after the rows under way, and the lookup comes back `stopped`, with no
+// directions and no file written.
 DirectionLookup direction_lookup(const Warp& warp, const std::filesystem::path& folder,
-                                 std::uint64_t budget_bytes = kDefaultDirectionCacheBudget);
+                                 std::uint64_t budget_bytes = kDefaultDirectionCacheBudget,
+                                 std::stop_token stop = {});
 
 // Removes the least recently modified cache files of `folder` until the rest total at most
 // `budget_bytes`, newest kept first; `keep` (a file name in the folder) is never removed and

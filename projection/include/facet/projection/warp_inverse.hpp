@@ -15,6 +15,7 @@
 #include <functional>
 #include <glm/glm.hpp>
 #include <optional>
+#include <stop_token>
 #include <vector>
 
 #include "facet/projection/warp.hpp"
@@ -52,8 +53,11 @@ class WarpInverse {
   // kTolerancePx in output pixels.
   std::vector<glm::dvec2> st_at_pixel_centres(std::size_t threads = 0) const;
   // The same pixel centres' unit eye directions, normalize(Warp::v_eye_from_st(st)) rounded to
-  // float (as a direction lookup texture holds them); NaN where uncovered.
-  std::vector<glm::vec3> v_eye_at_pixel_centres(std::size_t threads = 0) const;
+  // float (as a direction lookup texture holds them); NaN where uncovered. Once `stop` is
+  // requested, rows not yet begun are left NaN and the call returns when the rows under way
+  // finish: the result is then incomplete, for the caller to drop.
+  std::vector<glm::vec3> v_eye_at_pixel_centres(std::size_t threads = 0,
+                                                std::stop_token stop = {}) const;
 
   // The cell (i + j·(Gw − 1)) stored for the pixel holding q's centre, or −1: for tests.
   std::int32_t cell_at_pixel(glm::ivec2 pixel) const;
@@ -68,9 +72,9 @@ class WarpInverse {
   std::optional<glm::dvec2> walk_from(glm::ivec2 cell, glm::dvec2 q) const;
   glm::dvec2 q_node(int i, int j) const;
   // Calls found(y · width + x, st) for every covered pixel centre, rows in parallel on
-  // `threads` threads (0: every hardware thread).
+  // `threads` threads (0: every hardware thread); no row begins once `stop` is requested.
   void for_each_pixel_centre(const std::function<void(std::size_t, glm::dvec2)>& found,
-                             std::size_t threads) const;
+                             std::size_t threads, std::stop_token stop = {}) const;
   void build_bins();
 
   Warp warp_;
