@@ -2526,6 +2526,14 @@ void add_flags_interop(std::vector<Variant>& out) {
   add_flag_values(out, "bourke import", bourke, "--zenith", choices("centre"));
   add_flag_values(out, "bourke import", bourke, "--tilt", angles("91"));
   add_flag_values(out, "bourke import", bourke, "--orientation", angles("361"));
+  // A tile screen: every bad value is refused before the build.
+  const Base tiles{
+      {"tiles", (kSource / "configs/tiles/panorama-360.json").string(), "--out", "@out"},
+      "out",
+      {}};
+  add_flag_values(out, "tiles", tiles, "--out", out_folders());
+  add_flag_values(out, "tiles", tiles, "--size", sizes({"1000x1000", "1x1"}));
+  add_flag_values(out, "tiles", tiles, "--tolerance", positives({"16385", "1e9"}));
   // A display both exports take (dome180's footprints are wider than one frustum holds).
   const std::string wall = (kSource / "configs/displays/wall2x2/display.json").string();
   const Base mpcdi_export{{"mpcdi", "export", wall, "--out", "@out.mpcdi"}, "out.mpcdi", {}};
