@@ -272,6 +272,41 @@ TEST(RenderCli, ReferenceReportsTheEdgeDisplacement) {
   std::filesystem::remove_all(folder);
 }
 
+// --reference compares what the display shows. A split tile screen's pieces are projectors on
+// one window, each with a 0/1 blend map; facets that straddle the edge of a piece's coverage are
+// drawn whole, reaching into the other piece's half (here up to about 55 px of the 100 px
+// half), where the blend map hides them. Counted as drawn, they made 3,830 of 33,335 compared
+// pixels mismatched (19.8% of the right piece's); compared where the blend shows them, none.
+TEST(RenderCli, ReferenceComparesOnlyWhatTheBlendMapsShow) {
+  const std::filesystem::path folder =
+      std::filesystem::temp_directory_path() / ("facet_render_split_" + std::to_string(getpid()));
+  std::filesystem::remove_all(folder);
+  const std::filesystem::path tiles =
+      std::filesystem::path(FACET_SOURCE_DIR) / "configs/tiles/split-tpts.json";
+  const Result built = run_cli("tiles " + tiles.string() + " --size 200x100 --out " +
+                               (folder / "display").string() + " --json");
+  ASSERT_EQ(built.status, 0) << built.output;
+  const Result result = run_cli("render --display " + (folder / "display/display.json").string() +
+                                " --method facets --reference --json");
+  ASSERT_EQ(result.status, 0) << result.output;
+  const nlohmann::json report = nlohmann::json::parse(result.output);
+  const nlohmann::json& reference = report["reference"];
+  ASSERT_EQ(reference["outputs"].size(), 2u);
+  std::uint64_t hidden = 0;
+  for (const nlohmann::json& output : reference["outputs"]) {
+    SCOPED_TRACE(output["name"].get<std::string>());
+    EXPECT_LE(output["id_mismatch"].get<double>(), 1e-3);
+    EXPECT_EQ(output["edge_beyond_window_pixels"].get<std::uint64_t>(), 0u);
+    EXPECT_LE(output["max_edge_px"].get<double>(), 0.25 + 0.02);
+    EXPECT_GT(output.value("compared_pixels", std::uint64_t(0)), 15000u);
+    // Each piece's blend hides the other half: 100 of 200 columns.
+    EXPECT_EQ(output.value("blend_hidden_pixels", std::uint64_t(0)), 100u * 100u);
+    hidden += output.value("blend_hidden_pixels", std::uint64_t(0));
+  }
+  EXPECT_EQ(reference.value("blend_hidden_pixels", std::uint64_t(0)), hidden);
+  std::filesystem::remove_all(folder);
+}
+
 // A render of a million frames stopped by SIGINT once its handler is in place: exit 130, one line
 // saying how far it got, and neither --out nor a temporary folder beside it.
 TEST(RenderCli, SigintStopsBetweenFramesAndWritesNothing) {

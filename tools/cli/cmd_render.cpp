@@ -27,6 +27,7 @@
 #include "facet/projection/atomic_folder.hpp"
 #include "facet/projection/errors.hpp"
 #include "facet/projection/interrupt.hpp"
+#include "facet/projection_io/blend_file.hpp"
 #include "frames_flag.hpp"
 #include "option_flags.hpp"
 #include "view_flags.hpp"
@@ -62,13 +63,43 @@ double median(std::vector<double> values) {
   return n % 2 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
 }
 
+// Per output, which pixels its display.json's blend map hides: α = 0 in every channel, where
+// the projector shows black whatever it draws. Empty for an output without a blend map (and for
+// built-in displays, which `render` draws unblended).
+std::vector<std::vector<bool>> hidden_by_blend(
+    const std::optional<projection_io::DisplayConfig>& config) {
+  std::vector<std::vector<bool>> hidden;
+  if (!config) return hidden;
+  for (const auto& projector : config->projectors) {
+    std::vector<bool>& mask = hidden.emplace_back();
+    if (!projector.blend) continue;
+    const projection_io::BlendMap alpha =
+        projection_io::read_blend_map(config->resolve(*projector.blend).string(), projector.size);
+    mask.assign(std::size_t(alpha.size.x) * alpha.size.y, false);
+    for (int y = 0; y < alpha.size.y; ++y) {
+      for (int x = 0; x < alpha.size.x; ++x) {
+        bool dark = true;
+        for (int c = 0; c < alpha.channels && dark; ++c) dark = alpha.at(x, y, c) <= 0.0f;
+        mask[std::size_t(y) * alpha.size.x + x] = dark;
+      }
+    }
+  }
+  return hidden;
+}
+
 // The last frame's IDs against the Embree ray cast of the same view, pooled over the outputs:
 // id_mismatch from compare_ids (ratio of pooled pixel counts), edge distances from the exact
 // geometry (ReferenceRaycaster::edge_displacement; the worst output's). With --reference-scene the
 // ray cast sees that scene and the rendered IDs are mapped to it through `source_ids`
 // (load_scene: a depth image's triangles to the triangles they were rendered from).
+// What the viewer sees is compared: where an output's blend map hides a pixel (`hidden`, per
+// output; see hidden_by_blend) both IDs count as 0, nothing shown. Facets that straddle the edge
+// of a warp's coverage are drawn whole, past it, and the blend map is what hides that part (as
+// for the pieces of a split tile screen, each drawn over the whole window). The ID files written
+// with --ids are the images as rendered and cast.
 nlohmann::json compare_with_reference(const Scene& scene, const std::vector<OutputSpec>& outputs,
                                       const std::vector<OutputTarget>& targets,
+                                      const std::vector<std::vector<bool>>& hidden,
                                       const glm::dmat4& T_eye_world,
                                       const std::filesystem::path& ids_folder,
                                       const std::string& stopped,
@@ -76,6 +107,7 @@ nlohmann::json compare_with_reference(const Scene& scene, const std::vector<Outp
   const ReferenceRaycaster raycaster(scene);
   IdComparison pooled;
   EdgeDisplacement edges;
+  std::size_t blend_hidden_pixels = 0;
   nlohmann::json per_output = nlohmann::json::array();
   for (std::size_t i = 0; i < outputs.size(); ++i) {
     throw_if_interrupted(stopped);
@@ -90,11 +122,23 @@ nlohmann::json compare_with_reference(const Scene& scene, const std::vector<Outp
     if (source_ids) {
       for (std::uint32_t& id : tested) id = id < source_ids->size() ? (*source_ids)[id] : 0;
     }
-    const IdComparison c = compare_ids(reference, tested, targets[i].size(), {.wrap_x = wrap_x});
+    std::vector<std::uint32_t> shown = reference;
+    std::size_t hidden_pixels = 0;
+    if (i < hidden.size() && hidden[i].size() == tested.size()) {
+      for (std::size_t k = 0; k < tested.size(); ++k) {
+        if (!hidden[i][k]) continue;
+        tested[k] = shown[k] = 0;
+        ++hidden_pixels;
+      }
+    }
+    const IdComparison c = compare_ids(shown, tested, targets[i].size(), {.wrap_x = wrap_x});
     const EdgeDisplacement e =
-        raycaster.edge_displacement(inverse, T_eye_world, reference, tested, {.wrap_x = wrap_x});
+        raycaster.edge_displacement(inverse, T_eye_world, shown, tested, {.wrap_x = wrap_x});
     per_output.push_back({{"name", outputs[i].name},
                           {"id_mismatch", c.id_mismatch},
+                          {"compared_pixels", c.compared_pixels},
+                          {"mismatched_pixels", c.mismatched_pixels},
+                          {"blend_hidden_pixels", hidden_pixels},
                           {"max_edge_px", e.max_px},
                           {"p99_edge_px", e.p99_px},
                           {"edge_beyond_window_pixels", e.beyond_window},
@@ -104,6 +148,7 @@ nlohmann::json compare_with_reference(const Scene& scene, const std::vector<Outp
                           {"worst_edge_pixel", {e.worst_pixel.x, e.worst_pixel.y}}});
     pooled.compared_pixels += c.compared_pixels;
     pooled.mismatched_pixels += c.mismatched_pixels;
+    blend_hidden_pixels += hidden_pixels;
     edges.differing_pixels += e.differing_pixels;
     edges.measured_pixels += e.measured_pixels;
     edges.beyond_window += e.beyond_window;
@@ -119,6 +164,7 @@ nlohmann::json compare_with_reference(const Scene& scene, const std::vector<Outp
   return {{"id_mismatch", mismatch},
           {"compared_pixels", pooled.compared_pixels},
           {"mismatched_pixels", pooled.mismatched_pixels},
+          {"blend_hidden_pixels", blend_hidden_pixels},
           {"max_edge_px", edges.max_px},
           {"p99_edge_px", edges.p99_px},
           {"differing_pixels", edges.differing_pixels},
@@ -162,7 +208,11 @@ void run(const RenderOptions& options) {
   std::optional<glm::ivec2> size;
   if (!options.size.empty()) size = parse_size(options.size, "--size");
   const auto orientation = builtin_dome_orientation(options.orientation, options.display);
-  std::vector<OutputSpec> outputs = load_display_outputs(options.display, size);
+  LoadedDisplay loaded = load_display(options.display, size);
+  std::vector<OutputSpec> outputs = std::move(loaded.outputs);
+  // Read with the display, before any GL work: a bad blend map is refused at once.
+  const std::vector<std::vector<bool>> hidden =
+      options.reference ? hidden_by_blend(loaded.config) : std::vector<std::vector<bool>>{};
   for (OutputSpec& output : outputs) {
     if (orientation) orient_warp(output.warp, *orientation);
   }
@@ -279,9 +329,9 @@ void run(const RenderOptions& options) {
   std::optional<nlohmann::json> reference;
   auto compare = [&](const std::filesystem::path& ids_folder) {
     if (options.reference)
-      reference = compare_with_reference(reference_scene ? *reference_scene : scene, outputs,
-                                         targets, T_eye_world, options.ids ? ids_folder : "",
-                                         stopped, reference_scene ? &source_ids : nullptr);
+      reference = compare_with_reference(
+          reference_scene ? *reference_scene : scene, outputs, targets, hidden, T_eye_world,
+          options.ids ? ids_folder : "", stopped, reference_scene ? &source_ids : nullptr);
   };
   if (options.out.empty()) {
     compare("");
