@@ -167,42 +167,6 @@ double distance_to_triangle(glm::dvec2 p, glm::dvec2 a, glm::dvec2 b, glm::dvec2
   return std::min({segment(a, b), segment(b, c), segment(c, a)});
 }
 
-// The normalised output position near `guess` at which the piece shows direction d (unit), by
-// Newton's method on the direction's components across d; nullopt where it does not converge.
-std::optional<glm::dvec2> solve_position(const TileScreen& screen,
-                                         const std::vector<std::vector<int>>& pieces, int piece,
-                                         glm::dvec3 d, glm::dvec2 guess) {
-  const glm::dvec3 a = std::abs(d.x) < 0.9 ? glm::dvec3(1, 0, 0) : glm::dvec3(0, 1, 0);
-  const glm::dvec3 e1 = glm::normalize(glm::cross(d, a));
-  const glm::dvec3 e2 = glm::cross(d, e1);
-  const auto residual = [&](glm::dvec2 xy) -> std::optional<glm::dvec2> {
-    const auto v = tile_direction(screen, pieces, piece, xy, true);
-    if (!v || !(glm::dot(*v, d) > 0)) return std::nullopt;
-    return glm::dvec2(glm::dot(*v, e1), glm::dot(*v, e2));
-  };
-  glm::dvec2 xy = guess;
-  constexpr double h = 1e-7;
-  for (int iteration = 0; iteration < 40; ++iteration) {
-    const auto r = residual(xy);
-    if (!r) return std::nullopt;
-    if (glm::length(*r) < 1e-14) return xy;
-    const auto rx = residual(xy + glm::dvec2(h, 0));
-    const auto ry = residual(xy + glm::dvec2(0, h));
-    if (!rx || !ry) return std::nullopt;
-    const glm::dmat2 J((*rx - *r) / h, (*ry - *r) / h);
-    const double det = glm::determinant(J);
-    if (!(std::abs(det) > 1e-300)) return std::nullopt;
-    glm::dvec2 step = -(glm::inverse(J) * *r);
-    const double length = glm::length(step);
-    if (length > 0.05) step *= 0.05 / length;
-    xy += step;
-    if (length < 1e-15) return xy;
-  }
-  const auto r = residual(xy);
-  if (r && glm::length(*r) < 1e-11) return xy;
-  return std::nullopt;
-}
-
 }  // namespace
 
 double fisheye_lens_theta(double r) {
@@ -428,12 +392,13 @@ std::vector<std::vector<int>> tile_pieces(const TileScreen& screen) {
   return pieces;
 }
 
-std::optional<glm::dvec3> tile_direction(const TileScreen& screen,
-                                         const std::vector<std::vector<int>>& pieces, int piece,
-                                         glm::dvec2 xy, bool continue_past) {
-  const auto dir = [&](std::size_t k) {
-    return feature_direction(screen.features[k], screen.zoom);
-  };
+namespace {
+
+// tile_direction with `dir(k)` giving feature k's direction (feature_direction).
+template <class Direction>
+std::optional<glm::dvec3> field_direction(const TileScreen& screen,
+                                          const std::vector<std::vector<int>>& pieces, int piece,
+                                          glm::dvec2 xy, bool continue_past, const Direction& dir) {
   if (screen.kind == TileScreen::Kind::rpts) {
     const int gx = screen.grid.x, gy = screen.grid.y;
     if (!continue_past && (xy.x < 0 || xy.x > 1 || xy.y < 0 || xy.y > 1)) return std::nullopt;
@@ -522,6 +487,73 @@ std::optional<glm::dvec3> tile_direction(const TileScreen& screen,
   return blend(d, w, 3, screen.off_axis);
 }
 
+// The screen's field with every feature's direction computed once, for the warp build, which
+// asks for directions millions of times.
+class TileField {
+ public:
+  TileField(const TileScreen& screen, const std::vector<std::vector<int>>& pieces)
+      : screen_(screen), pieces_(pieces) {
+    directions_.reserve(screen.features.size());
+    for (const TileFeature& f : screen.features) {
+      directions_.push_back(feature_direction(f, screen.zoom));
+    }
+  }
+  std::optional<glm::dvec3> operator()(int piece, glm::dvec2 xy, bool continue_past) const {
+    return field_direction(screen_, pieces_, piece, xy, continue_past,
+                           [this](std::size_t k) { return directions_[k]; });
+  }
+
+ private:
+  const TileScreen& screen_;
+  const std::vector<std::vector<int>>& pieces_;
+  std::vector<glm::dvec3> directions_;
+};
+
+// The normalised output position near `guess` at which the piece shows direction d (unit), by
+// Newton's method on the direction's components across d; nullopt where it does not converge.
+std::optional<glm::dvec2> solve_position(const TileField& field, int piece, glm::dvec3 d,
+                                         glm::dvec2 guess) {
+  const glm::dvec3 a = std::abs(d.x) < 0.9 ? glm::dvec3(1, 0, 0) : glm::dvec3(0, 1, 0);
+  const glm::dvec3 e1 = glm::normalize(glm::cross(d, a));
+  const glm::dvec3 e2 = glm::cross(d, e1);
+  const auto residual = [&](glm::dvec2 xy) -> std::optional<glm::dvec2> {
+    const auto v = field(piece, xy, true);
+    if (!v || !(glm::dot(*v, d) > 0)) return std::nullopt;
+    return glm::dvec2(glm::dot(*v, e1), glm::dot(*v, e2));
+  };
+  glm::dvec2 xy = guess;
+  constexpr double h = 1e-7;
+  for (int iteration = 0; iteration < 40; ++iteration) {
+    const auto r = residual(xy);
+    if (!r) return std::nullopt;
+    if (glm::length(*r) < 1e-14) return xy;
+    const auto rx = residual(xy + glm::dvec2(h, 0));
+    const auto ry = residual(xy + glm::dvec2(0, h));
+    if (!rx || !ry) return std::nullopt;
+    const glm::dmat2 J((*rx - *r) / h, (*ry - *r) / h);
+    const double det = glm::determinant(J);
+    if (!(std::abs(det) > 1e-300)) return std::nullopt;
+    glm::dvec2 step = -(glm::inverse(J) * *r);
+    const double length = glm::length(step);
+    if (length > 0.05) step *= 0.05 / length;
+    xy += step;
+    if (length < 1e-15) return xy;
+  }
+  const auto r = residual(xy);
+  if (r && glm::length(*r) < 1e-11) return xy;
+  return std::nullopt;
+}
+
+}  // namespace
+
+std::optional<glm::dvec3> tile_direction(const TileScreen& screen,
+                                         const std::vector<std::vector<int>>& pieces, int piece,
+                                         glm::dvec2 xy, bool continue_past) {
+  return field_direction(screen, pieces, piece, xy, continue_past, [&](std::size_t k) {
+    return feature_direction(screen.features[k], screen.zoom);
+  });
+}
+
 TileDisplay build_tile_display(const TileScreen& screen, glm::ivec2 size,
                                const std::string& source) {
   check_image_size(size, source, "size");
@@ -533,6 +565,7 @@ TileDisplay build_tile_display(const TileScreen& screen, glm::ivec2 size,
                          std::to_string(size.x) + "×" + std::to_string(size.y));
   }
   const std::vector<std::vector<int>> pieces = tile_pieces(screen);
+  const TileField field(screen, pieces);
   const bool several = pieces.size() > 1;
   const glm::ivec2 nodes = glm::min(size + 1, glm::ivec2(kMaxLatticeNodes));
   TileDisplay result;
@@ -549,7 +582,7 @@ TileDisplay build_tile_display(const TileScreen& screen, glm::ivec2 size,
     for (int j = 0; j < nodes.y; ++j) {
       for (int i = 0; i < nodes.x; ++i) {
         const std::size_t k = std::size_t(j) * nodes.x + i;
-        v[k] = tile_direction(screen, pieces, piece, node_xy(i, j), false);
+        v[k] = field(piece, node_xy(i, j), false);
         inside[k] = v[k].has_value();
       }
     }
@@ -567,7 +600,7 @@ TileDisplay build_tile_display(const TileScreen& screen, glm::ivec2 size,
                      inside[std::size_t(b) * nodes.x + a];
             }
           }
-          if (near) v[k] = tile_direction(screen, pieces, piece, node_xy(i, j), true);
+          if (near) v[k] = field(piece, node_xy(i, j), true);
         }
       }
     }
@@ -633,12 +666,18 @@ TileDisplay build_tile_display(const TileScreen& screen, glm::ivec2 size,
     for (int j = 0; j <= 64; ++j) {
       for (int i = 0; i <= 64; ++i) {
         const glm::dvec2 xy{-0.25 + 1.5 * i / 64, -0.25 + 1.5 * j / 64};
-        if (auto d = tile_direction(screen, pieces, piece, xy, true)) lattice.emplace_back(xy, *d);
+        if (auto d = field(piece, xy, true)) lattice.emplace_back(xy, *d);
       }
     }
-    const auto inside_piece = [&](glm::dvec2 xy) {
-      return tile_direction(screen, pieces, piece, xy, false).has_value();
+    const auto inside_piece = [&](glm::dvec2 xy) { return field(piece, xy, false).has_value(); };
+    // The solved output positions of a grid's nodes: a finer grid takes the nodes it shares
+    // with it as they are and starts its others from them.
+    struct Solution {
+      glm::ivec2 grid{0, 0};
+      std::vector<glm::dvec2> xy;
+      std::vector<bool> solved;
     };
+    Solution coarse;
     const auto make_warp = [&](glm::ivec2 warp_grid) {
       Warp warp;
       warp.base = base;
@@ -648,20 +687,51 @@ TileDisplay build_tile_display(const TileScreen& screen, glm::ivec2 size,
       const std::size_t n = std::size_t(warp_grid.x) * warp_grid.y;
       std::vector<glm::dvec2> xy(n, glm::dvec2(std::numeric_limits<double>::quiet_NaN()));
       std::vector<bool> solved(n, false);
+      // Fine nodes per coarse cell, when the coarse grid's nodes are nodes of this one.
+      glm::ivec2 ratio{0, 0};
+      if (coarse.grid.x > 1 && (warp_grid.x - 1) % (coarse.grid.x - 1) == 0 &&
+          (warp_grid.y - 1) % (coarse.grid.y - 1) == 0) {
+        ratio = (warp_grid - 1) / (coarse.grid - 1);
+      }
+      const auto coarse_at = [&](int a, int b) {
+        return std::size_t(b) * std::size_t(coarse.grid.x) + std::size_t(a);
+      };
       for (int j = 0; j < warp_grid.y; ++j) {
         for (int i = 0; i < warp_grid.x; ++i) {
           const std::size_t k = warp.node_index(i, j);
+          if (ratio.x > 0 && i % ratio.x == 0 && j % ratio.y == 0) {
+            const std::size_t c = coarse_at(i / ratio.x, j / ratio.y);
+            xy[k] = coarse.xy[c];
+            solved[k] = coarse.solved[c];
+            continue;
+          }
           const glm::dvec2 st{double(i) / (warp_grid.x - 1), double(j) / (warp_grid.y - 1)};
           const glm::dvec3 d = R_eye_base * base.direction(st);
-          // From a neighbour's solution, else the best lattice point (ties, as on a 360° seam,
-          // go to the one nearest st); a solution far from its guess is another branch.
+          // From the coarse grid's bilinear guess, else a neighbour's solution, else the best
+          // lattice point (ties, as on a 360° seam, go to the one nearest st); a solution far
+          // from its guess is another branch.
           const auto near = [&](glm::dvec2 guess, double within) -> std::optional<glm::dvec2> {
-            const auto found = solve_position(screen, pieces, piece, d, guess);
+            const auto found = solve_position(field, piece, d, guess);
             if (found && glm::length(*found - guess) < within) return found;
             return std::nullopt;
           };
           std::optional<glm::dvec2> found;
-          if (i > 0 && solved[k - 1]) found = near(xy[k - 1], 0.1);
+          if (ratio.x > 0) {
+            const int a = std::min(i / ratio.x, coarse.grid.x - 2);
+            const int b = std::min(j / ratio.y, coarse.grid.y - 2);
+            const std::size_t c00 = coarse_at(a, b), c10 = coarse_at(a + 1, b),
+                              c01 = coarse_at(a, b + 1), c11 = coarse_at(a + 1, b + 1);
+            if (coarse.solved[c00] && coarse.solved[c10] && coarse.solved[c01] &&
+                coarse.solved[c11]) {
+              const double fx = double(i - a * ratio.x) / ratio.x;
+              const double fy = double(j - b * ratio.y) / ratio.y;
+              const glm::dvec2 guess =
+                  (coarse.xy[c00] * (1 - fx) + coarse.xy[c10] * fx) * (1 - fy) +
+                  (coarse.xy[c01] * (1 - fx) + coarse.xy[c11] * fx) * fy;
+              found = near(guess, 0.1);
+            }
+          }
+          if (!found && i > 0 && solved[k - 1]) found = near(xy[k - 1], 0.1);
           if (!found && j > 0 && solved[k - std::size_t(warp_grid.x)]) {
             found = near(xy[k - std::size_t(warp_grid.x)], 0.1);
           }
@@ -711,6 +781,7 @@ TileDisplay build_tile_display(const TileScreen& screen, glm::ivec2 size,
         }
       }
       warp.validate(source);
+      coarse = {warp_grid, std::move(xy), std::move(solved)};
       return warp;
     };
     // Samples at pixel centres inside the piece, about 160 a side.
@@ -719,7 +790,7 @@ TileDisplay build_tile_display(const TileScreen& screen, glm::ivec2 size,
     for (int y = 0; y < size.y; y += step) {
       for (int x = 0; x < size.x; x += step) {
         const glm::dvec2 q{x + 0.5, y + 0.5};
-        if (auto d = tile_direction(screen, pieces, piece, q / glm::dvec2(size), false)) {
+        if (auto d = field(piece, q / glm::dvec2(size), false)) {
           samples.emplace_back(q, *d);
         }
       }
@@ -740,7 +811,12 @@ TileDisplay build_tile_display(const TileScreen& screen, glm::ivec2 size,
     for (;;) {
       projector.warp = make_warp(warp_grid);
       worst = worst_of(projector.warp);
-      const glm::ivec2 finer = glm::min(2 * (warp_grid - 1) + 1, glm::ivec2(kMaxWarpGrid));
+      // A bilinear cell's error goes with the square of its side where the field is smooth: the
+      // grid is made 2, 4 or 8 times finer, as that predicts the bound needs (a kink of a TPTS
+      // converges more slowly, and takes another step).
+      int factor = 2;
+      while (factor < 8 && worst / (factor * factor) > kCheckBoundPx) factor *= 2;
+      const glm::ivec2 finer = glm::min(factor * (warp_grid - 1) + 1, glm::ivec2(kMaxWarpGrid));
       if (worst <= kCheckBoundPx || finer == warp_grid) break;
       warp_grid = finer;
     }
@@ -756,7 +832,7 @@ TileDisplay build_tile_display(const TileScreen& screen, glm::ivec2 size,
       for (int y = 0; y < size.y; ++y) {
         for (int x = 0; x < size.x; ++x) {
           const glm::dvec2 xy{(x + 0.5) / size.x, (y + 0.5) / size.y};
-          if (tile_direction(screen, pieces, piece, xy, false)) alpha.at(x, y) = 1.0f;
+          if (field(piece, xy, false)) alpha.at(x, y) = 1.0f;
         }
       }
       projector.blend = std::move(alpha);
