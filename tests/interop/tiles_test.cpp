@@ -50,49 +50,63 @@ TEST(Tiles, FisheyeLensPolynomialMapsRadiusToAngle) {
   }
 }
 
-// Every sample screen builds (at 240 px wide, its aspect kept); its warps send the screen's
-// own direction at pixel centres (a lattice apart from the builder's own check) back to that
-// pixel within 0.01 px worst case for RPTS, whose field is C1, and 0.02 px for TPTS, whose
-// triangles meet at kinks that the warp's bilinear cells cross; facets meet the 0.25 px tolerance
-// on them.
-TEST(Tiles, EverySampleScreenBuildsAndItsWarpsFollowTheScreen) {
-  const std::vector<fs::path> files = sample_screens();
-  ASSERT_GE(files.size(), 4u);
-  for (const fs::path& file : files) {
-    SCOPED_TRACE(file.filename().string());
-    TileScreen screen = read_tile_screen(file);
-    const int width = 240;
-    screen.size = {width, int(std::lround(double(width) * screen.size.y / screen.size.x))};
-    const TileDisplay tiles = build_tile_display(screen, screen.size, file.string());
-    const double bound = screen.kind == TileScreen::Kind::rpts ? 0.01 : 0.02;
-    const auto pieces = tile_pieces(screen);
-    ASSERT_EQ(tiles.display.projectors.size(), pieces.size());
-    for (std::size_t p = 0; p < pieces.size(); ++p) {
-      const Warp& warp = tiles.display.projectors[p].warp;
-      double worst = 0;
-      int compared = 0;
-      for (int y = 1; y < screen.size.y; y += 5) {
-        for (int x = 2; x < screen.size.x; x += 5) {
-          const glm::dvec2 q{x + 0.5, y + 0.5};
-          const auto d = tile_direction(screen, pieces, int(p), q / glm::dvec2(screen.size));
-          if (!d) continue;
-          const auto projected = warp.project(*d, q.x / screen.size.x);
-          ASSERT_TRUE(projected) << q.x << ", " << q.y;
-          worst = std::max(worst, glm::length(projected->q - q));
-          ++compared;
-        }
+// The sample screens, one test each (TileSample below).
+const std::vector<std::string> kSamples{"dome-fisheye", "mixed-wide", "off-axis-zoom",
+                                        "panorama-360", "split-tpts"};
+
+TEST(Tiles, EverySampleScreenHasItsTest) {
+  std::vector<std::string> names;
+  for (const fs::path& file : sample_screens()) names.push_back(file.stem().string());
+  EXPECT_EQ(names, kSamples);
+}
+
+// A sample screen builds (at 240 px wide, its aspect kept); its warps send the screen's own
+// direction at pixel centres (a lattice apart from the builder's own check) back to that pixel
+// within 0.01 px worst case for RPTS, whose field is C1, and 0.02 px for TPTS, whose triangles
+// meet at kinks that the warp's bilinear cells cross; facets meet the 0.25 px tolerance on them.
+class TileSample : public testing::TestWithParam<std::string> {};
+
+TEST_P(TileSample, BuildsAndItsWarpsFollowTheScreen) {
+  const fs::path file = kTiles / (GetParam() + ".json");
+  TileScreen screen = read_tile_screen(file);
+  const int width = 240;
+  screen.size = {width, int(std::lround(double(width) * screen.size.y / screen.size.x))};
+  const TileDisplay tiles = build_tile_display(screen, screen.size, file.string());
+  const double bound = screen.kind == TileScreen::Kind::rpts ? 0.01 : 0.02;
+  const auto pieces = tile_pieces(screen);
+  ASSERT_EQ(tiles.display.projectors.size(), pieces.size());
+  for (std::size_t p = 0; p < pieces.size(); ++p) {
+    const Warp& warp = tiles.display.projectors[p].warp;
+    double worst = 0;
+    int compared = 0;
+    for (int y = 1; y < screen.size.y; y += 5) {
+      for (int x = 2; x < screen.size.x; x += 5) {
+        const glm::dvec2 q{x + 0.5, y + 0.5};
+        const auto d = tile_direction(screen, pieces, int(p), q / glm::dvec2(screen.size));
+        if (!d) continue;
+        const auto projected = warp.project(*d, q.x / screen.size.x);
+        ASSERT_TRUE(projected) << q.x << ", " << q.y;
+        worst = std::max(worst, glm::length(projected->q - q));
+        ++compared;
       }
-      EXPECT_GT(compared, 150);
-      EXPECT_LE(worst, bound) << "piece " << p;
-      FacetBuildOptions options;
-      options.layout = FacetTolerance{0.25};
-      const FacetMesh mesh = build_facets(warp, options);
-      const FacetError error = evaluate_facet_error(warp, mesh);
-      EXPECT_LE(error.max_px, 0.25) << "piece " << p;
-      EXPECT_EQ(error.missed_samples, 0u) << "piece " << p;
     }
+    EXPECT_GT(compared, 150);
+    EXPECT_LE(worst, bound) << "piece " << p;
+    FacetBuildOptions options;
+    options.layout = FacetTolerance{0.25};
+    const FacetMesh mesh = build_facets(warp, options);
+    const FacetError error = evaluate_facet_error(warp, mesh);
+    EXPECT_LE(error.max_px, 0.25) << "piece " << p;
+    EXPECT_EQ(error.missed_samples, 0u) << "piece " << p;
   }
 }
+
+INSTANTIATE_TEST_SUITE_P(Tiles, TileSample, testing::ValuesIn(kSamples),
+                         [](const testing::TestParamInfo<std::string>& sample) {
+                           std::string name = sample.param;
+                           std::replace(name.begin(), name.end(), '-', '_');
+                           return name;
+                         });
 
 TEST(Tiles, DiscontinuousTptsSplitsIntoPiecesWithComplementaryBlends) {
   const TileScreen screen = read_tile_screen(kTiles / "split-tpts.json");
