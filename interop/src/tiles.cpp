@@ -716,11 +716,16 @@ TileDisplay build_tile_display(const TileScreen& screen, glm::ivec2 size,
             return std::nullopt;
           };
           std::optional<glm::dvec2> found;
+          // Inside a coarse cell none of whose corners the lattice found, the lattice is not
+          // searched again.
+          bool search_lattice = true;
           if (ratio.x > 0) {
             const int a = std::min(i / ratio.x, coarse.grid.x - 2);
             const int b = std::min(j / ratio.y, coarse.grid.y - 2);
             const std::size_t c00 = coarse_at(a, b), c10 = coarse_at(a + 1, b),
                               c01 = coarse_at(a, b + 1), c11 = coarse_at(a + 1, b + 1);
+            search_lattice = coarse.solved[c00] || coarse.solved[c10] || coarse.solved[c01] ||
+                             coarse.solved[c11];
             if (coarse.solved[c00] && coarse.solved[c10] && coarse.solved[c01] &&
                 coarse.solved[c11]) {
               const double fx = double(i - a * ratio.x) / ratio.x;
@@ -735,7 +740,7 @@ TileDisplay build_tile_display(const TileScreen& screen, glm::ivec2 size,
           if (!found && j > 0 && solved[k - std::size_t(warp_grid.x)]) {
             found = near(xy[k - std::size_t(warp_grid.x)], 0.1);
           }
-          if (!found) {
+          if (!found && search_lattice) {
             double best = -2;
             glm::dvec2 guess(0.5);
             for (const auto& [g, dg] : lattice) {
