@@ -114,7 +114,8 @@ void main() {
       (gl_WorkGroupID.y * kWalkRow + gl_WorkGroupID.x) * LOCAL_SIZE + gl_LocalInvocationIndex;
   uint t = queued < grid_count ? grid_queue[queued] : triangle_count + 1u;
 #else
-  uint t = gl_GlobalInvocationID.x;
+  // Rows of kWalkRow work groups (ListArgs: a dispatch may hold 65535 groups a dimension).
+  uint t = (gl_WorkGroupID.y * kWalkRow + gl_WorkGroupID.x) * LOCAL_SIZE + gl_LocalInvocationIndex;
 #endif
   if (gl_LocalInvocationIndex == 0u) {
     group_pairs = 0u;

@@ -81,6 +81,7 @@ layout(std430, binding = 13) writeonly buffer MaterialRanges { uvec2 material_ra
 layout(std430, binding = 27) readonly buffer MaterialFirstEntries { uint material_first_entry[]; };
 // The indirect arguments (kListArgs* in replication_common.hpp): the cull pass's dispatch (one
 // invocation per triangle and one more), the per-triangle dispatch (scatter, replicate.comp),
+// each in rows of kRowGroups work groups,
 // facets-gs' pass-1 draw, then a patch draw per material for the tessellator form.
 layout(std430, binding = 25) writeonly buffer ListArgs { uint list_args[]; };
 layout(std430, binding = 24) readonly buffer ObjectVisible { uint object_state[]; };
@@ -88,6 +89,9 @@ layout(location = 43) uniform uint material_count;
 layout(location = 51) uniform uint patch_instances;  // the tessellator form's instances per draw
 const uint kTableBlockTriangles = 64u;  // kListBlockTriangles
 const uint kLocalSize = 64u;  // count.comp, scatter.comp and replicate.comp
+// Their dispatches come in rows of this many work groups (kListArgsRowGroups), as a dispatch may
+// hold 65535 groups a dimension: a list of over 4.2 million triangles takes more than one row.
+const uint kRowGroups = 1024u;
 
 void set_block_entry(uint block, uint entry) {
   list_out[list_entries + 1u + block / 4u][block % 4u] = entry;
@@ -125,9 +129,11 @@ void main() {
   if (k != 0u) return;
   list_out[list_entries] = uvec4(total, list_triangles_sole_piece, 0u, 0u);
   list_triangles = total;
-  uint args[16] = uint[16]((total + kLocalSize) / kLocalSize, 1u, 1u, 0u,
-                           (total + kLocalSize - 1u) / kLocalSize, 1u, 1u, 0u,
-                           total, 1u, 0u, 0u, 0u, 0u, 0u, 0u);
+  uint cull_groups = total / kLocalSize + 1u, triangle_groups = (total + kLocalSize - 1u) / kLocalSize;
+  uint args[16] = uint[16](min(cull_groups, kRowGroups), (cull_groups + kRowGroups - 1u) / kRowGroups,
+                           1u, 0u, min(triangle_groups, kRowGroups),
+                           (triangle_groups + kRowGroups - 1u) / kRowGroups, 1u, 0u, total, 1u, 0u,
+                           0u, 0u, 0u, 0u, 0u);
   for (uint a = 0u; a < 16u; ++a) list_args[a] = args[a];
 }
 #endif

@@ -14,9 +14,12 @@ layout(std430, binding = 12) buffer Stats {
 uint list_triangle_count();
 layout(location = 45) uniform uint pair_capacity;
 
+const uint kRowGroups = 1024u;  // kListArgsRowGroups
+
 void main() {
   uint triangle_count = list_triangle_count();
-  uint t = gl_GlobalInvocationID.x;
+  // Rows of kRowGroups work groups (ListArgs: a dispatch may hold 65535 groups a dimension).
+  uint t = (gl_WorkGroupID.y * kRowGroups + gl_WorkGroupID.x) * 64u + gl_LocalInvocationIndex;
   uint total = scan[triangle_count];
   if (t == 0u) {
     pair_total = total;

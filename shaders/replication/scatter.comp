@@ -32,9 +32,12 @@ uint vertex_index_of(uint e, uint t);
 uint object_of(uint e);
 uint triangle_id(uint e, uint t);
 
+const uint kRowGroups = 1024u;  // kListArgsRowGroups
+
 void main() {
   uint triangle_count = list_triangle_count();
-  uint t = gl_GlobalInvocationID.x;
+  // Rows of kRowGroups work groups (ListArgs: a dispatch may hold 65535 groups a dimension).
+  uint t = (gl_WorkGroupID.y * kRowGroups + gl_WorkGroupID.x) * uint(LOCAL_SIZE) + gl_LocalInvocationIndex;
   if (t >= triangle_count || overflow != 0u) return;
   uint first = scan(t), count = scan(t + 1u) - first;
   if (count == 0u) return;

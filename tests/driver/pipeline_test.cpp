@@ -798,6 +798,56 @@ TEST(Pipeline, GpuSolePiecesAreTheCpusOnTheCityTiles) {
   EXPECT_EQ(ids[1], ids[0]);
 }
 
+// A list of more triangles than one row of 65535 work groups of 64 holds (4,194,240, GL's least
+// limit a dimension) is covered whole, with the list built on the CPU and on the GPU: the
+// dispatches after the list come in rows (llvmpipe does not check an indirect dispatch's size,
+// so there one row passes too). One triangle in the middle of a strip, then 4.3 million copies of
+// a smaller one beside it.
+TEST(Pipeline, ListsOfMoreThanOneDispatchRowAreCoveredWhole) {
+  test::shared_context();
+  Scene scene;
+  scene.materials.resize(1);
+  const glm::mat3 R_eye_strip(glm::rotate(glm::mat4(1.0f), -0.3927f, glm::vec3(0, 1, 0)));
+  for (const glm::vec3& p :
+       {glm::vec3(-0.15f, -0.25f, -1), glm::vec3(0.15f, -0.25f, -1), glm::vec3(0.0f, 0.05f, -1),
+        glm::vec3(-0.04f, 0.2f, -1), glm::vec3(0.04f, 0.2f, -1), glm::vec3(0.0f, 0.28f, -1)}) {
+    scene.positions.push_back(R_eye_strip * p);
+    scene.normals.push_back({0, 0, 1});
+    scene.uvs.push_back({0, 0});
+  }
+  const std::uint32_t triangles = 4'300'000;
+  scene.indices.resize(3 * std::size_t(triangles));
+  for (std::size_t i = 0; i < scene.indices.size(); ++i)
+    scene.indices[i] = std::uint32_t(i % 3 + (i < 3 ? 0 : 3));
+  scene.primitives.push_back({0, std::uint32_t(scene.indices.size()), 0});
+  Object object;
+  object.primitive_count = 1;
+  scene.objects.push_back(object);
+  scene.update_bounds();
+  const auto outputs = load_display_outputs("builtin:cylinder360", glm::ivec2(128, 96));
+  const GpuScene gpu = upload_scene(scene);
+  for (const TriangleListBuild list : {TriangleListBuild::cpu, TriangleListBuild::gpu}) {
+    SCOPED_TRACE(list == TriangleListBuild::gpu ? "GPU list" : "CPU list");
+    RenderSettings settings = strips(8);
+    settings.triangle_list = list;
+    auto renderer = make_render_method("facets");
+    renderer->prepare(scene, gpu, outputs, settings);
+    std::vector<OutputTarget> targets;
+    targets.push_back(OutputTarget::create(outputs[0].warp.output_size));
+    const RenderStats stats = renderer->render(glm::dmat4(1.0), targets);
+    check_gl_error("render");
+    EXPECT_EQ(stats.triangles_in, triangles);
+    EXPECT_EQ(stats.triangles_visible, triangles);
+    EXPECT_EQ(stats.replicas, triangles);
+    // The first triangle (ID 1), and the first copy (ID 2) in front of the later copies at the
+    // same depth.
+    const auto ids = targets[0].read_ids();
+    EXPECT_GT(count_value(ids, 1), 10u);
+    EXPECT_GT(count_value(ids, 2), 0u);
+    EXPECT_EQ(count_value(ids, 0) + count_value(ids, 1) + count_value(ids, 2), ids.size());
+  }
+}
+
 // The pair buffers start at one pair per triangle: a view that needs more overflows them, the
 // frame is replicated again with room, and its image is the one a roomy frame gives. Both pair
 // pipelines size their buffers this way, without reading the pair count back before drawing,

@@ -289,9 +289,27 @@ void FacetMethodBase::build_list_on_cpu(std::size_t i) {
     args[at + 2] = begin;
   }
   out.triangles = triangles;
-  const std::uint32_t groups = triangles / 64 + 1, triangle_groups = (triangles + 63) / 64;
+  const std::uint32_t cull_groups = triangles / 64 + 1, triangle_groups = (triangles + 63) / 64;
+  const auto rows = [](std::uint32_t groups) {
+    return (groups + kListArgsRowGroups - 1) / kListArgsRowGroups;
+  };
   const std::uint32_t fixed_args[kListArgsPatchDraws] = {
-      groups, 1, 1, 0, triangle_groups, 1, 1, 0, triangles, 1, 0, 0, 0, 0, 0, 0};
+      std::min(cull_groups, kListArgsRowGroups),
+      rows(cull_groups),
+      1,
+      0,
+      std::min(triangle_groups, kListArgsRowGroups),
+      rows(triangle_groups),
+      1,
+      0,
+      triangles,
+      1,
+      0,
+      0,
+      0,
+      0,
+      0,
+      0};
   std::copy_n(fixed_args, kListArgsPatchDraws, args.begin());
   out.list_args.sub_data(0, args.size() * sizeof(std::uint32_t), args.data());
   const std::uint32_t list_counts[2] = {triangles, out.triangles_sole_piece};

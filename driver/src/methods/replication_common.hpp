@@ -99,11 +99,15 @@ std::vector<std::uint32_t> list_block_table(std::span<const ListEntry> list,
 
 // The list's indirect arguments (binding::list_args, uint words), written with the list: the cull
 // pass's dispatch (a work group per 64 list triangles and one more), the per-triangle dispatch
-// of the scatter and replicate.comp, facets-gs' pass-1 draw (DrawArraysIndirectCommand of the
+// of the scatter and replicate.comp (both in rows of kListArgsRowGroups groups), facets-gs'
+// pass-1 draw (DrawArraysIndirectCommand of the
 // list's triangles), then from kListArgsPatchDraws a patch draw of each material's triangles for
 // the tessellator form.
 inline constexpr std::uint32_t kListArgsCullDispatch = 0, kListArgsTriangleDispatch = 4,
                                kListArgsTriangleDraw = 8, kListArgsPatchDraws = 16;
+// The dispatches come in rows of this many work groups of 64 (GL guarantees 65535 groups a
+// dimension): a list of more than 65535 · 64 triangles takes several rows.
+inline constexpr std::uint32_t kListArgsRowGroups = 1024;
 
 class FacetMethodBase : public RenderMethod {
  public:
