@@ -738,6 +738,8 @@ TEST(Pipeline, GpuTriangleListGivesTheCpuListsIds) {
         const RenderStats gpu_stats = gpu_renderer->render(view, gpu_targets);
         check_gl_error("render");
         EXPECT_FALSE(gpu_stats.reused_replication) << frame;
+        EXPECT_TRUE(gpu_stats.triangle_list_on_gpu) << frame;
+        EXPECT_FALSE(cpu_stats.triangle_list_on_gpu) << frame;
         EXPECT_GE(gpu_stats.triangles_in, cpu_stats.triangles_in) << frame;
         EXPECT_LE(gpu_stats.triangles_in, cpu_stats.triangles_in + cpu_stats.triangles_in / 10)
             << frame;

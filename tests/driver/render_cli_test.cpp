@@ -178,6 +178,14 @@ TEST(RenderCli, TheViewMovesUnlessStatic) {
   EXPECT_TRUE(s["reused_replication"].get<bool>());
   EXPECT_EQ(s["reused_frames"].get<int>(), 2);
   EXPECT_TRUE(s["static_view"].get<bool>());
+  // --triangle-list: auto takes the CPU on this software renderer; gpu draws the same.
+  EXPECT_FALSE(m["triangle_list_on_gpu"].get<bool>());
+  const Result on_gpu = run_cli(common + " --triangle-list gpu");
+  ASSERT_EQ(on_gpu.status, 0) << on_gpu.output;
+  const nlohmann::json g = nlohmann::json::parse(on_gpu.output);
+  EXPECT_TRUE(g["triangle_list_on_gpu"].get<bool>());
+  EXPECT_EQ(g["replicas"], m["replicas"]);
+  EXPECT_EQ(g["triangles_in"], m["triangles_in"]);
   std::filesystem::remove_all(folder);
 }
 

@@ -382,6 +382,7 @@ void run(const RenderOptions& options) {
                            {"triangles_in", last.triangles_in},
                            {"triangles_visible", last.triangles_visible},
                            {"triangles_sole_piece", last.triangles_sole_piece},
+                           {"triangle_list_on_gpu", last.triangle_list_on_gpu},
                            {"replicas", last.replicas},
                            {"replication_ratio", last.replication_ratio()},
                            {"replication_ratio_mean", ratio_sum / double(frame_count)},

@@ -430,6 +430,7 @@ void FacetMethodBase::add_output_stats(const OutputState& out, RenderStats& stat
   stats.facets += out.facets.mesh.facets.size();
   stats.triangles_in += out.triangles;
   stats.triangles_sole_piece += out.triangles_sole_piece;
+  stats.triangle_list_on_gpu = stats.triangle_list_on_gpu || out.list_on_gpu;
   stats.gpu_buffer_bytes += buffer_bytes(out);
 }
 

@@ -135,6 +135,9 @@ struct RenderStats {
   // and clear of every other piece's (sole_piece_of_sphere), which pass 1 gives that piece
   // without the coverage grid.
   std::uint64_t triangles_sole_piece = 0;
+  // Facet pipelines: whether an output's triangle list was built on the GPU
+  // (RenderSettings::triangle_list).
+  bool triangle_list_on_gpu = false;
   std::uint64_t replicas = 0;  // triangle draws issued, summed over outputs
   std::uint64_t facets = 0;    // facets over all outputs (0 for non-facet methods)
   // Passes 1+2 skipped: neither the view nor any object's transform changed since the last frame.
