@@ -22,7 +22,6 @@ std::vector<std::vector<std::uint32_t>> gpu_triangle_coverage(
 namespace facet::driver::detail {
 namespace {
 
-constexpr GLuint kLocalSize = 64;
 // A queue's header: its pass's indirect dispatch (x, y, z), then the queue's length
 // (replication/count.comp).
 constexpr std::size_t kQueueHeaderWords = 4;
