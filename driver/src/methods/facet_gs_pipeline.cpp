@@ -53,11 +53,14 @@ class FacetGsPipeline final : public PairPipelineBase {
       TimedPass scope(timer, "pass1 coverage");
       const std::uint32_t zero[4] = {0, 0, 0, 0};
       out.stats.sub_data(0, sizeof zero, zero);
-      // Transform feedback writes the list's counts; the scan's end marker, past them, is 0.
+      // Transform feedback writes the list's counts; the scan's end marker, past them, is 0. A
+      // list built on the GPU may end anywhere up to n, so every word is cleared; a CPU list's
+      // has n triangles, so only the marker is.
       const std::uint32_t no_count = 0;
-      glClearNamedBufferSubData(out.scan.id(), GL_R32UI, 0,
-                                (std::size_t(n) + 1) * sizeof(std::uint32_t), GL_RED_INTEGER,
-                                GL_UNSIGNED_INT, &no_count);
+      const std::size_t cleared_from = out.list_on_gpu ? 0 : n;
+      glClearNamedBufferSubData(out.scan.id(), GL_R32UI, cleared_from * sizeof(std::uint32_t),
+                                (std::size_t(n) + 1 - cleared_from) * sizeof(std::uint32_t),
+                                GL_RED_INTEGER, GL_UNSIGNED_INT, &no_count);
       // Pass 1 draws (with rasterizer discard), which needs a complete framebuffer bound.
       target.bind();
       bind_output(i);
