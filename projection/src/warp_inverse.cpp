@@ -41,28 +41,33 @@ bool newton_in_cell(glm::dvec2 q00, glm::dvec2 q10, glm::dvec2 q01, glm::dvec2 q
 
 }  // namespace
 
-WarpInverse::WarpInverse(Warp warp) : warp_(std::move(warp)) {
+WarpInverse::WarpInverse(Warp warp) : WarpInverse(std::move(warp), {}, false) {}
+
+int WarpInverse::cell_rank(const std::vector<float>& ranking, int i, int j) const {
+  const int covered = int(ranking[warp_.node_index(i, j)] >= 0.5f) +
+                      int(ranking[warp_.node_index(i + 1, j)] >= 0.5f) +
+                      int(ranking[warp_.node_index(i, j + 1)] >= 0.5f) +
+                      int(ranking[warp_.node_index(i + 1, j + 1)] >= 0.5f);
+  return covered == 4 ? 2 : covered > 0 ? 1 : 0;  // bilinear coverage stays within its corners
+}
+
+WarpInverse::WarpInverse(Warp warp, const std::vector<float>& ranking_or_empty, bool continued)
+    : warp_(std::move(warp)) {
   FACET_ASSERT(warp_.grid_size.x >= 2 && warp_.grid_size.y >= 2);
   FACET_ASSERT(warp_.offset_px.size() == std::size_t(warp_.grid_size.x) * warp_.grid_size.y);
   FACET_ASSERT(warp_.coverage.size() == warp_.offset_px.size());
+  const std::vector<float>& ranking = ranking_or_empty.empty() ? warp_.coverage : ranking_or_empty;
+  FACET_ASSERT(ranking.size() == warp_.coverage.size());
   cells_ = warp_.grid_size - 1;
   const glm::ivec2 size = warp_.output_size;
   cell_of_pixel_.assign(std::size_t(std::max(size.x, 0)) * std::max(size.y, 0), -1);
 
-  // Partly covered cells first, so that where an uncovered part overlaps a fully covered cell
+  // Cells of lower rank first, so that where an uncovered part overlaps a fully covered cell
   // (uncovered nodes need not be injective) the covered cell is stored.
-  auto coverage_class = [&](int i, int j) {
-    const float a[4] = {
-        warp_.coverage[warp_.node_index(i, j)], warp_.coverage[warp_.node_index(i + 1, j)],
-        warp_.coverage[warp_.node_index(i, j + 1)], warp_.coverage[warp_.node_index(i + 1, j + 1)]};
-    const int covered =
-        int(a[0] >= 0.5f) + int(a[1] >= 0.5f) + int(a[2] >= 0.5f) + int(a[3] >= 0.5f);
-    return covered == 4 ? 2 : covered > 0 ? 1 : 0;  // bilinear coverage stays within its corners
-  };
-  for (int pass = 1; pass <= 2; ++pass) {
+  for (int pass = continued ? 0 : 1; pass <= 2; ++pass) {
     for (int j = 0; j < cells_.y; ++j) {
       for (int i = 0; i < cells_.x; ++i) {
-        if (coverage_class(i, j) != pass) continue;
+        if (cell_rank(ranking, i, j) != pass) continue;
         const std::int32_t cell = j * cells_.x + i;
         // Counter-clockwise in a y-down image: s right, t down.
         const glm::dvec2 quad[4] = {q_node(i, j), q_node(i + 1, j), q_node(i + 1, j + 1),
@@ -98,27 +103,24 @@ WarpInverse::WarpInverse(Warp warp) : warp_(std::move(warp)) {
       }
     }
   }
-  build_bins();
+  build_bins(ranking, continued);
 }
 
-void WarpInverse::build_bins() {
-  // Bounds of every cell that has a covered corner, grown by a hair so that points on an edge
-  // land in the bin of each cell they touch.
+void WarpInverse::build_bins(const std::vector<float>& ranking, bool continued) {
+  // Bounds of every cell that has a covered corner (every cell when continued), grown by a hair
+  // so that points on an edge land in the bin of each cell they touch; higher ranks first.
   std::vector<std::int32_t> cells;
   std::vector<glm::dvec2> lo, hi;
-  for (int j = 0; j < cells_.y; ++j) {
-    for (int i = 0; i < cells_.x; ++i) {
-      if (!(warp_.coverage[warp_.node_index(i, j)] >= 0.5f ||
-            warp_.coverage[warp_.node_index(i + 1, j)] >= 0.5f ||
-            warp_.coverage[warp_.node_index(i, j + 1)] >= 0.5f ||
-            warp_.coverage[warp_.node_index(i + 1, j + 1)] >= 0.5f)) {
-        continue;
+  for (int rank = 2; rank >= (continued ? 0 : 1); --rank) {
+    for (int j = 0; j < cells_.y; ++j) {
+      for (int i = 0; i < cells_.x; ++i) {
+        if (cell_rank(ranking, i, j) != rank) continue;
+        const glm::dvec2 a = q_node(i, j), b = q_node(i + 1, j), c = q_node(i, j + 1),
+                         d = q_node(i + 1, j + 1);
+        cells.push_back(j * cells_.x + i);
+        lo.push_back(glm::min(glm::min(a, b), glm::min(c, d)) - 1e-6);
+        hi.push_back(glm::max(glm::max(a, b), glm::max(c, d)) + 1e-6);
       }
-      const glm::dvec2 a = q_node(i, j), b = q_node(i + 1, j), c = q_node(i, j + 1),
-                       d = q_node(i + 1, j + 1);
-      cells.push_back(j * cells_.x + i);
-      lo.push_back(glm::min(glm::min(a, b), glm::min(c, d)) - 1e-6);
-      hi.push_back(glm::max(glm::max(a, b), glm::max(c, d)) + 1e-6);
     }
   }
   if (cells.empty()) return;
@@ -321,8 +323,9 @@ std::int32_t WarpInverse::cell_at_pixel(glm::ivec2 pixel) const {
 }
 
 WarpInverse continued_inverse(Warp warp) {
+  const std::vector<float> ranking = warp.coverage;
   warp.coverage.assign(warp.coverage.size(), 1.0f);
-  return WarpInverse(std::move(warp));
+  return WarpInverse(std::move(warp), ranking, true);
 }
 
 }  // namespace facet

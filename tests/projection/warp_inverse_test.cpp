@@ -147,6 +147,50 @@ TEST(WarpInverse, UncoveredNodesHaveNoPreimage) {
   EXPECT_LE(worst_forward_then_inverse(inverse, 4000, 3), 1e-9);
 }
 
+TEST(WarpInverse, AContinuedInverseKeepsTheCoveredAnswerWhereItsContinuationOverlapsIt) {
+  // Node columns 0-4 covered at their own positions (q.x = 40 i); columns 5-8 uncovered, column 5
+  // in place (q.x = 200) and 6-8 laid over the covered part (q.x = 0, 40, 80), as an
+  // extrapolated offset field may lie: cells 6 and 7 cover q.x in [0, 80] a second time, the
+  // right way round.
+  Warp warp = Warp::analytic(BaseProjection::perspective_fov(90, 70), {320, 240}, {9, 5});
+  for (int j = 0; j < 5; ++j) {
+    for (int i = 5; i < 9; ++i) {
+      const float folded_x = i == 5 ? 200.0f : 40.0f * float(i - 6);
+      warp.offset_px[warp.node_index(i, j)] = glm::vec2(folded_x - 40.0f * float(i), 0);
+      warp.coverage[warp.node_index(i, j)] = 0;
+    }
+  }
+  const WarpInverse inverse(warp);
+  const WarpInverse continued = continued_inverse(warp);
+  std::size_t compared = 0;
+  double worst_st = 0;
+  for (int y = 0; y < 240; y += 3) {
+    for (int x = 0; x < 320; ++x) {
+      const glm::dvec2 q(x + 0.5, y + 0.5);
+      const auto covered = inverse.st_from_q(q);
+      if (!covered) continue;
+      const auto either = continued.st_from_q(q);
+      ASSERT_TRUE(either.has_value()) << x << ", " << y;
+      worst_st = std::max(worst_st, glm::length(*either - *covered));
+      ++compared;
+    }
+  }
+  // Coverage reaches 0.5 halfway between columns 4 and 5 (q.x = 180).
+  EXPECT_EQ(compared, 180u * 80u);
+  EXPECT_LE(worst_st, 1e-12);
+  // Past the coverage's edge the partly covered cell (columns 4-5) answers before the fold, and
+  // between pixel centres too.
+  for (const glm::dvec2 q : {glm::dvec2(190.5, 100.5), glm::dvec2(185.25, 7.75)}) {
+    EXPECT_FALSE(inverse.st_from_q(q).has_value());
+    const auto past = continued.st_from_q(q);
+    ASSERT_TRUE(past.has_value());
+    EXPECT_NEAR(past->x, q.x / 320, 1e-12);
+    EXPECT_NEAR(past->y, q.y / 240, 1e-12);
+  }
+  // Only the continuation reaches q.x in (200, 320): nothing there.
+  EXPECT_FALSE(continued.st_from_q({250.5, 100.5}).has_value());
+}
+
 TEST(WarpInverse, EyeDirectionProjectsBackToQ) {
   Warp warp = test::with_smooth_offsets(
       Warp::analytic(BaseProjection::equirectangular(-120, 120, 60, -60), {480, 240}), {13, 7}, 5);

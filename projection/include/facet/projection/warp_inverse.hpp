@@ -71,11 +71,19 @@ class WarpInverse {
   // Moves from cell to neighbouring cell towards q until the solution lies inside the cell.
   std::optional<glm::dvec2> walk_from(glm::ivec2 cell, glm::dvec2 q) const;
   glm::dvec2 q_node(int i, int j) const;
+  // The cell table and the bins, with cells ranked by `ranking` (node coverage, the warp's own
+  // for an inverse, the warp's real one for a continued inverse): cells with every corner covered
+  // are stored last, so that they hold every pixel centre they cover, and the bins list them
+  // first. Cells of rank 0 (no covered corner) enter only when `continued`.
+  WarpInverse(Warp warp, const std::vector<float>& ranking, bool continued);
+  friend WarpInverse continued_inverse(Warp warp);
+  // 2 when all four corners of cell (i, j) are covered in `ranking`, 1 when some are, else 0.
+  int cell_rank(const std::vector<float>& ranking, int i, int j) const;
   // Calls found(y · width + x, st) for every covered pixel centre, rows in parallel on
   // `threads` threads (0: every hardware thread); no row begins once `stop` is requested.
   void for_each_pixel_centre(const std::function<void(std::size_t, glm::dvec2)>& found,
                              std::size_t threads, std::stop_token stop = {}) const;
-  void build_bins();
+  void build_bins(const std::vector<float>& ranking, bool continued);
 
   Warp warp_;
   glm::ivec2 cells_{0, 0};
@@ -89,7 +97,9 @@ class WarpInverse {
 };
 
 // The inverse of the warp's map over its whole base image, coverage ignored: output positions
-// just past the coverage's edge invert too, the offsets being defined there.
+// just past the coverage's edge invert too, the offsets being defined there. Where the
+// continuation folds back over covered output (its offsets are only an extrapolation), a
+// position the warp covers still inverts to its covered st, as the plain inverse gives it.
 WarpInverse continued_inverse(Warp warp);
 
 }  // namespace facet
