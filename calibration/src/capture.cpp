@@ -44,65 +44,6 @@ void check_rotation(const glm::dmat3& R, const FieldPath& at) {
 
 bool is_unit(const glm::dvec3& v) { return std::abs(glm::length(v) - 1.0) <= 1e-6; }
 
-Screen screen_from_json(const Json& object, const FieldPath& at) {
-  using namespace json_fields;
-  Fields fields(object, at);
-  const std::string expected_type = "\"sphere\", \"cylinder\" or \"plane\"";
-  const std::string type = to_string(fields.required("type", expected_type), at["type"]);
-  Screen screen;
-  auto read_point = [&](const std::string& key) {
-    return to_dvec3(fields.required(key, "a point in metres"), at[key]);
-  };
-  auto read_radius = [&] {
-    const double radius =
-        to_number(fields.required("radius", "a positive number of metres"), at["radius"]);
-    if (!(radius > 0)) at["radius"].fail("a positive number of metres", radius);
-    return radius;
-  };
-  auto read_unit = [&](const std::string& key) {
-    const glm::dvec3 v = to_dvec3(fields.required(key, "a list of 3 numbers"), at[key]);
-    const double length = glm::length(v);
-    if (!(length > 1e-12)) at[key].fail("a non-zero vector");
-    return v / length;
-  };
-  if (type == "sphere") {
-    screen.type = Screen::Type::sphere;
-    screen.center = read_point("center");
-    screen.radius = read_radius();
-  } else if (type == "cylinder") {
-    screen.type = Screen::Type::cylinder;
-    screen.center = read_point("center");
-    screen.axis = read_unit("axis");
-    screen.radius = read_radius();
-  } else if (type == "plane") {
-    screen.type = Screen::Type::plane;
-    screen.point = read_point("point");
-    screen.normal = read_unit("normal");
-  } else {
-    at["type"].fail(expected_type, type);
-  }
-  fields.finish();
-  return screen;
-}
-
-nlohmann::json screen_to_json(const Screen& screen) {
-  using json_fields::from_dvec3;
-  switch (screen.type) {
-    case Screen::Type::sphere:
-      return {{"type", "sphere"}, {"center", from_dvec3(screen.center)}, {"radius", screen.radius}};
-    case Screen::Type::cylinder:
-      return {{"type", "cylinder"},
-              {"center", from_dvec3(screen.center)},
-              {"axis", from_dvec3(screen.axis)},
-              {"radius", screen.radius}};
-    case Screen::Type::plane:
-      return {{"type", "plane"},
-              {"point", from_dvec3(screen.point)},
-              {"normal", from_dvec3(screen.normal)}};
-  }
-  FACET_ASSERT(false);
-}
-
 CaptureProjector projector_from_json(const Json& object, const FieldPath& at) {
   using namespace json_fields;
   Fields fields(object, at);
@@ -242,7 +183,7 @@ Capture read_capture(const std::filesystem::path& path) {
   }
   camera.finish();
   if (const Json* screen = fields.optional("screen")) {
-    capture.screen = screen_from_json(*screen, at["screen"]);
+    capture.screen = json_fields::to_screen(*screen, at["screen"]);
   }
   const Json& projectors = fields.required("projectors", "a list of projectors");
   if (!projectors.is_array()) at["projectors"].fail("a list of projectors", projectors);
@@ -296,7 +237,7 @@ nlohmann::json capture_to_json(const Capture& capture) {
                           {"frames", frames}});
   }
   nlohmann::json root{{"format", kCaptureFormat}, {"camera", camera}, {"projectors", projectors}};
-  if (capture.screen) root["screen"] = screen_to_json(*capture.screen);
+  if (capture.screen) root["screen"] = json_fields::from_screen(*capture.screen);
   if (capture.truth) root["truth"] = capture.truth->generic_string();
   if (capture.display) root["display"] = capture.display->generic_string();
   return root;

@@ -263,6 +263,13 @@ TEST(RigFile, BadFieldsNameFileAndField) {
   expect_error(R"({"format": "facet-rig/2"})", "format");
   expect_error(rig(R"({"type": "sphere", "center": [0,0,0], "radius": -1})", projector, camera),
                "screen.radius");
+  expect_error(rig(R"({"type": "sphere", "center": [0,0,0], "radius": 1e300})", projector, camera),
+               "screen.radius");
+  expect_error(rig(R"({"type": "plane", "point": [0,0,-3], "normal": [0,0,0]})", projector, camera),
+               "screen.normal");
+  expect_error(rig(R"({"type": "sphere", "center": [0,0,0], "radius": 5, "axis": [0,1,0]})",
+                   projector, camera),
+               "screen.axis");
   expect_error(rig(R"({"type": "cone"})", projector, camera), "screen.type");
   expect_error(rig(sphere, R"({"name": "p0", "size": [64, 48], "look_at": [0,0,-1]})", camera),
                "projectors[0].focal_px");

@@ -51,54 +51,6 @@ bool within_reach(const glm::dvec3& p_m) {
          std::abs(p_m.z) <= kMaxDistance_m;
 }
 
-DisplayScreen screen_from_json(const Json& value, const At& at) {
-  Fields fields(value, at);
-  const std::string expected_type = "\"sphere\", \"cylinder\" or \"plane\"";
-  const std::string type =
-      json_fields::to_string(fields.required("type", expected_type), at["type"]);
-  DisplayScreen screen;
-  auto point = [&](const char* key) {
-    return json_fields::to_dvec3(fields.required(key, "a point in metres"), at[key]);
-  };
-  auto unit = [&](const char* key) {
-    const glm::dvec3 v =
-        json_fields::to_dvec3(fields.required(key, "a list of 3 numbers"), at[key]);
-    if (!(glm::length(v) > 1e-12)) at[key].fail("a non-zero vector");
-    return glm::normalize(v);
-  };
-  if (type == "sphere" || type == "cylinder") {
-    screen.type = type == "sphere" ? DisplayScreen::Type::sphere : DisplayScreen::Type::cylinder;
-    screen.center = point("center");
-    screen.radius = json_fields::to_number(fields.required("radius", "a positive number of metres"),
-                                           at["radius"]);
-    if (type == "cylinder") screen.axis = unit("axis");
-  } else if (type == "plane") {
-    screen.type = DisplayScreen::Type::plane;
-    screen.point = point("point");
-    screen.normal = unit("normal");
-  } else {
-    at["type"].fail(expected_type, type);
-  }
-  fields.finish();
-  return screen;
-}
-
-Json screen_to_json(const DisplayScreen& screen) {
-  auto list = [](const glm::dvec3& v) { return Json::array({v.x, v.y, v.z}); };
-  switch (screen.type) {
-    case DisplayScreen::Type::sphere:
-      return {{"type", "sphere"}, {"center", list(screen.center)}, {"radius", screen.radius}};
-    case DisplayScreen::Type::cylinder:
-      return {{"type", "cylinder"},
-              {"center", list(screen.center)},
-              {"axis", list(screen.axis)},
-              {"radius", screen.radius}};
-    case DisplayScreen::Type::plane:
-      return {{"type", "plane"}, {"point", list(screen.point)}, {"normal", list(screen.normal)}};
-  }
-  return {};
-}
-
 DisplayOutput output_from_json(const Json& value, const At& at) {
   Fields fields(value, at);
   const std::string expected = "{\"monitor\": NAME} or {\"window\": [x, y, width, height]}";
@@ -383,7 +335,7 @@ DisplayConfig display_from_json(const Json& document, const std::string& source,
   config.name = to_string(fields.required("name", "the display's name"), root["name"]);
   config.eye = to_dvec3(fields.required("eye", "[x, y, z] in metres"), root["eye"]);
   if (const Json* screen = fields.optional("screen")) {
-    config.screen = screen_from_json(*screen, root["screen"]);
+    config.screen = json_fields::to_screen(*screen, root["screen"]);
   }
   const std::string expected_projectors = "a list of at least one projector";
   const Json& projectors = fields.required("projectors", expected_projectors);
@@ -451,7 +403,7 @@ Json display_to_json(const DisplayConfig& config) {
   Json document = {{"format", kDisplayFormat},
                    {"name", config.name},
                    {"eye", {config.eye.x, config.eye.y, config.eye.z}}};
-  if (config.screen) document["screen"] = screen_to_json(*config.screen);
+  if (config.screen) document["screen"] = json_fields::from_screen(*config.screen);
   Json projectors = Json::array();
   for (const DisplayProjector& projector : config.projectors) {
     Json item = {{"name", projector.name},

@@ -206,6 +206,62 @@ Json from_dmat3(const glm::dmat3& m) {
   return rows;
 }
 
+Screen to_screen(const Json& value, const FieldPath& at) {
+  Fields fields(value, at);
+  const std::string expected_type = "\"sphere\", \"cylinder\" or \"plane\"";
+  const std::string type = to_string(fields.required("type", expected_type), at["type"]);
+  auto point = [&](const char* key) {
+    return to_dvec3(fields.required(key, "a point in metres"), at[key]);
+  };
+  auto unit = [&](const char* key) {
+    const glm::dvec3 v = to_dvec3(fields.required(key, "a list of 3 numbers"), at[key]);
+    if (!(glm::length(v) > 1e-12)) at[key].fail("a non-zero vector");
+    return glm::normalize(v);
+  };
+  auto radius = [&] {
+    const std::string expected = "a positive number of metres, at most 1,000 km (1e6 m)";
+    const double r = to_number(fields.required("radius", expected), at["radius"]);
+    if (!(r > 0 && r <= 1e6)) at["radius"].fail(expected, r);
+    return r;
+  };
+  Screen screen;
+  if (type == "sphere") {
+    screen.type = Screen::Type::sphere;
+    screen.center = point("center");
+    screen.radius = radius();
+  } else if (type == "cylinder") {
+    screen.type = Screen::Type::cylinder;
+    screen.center = point("center");
+    screen.axis = unit("axis");
+    screen.radius = radius();
+  } else if (type == "plane") {
+    screen.type = Screen::Type::plane;
+    screen.point = point("point");
+    screen.normal = unit("normal");
+  } else {
+    at["type"].fail(expected_type, type);
+  }
+  fields.finish();
+  return screen;
+}
+
+Json from_screen(const Screen& screen) {
+  switch (screen.type) {
+    case Screen::Type::sphere:
+      return {{"type", "sphere"}, {"center", from_dvec3(screen.center)}, {"radius", screen.radius}};
+    case Screen::Type::cylinder:
+      return {{"type", "cylinder"},
+              {"center", from_dvec3(screen.center)},
+              {"axis", from_dvec3(screen.axis)},
+              {"radius", screen.radius}};
+    case Screen::Type::plane:
+      return {{"type", "plane"},
+              {"point", from_dvec3(screen.point)},
+              {"normal", from_dvec3(screen.normal)}};
+  }
+  return {};
+}
+
 // Deeper nesting is refused while parsing: no facet document comes near it, and walking such a
 // document recursively (dumping a value into an error message) would overflow the stack.
 constexpr int kMaxJsonDepth = 256;

@@ -19,6 +19,8 @@
 #include <string_view>
 #include <vector>
 
+#include "facet/projection/screen.hpp"
+
 namespace facet::json_fields {
 
 using Json = nlohmann::json;
@@ -108,6 +110,15 @@ glm::dmat3 to_dmat3(const Json& value, const FieldPath& at);
 
 Json from_dvec3(const glm::dvec3& v);
 Json from_dmat3(const glm::dmat3& m);
+
+// A screen surface, as display.json, rig files and capture.json all hold it:
+//   {"type": "sphere", "center": [x, y, z], "radius": r}
+//   {"type": "cylinder", "center": [x, y, z], "axis": [x, y, z], "radius": r}
+//   {"type": "plane", "point": [x, y, z], "normal": [x, y, z]}
+// in metres; the axis and normal any non-zero length (normalised on reading), the radius in
+// (0, 1e6]. Unknown members are refused.
+Screen to_screen(const Json& value, const FieldPath& at);
+Json from_screen(const Screen& screen);
 
 // Parses `text` as JSON; fails with "expected valid JSON (...)" at the document.
 Json parse(const std::string& text, const std::string& source);

@@ -57,64 +57,6 @@ glm::dmat3 rotation(Fields& fields, const std::string& matrix_key, const glm::dv
   return glm::dmat3(right, down, forward);
 }
 
-Screen screen_from_json(const Json& value, const At& at) {
-  Fields fields(value, at);
-  const std::string expected = "\"sphere\", \"cylinder\" or \"plane\"";
-  const std::string type = to_string(fields.required("type", expected), at["type"]);
-  Screen screen;
-  auto radius = [&] {
-    const double r =
-        to_number(fields.required("radius", "a positive number of metres"), at["radius"]);
-    if (!(r > 0)) at["radius"].fail("a positive number of metres", r);
-    return r;
-  };
-  auto point = [&](const std::string& key) {
-    return to_dvec3(fields.required(key, "a point in metres"), at[key]);
-  };
-  auto unit = [&](const std::string& key) {
-    const glm::dvec3 v = to_dvec3(fields.required(key, "a list of 3 numbers"), at[key]);
-    if (!(glm::length(v) > 1e-12)) at[key].fail("a non-zero vector");
-    return glm::normalize(v);
-  };
-  if (type == "sphere") {
-    screen.type = Screen::Type::sphere;
-    screen.center = point("center");
-    screen.radius = radius();
-  } else if (type == "cylinder") {
-    screen.type = Screen::Type::cylinder;
-    screen.center = point("center");
-    screen.axis = unit("axis");
-    screen.radius = radius();
-  } else if (type == "plane") {
-    screen.type = Screen::Type::plane;
-    screen.point = point("point");
-    screen.normal = unit("normal");
-  } else {
-    at["type"].fail(expected, type);
-  }
-  fields.finish();
-  return screen;
-}
-
-Json screen_to_json(const Screen& screen) {
-  switch (screen.type) {
-    case Screen::Type::sphere:
-      return {{"type", "sphere"},
-              {"center", json_fields::from_dvec3(screen.center)},
-              {"radius", screen.radius}};
-    case Screen::Type::cylinder:
-      return {{"type", "cylinder"},
-              {"center", json_fields::from_dvec3(screen.center)},
-              {"axis", json_fields::from_dvec3(screen.axis)},
-              {"radius", screen.radius}};
-    case Screen::Type::plane:
-      return {{"type", "plane"},
-              {"point", json_fields::from_dvec3(screen.point)},
-              {"normal", json_fields::from_dvec3(screen.normal)}};
-  }
-  return {};
-}
-
 ProjectorModel projector_from_json(const Json& value, const At& at) {
   Fields fields(value, at);
   ProjectorModel p;
@@ -235,7 +177,7 @@ Rig parse_rig(const std::string& text_in, const std::string& source) {
     at["format"].fail(expected_format, format);
   }
   Rig rig;
-  rig.screen = screen_from_json(fields.required("screen", "a screen object"), at["screen"]);
+  rig.screen = json_fields::to_screen(fields.required("screen", "a screen object"), at["screen"]);
   const Json& projectors = fields.required("projectors", "a list of projectors");
   if (!projectors.is_array()) at["projectors"].fail("a list of projectors", projectors);
   for (std::size_t k = 0; k < projectors.size(); ++k) {
@@ -299,7 +241,7 @@ std::string format_rig(const Rig& rig) {
               {"t_eye_camera", json_fields::from_dvec3(rig.camera.t_eye_camera)}};
   if (!rig.camera.intrinsics.empty()) camera["intrinsics"] = rig.camera.intrinsics;
   const Json root{{"format", kRigFormat},
-                  {"screen", screen_to_json(rig.screen)},
+                  {"screen", json_fields::from_screen(rig.screen)},
                   {"projectors", projectors},
                   {"camera", camera},
                   {"simulation", simulation_to_json(rig.simulation)}};
