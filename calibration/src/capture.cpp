@@ -42,8 +42,6 @@ void check_rotation(const glm::dmat3& R, const FieldPath& at) {
   }
 }
 
-bool is_unit(const glm::dvec3& v) { return std::abs(glm::length(v) - 1.0) <= 1e-6; }
-
 CaptureProjector projector_from_json(const Json& object, const FieldPath& at) {
   using namespace json_fields;
   Fields fields(object, at);
@@ -87,19 +85,7 @@ void validate_capture(const Capture& capture, const std::string& source) {
         "a screen description: the camera is not at the eye point (t_eye_camera is not 0), so "
         "directions from the eye need the surface");
   }
-  if (capture.screen) {
-    const Screen& screen = *capture.screen;
-    const FieldPath at = root["screen"];
-    if (screen.type != Screen::Type::plane && !(screen.radius > 0)) {
-      at["radius"].fail("a positive number of metres");
-    }
-    if (screen.type == Screen::Type::cylinder && !is_unit(screen.axis)) {
-      at["axis"].fail("a unit vector");
-    }
-    if (screen.type == Screen::Type::plane && !is_unit(screen.normal)) {
-      at["normal"].fail("a unit vector");
-    }
-  }
+  if (capture.screen) json_fields::check_screen(*capture.screen, root["screen"]);
   if (capture.projectors.empty()) root["projectors"].fail("a non-empty list of projectors");
   std::set<std::string> names;
   for (std::size_t p = 0; p < capture.projectors.size(); ++p) {

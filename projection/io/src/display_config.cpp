@@ -38,7 +38,6 @@ bool valid_method(const std::string& method) {
   return true;
 }
 
-bool is_unit(const glm::dvec3& v) { return std::abs(glm::length(v) - 1.0) <= 1e-6; }
 bool finite(const glm::dvec3& v) {
   return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
 }
@@ -205,24 +204,7 @@ void validate_display_config(const DisplayConfig& config, const std::string& sou
   if (config.name.empty()) root["name"].fail("a non-empty display name");
   if (!within_reach(config.eye))
     root["eye"].fail("3 finite numbers (metres), each within ±1,000 km (1e6 m)");
-  if (config.screen) {
-    const DisplayScreen& screen = *config.screen;
-    const At at = root["screen"];
-    if (!within_reach(screen.center) || !within_reach(screen.point) || !finite(screen.axis) ||
-        !finite(screen.normal)) {
-      at.fail("finite numbers, positions each within ±1,000 km (1e6 m)");
-    }
-    if (screen.type != DisplayScreen::Type::plane &&
-        !(screen.radius > 0 && screen.radius <= kMaxDistance_m)) {
-      at["radius"].fail("a positive number of metres, at most 1,000 km (1e6 m)");
-    }
-    if (screen.type == DisplayScreen::Type::cylinder && !is_unit(screen.axis)) {
-      at["axis"].fail("a unit vector");
-    }
-    if (screen.type == DisplayScreen::Type::plane && !is_unit(screen.normal)) {
-      at["normal"].fail("a unit vector");
-    }
-  }
+  if (config.screen) json_fields::check_screen(*config.screen, root["screen"]);
   if (config.projectors.empty()) root["projectors"].fail("a list of at least one projector");
   std::set<std::string> names;
   for (std::size_t k = 0; k < config.projectors.size(); ++k) {

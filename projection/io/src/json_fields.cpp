@@ -262,6 +262,32 @@ Json from_screen(const Screen& screen) {
   return {};
 }
 
+void check_screen(const Screen& screen, const FieldPath& at) {
+  constexpr double kMaxDistance_m = 1e6;
+  auto finite = [](const glm::dvec3& v) {
+    return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+  };
+  auto within_reach = [&](const glm::dvec3& p_m) {
+    return finite(p_m) && std::abs(p_m.x) <= kMaxDistance_m && std::abs(p_m.y) <= kMaxDistance_m &&
+           std::abs(p_m.z) <= kMaxDistance_m;
+  };
+  auto is_unit = [](const glm::dvec3& v) { return std::abs(glm::length(v) - 1.0) <= 1e-6; };
+  if (!within_reach(screen.center) || !within_reach(screen.point) || !finite(screen.axis) ||
+      !finite(screen.normal)) {
+    at.fail("finite numbers, positions each within ±1,000 km (1e6 m)");
+  }
+  if (screen.type != Screen::Type::plane &&
+      !(screen.radius > 0 && screen.radius <= kMaxDistance_m)) {
+    at["radius"].fail("a positive number of metres, at most 1,000 km (1e6 m)");
+  }
+  if (screen.type == Screen::Type::cylinder && !is_unit(screen.axis)) {
+    at["axis"].fail("a unit vector");
+  }
+  if (screen.type == Screen::Type::plane && !is_unit(screen.normal)) {
+    at["normal"].fail("a unit vector");
+  }
+}
+
 // Deeper nesting is refused while parsing: no facet document comes near it, and walking such a
 // document recursively (dumping a value into an error message) would overflow the stack.
 constexpr int kMaxJsonDepth = 256;

@@ -119,6 +119,10 @@ Json from_dmat3(const glm::dmat3& m);
 // (0, 1e6]. Unknown members are refused.
 Screen to_screen(const Json& value, const FieldPath& at);
 Json from_screen(const Screen& screen);
+// A screen as a validate checks one built in code: finite, positions and the radius within
+// 1,000 km, the radius positive, the axis (cylinder) and normal (plane) of unit length within
+// 1e-6. Fails at `at` or the field at fault.
+void check_screen(const Screen& screen, const FieldPath& at);
 
 // Parses `text` as JSON; fails with "expected valid JSON (...)" at the document.
 Json parse(const std::string& text, const std::string& source);
