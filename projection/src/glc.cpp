@@ -366,7 +366,7 @@ namespace {
 
 // The image-plane point of pixel corner (x, y) (see the constructors' comment).
 glm::dvec3 plane_point(glm::dvec2 pixel, glm::dvec2 plane_size, glm::ivec2 size) {
-  return {(pixel.x / size.x - 0.5) * plane_size.x, (0.5 - pixel.y / size.y) * plane_size.y, 0.0};
+  return {(pixel.x / size.x - 0.5) * plane_size.x, (pixel.y / size.y - 0.5) * plane_size.y, 0.0};
 }
 
 void check_plane(glm::dvec2 plane_size, glm::ivec2 size, const std::string& source,

@@ -168,8 +168,9 @@ void check_glc_size(glm::ivec2 size, const std::string& source, const std::strin
 PiecewiseGlc single_glc(const Glc& glc, glm::ivec2 size);
 
 // Constructors of the classic GLCs, all over a whole image of `size` pixels. The image plane is
-// the plane z = 0 of `frame`, on which pixel (x, y) lies at frame point
-//   ((x / w - 0.5)·plane_size.x, (0.5 - y / h)·plane_size.y, 0),
+// the plane z = 0 of `frame` (a camera-like frame: x right, y down, z forward), on which pixel
+// (x, y) lies at frame point
+//   ((x / w - 0.5)·plane_size.x, (y / h - 0.5)·plane_size.y, 0),
 // and the generators are the camera's rays through three corners of that rectangle.
 // Cross-slit: the rays through both slit lines (frame points and directions). Refused (naming
 // slit1/slit2): intersecting or parallel slits, a slit through a generator's image point, or
