@@ -222,6 +222,57 @@ TEST(RenderCli, BadInputExitsWithStatus2) {
   }
 }
 
+// A GLC camera (*.glc.json) renders with --method glc alone, and its file's errors name the file
+// and the field; the result is compared with the oracle casting the camera's own rays.
+TEST(RenderCli, GlcCameraRendersWithItsMethodAndRefusesBadInput) {
+  const std::filesystem::path folder =
+      std::filesystem::temp_directory_path() / ("facet_render_glc_" + std::to_string(getpid()));
+  std::filesystem::remove_all(folder);
+  std::filesystem::create_directories(folder);
+  const std::string good = (folder / "small.glc.json").string();
+  std::ofstream(good) << R"({"format": "facet-glc/1", "camera": {"type": "cross-slit",
+    "size": [96, 32], "plane_size": [3.2, 2.0],
+    "slit1": {"point": [0, 0, -1], "direction": [0, 1, 0]},
+    "slit2": {"point": [0, 0, -4], "direction": [1, 0, 0]}}})";
+  const std::string bad = (folder / "bad.glc.json").string();
+  std::ofstream(bad) << R"({"format": "facet-glc/1", "camera": {"type": "generators",
+    "size": [96, 32], "generators": [
+      {"origin": [0, 0, 0], "direction": [0, 0, 1], "pixel": [0, 0]},
+      {"origin": [1, 0, 0], "direction": [1, 0, 0], "pixel": [96, 0]},
+      {"origin": [0, 1, 0], "direction": [0, 0, 1], "pixel": [0, 32]}]}})";
+  const std::string huge = (folder / "huge.glc.json").string();
+  std::ofstream(huge) << R"({"format": "facet-glc/1", "camera": {"type": "panorama",
+    "size": [100000, 100000], "angle_deg": 360, "radius": 0.2, "vertical_fov_deg": 90,
+    "strips": 40}})";
+
+  const Result ok = run_cli("render --display " + good + " --method glc --reference --json");
+  ASSERT_EQ(ok.status, 0) << ok.output;
+  const nlohmann::json report = nlohmann::json::parse(ok.output);
+  EXPECT_EQ(report["method"], "glc");
+  EXPECT_GT(report["replicas"].get<int>(), 0);
+  EXPECT_LE(report["reference"]["id_mismatch"].get<double>(), 1e-3);
+
+  const struct {
+    std::string arguments, expected;
+  } refused[] = {
+      {"render --display " + bad + " --method glc",
+       bad + ": field 'camera.generators[1].direction'"},
+      {"render --display " + huge + " --method glc", huge + ": field 'camera.size'"},
+      {"render --display " + good + " --method facets", "expected glc for the GLC camera"},
+      {"render --display builtin:dome180 --size 32x32 --method glc",
+       "expected a GLC camera (FILE.glc.json) for --method glc"},
+      {"render --display " + good + " --method glc --size 64x64", "expected the size of"},
+      {"run " + good + " --frames 1", "only facet render --method glc draws"},
+  };
+  for (const auto& [arguments, expected] : refused) {
+    const Result result = run_cli(arguments);
+    EXPECT_EQ(result.status, 2) << arguments << "\n" << result.output;
+    EXPECT_NE(result.output.find(expected), std::string::npos) << arguments << "\n"
+                                                               << result.output;
+  }
+  std::filesystem::remove_all(folder);
+}
+
 TEST(RenderCli, JsonHasTheReportedFieldsAndOutWritesImages) {
   const std::filesystem::path folder =
       std::filesystem::temp_directory_path() / ("facet_render_cli_" + std::to_string(getpid()));

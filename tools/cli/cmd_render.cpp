@@ -103,7 +103,7 @@ nlohmann::json compare_with_reference(const Scene& scene, const std::vector<Outp
                                       const glm::dmat4& T_eye_world,
                                       const std::filesystem::path& ids_folder,
                                       const std::string& stopped,
-                                      const std::vector<std::uint32_t>* source_ids) {
+                                      const std::vector<std::uint32_t>* source_ids, double z_near) {
   const ReferenceRaycaster raycaster(scene);
   IdComparison pooled;
   EdgeDisplacement edges;
@@ -111,9 +111,15 @@ nlohmann::json compare_with_reference(const Scene& scene, const std::vector<Outp
   nlohmann::json per_output = nlohmann::json::array();
   for (std::size_t i = 0; i < outputs.size(); ++i) {
     throw_if_interrupted(stopped);
-    const WarpInverse inverse(outputs[i].warp);
-    const bool wrap_x = outputs[i].warp.base.wraps_horizontally();
-    const std::vector<std::uint32_t> reference = raycaster.ids(inverse, T_eye_world);
+    // A GLC camera's pixels cast its own rays (no warp inverse applies); the edge displacement,
+    // which walks a warp's inverse, is not measured for it.
+    const OutputSpec& output = outputs[i];
+    std::optional<WarpInverse> inverse;
+    if (!output.glc) inverse.emplace(output.warp);
+    const bool wrap_x = !output.glc && output.warp.base.wraps_horizontally();
+    const std::vector<std::uint32_t> reference =
+        output.glc ? raycaster.ids(*output.glc, T_eye_world, z_near)
+                   : raycaster.ids(*inverse, T_eye_world);
     if (!ids_folder.empty()) {
       write_ids_exr(ids_folder / (outputs[i].name + ".reference.ids.exr"), targets[i].size(),
                     reference);
@@ -132,8 +138,10 @@ nlohmann::json compare_with_reference(const Scene& scene, const std::vector<Outp
       }
     }
     const IdComparison c = compare_ids(shown, tested, targets[i].size(), {.wrap_x = wrap_x});
-    const EdgeDisplacement e =
-        raycaster.edge_displacement(inverse, T_eye_world, shown, tested, {.wrap_x = wrap_x});
+    EdgeDisplacement e = inverse ? raycaster.edge_displacement(*inverse, T_eye_world, shown, tested,
+                                                               {.wrap_x = wrap_x})
+                                 : EdgeDisplacement{};
+    if (!inverse) e.differing_pixels = c.differing_pixels;
     per_output.push_back({{"name", outputs[i].name},
                           {"id_mismatch", c.id_mismatch},
                           {"compared_pixels", c.compared_pixels},
@@ -208,8 +216,21 @@ void run(const RenderOptions& options) {
   std::optional<glm::ivec2> size;
   if (!options.size.empty()) size = parse_size(options.size, "--size");
   const auto orientation = builtin_dome_orientation(options.orientation, options.display);
-  LoadedDisplay loaded = load_display(options.display, size);
+  LoadedDisplay loaded = load_display(options.display, size, /*allow_glc=*/true);
   std::vector<OutputSpec> outputs = std::move(loaded.outputs);
+  // A GLC camera has no single centre of projection, which every other method's warp needs.
+  check_render_method(options.method);
+  const bool glc_display = !outputs.empty() && outputs.front().glc;
+  if (glc_display && options.method != "glc") {
+    throw InputError("command line", "--method",
+                     "expected glc for the GLC camera " + options.display +
+                         " (its rays share no centre, which method " + options.method + " needs)");
+  }
+  if (!glc_display && options.method == "glc") {
+    throw InputError(
+        "command line", "--display",
+        "expected a GLC camera (FILE.glc.json) for --method glc; got " + options.display);
+  }
   // Read with the display, before any GL work: a bad blend map is refused at once.
   const std::vector<std::vector<bool>> hidden =
       options.reference ? hidden_by_blend(loaded.config) : std::vector<std::vector<bool>>{};
@@ -329,9 +350,10 @@ void run(const RenderOptions& options) {
   std::optional<nlohmann::json> reference;
   auto compare = [&](const std::filesystem::path& ids_folder) {
     if (options.reference)
-      reference = compare_with_reference(
-          reference_scene ? *reference_scene : scene, outputs, targets, hidden, T_eye_world,
-          options.ids ? ids_folder : "", stopped, reference_scene ? &source_ids : nullptr);
+      reference =
+          compare_with_reference(reference_scene ? *reference_scene : scene, outputs, targets,
+                                 hidden, T_eye_world, options.ids ? ids_folder : "", stopped,
+                                 reference_scene ? &source_ids : nullptr, settings.z_near);
   };
   if (options.out.empty()) {
     compare("");
@@ -395,6 +417,11 @@ void run(const RenderOptions& options) {
                            {"frame_ms", median(frame_ms)},
                            {"pass_ms", pass_ms},
                            {"texture_anisotropy", gpu_scene.max_anisotropy}};
+  if (glc_display) {
+    std::size_t pieces = 0;
+    for (const OutputSpec& output : outputs) pieces += output.glc->pieces.size();
+    report["glc_pieces"] = pieces;  // GLCs of the camera (strips, reflector triangles)
+  }
   if (reference) report["reference"] = *reference;
   if (options.json) {
     std::cout << report.dump(2) << "\n";
@@ -438,7 +465,8 @@ const Registration registration{
       auto options = std::make_shared<RenderOptions>();
       command
           ->add_option("--display", options->display,
-                       "builtin:cylinder360 | builtin:dome180 | FILE.warp.exr | display.json")
+                       "builtin:cylinder360 | builtin:dome180 | FILE.warp.exr | display.json | "
+                       "FILE.glc.json (a GLC camera, --method glc)")
           ->required();
       command->add_option("--scene", options->scene, kSceneNameSyntax)->capture_default_str();
       command->add_flag("--static-view", options->static_view,
@@ -446,7 +474,8 @@ const Registration registration{
                         "passes 1 and 2); by default the view moves every frame");
       command
           ->add_option("--method", options->method,
-                       "facets | facets-gs | tessellated | cubemap | perspective | naive | vertex")
+                       "facets | facets-gs | tessellated | cubemap | perspective | naive | vertex "
+                       "| glc")
           ->capture_default_str();
       command
           ->add_option("--material", options->material,

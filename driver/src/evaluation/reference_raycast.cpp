@@ -134,17 +134,21 @@ std::size_t ReferenceRaycaster::triangle_count() const { return impl_->p_world.s
 
 std::uint32_t ReferenceRaycaster::id_along(const glm::dvec3& p_world,
                                            const glm::dvec3& v_world) const {
+  return id_between(p_world, glm::normalize(v_world), impl_->options.near_m);
+}
+
+std::uint32_t ReferenceRaycaster::id_between(const glm::dvec3& p_world, const glm::dvec3& v_world,
+                                             double t_near) const {
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);
   RTCRayHit rayhit{};
   rayhit.ray.org_x = float(p_world.x);
   rayhit.ray.org_y = float(p_world.y);
   rayhit.ray.org_z = float(p_world.z);
-  const glm::dvec3 v = glm::normalize(v_world);
-  rayhit.ray.dir_x = float(v.x);
-  rayhit.ray.dir_y = float(v.y);
-  rayhit.ray.dir_z = float(v.z);
-  rayhit.ray.tnear = float(impl_->options.near_m);
+  rayhit.ray.dir_x = float(v_world.x);
+  rayhit.ray.dir_y = float(v_world.y);
+  rayhit.ray.dir_z = float(v_world.z);
+  rayhit.ray.tnear = float(t_near);
   rayhit.ray.tfar = std::numeric_limits<float>::infinity();
   rayhit.ray.mask = 0xFFFFFFFFu;
   rayhit.hit.geomID = RTC_INVALID_GEOMETRY_ID;
@@ -165,6 +169,24 @@ std::vector<std::uint32_t> ReferenceRaycaster::ids(const WarpInverse& inverse,
       const auto found = inverse.invert(glm::dvec2(x + 0.5, y + 0.5));
       if (!found) continue;
       ids[std::size_t(y) * size.x + x] = id_along(p_eye_world, R_world_eye * found->v_eye);
+    }
+  });
+  return ids;
+}
+
+std::vector<std::uint32_t> ReferenceRaycaster::ids(const PiecewiseGlc& camera,
+                                                   const glm::dmat4& T_eye_world,
+                                                   double z_near) const {
+  const glm::dmat4 T_world_eye = glm::inverse(T_eye_world);
+  const glm::dmat3 R_world_eye(T_world_eye);
+  std::vector<std::uint32_t> ids(std::size_t(camera.size.x) * camera.size.y, 0);
+  for_each_row(camera.size.y, [&](int y) {
+    for (int x = 0; x < camera.size.x; ++x) {
+      const auto ray = camera.ray(x, y);
+      if (!ray) continue;
+      ids[std::size_t(y) * camera.size.x + x] =
+          id_between(glm::dvec3(T_world_eye * glm::dvec4(ray->origin, 1.0)),
+                     R_world_eye * ray->direction, z_near);
     }
   });
   return ids;

@@ -10,13 +10,13 @@
 namespace facet::driver {
 namespace {
 
-constexpr std::array<std::string_view, 7> kNames = {
-    "facets", "facets-gs", "tessellated", "cubemap", "perspective", "naive", "vertex"};
+constexpr std::array<std::string_view, 8> kNames = {
+    "facets", "facets-gs", "tessellated", "cubemap", "perspective", "naive", "vertex", "glc"};
 
 using Factory = std::unique_ptr<RenderMethod> (*)();
 
 // The methods built so far; a listed name with no factory here is not available yet.
-const std::array<std::pair<std::string_view, Factory>, 7> kFactories = {{
+const std::array<std::pair<std::string_view, Factory>, 8> kFactories = {{
     {"facets", &detail::make_facet_pipeline},
     {"facets-gs", &detail::make_facet_gs_pipeline},
     {"tessellated", &detail::make_tessellated_pipeline},
@@ -24,6 +24,7 @@ const std::array<std::pair<std::string_view, Factory>, 7> kFactories = {{
     {"perspective", &detail::make_perspective_method},
     {"naive", &detail::make_naive_method},
     {"vertex", &detail::make_vertex_method},
+    {"glc", &detail::make_glc_method},
 }};
 
 std::string joined_names() {

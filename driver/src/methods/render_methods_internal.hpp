@@ -14,5 +14,6 @@ std::unique_ptr<RenderMethod> make_naive_method();          // "naive" (naive_me
 std::unique_ptr<RenderMethod> make_cubemap_method();        // "cubemap" (cubemap_method.cpp)
 std::unique_ptr<RenderMethod> make_perspective_method();    // "perspective"
 std::unique_ptr<RenderMethod> make_vertex_method();         // "vertex" (vertex_method.cpp)
+std::unique_ptr<RenderMethod> make_glc_method();            // "glc" (glc_method.cpp)
 
 }  // namespace facet::driver::detail

@@ -1,10 +1,12 @@
 #include "facet/driver/display_outputs.hpp"
 
 #include <filesystem>
+#include <memory>
 #include <string>
 
 #include "facet/projection/errors.hpp"
 #include "facet/projection_io/display_config.hpp"
+#include "facet/projection_io/glc_file.hpp"
 #include "facet/projection_io/warp_file.hpp"
 
 namespace facet::driver {
@@ -29,7 +31,8 @@ std::vector<OutputSpec> display_config_outputs(const projection_io::DisplayConfi
 
 }  // namespace
 
-LoadedDisplay load_display(std::string_view display, std::optional<glm::ivec2> size) {
+LoadedDisplay load_display(std::string_view display, std::optional<glm::ivec2> size,
+                           bool allow_glc) {
   if (size && (size->x < 1 || size->y < 1)) {
     throw InputError("command line", OptionName{"size"}, "expected a positive output size");
   }
@@ -70,6 +73,25 @@ LoadedDisplay load_display(std::string_view display, std::optional<glm::ivec2> s
     std::string name = std::filesystem::path(path).filename().string();
     name = name.substr(0, name.size() - std::string_view(".warp.exr").size());
     outputs.push_back({name.empty() ? "output" : name, std::move(warp)});
+  } else if (display.ends_with(".glc.json")) {
+    if (!allow_glc) {
+      throw InputError("command line", OptionName{"display"},
+                       "expected a display; " + std::string(display) +
+                           " is a GLC camera, which only facet render --method glc draws");
+    }
+    auto camera = std::make_shared<const PiecewiseGlc>(read_glc_camera(std::string(display)));
+    if (size && *size != camera->size) {
+      throw InputError("command line", OptionName{"size"},
+                       "expected the size of " + std::string(display) + " (" +
+                           std::to_string(camera->size.x) + "x" + std::to_string(camera->size.y) +
+                           ") or none");
+    }
+    std::string name = std::filesystem::path(display).filename().string();
+    name = name.substr(0, name.size() - std::string_view(".glc.json").size());
+    // The warp only carries the output size: no warp describes a GLC camera.
+    outputs.push_back({name.empty() ? "output" : name,
+                       Warp::analytic(BaseProjection::perspective(-1, 1, 1, -1), camera->size),
+                       std::move(camera)});
   } else if (display.ends_with(".json")) {
     projection_io::DisplayConfig config =
         projection_io::read_display_config(std::filesystem::path(display));

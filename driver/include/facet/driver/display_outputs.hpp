@@ -35,6 +35,10 @@ struct LoadedDisplay {
   std::vector<OutputSpec> outputs;
   std::optional<projection_io::DisplayConfig> config;  // set for a display.json
 };
-LoadedDisplay load_display(std::string_view display, std::optional<glm::ivec2> size = std::nullopt);
+// With `allow_glc`, `display` may also be a GLC camera, FILE.glc.json (driver/README.md, "GLC
+// cameras"): one output named after the file, with OutputSpec::glc set; otherwise such a file is
+// an InputError naming "display".
+LoadedDisplay load_display(std::string_view display, std::optional<glm::ivec2> size = std::nullopt,
+                           bool allow_glc = false);
 
 }  // namespace facet::driver

@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "facet/driver/scene.hpp"
+#include "facet/projection/glc.hpp"
 #include "facet/projection/warp.hpp"
 #include "facet/projection/warp_inverse.hpp"
 
@@ -52,6 +53,12 @@ class ReferenceRaycaster {
   // eye frame): output-sized, row 0 at the top, as OutputTarget::read_ids.
   std::vector<std::uint32_t> ids(const WarpInverse& inverse, const glm::dmat4& T_eye_world) const;
 
+  // The reference ID image of a (piecewise) GLC camera seen from T_eye_world: pixel (x, y)
+  // (row 0 at the top) casts its centre's GLC ray (PiecewiseGlc::ray: from its image plane, its
+  // direction's frame-z component 1), hits at frame depth z_near or beyond; 0 where no piece
+  // covers the pixel. The SCOP warp inverse does not apply to such a camera.
+  std::vector<std::uint32_t> ids(const PiecewiseGlc& camera, const glm::dmat4& T_eye_world,
+                                 double z_near) const;
   // Triangles in the Embree scene (every object's instance counted).
   std::size_t triangle_count() const;
 
@@ -64,6 +71,9 @@ class ReferenceRaycaster {
                                      const EdgeDisplacementOptions& options) const;
 
  private:
+  // The nearest hit along p_world + t·v_world (v_world as given, not normalised) for t >= t_near.
+  std::uint32_t id_between(const glm::dvec3& p_world, const glm::dvec3& v_world,
+                           double t_near) const;
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };

@@ -22,15 +22,19 @@
 #include "facet/driver/material_shader.hpp"
 #include "facet/driver/scene.hpp"
 #include "facet/projection/facets.hpp"
+#include "facet/projection/glc.hpp"
 #include "facet/projection/warp.hpp"
 
 namespace facet::driver {
 
 // One projector output as a renderer sees it: its exact warp (the map from eye directions to
-// its output pixels) and its name.
+// its output pixels) and its name. An output of a GLC camera (a *.glc.json display) has no
+// single centre of projection: `glc` is its camera, drawn by the "glc" method alone, and `warp`
+// only carries its output size.
 struct OutputSpec {
   std::string name;
   Warp warp;
+  std::shared_ptr<const PiecewiseGlc> glc{};
 };
 
 // How pass 1 of the facet methods finds the facets a triangle may cover: the bucket grid
@@ -163,7 +167,7 @@ struct RenderStats {
 class RenderMethod {
  public:
   virtual ~RenderMethod() = default;
-  // "facets", "facets-gs", "tessellated", "cubemap", "naive", "vertex".
+  // "facets", "facets-gs", "tessellated", "cubemap", "perspective", "naive", "vertex", "glc".
   virtual std::string_view name() const = 0;
 
   // Builds everything that depends only on the outputs and the scene: facets, matrices, cube

@@ -1,0 +1,309 @@
+// Multi-perspective rasterization of a (piecewise) general linear camera ("glc"; Yu, Yu &
+// McMillan), for an output given as a *.glc.json camera (OutputSpec::glc).
+//
+// Per frame, on the CPU: every triangle is carried into the eye frame, and for every GLC piece
+// whose rays it may meet, Glc::triangle_bounds gives a conservative box of the pixels whose rays
+// can hit it (exact extremes of the projection over the triangle clipped to z >= z_near: on each
+// depth plane the map is affine, so the extremes lie on the clipped triangle's edges; a slit depth
+// inside the triangle makes the box the whole piece). The box is clipped to the piece's pixel box.
+// Per piece a triangle is first tested against a cone that holds every ray of the piece (its axis
+// the mean ray direction at the piece box's corners, its apex behind their origins), with its
+// bounding sphere, and objects likewise with theirs.
+// On the GPU: one quad per (triangle, piece) box; every fragment whose pixel belongs to that
+// piece (the piece map, the same that the oracle reads) casts its pixel centre's GLC ray and
+// intersects the triangle exactly, writing depth from the hit. The image is therefore the ray
+// cast of the camera's own rays: hole-free, whatever the camera does to straight lines.
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <memory>
+
+#include "facet/driver/gpu_timer.hpp"
+#include "facet/driver/program.hpp"
+#include "facet/projection/errors.hpp"
+#include "render_methods_internal.hpp"
+#include "replication_common.hpp"
+
+namespace facet::driver::detail {
+namespace {
+
+struct GpuQuad {
+  glm::vec4 box, a, b, c;
+  glm::uvec4 ids;  // triangle ID, piece, material
+};
+static_assert(sizeof(GpuQuad) == 80);
+
+struct GpuPiece {
+  glm::vec4 o0, ox, oy, d0, dx, dy;
+};
+
+// A cone holding every ray of a piece from its origin on: apex, unit axis, cos and sin of the
+// half-angle; `all` when no cone narrower than a half-space does.
+struct RayCone {
+  glm::dvec3 apex{0.0}, axis{0.0, 0.0, -1.0};
+  double cos_angle = -1, sin_angle = 1;
+  bool all = true;
+
+  // Whether the sphere may meet the cone (conservative).
+  bool may_meet(const glm::dvec3& centre, double radius) const {
+    if (all) return true;
+    const glm::dvec3 v = centre - apex;
+    const double d = glm::length(v);
+    if (d <= radius) return true;
+    // The angle between v and the axis is at most the half-angle plus asin(radius / d).
+    const double sin_r = radius / d, cos_r = std::sqrt(std::max(0.0, 1 - sin_r * sin_r));
+    // cos(half-angle + r): the half-angle is below 80 degrees and r at most 90.
+    const double cos_limit = cos_angle * cos_r - sin_angle * sin_r;
+    return glm::dot(v, axis) / d >= cos_limit - 1e-9;
+  }
+};
+
+RayCone ray_cone(const Glc& glc, const glm::ivec4& box) {
+  RayCone cone;
+  std::array<EyeRay, 4> rays;
+  const std::array<glm::dvec2, 4> corners = {glm::dvec2(box.x, box.y), glm::dvec2(box.z, box.y),
+                                             glm::dvec2(box.x, box.w), glm::dvec2(box.z, box.w)};
+  glm::dvec3 axis(0.0), centre(0.0);
+  for (std::size_t k = 0; k < 4; ++k) {
+    rays[k] = glc.ray(corners[k]);
+    axis += glm::normalize(rays[k].direction);
+    centre += 0.25 * rays[k].origin;
+  }
+  if (!(glm::length(axis) > 1e-9)) return cone;
+  axis = glm::normalize(axis);
+  double cos_angle = 1, reach = 0;
+  for (const EyeRay& r : rays) {
+    cos_angle = std::min(cos_angle, glm::dot(glm::normalize(r.direction), axis));
+    reach = std::max(reach, glm::length(r.origin - centre));
+  }
+  if (!(cos_angle > 0.17)) return cone;  // 80 degrees or more: no useful cone
+  cone.all = false;
+  cone.axis = axis;
+  // A margin for rounding: the rays' directions are affine in the pixel, their hull is the
+  // corners' (the frame-z components are all 1).
+  cone.cos_angle = std::max(0.0, cos_angle - 1e-6);
+  cone.sin_angle = std::sqrt(1 - cone.cos_angle * cone.cos_angle);
+  // Every origin lies within `reach` of the centre: from an apex reach / sin behind it, every
+  // origin is inside the cone, and so is every ray from it (a sum of two vectors in the cone).
+  cone.apex = centre - axis * (reach * (1 + 1e-6) / std::max(cone.sin_angle, 1e-6));
+  return cone;
+}
+
+class GlcMethod final : public RenderMethod {
+ public:
+  std::string_view name() const override { return "glc"; }
+
+  void prepare(const Scene& scene, const GpuScene&, std::span<const OutputSpec> outputs,
+               const RenderSettings& settings) override {
+    for (const OutputSpec& output : outputs) {
+      if (!output.glc) {
+        throw InputError("command line", OptionName{"method"},
+                         "expected a GLC camera display (*.glc.json) for method glc; output '" +
+                             output.name + "' is a warp");
+      }
+    }
+    if (!(settings.z_near > 0)) {
+      throw InputError("render settings", "z_near", "expected a positive near distance");
+    }
+    scene_ = &scene;
+    settings_ = settings;
+    triangle_base_ = scene_triangle_base(scene);
+    program_ = ProgramBuilder().shader("glc/glc_quad.vert").shader("glc/glc_hit.frag").link();
+    std::vector<glm::vec4> colours;
+    for (const Material& m : scene.materials) colours.push_back(m.base_colour);
+    if (colours.empty()) colours.push_back(glm::vec4(1.0f));
+    materials_ = Buffer::create_from(colours);
+    outputs_.clear();
+    for (const OutputSpec& output : outputs) {
+      OutputState out;
+      out.camera = output.glc;
+      const PiecewiseGlc& camera = *out.camera;
+      FACET_ASSERT(camera.size == output.warp.output_size);
+      std::vector<GpuPiece> pieces;
+      for (std::size_t k = 0; k < camera.pieces.size(); ++k) {
+        const Glc& glc = camera.pieces[k];
+        // Affine in the pixel: differences of rays one pixel apart, about the piece box's corner.
+        const glm::dvec2 at(camera.piece_boxes[k].x, camera.piece_boxes[k].y);
+        const EyeRay r0 = glc.ray(at), rx = glc.ray(at + glm::dvec2(1, 0)),
+                     ry = glc.ray(at + glm::dvec2(0, 1));
+        const glm::dvec3 ox = rx.origin - r0.origin, oy = ry.origin - r0.origin;
+        const glm::dvec3 dx = rx.direction - r0.direction, dy = ry.direction - r0.direction;
+        pieces.push_back({glm::vec4(r0.origin - at.x * ox - at.y * oy, 0), glm::vec4(ox, 0),
+                          glm::vec4(oy, 0), glm::vec4(r0.direction - at.x * dx - at.y * dy, 0),
+                          glm::vec4(dx, 0), glm::vec4(dy, 0)});
+        out.cones.push_back(camera.pieces.size() > 1 ? ray_cone(glc, camera.piece_boxes[k])
+                                                     : RayCone{});
+      }
+      out.pieces = Buffer::create_from(pieces);
+      // The piece map in GL rows (row 0 at the bottom).
+      std::vector<std::int32_t> rows(camera.piece_of_pixel.size());
+      for (int y = 0; y < camera.size.y; ++y) {
+        std::copy_n(camera.piece_of_pixel.begin() + std::ptrdiff_t(y) * camera.size.x,
+                    camera.size.x,
+                    rows.begin() + std::ptrdiff_t(camera.size.y - 1 - y) * camera.size.x);
+      }
+      out.piece_map = Texture::create_2d(GL_R32I, camera.size.x, camera.size.y);
+      // Integer textures are complete only with nearest filtering.
+      glTextureParameteri(out.piece_map.id(), GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+      glTextureParameteri(out.piece_map.id(), GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+      glTextureSubImage2D(out.piece_map.id(), 0, 0, 0, camera.size.x, camera.size.y, GL_RED_INTEGER,
+                          GL_INT, rows.data());
+      outputs_.push_back(std::move(out));
+    }
+    vao_ = VertexArray::create();
+  }
+
+  RenderStats render(const glm::dmat4& T_eye_world, std::span<OutputTarget> targets,
+                     GpuTimer* timer) override {
+    FACET_ASSERT(targets.size() == outputs_.size());
+    const Scene& scene = *scene_;
+    RenderStats stats;
+    // The triangles in the eye frame, in ID order, and per object its range and sphere.
+    triangles_.clear();
+    object_ranges_.assign(scene.objects.size() + 1, 0);
+    const std::vector<BoundingSphere> spheres = object_spheres(scene, T_eye_world);
+    for (std::size_t o = 0; o < scene.objects.size(); ++o) {
+      const Object& object = scene.objects[o];
+      const glm::mat4 T_eye_object = glm::mat4(T_eye_world * glm::dmat4(object.T_world_object));
+      for (std::uint32_t k = 0; k < object.primitive_count; ++k) {
+        const Primitive& primitive = scene.primitives[object.first_primitive + k];
+        for (std::uint32_t i = 0; i + 2 < primitive.index_count; i += 3) {
+          EyeTriangle t;
+          for (int v = 0; v < 3; ++v) {
+            const glm::vec3& p = scene.positions[scene.indices[primitive.first_index + i + v]];
+            t.v[v] = glm::vec3(T_eye_object * glm::vec4(p, 1.0f));
+          }
+          t.material = primitive.material;
+          const glm::dvec3 centre =
+              (glm::dvec3(t.v[0]) + glm::dvec3(t.v[1]) + glm::dvec3(t.v[2])) / 3.0;
+          t.centre = centre;
+          t.radius = 0;
+          for (int v = 0; v < 3; ++v) {
+            t.radius = std::max(t.radius, glm::length(glm::dvec3(t.v[v]) - centre));
+          }
+          triangles_.push_back(t);
+        }
+      }
+      object_ranges_[o + 1] = std::uint32_t(triangles_.size());
+    }
+    stats.triangles_in = triangles_.size();
+    std::vector<std::uint8_t> visible(triangles_.size(), 0);
+
+    begin_reversed_z_scene(false);
+    glDepthMask(GL_TRUE);
+    for (std::size_t i = 0; i < outputs_.size(); ++i) {
+      OutputState& out = outputs_[i];
+      const PiecewiseGlc& camera = *out.camera;
+      // "bounds": the CPU's per-(triangle, piece) boxes; "draw": the GPU's quads.
+      TimedPass bounds_pass(timer, "bounds");
+      quads_.clear();
+      for (std::size_t k = 0; k < camera.pieces.size(); ++k) {
+        const Glc& glc = camera.pieces[k];
+        const glm::ivec4 box = camera.piece_boxes[k];
+        if (box.x >= box.z || box.y >= box.w) continue;
+        const RayCone& cone = out.cones[k];
+        for (std::size_t o = 0; o < scene.objects.size(); ++o) {
+          if (spheres[o].radius < 0 ||
+              !cone.may_meet(spheres[o].centre, spheres[o].radius * 1.0001))
+            continue;
+          for (std::uint32_t t = object_ranges_[o]; t < object_ranges_[o + 1]; ++t) {
+            const EyeTriangle& tri = triangles_[t];
+            if (!cone.may_meet(tri.centre, tri.radius * 1.0001 + 1e-6)) continue;
+            const auto bounds = glc.triangle_bounds(glm::dvec3(tri.v[0]), glm::dvec3(tri.v[1]),
+                                                    glm::dvec3(tri.v[2]), settings_.z_near, 0.5);
+            if (!bounds) continue;
+            // Clip to the piece's box (whole pixels); the bound's box holds every pixel centre
+            // whose ray can meet the triangle.
+            const double x0 = std::max<double>(box.x, bounds->min.x);
+            const double x1 = std::min<double>(box.z, bounds->max.x);
+            const double y0 = std::max<double>(box.y, bounds->min.y);
+            const double y1 = std::min<double>(box.w, bounds->max.y);
+            if (!(x0 < x1 && y0 < y1)) continue;
+            const float h = float(camera.size.y);
+            quads_.push_back({glm::vec4(float(x0), h - float(y1), float(x1), h - float(y0)),
+                              glm::vec4(tri.v[0], 1), glm::vec4(tri.v[1], 1),
+                              glm::vec4(tri.v[2], 1),
+                              glm::uvec4(triangle_id(o, t), std::uint32_t(k), tri.material, 0)});
+            visible[t] = 1;
+          }
+        }
+      }
+      stats.replicas += quads_.size();
+      bounds_pass.end();
+      TimedPass draw_pass(timer, "draw");
+      targets[i].clear();
+      targets[i].bind();
+      glDepthMask(GL_TRUE);
+      if (!quads_.empty()) {
+        ensure_capacity(out.quads, quads_.size() * sizeof(GpuQuad));
+        out.quads.sub_data(0, quads_.size() * sizeof(GpuQuad), quads_.data());
+        program_.use();
+        glUniform2f(0, float(camera.size.x), float(camera.size.y));
+        glUniform1f(1, float(settings_.z_near));
+        glUniform1i(2, settings_.cull_back_faces ? 1 : 0);
+        out.quads.bind_base(GL_SHADER_STORAGE_BUFFER, 0);
+        out.pieces.bind_base(GL_SHADER_STORAGE_BUFFER, 1);
+        materials_.bind_base(GL_SHADER_STORAGE_BUFFER, 2);
+        glBindTextureUnit(0, out.piece_map.id());
+        glBindSampler(0, 0);  // the scene's samplers would filter it
+        glBindVertexArray(vao_.id());
+        // Draws of kSoftwareReplicasPerDraw quads: llvmpipe's draw module costs time quadratic
+        // in a draw's batch (replication_common.hpp).
+        const std::size_t per_draw = kSoftwareReplicasPerDraw;
+        for (std::size_t first = 0; first < quads_.size(); first += per_draw) {
+          const std::size_t count = std::min(per_draw, quads_.size() - first);
+          glDrawArrays(GL_TRIANGLES, GLint(6 * first), GLsizei(6 * count));
+        }
+        glBindVertexArray(0);
+      }
+      stats.gpu_buffer_bytes +=
+          out.quads.size() + out.pieces.size() + std::uint64_t(camera.size.x) * camera.size.y * 4;
+      targets[i].resolve();
+      draw_pass.end();
+    }
+    glDisable(GL_DEPTH_TEST);
+    glDepthFunc(GL_LESS);
+    glClipControl(GL_LOWER_LEFT, GL_NEGATIVE_ONE_TO_ONE);
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    if (timer) timer->end_frame();
+    for (std::uint8_t v : visible) stats.triangles_visible += v;
+    stats.gpu_buffer_bytes += materials_.size();
+    return stats;
+  }
+
+ private:
+  struct EyeTriangle {
+    std::array<glm::vec3, 3> v;
+    std::uint32_t material = 0;
+    glm::dvec3 centre{0.0};
+    double radius = 0;
+  };
+  struct OutputState {
+    std::shared_ptr<const PiecewiseGlc> camera;
+    std::vector<RayCone> cones;
+    Buffer pieces, quads;
+    Texture piece_map;
+  };
+
+  // The ID of list triangle t of object o (render_method.hpp's numbering).
+  std::uint32_t triangle_id(std::size_t o, std::uint32_t t) const {
+    return triangle_base_[o] + (t - object_ranges_[o]) + 1;
+  }
+
+  const Scene* scene_ = nullptr;
+  RenderSettings settings_;
+  std::vector<std::uint32_t> triangle_base_;
+  Program program_;
+  Buffer materials_;
+  VertexArray vao_;
+  std::vector<OutputState> outputs_;
+  std::vector<EyeTriangle> triangles_;
+  std::vector<std::uint32_t> object_ranges_;
+  std::vector<GpuQuad> quads_;
+};
+
+}  // namespace
+
+std::unique_ptr<RenderMethod> make_glc_method() { return std::make_unique<GlcMethod>(); }
+
+}  // namespace facet::driver::detail
