@@ -343,6 +343,26 @@ TEST(BenchScenarios, EveryScenarioHasValidOutputsAndEveryMethod) {
   EXPECT_THROW(driver::make_bench_scenarios(options), InputError);
 }
 
+// The GLC paper cases: three scenarios of one glc row each, matching the oracle's GLC rays.
+TEST(BenchCli, GlcScenarioHasARowPerPaperCase) {
+  const fs::path folder = fresh_folder("glc");
+  const fs::path out = folder / "bench";
+  ASSERT_EQ(
+      run("bench --quick --scenario glc --frames 1 --out " + out.string(), folder / "log.txt"), 0)
+      << slurp(folder / "log.txt");
+  const nlohmann::json json = nlohmann::json::parse(slurp(out / "bench.json"));
+  std::set<std::string> scenarios;
+  for (const auto& row : json["rows"]) {
+    ASSERT_FALSE(row.contains("error")) << row.dump();
+    EXPECT_EQ(row["method"], "glc");
+    EXPECT_EQ(row["geometric_source"], "exact rays");
+    EXPECT_LE(row["id_mismatch"].get<double>(), 1e-3) << row.dump();
+    EXPECT_GT(row["replicas"].get<double>(), 0) << row.dump();
+    scenarios.insert(row["scenario"].get<std::string>());
+  }
+  EXPECT_EQ(scenarios, (std::set<std::string>{"glc-city", "glc-panorama", "glc-mirror"}));
+}
+
 // At equal error: the cylinder at quarter size runs 512² faces, so it gains a facets tolerance
 // build at the cube map's error, rounded down; the quick sweep does not.
 TEST(BenchScenarios, MatchedToleranceFollowsTheCubeMapsError) {

@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <memory>
 #include <numbers>
 #include <set>
 
@@ -20,6 +21,7 @@
 #include "facet/projection/content_projection.hpp"
 #include "facet/projection/errors.hpp"
 #include "facet/projection/facet_error.hpp"
+#include "facet/projection/glc.hpp"
 #include "facet/projection/rig.hpp"
 #include "facet/projection/warp_inverse.hpp"
 #include "facet/projection_io/rig_file.hpp"
@@ -282,15 +284,19 @@ std::vector<BenchScenario> make_bench_scenarios(const BenchOptions& options) {
                                               "scale",
                                               "scale-scenes",
                                               "scale-facets",
-                                              "scale-width"};
+                                              "scale-width",
+                                              "glc",
+                                              "glc-city",
+                                              "glc-panorama",
+                                              "glc-mirror"};
   std::vector<std::string> names = options.scenarios;
   if (names.empty()) names = {"cylinder", "deformation", "dome"};
   for (const std::string& name : names) {
     if (!known.contains(name)) {
       throw InputError("command line", OptionName{"scenarios"},
                        "expected cylinder, deformation, deformation-80x60, deformation-128x128, "
-                       "dome, dome-master, dome4, scale (scale-scenes, scale-facets, scale-width) "
-                       "or all; got '" +
+                       "dome, dome-master, dome4, scale (scale-scenes, scale-facets, scale-width), "
+                       "glc (glc-city, glc-panorama, glc-mirror) or all; got '" +
                            name + "'");
     }
   }
@@ -333,6 +339,47 @@ std::vector<BenchScenario> make_bench_scenarios(const BenchOptions& options) {
       }
       s.matched_cube_face = matched_face;
       scenarios.push_back(std::move(s));
+    } else if (name.starts_with("glc")) {
+      // The GLC cameras of Yu, Yu & McMillan's paper cases (configs/glc holds the same as
+      // files): the cross-slit city, the 360° circular cross-slit panorama and the mirror sphere,
+      // each drawn by the glc method alone.
+      auto glc_scenario = [&](const std::string& part, const std::string& description,
+                              PiecewiseGlc camera) {
+        BenchScenario s;
+        s.name = part;
+        s.description = description + " at " + size_text(camera.size) + ", " +
+                        std::to_string(camera.pieces.size()) + " GLCs, the city";
+        const glm::ivec2 size = camera.size;
+        s.outputs.push_back({part, Warp::analytic(BaseProjection::perspective(-1, 1, 1, -1), size),
+                             std::make_shared<const PiecewiseGlc>(std::move(camera))});
+        BenchSetting setting;
+        setting.method = "glc";
+        setting.label = "camera";
+        s.settings.push_back(setting);
+        scenarios.push_back(std::move(s));
+      };
+      const bool all_parts = name == "glc";
+      if (all_parts || name == "glc-city") {
+        const glm::ivec2 size = scaled({1024, 320}, scale);
+        GlcFrame frame;
+        frame.axes = glm::dmat3(glm::dvec3(1, 0, 0), glm::dvec3(0, -1, 0), glm::dvec3(0, 0, -1));
+        glc_scenario(
+            "glc-city", "cross-slit camera (slits 1 and 4 m behind the image plane)",
+            single_glc(cross_slit_glc(frame, {{0, 0, -1}, {0, 1, 0}}, {{0, 0, -4}, {1, 0, 0}},
+                                      {3.2, 2.0}, size, "bench", "glc-city"),
+                       size));
+      }
+      if (all_parts || name == "glc-panorama") {
+        const glm::ivec2 size = scaled({800, 600}, scale);
+        glc_scenario(
+            "glc-panorama", "360-degree circular cross-slit panorama",
+            circular_panorama(360, 0.25, 120, std::min(40, size.x), size, "bench", "glc-panorama"));
+      }
+      if (all_parts || name == "glc-mirror") {
+        const glm::ivec2 size = scaled({800, 800}, scale);
+        glc_scenario("glc-mirror", "mirror sphere (32 rings)",
+                     mirror_sphere({0, 0, -3}, 1.0, 50, 32, size, "bench", "glc-mirror"));
+      }
     } else if (name.starts_with("scale")) {
       // Frame cost against what grows, each in a scale group of its own (bench_scale_fits).
       const bool all_parts = name == "scale";
@@ -522,7 +569,9 @@ BenchReport run_bench(const BenchOptions& options, const std::string& renderer,
     const glm::dmat4 T0 = views.T_eye_world(0);
     for (const OutputSpec& output : scenario.outputs) {
       inverses.emplace_back(output.warp);
-      reference.push_back(raycaster.ids(inverses.back(), T0));
+      // A GLC camera's pixels cast its own rays (the default near distance of RenderSettings).
+      reference.push_back(output.glc ? raycaster.ids(*output.glc, T0, RenderSettings{}.z_near)
+                                     : raycaster.ids(inverses.back(), T0));
     }
     std::vector<OutputTarget> targets;
     for (const OutputSpec& output : scenario.outputs) {
@@ -593,8 +642,11 @@ BenchReport run_bench(const BenchOptions& options, const std::string& renderer,
         ids.push_back(targets[i].read_ids());
         const IdComparison c =
             compare_ids(reference[i], ids.back(), targets[i].size(), {.wrap_x = wrap_x});
-        const EdgeDisplacement e = raycaster.edge_displacement(inverses[i], T0, reference[i],
-                                                               ids.back(), {.wrap_x = wrap_x});
+        // The edge displacement walks a warp's inverse: not measured for a GLC camera.
+        const EdgeDisplacement e =
+            scenario.outputs[i].glc ? EdgeDisplacement{}
+                                    : raycaster.edge_displacement(inverses[i], T0, reference[i],
+                                                                  ids.back(), {.wrap_x = wrap_x});
         pooled.compared_pixels += c.compared_pixels;
         pooled.mismatched_pixels += c.mismatched_pixels;
         if (e.max_px > pooled.max_edge_px) {
@@ -645,6 +697,9 @@ BenchReport run_bench(const BenchOptions& options, const std::string& renderer,
         row.geometric_max_px = max_px;
         row.geometric_rms_px = std::sqrt(sum_sq / double(scenario.outputs.size()));
         row.geometric_source = cube ? "cube texel" : "image texel";
+      } else if (setting.method == "glc") {
+        // Each pixel's own ray is cast at the triangles: no geometric approximation.
+        row.geometric_source = "exact rays";
       } else {
         row.geometric_max_px = row.max_edge_px;
         row.geometric_rms_px = row.p99_edge_px;
