@@ -222,24 +222,27 @@ std::optional<PixelBounds> Glc::triangle_bounds(const glm::dvec3& a, const glm::
                                         to_frame * (b - frame_.origin),
                                         to_frame * (c - frame_.origin)};
   // Clip to z >= z_near (one plane of Sutherland-Hodgman).
-  std::vector<glm::dvec3> poly;
+  // At most 4 corners: one plane cuts a triangle into a triangle or a quadrilateral.
+  std::array<glm::dvec3, 4> poly{};
+  std::size_t corners = 0;
   for (std::size_t k = 0; k < 3; ++k) {
     const glm::dvec3& p = in[k];
     const glm::dvec3& q = in[(k + 1) % 3];
     const bool p_in = p.z >= z_near, q_in = q.z >= z_near;
-    if (p_in) poly.push_back(p);
+    if (p_in) poly[corners++] = p;
     if (p_in != q_in) {
       const double t = (z_near - p.z) / (q.z - p.z);
       glm::dvec3 x = p + t * (q - p);
       x.z = z_near;
-      poly.push_back(x);
+      poly[corners++] = x;
     }
   }
-  if (poly.empty()) return std::nullopt;
+  if (corners == 0) return std::nullopt;
   constexpr double kInf = std::numeric_limits<double>::infinity();
   const PixelBounds unbounded{{-kInf, -kInf}, {kInf, kInf}};
   double z_min = kInf, z_max = -kInf;
-  for (const glm::dvec3& p : poly) {
+  for (std::size_t k = 0; k < corners; ++k) {
+    const glm::dvec3& p = poly[k];
     if (!finite(p)) return unbounded;
     z_min = std::min(z_min, p.z);
     z_max = std::max(z_max, p.z);
@@ -260,8 +263,8 @@ std::optional<PixelBounds> Glc::triangle_bounds(const glm::dvec3& a, const glm::
   // Per edge: pixel coordinate = N(t) / D(t), N and D quadratics in the edge parameter t, found
   // from three samples; the extremes are at the ends or where N'D - ND' = 0.
   auto denominator = [&](double z) { return (a_ * z + b_) * z + c_; };
-  for (std::size_t k = 0; k < poly.size(); ++k) {
-    const glm::dvec3 p = poly[k], q = poly[(k + 1) % poly.size()];
+  for (std::size_t k = 0; k < corners; ++k) {
+    const glm::dvec3 p = poly[k], q = poly[(k + 1) % corners];
     if (!add(p)) return unbounded;
     const std::array<double, 3> ts = {0.0, 0.5, 1.0};
     std::array<double, 3> dv{};
@@ -283,7 +286,7 @@ std::optional<PixelBounds> Glc::triangle_bounds(const glm::dvec3& a, const glm::
       const double n2 = 2 * nv[2][axis] - 4 * nv[1][axis] + 2 * nv[0][axis];
       const double n1 = nv[2][axis] - nv[0][axis] - n2, n0 = nv[0][axis];
       const double qa = n2 * d1 - n1 * d2, qb = 2 * (n2 * d0 - n0 * d2), qc = n1 * d0 - n0 * d1;
-      std::vector<double> roots;
+      std::array<double, 2> roots{-1.0, -1.0};  // outside (0, 1): none
       const double qscale = std::max({std::abs(qa), std::abs(qb), std::abs(qc), 1e-300});
       if (std::abs(qa) > 1e-12 * qscale) {
         const double disc = qb * qb - 4 * qa * qc;
@@ -292,7 +295,7 @@ std::optional<PixelBounds> Glc::triangle_bounds(const glm::dvec3& a, const glm::
           roots = {(-qb - s) / (2 * qa), (-qb + s) / (2 * qa)};
         }
       } else if (std::abs(qb) > 1e-12 * qscale) {
-        roots = {-qc / qb};
+        roots = {-qc / qb, -1.0};
       }
       for (double t : roots) {
         if (t > 0 && t < 1 && !add(p + t * (q - p))) return unbounded;

@@ -1,22 +1,24 @@
 // Multi-perspective rasterization of a (piecewise) general linear camera ("glc"; Yu, Yu &
 // McMillan), for an output given as a *.glc.json camera (OutputSpec::glc).
 //
-// Per frame, on the CPU: every triangle is carried into the eye frame, and for every GLC piece
-// whose rays it may meet, Glc::triangle_bounds gives a conservative box of the pixels whose rays
-// can hit it (exact extremes of the projection over the triangle clipped to z >= z_near: on each
-// depth plane the map is affine, so the extremes lie on the clipped triangle's edges; a slit depth
-// inside the triangle makes the box the whole piece). The box is clipped to the piece's pixel box.
-// Per piece a triangle is first tested against a cone that holds every ray of the piece (its axis
-// the mean ray direction at the piece box's corners, its apex behind their origins), with its
-// bounding sphere, and objects likewise with theirs.
-// On the GPU: one quad per (triangle, piece) box; every fragment whose pixel belongs to that
-// piece (the piece map, the same that the oracle reads) casts its pixel centre's GLC ray and
-// intersects the triangle exactly, writing depth from the hit. The image is therefore the ray
-// cast of the camera's own rays: hole-free, whatever the camera does to straight lines.
+// Per frame, on the CPU (the pieces shared out over every hardware thread): every triangle is
+// carried into the eye frame, and for every GLC piece whose rays it may meet,
+// Glc::triangle_bounds gives a conservative box of the pixels whose rays can hit it (exact extremes
+// of the projection over the triangle clipped to z >= z_near: on each depth plane the map is
+// affine, so the extremes lie on the clipped triangle's edges; a slit depth inside the triangle
+// makes the box the whole piece). The box is clipped to the piece's pixel box. Per piece a triangle
+// is first tested against a cone that holds every ray of the piece (its axis the mean ray direction
+// at the piece box's corners, its apex behind their origins), with its bounding sphere, and objects
+// likewise with theirs. On the GPU: one quad per (triangle, piece) box; every fragment whose pixel
+// belongs to that piece (the piece map, the same that the oracle reads) casts its pixel centre's
+// GLC ray and intersects the triangle exactly, writing depth from the hit. The image is therefore
+// the ray cast of the camera's own rays: hole-free, whatever the camera does to straight lines.
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
 #include <memory>
+#include <thread>
 
 #include "facet/driver/gpu_timer.hpp"
 #include "facet/driver/program.hpp"
@@ -196,38 +198,27 @@ class GlcMethod final : public RenderMethod {
       const PiecewiseGlc& camera = *out.camera;
       // "bounds": the CPU's per-(triangle, piece) boxes; "draw": the GPU's quads.
       TimedPass bounds_pass(timer, "bounds");
-      quads_.clear();
-      for (std::size_t k = 0; k < camera.pieces.size(); ++k) {
-        const Glc& glc = camera.pieces[k];
-        const glm::ivec4 box = camera.piece_boxes[k];
-        if (box.x >= box.z || box.y >= box.w) continue;
-        const RayCone& cone = out.cones[k];
-        for (std::size_t o = 0; o < scene.objects.size(); ++o) {
-          if (spheres[o].radius < 0 ||
-              !cone.may_meet(spheres[o].centre, spheres[o].radius * 1.0001))
-            continue;
-          for (std::uint32_t t = object_ranges_[o]; t < object_ranges_[o + 1]; ++t) {
-            const EyeTriangle& tri = triangles_[t];
-            if (!cone.may_meet(tri.centre, tri.radius * 1.0001 + 1e-6)) continue;
-            const auto bounds = glc.triangle_bounds(glm::dvec3(tri.v[0]), glm::dvec3(tri.v[1]),
-                                                    glm::dvec3(tri.v[2]), settings_.z_near, 0.5);
-            if (!bounds) continue;
-            // Clip to the piece's box (whole pixels); the bound's box holds every pixel centre
-            // whose ray can meet the triangle.
-            const double x0 = std::max<double>(box.x, bounds->min.x);
-            const double x1 = std::min<double>(box.z, bounds->max.x);
-            const double y0 = std::max<double>(box.y, bounds->min.y);
-            const double y1 = std::min<double>(box.w, bounds->max.y);
-            if (!(x0 < x1 && y0 < y1)) continue;
-            const float h = float(camera.size.y);
-            quads_.push_back({glm::vec4(float(x0), h - float(y1), float(x1), h - float(y0)),
-                              glm::vec4(tri.v[0], 1), glm::vec4(tri.v[1], 1),
-                              glm::vec4(tri.v[2], 1),
-                              glm::uvec4(triangle_id(o, t), std::uint32_t(k), tri.material, 0)});
-            visible[t] = 1;
-          }
+      // The pieces are boxed on every hardware thread, each piece's quads in a list of its own,
+      // then joined in piece order, so that the draw order does not depend on the threads.
+      piece_quads_.resize(camera.pieces.size());
+      std::atomic<std::size_t> next_piece{0};
+      auto box_pieces = [&] {
+        for (std::size_t k = next_piece++; k < camera.pieces.size(); k = next_piece++) {
+          piece_quads_[k].clear();
+          box_piece(camera, out.cones[k], k, spheres, piece_quads_[k]);
         }
+      };
+      const std::size_t workers = std::min<std::size_t>(
+          camera.pieces.size(), std::max(1u, std::thread::hardware_concurrency()));
+      std::vector<std::thread> pool;
+      for (std::size_t w = 1; w < workers; ++w) pool.emplace_back(box_pieces);
+      box_pieces();
+      for (std::thread& thread : pool) thread.join();
+      quads_.clear();
+      for (const std::vector<GpuQuad>& quads : piece_quads_) {
+        quads_.insert(quads_.end(), quads.begin(), quads.end());
       }
+      for (const GpuQuad& quad : quads_) visible[quad.ids.x - 1] = 1;
       stats.replicas += quads_.size();
       bounds_pass.end();
       TimedPass draw_pass(timer, "draw");
@@ -285,6 +276,37 @@ class GlcMethod final : public RenderMethod {
     Texture piece_map;
   };
 
+  // Piece k's quads: for every triangle its cone lets through, the triangle's pixel box clipped
+  // to the piece's.
+  void box_piece(const PiecewiseGlc& camera, const RayCone& cone, std::size_t k,
+                 const std::vector<BoundingSphere>& spheres, std::vector<GpuQuad>& quads) const {
+    const Glc& glc = camera.pieces[k];
+    const glm::ivec4 box = camera.piece_boxes[k];
+    if (box.x >= box.z || box.y >= box.w) return;
+    const float h = float(camera.size.y);
+    for (std::size_t o = 0; o + 1 < object_ranges_.size(); ++o) {
+      if (spheres[o].radius < 0 || !cone.may_meet(spheres[o].centre, spheres[o].radius * 1.0001))
+        continue;
+      for (std::uint32_t t = object_ranges_[o]; t < object_ranges_[o + 1]; ++t) {
+        const EyeTriangle& tri = triangles_[t];
+        if (!cone.may_meet(tri.centre, tri.radius * 1.0001 + 1e-6)) continue;
+        const auto bounds = glc.triangle_bounds(glm::dvec3(tri.v[0]), glm::dvec3(tri.v[1]),
+                                                glm::dvec3(tri.v[2]), settings_.z_near, 0.5);
+        if (!bounds) continue;
+        // Clip to the piece's box (whole pixels); the bound's box holds every pixel centre whose
+        // ray can meet the triangle.
+        const double x0 = std::max<double>(box.x, bounds->min.x);
+        const double x1 = std::min<double>(box.z, bounds->max.x);
+        const double y0 = std::max<double>(box.y, bounds->min.y);
+        const double y1 = std::min<double>(box.w, bounds->max.y);
+        if (!(x0 < x1 && y0 < y1)) continue;
+        quads.push_back({glm::vec4(float(x0), h - float(y1), float(x1), h - float(y0)),
+                         glm::vec4(tri.v[0], 1), glm::vec4(tri.v[1], 1), glm::vec4(tri.v[2], 1),
+                         glm::uvec4(triangle_id(o, t), std::uint32_t(k), tri.material, 0)});
+      }
+    }
+  }
+
   // The ID of list triangle t of object o (render_method.hpp's numbering).
   std::uint32_t triangle_id(std::size_t o, std::uint32_t t) const {
     return triangle_base_[o] + (t - object_ranges_[o]) + 1;
@@ -300,6 +322,7 @@ class GlcMethod final : public RenderMethod {
   std::vector<EyeTriangle> triangles_;
   std::vector<std::uint32_t> object_ranges_;
   std::vector<GpuQuad> quads_;
+  std::vector<std::vector<GpuQuad>> piece_quads_;
 };
 
 }  // namespace
