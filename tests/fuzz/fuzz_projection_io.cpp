@@ -1,10 +1,13 @@
-// Fuzz entry points of projection_io's readers: display.json, rig files, warp and blend EXRs.
+// Fuzz entry points of projection_io's readers: display.json, rig files, GLC cameras, warp and
+// blend EXRs.
+#include <cstdint>
 #include <glm/glm.hpp>
 
 #include "facet/projection/errors.hpp"
 #include "facet/projection/warp.hpp"
 #include "facet/projection_io/blend_file.hpp"
 #include "facet/projection_io/display_config.hpp"
+#include "facet/projection_io/glc_file.hpp"
 #include "facet/projection_io/rig_file.hpp"
 #include "facet/projection_io/warp_file.hpp"
 #include "fuzz_target.hpp"
@@ -27,6 +30,22 @@ FACET_FUZZ_TARGET(display_json) {
 FACET_FUZZ_TARGET(rig_json) {
   try {
     facet::parse_rig(std::string(text_of(bytes)), "fuzz/rig.json");
+  } catch (const facet::InputError&) {
+  }
+}
+
+// A GLC camera that reads must also give its centre pixel's ray and project a point on it.
+FACET_FUZZ_TARGET(glc_json) {
+  try {
+    const facet::PiecewiseGlc camera =
+        facet::parse_glc_camera(std::string(text_of(bytes)), "fuzz/camera.glc.json");
+    const auto ray = camera.ray(camera.size.x / 2, camera.size.y / 2);
+    if (ray) {
+      const std::int32_t piece =
+          camera.piece_of_pixel[std::size_t(camera.size.y / 2) * std::size_t(camera.size.x) +
+                                std::size_t(camera.size.x / 2)];
+      camera.pieces[std::size_t(piece)].project(ray->origin + 2.0 * ray->direction);
+    }
   } catch (const facet::InputError&) {
   }
 }
