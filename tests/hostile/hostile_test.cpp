@@ -737,6 +737,42 @@ void add_rig_json(std::vector<Variant>& out) {
   add_json_variants(out, "rig_json", rig_base, "rig.json", nullptr, m, args, "out");
 }
 
+// GLC camera: configs/glc/city_cross_slit.glc.json, through facet render --method glc.
+json glc_base() { return json::parse(slurp(kSource / "configs/glc/city_cross_slit.glc.json")); }
+
+void add_glc_json(std::vector<Variant>& out) {
+  const std::vector<std::string> args{"render", "--display", "@camera.glc.json", "--method", "glc",
+                                      "--out",  "@out"};
+  add_byte_variants(
+      out, "glc_json", [] { return glc_base().dump(1); }, "camera.glc.json", nullptr, args, "out",
+      {0.001, 0.3, 0.6, 0.999}, false);
+  add_non_regular_variants(out, "glc_json", "camera.glc.json", nullptr, args, "out");
+  std::vector<FieldMutation> m = {
+      {"format_unknown", "/format", "\"facet-glc/9\"", "format"},
+      {"format_missing", "/format", "", "format"},
+      {"camera_string", "/camera", "\"cross-slit\"", "camera"},
+      {"type_bogus", "/camera/type", "\"fisheye\"", "type"},
+      {"type_number", "/camera/type", "3", "type"},
+      {"size_zero", "/camera/size", "[0, 320]", "size"},
+      {"size_negative", "/camera/size", "[-1024, 320]", "size"},
+      {"size_huge", "/camera/size", "[100000, 100000]", "size"},
+      {"size_1e308", "/camera/size", "[1e308, 320]", "size"},
+      {"size_short", "/camera/size", "[1024]", "size"},
+      {"plane_size_zero", "/camera/plane_size", "[0, 2]", "plane_size"},
+      {"plane_size_negative", "/camera/plane_size", "[3.2, -2]", "plane_size"},
+      {"slit1_missing", "/camera/slit1", "", "slit1"},
+      {"slit1_direction_zero", "/camera/slit1/direction", "[0, 0, 0]", "slit1"},
+      {"slit1_point_short", "/camera/slit1/point", "[0, 0]", "point"},
+      {"slits_parallel", "/camera/slit2/direction", "[0, 2, 0]", "slit2"},
+      {"slits_meet", "/camera/slit2/point", "[0, 0, -1]", "slit2"},
+      {"slit_through_plane_corner", "/camera/slit1/point", "[-1.6, -1, 0]", "slit1"},
+      {"look_at_origin", "/camera/frame/look_at", "[0, 0, 0]", "look_at"},
+      {"up_along_view", "/camera/frame/up", "[0, 0, -1]", "up"},
+      {"unknown_key", "/camera/surprise", "true", "surprise"},
+  };
+  add_json_variants(out, "glc_json", glc_base, "camera.glc.json", nullptr, m, args, "out");
+}
+
 // capture.json and camera.cameramodel: the real procam-board capture, images linked in.
 const fs::path kCapture = kShared / "captures/procam-board";
 
@@ -2613,6 +2649,7 @@ const Kind kKinds[] = {
     {"warp_exr", add_warp_exr},
     {"blend_exr", add_blend_exr},
     {"rig_json", add_rig_json},
+    {"glc_json", add_glc_json},
     {"capture_and_cameramodel", add_capture},
     {"mpcdi_and_pfm", add_mpcdi},
     {"bourke_data", add_bourke},
