@@ -17,6 +17,7 @@
 #include <array>
 #include <atomic>
 #include <cmath>
+#include <exception>
 #include <memory>
 #include <thread>
 
@@ -202,18 +203,28 @@ class GlcMethod final : public RenderMethod {
       // then joined in piece order, so that the draw order does not depend on the threads.
       piece_quads_.resize(camera.pieces.size());
       std::atomic<std::size_t> next_piece{0};
-      auto box_pieces = [&] {
-        for (std::size_t k = next_piece++; k < camera.pieces.size(); k = next_piece++) {
-          piece_quads_[k].clear();
-          box_piece(camera, out.cones[k], k, spheres, piece_quads_[k]);
-        }
-      };
       const std::size_t workers = std::min<std::size_t>(
           camera.pieces.size(), std::max(1u, std::thread::hardware_concurrency()));
+      // A worker's exception (std::bad_alloc) is rethrown here, after every worker has ended.
+      std::vector<std::exception_ptr> failures(workers);
+      auto box_pieces = [&](std::size_t worker) {
+        try {
+          for (std::size_t k = next_piece++; k < camera.pieces.size(); k = next_piece++) {
+            piece_quads_[k].clear();
+            box_piece(camera, out.cones[k], k, spheres, piece_quads_[k]);
+          }
+        } catch (...) {
+          failures[worker] = std::current_exception();
+          next_piece = camera.pieces.size();
+        }
+      };
       std::vector<std::thread> pool;
-      for (std::size_t w = 1; w < workers; ++w) pool.emplace_back(box_pieces);
-      box_pieces();
+      for (std::size_t w = 1; w < workers; ++w) pool.emplace_back(box_pieces, w);
+      box_pieces(0);
       for (std::thread& thread : pool) thread.join();
+      for (const std::exception_ptr& failure : failures) {
+        if (failure) std::rethrow_exception(failure);
+      }
       quads_.clear();
       for (const std::vector<GpuQuad>& quads : piece_quads_) {
         quads_.insert(quads_.end(), quads.begin(), quads.end());
