@@ -533,6 +533,7 @@ PiecewiseGlc circular_panorama(double angle_deg, double radius, double vertical_
     }
   }
   camera.update_boxes();
+  camera.wraps_horizontally = angle_deg == 360;
   return camera;
 }
 

@@ -330,6 +330,7 @@ TEST(Glc, PanoramaStripsAreCrossSlitsThatMeetAtTheirSeams) {
         }
       }
     }
+    EXPECT_EQ(pano.wraps_horizontally, angle == 360.0);
     // Every pixel has a piece; the middle column looks down -z, level at the middle row.
     for (std::int32_t p : pano.piece_of_pixel) ASSERT_GE(p, 0);
     const auto middle = pano.ray(400, 300);

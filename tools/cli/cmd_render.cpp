@@ -116,7 +116,8 @@ nlohmann::json compare_with_reference(const Scene& scene, const std::vector<Outp
     const OutputSpec& output = outputs[i];
     std::optional<WarpInverse> inverse;
     if (!output.glc) inverse.emplace(output.warp);
-    const bool wrap_x = !output.glc && output.warp.base.wraps_horizontally();
+    const bool wrap_x =
+        output.glc ? output.glc->wraps_horizontally : output.warp.base.wraps_horizontally();
     const std::vector<std::uint32_t> reference =
         output.glc ? raycaster.ids(*output.glc, T_eye_world, z_near)
                    : raycaster.ids(*inverse, T_eye_world);

@@ -563,7 +563,9 @@ BenchReport run_bench(const BenchOptions& options, const std::string& renderer,
     const ReferenceRaycaster& raycaster = *loaded->raycaster;
     const FrameViews& views = *loaded->views;
     say("scenario " + scenario.name + ": " + scenario.description);
-    const bool wrap_x = scenario.outputs[0].warp.base.wraps_horizontally();
+    const bool wrap_x = scenario.outputs[0].glc
+                            ? scenario.outputs[0].glc->wraps_horizontally
+                            : scenario.outputs[0].warp.base.wraps_horizontally();
     std::vector<WarpInverse> inverses;
     std::vector<std::vector<std::uint32_t>> reference;
     const glm::dmat4 T0 = views.T_eye_world(0);

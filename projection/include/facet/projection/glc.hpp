@@ -153,6 +153,8 @@ struct PiecewiseGlc {
   // Each piece's pixel region: the bounding box of the pixels it owns, [min, max) in whole pixels.
   std::vector<glm::ivec4> piece_boxes;  // (x0, y0, x1, y1)
   std::vector<std::int32_t> piece_of_pixel;
+  // The image's left and right edges meet (a 360° panorama): neighbours for ID comparisons.
+  bool wraps_horizontally = false;
 
   // The ray of pixel (x, y)'s centre, nullopt where no piece covers it.
   std::optional<EyeRay> ray(int x, int y) const;
