@@ -110,5 +110,21 @@ TEST(GlcRender, WarpOutputIsRefused) {
   EXPECT_THROW(method->prepare(f.scene, gpu_scene, outputs, RenderSettings{}), InputError);
 }
 
+TEST(GlcRender, EveryOtherMethodRefusesAGlcOutput) {
+  test::shared_context();
+  const Fixture& f = fixture();
+  const GpuScene gpu_scene = upload_scene(f.scene);
+  const PiecewiseGlc camera = circular_panorama(360, 0.25, 120, 16, {64, 48}, "test", "camera");
+  const OutputSpec outputs[1] = {
+      {"glc", Warp::analytic(BaseProjection::perspective(-1, 1, 1, -1), camera.size),
+       std::make_shared<const PiecewiseGlc>(camera)}};
+  for (const std::string_view name : render_method_names()) {
+    if (name == "glc") continue;
+    auto method = make_render_method(name);
+    EXPECT_THROW(method->prepare(f.scene, gpu_scene, outputs, RenderSettings{}), InputError)
+        << name;
+  }
+}
+
 }  // namespace
 }  // namespace facet::driver

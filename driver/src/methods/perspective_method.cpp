@@ -61,6 +61,7 @@ class PerspectiveMethod final : public RenderMethod {
 
   void prepare(const Scene& scene, const GpuScene& gpu_scene, std::span<const OutputSpec> outputs,
                const RenderSettings& settings) override {
+    refuse_glc_outputs(outputs, name());
     if (settings.cube_face_size < 1 || settings.cube_face_size > 16384) {
       throw InputError("render settings", "cube_face_size",
                        "expected the perspective image's longer side, 1 to 16384 pixels, got " +

@@ -63,6 +63,20 @@ std::unique_ptr<RenderMethod> make_render_method(std::string_view name) {
   return nullptr;
 }
 
+namespace detail {
+
+void refuse_glc_outputs(std::span<const OutputSpec> outputs, std::string_view method) {
+  for (const OutputSpec& output : outputs) {
+    if (output.glc) {
+      throw InputError("command line", OptionName{"method"},
+                       "expected glc for output '" + output.name + "', a GLC camera's; got " +
+                           std::string(method));
+    }
+  }
+}
+
+}  // namespace detail
+
 std::vector<std::uint32_t> scene_triangle_base(const Scene& scene) {
   std::vector<std::uint32_t> base(scene.objects.size() + 1, 0);
   for (std::size_t o = 0; o < scene.objects.size(); ++o) {

@@ -2,6 +2,8 @@
 // Factories of the render methods, one per implementation file; make_render_method
 // (render_method.cpp) picks one by name.
 #include <memory>
+#include <span>
+#include <string_view>
 
 #include "facet/driver/render_method.hpp"
 
@@ -15,5 +17,9 @@ std::unique_ptr<RenderMethod> make_cubemap_method();        // "cubemap" (cubema
 std::unique_ptr<RenderMethod> make_perspective_method();    // "perspective"
 std::unique_ptr<RenderMethod> make_vertex_method();         // "vertex" (vertex_method.cpp)
 std::unique_ptr<RenderMethod> make_glc_method();            // "glc" (glc_method.cpp)
+
+// For every method but glc, in its prepare: throws InputError(OptionName "method") when an output
+// is a GLC camera's, whose warp only carries the output size.
+void refuse_glc_outputs(std::span<const OutputSpec> outputs, std::string_view method);
 
 }  // namespace facet::driver::detail

@@ -8,6 +8,7 @@
 #include "facet/driver/gpu_scene.hpp"
 #include "facet/driver/shader_library.hpp"
 #include "facet/projection/errors.hpp"
+#include "render_methods_internal.hpp"
 
 namespace facet::driver::detail {
 
@@ -104,6 +105,7 @@ void PrefixScan::run_level(const Buffer& data, std::uint32_t count, std::size_t 
 
 void FacetMethodBase::prepare(const Scene& scene, const GpuScene& gpu_scene,
                               std::span<const OutputSpec> outputs, const RenderSettings& settings) {
+  refuse_glc_outputs(outputs, name());
   if (!(settings.z_near > 0)) {
     throw InputError("render settings", "z_near", "expected a near distance > 0 metres");
   }

@@ -176,6 +176,7 @@ class VertexMethod final : public RenderMethod {
 
   void prepare(const Scene& scene, const GpuScene& gpu_scene, std::span<const OutputSpec> outputs,
                const RenderSettings& settings) override {
+    refuse_glc_outputs(outputs, name());
     if (settings.max_tessellation < 1 || settings.max_tessellation > kMaxTessellation) {
       throw InputError("render settings", "max_tessellation",
                        "expected a tessellation level cap of 1 to " +
