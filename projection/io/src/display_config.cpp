@@ -16,9 +16,9 @@
 namespace facet::projection_io {
 namespace {
 
+using json_fields::FieldPath;
 using json_fields::Fields;
 using json_fields::Json;
-using At = json_fields::FieldPath;
 
 bool valid_name(const std::string& name) {
   if (name.empty()) return false;
@@ -50,7 +50,7 @@ bool within_reach(const glm::dvec3& p_m) {
          std::abs(p_m.z) <= kMaxDistance_m;
 }
 
-DisplayOutput output_from_json(const Json& value, const At& at) {
+DisplayOutput output_from_json(const Json& value, const FieldPath& at) {
   Fields fields(value, at);
   const std::string expected = "{\"monitor\": NAME} or {\"window\": [x, y, width, height]}";
   const Json* monitor = fields.optional("monitor");
@@ -87,7 +87,8 @@ Json output_to_json(const DisplayOutput& output) {
   return result;
 }
 
-void check_file(const DisplayConfig& config, const std::filesystem::path& relative, const At& at) {
+void check_file(const DisplayConfig& config, const std::filesystem::path& relative,
+                const FieldPath& at) {
   if (relative.empty()) at.fail("a file path relative to display.json");
   if (relative.is_absolute()) at.fail("a path relative to display.json, not an absolute path");
   std::error_code error;
@@ -96,7 +97,7 @@ void check_file(const DisplayConfig& config, const std::filesystem::path& relati
   }
 }
 
-void check_relative(const std::filesystem::path& relative, const At& at) {
+void check_relative(const std::filesystem::path& relative, const FieldPath& at) {
   if (relative.empty()) at.fail("a file path relative to display.json");
   if (relative.is_absolute()) at.fail("a path relative to display.json, not an absolute path");
 }
@@ -115,9 +116,9 @@ bool split_tcp(const std::string& address, std::string& host, int& port) {
          digits.find_first_not_of("0123456789") == std::string::npos;
 }
 
-void validate_cluster(const DisplayConfig& config, const At& root) {
+void validate_cluster(const DisplayConfig& config, const FieldPath& root) {
   const DisplayCluster& cluster = *config.cluster;
-  const At at = root["cluster"];
+  const FieldPath at = root["cluster"];
   if (cluster.nodes.empty()) at["nodes"].fail("a list of at least one node");
   std::vector<std::string> projector_names;
   for (const DisplayProjector& projector : config.projectors)
@@ -126,7 +127,7 @@ void validate_cluster(const DisplayConfig& config, const At& root) {
   std::set<std::string> node_names, addresses;
   for (std::size_t k = 0; k < cluster.nodes.size(); ++k) {
     const ClusterNode& node = cluster.nodes[k];
-    const At node_at = at["nodes"][k];
+    const FieldPath node_at = at["nodes"][k];
     if (!valid_name(node.name))
       node_at["name"].fail("a non-empty node name of letters, digits, '_', '-' and '.'");
     if (!node_names.insert(node.name).second)
@@ -144,7 +145,7 @@ void validate_cluster(const DisplayConfig& config, const At& root) {
       node_at["projectors"].fail("a list of at least one projector name");
     for (std::size_t p = 0; p < node.projectors.size(); ++p) {
       const std::string& name = node.projectors[p];
-      const At projector_at = node_at["projectors"][p];
+      const FieldPath projector_at = node_at["projectors"][p];
       if (std::find(projector_names.begin(), projector_names.end(), name) ==
           projector_names.end()) {
         const std::string nearest = json_fields::nearest_key(name, projector_names);
@@ -200,7 +201,7 @@ std::string cluster_barrier_address(const std::string& address) {
 
 void validate_display_config(const DisplayConfig& config, const std::string& source,
                              bool check_files) {
-  const At root(source);
+  const FieldPath root(source);
   if (config.name.empty()) root["name"].fail("a non-empty display name");
   if (!within_reach(config.eye))
     root["eye"].fail("3 finite numbers (metres), each within ±1,000 km (1e6 m)");
@@ -209,7 +210,7 @@ void validate_display_config(const DisplayConfig& config, const std::string& sou
   std::set<std::string> names;
   for (std::size_t k = 0; k < config.projectors.size(); ++k) {
     const DisplayProjector& projector = config.projectors[k];
-    const At at = root["projectors"][k];
+    const FieldPath at = root["projectors"][k];
     if (!valid_name(projector.name)) {
       at["name"].fail("a non-empty name of letters, digits, '_', '-' and '.'");
     }
@@ -243,7 +244,7 @@ void validate_display_config(const DisplayConfig& config, const std::string& sou
       at["output"]["window"].fail("[x, y, width, height] with a positive width and height");
     }
   }
-  const At render = root["render"];
+  const FieldPath render = root["render"];
   if (!valid_method(config.render.method)) {
     render["method"].fail("a render method name of lower-case letters, digits, '_' and '-'");
   }
@@ -258,7 +259,7 @@ void validate_display_config(const DisplayConfig& config, const std::string& sou
 
 namespace {
 
-DisplayCluster cluster_from_json(const Json& value, const At& at) {
+DisplayCluster cluster_from_json(const Json& value, const FieldPath& at) {
   using namespace json_fields;
   Fields fields(value, at);
   DisplayCluster cluster;
@@ -266,7 +267,7 @@ DisplayCluster cluster_from_json(const Json& value, const At& at) {
   const Json& nodes = fields.required("nodes", expected_nodes);
   if (!nodes.is_array()) at["nodes"].fail(expected_nodes, nodes);
   for (std::size_t k = 0; k < nodes.size(); ++k) {
-    const At node_at = at["nodes"][k];
+    const FieldPath node_at = at["nodes"][k];
     Fields item(nodes[k], node_at);
     ClusterNode node;
     node.name = to_string(item.required("name", "the node's name"), node_at["name"]);
@@ -305,7 +306,7 @@ Json cluster_to_json(const DisplayCluster& cluster) {
 DisplayConfig display_from_json(const Json& document, const std::string& source,
                                 const std::filesystem::path& folder, bool check_files) {
   using namespace json_fields;
-  const At root(source);
+  const FieldPath root(source);
   Fields fields(document, root);
   const std::string expected_format = std::string("\"") + kDisplayFormat + "\"";
   const Json& format = fields.required("format", expected_format);
@@ -323,7 +324,7 @@ DisplayConfig display_from_json(const Json& document, const std::string& source,
   const Json& projectors = fields.required("projectors", expected_projectors);
   if (!projectors.is_array()) root["projectors"].fail(expected_projectors, projectors);
   for (std::size_t k = 0; k < projectors.size(); ++k) {
-    const At at = root["projectors"][k];
+    const FieldPath at = root["projectors"][k];
     Fields item(projectors[k], at);
     DisplayProjector projector;
     projector.name = to_string(item.required("name", "the projector's name"), at["name"]);
@@ -351,7 +352,7 @@ DisplayConfig display_from_json(const Json& document, const std::string& source,
     config.projectors.push_back(std::move(projector));
   }
   if (const Json* render_value = fields.optional("render")) {
-    const At at = root["render"];
+    const FieldPath at = root["render"];
     Fields render(*render_value, at);
     if (const Json* method = render.optional("method")) {
       config.render.method = to_string(*method, at["method"]);

@@ -23,18 +23,18 @@ extern const std::size_t kBuiltinRigCount;
 
 namespace {
 
+using json_fields::FieldPath;
 using json_fields::Fields;
 using json_fields::Json;
 using json_fields::to_dvec3;
 using json_fields::to_number;
 using json_fields::to_string;
-using At = json_fields::FieldPath;
 
 // The pose's rotation (camera-like frame: x right, y down, z forward) from either a matrix or a
 // point to look at from `position`. With a matrix, `look_at` and `up` are not read (and allowed).
 glm::dmat3 rotation(Fields& fields, const std::string& matrix_key, const glm::dvec3& position,
                     const glm::dmat3& fallback) {
-  const At& at = fields.path();
+  const FieldPath& at = fields.path();
   if (const Json* R = fields.optional(matrix_key)) {
     fields.allow({"look_at", "up"});
     return json_fields::to_dmat3(*R, at[matrix_key]);
@@ -57,7 +57,7 @@ glm::dmat3 rotation(Fields& fields, const std::string& matrix_key, const glm::dv
   return glm::dmat3(right, down, forward);
 }
 
-ProjectorModel projector_from_json(const Json& value, const At& at) {
+ProjectorModel projector_from_json(const Json& value, const FieldPath& at) {
   Fields fields(value, at);
   ProjectorModel p;
   p.name = to_string(fields.required("name", "a name"), at["name"]);
@@ -98,7 +98,7 @@ ProjectorModel projector_from_json(const Json& value, const At& at) {
   return p;
 }
 
-RigCamera camera_from_json(const Json& value, const At& at) {
+RigCamera camera_from_json(const Json& value, const FieldPath& at) {
   Fields fields(value, at);
   RigCamera camera;
   camera.lensmodel =
@@ -121,7 +121,7 @@ RigCamera camera_from_json(const Json& value, const At& at) {
   return camera;
 }
 
-SimulationSettings simulation_from_json(const Json& value, const At& at) {
+SimulationSettings simulation_from_json(const Json& value, const FieldPath& at) {
   Fields fields(value, at);
   SimulationSettings s;
   auto read_number = [&](const char* key, double& out) {
@@ -169,7 +169,7 @@ Json simulation_to_json(const SimulationSettings& s) {
 
 Rig parse_rig(const std::string& text_in, const std::string& source) {
   const Json root = json_fields::parse(text_in, source);
-  const At at(source);
+  const FieldPath at(source);
   Fields fields(root, at);
   const std::string expected_format = std::string("\"") + kRigFormat + "\"";
   const Json& format = fields.required("format", expected_format);
