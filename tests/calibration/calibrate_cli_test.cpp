@@ -268,6 +268,7 @@ TEST(Verdict, RealBoardIsCheckInJsonAndText) {
   EXPECT_EQ(summary.find("(bad)"), std::string::npos) << summary;
 }
 
+#ifndef FACET_TEST_WITHOUT_DRIVER
 namespace {
 
 // The RGB colour of pixel (x, y) of an 8-bit RGB image file.
@@ -379,6 +380,7 @@ TEST(CliCalibrate, RealBoardReportHasResidualAndCoverageMaps) {
   EXPECT_GT(covered, 0u);
   EXPECT_NEAR(share, expected_share, 0.01);
 }
+#endif
 
 // A run never refuses over a whisker (facets.hpp, kRunNearMiss). The procam-board display at half
 // its size (as `facet run --scale 0.5` previews it) with a tolerance of 0.29 px is a near miss:
@@ -399,6 +401,7 @@ facet::Warp half_size_board_warp() {
   return warp;
 }
 
+#ifndef FACET_TEST_WITHOUT_DRIVER
 // A copy of the board's display folder whose display.json sets render.tolerance_px.
 fs::path board_display_with_tolerance(const fs::path& folder, double tolerance_px) {
   for (const char* file : {"projector.warp.exr", "projector.blend.exr"})
@@ -414,6 +417,7 @@ std::string slurp_file(const fs::path& path) {
   std::ifstream stream(path);
   return {std::istreambuf_iterator<char>(stream), std::istreambuf_iterator<char>()};
 }
+#endif
 
 }  // namespace
 
@@ -459,6 +463,7 @@ TEST(NearMiss, KeptWithinItsFractionWithOneWarningAndRefusedBeyond) {
   EXPECT_TRUE(warnings.empty());
 }
 
+#ifndef FACET_TEST_WITHOUT_DRIVER
 // facet run --headless on that display renders (exit 0) and says why once; a tolerance no build
 // can meet stops it with exit 2 and an error naming display.json's render.tolerance_px.
 TEST(NearMiss, RunRendersANearMissWithAWarningAndNamesTheDisplaysField) {
@@ -499,3 +504,4 @@ TEST(NearMiss, RunRendersANearMissWithAWarningAndNamesTheDisplaysField) {
   EXPECT_EQ(far_output.find("--tolerance"), std::string::npos) << far_output;
   EXPECT_FALSE(fs::exists(far.path() / "frames"));
 }
+#endif

@@ -331,6 +331,7 @@ TEST(RenderCli, ReferenceReportsTheEdgeDisplacement) {
   std::filesystem::remove_all(folder);
 }
 
+#ifndef FACET_TEST_WITHOUT_INTEROP
 // --reference compares what the display shows. A split tile screen's pieces are projectors on
 // one window, each with a 0/1 blend map; facets that straddle the edge of a piece's coverage are
 // drawn whole, reaching into the other piece's half (here up to about 55 px of the 100 px
@@ -365,6 +366,7 @@ TEST(RenderCli, ReferenceComparesOnlyWhatTheBlendMapsShow) {
   EXPECT_EQ(reference.value("blend_hidden_pixels", std::uint64_t(0)), hidden);
   std::filesystem::remove_all(folder);
 }
+#endif
 
 // A render of a million frames stopped by SIGINT once its handler is in place: exit 130, one line
 // saying how far it got, and neither --out nor a temporary folder beside it.

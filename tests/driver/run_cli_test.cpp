@@ -63,20 +63,6 @@ fs::path fresh_folder(const std::string& name) {
   return folder;
 }
 
-// Runs `import_command` with --out FOLDER/display, then renders one headless frame of the
-// imported display.json into FOLDER/frames (with `run_options`).
-void import_then_run(const fs::path& folder, const std::string& import_command,
-                     const std::string& run_options = "") {
-  ASSERT_EQ(run(import_command + " --out " + (folder / "display").string(), folder / "import.log"),
-            0)
-      << slurp(folder / "import.log");
-  ASSERT_EQ(run("run " + (folder / "display" / "display.json").string() + " --headless --frames 1" +
-                    run_options + " --out " + (folder / "frames").string(),
-                folder / "run.log"),
-            0)
-      << slurp(folder / "run.log");
-}
-
 TEST(RunCli, HeadlessSessionRendersTheSamePixelsAsRender) {
   const fs::path folder = fresh_folder("same");
   const std::string common =
@@ -135,6 +121,21 @@ TEST(RunCli, EverySampleDisplayRunsHeadlessWithNonEmptyFrames) {
     EXPECT_GT(images, 0);
   }
   EXPECT_GE(displays, 3) << "configs/displays holds fewer sample displays than expected";
+}
+
+#ifndef FACET_TEST_WITHOUT_INTEROP
+// Runs `import_command` with --out FOLDER/display, then renders one headless frame of the
+// imported display.json into FOLDER/frames (with `run_options`).
+void import_then_run(const fs::path& folder, const std::string& import_command,
+                     const std::string& run_options = "") {
+  ASSERT_EQ(run(import_command + " --out " + (folder / "display").string(), folder / "import.log"),
+            0)
+      << slurp(folder / "import.log");
+  ASSERT_EQ(run("run " + (folder / "display" / "display.json").string() + " --headless --frames 1" +
+                    run_options + " --out " + (folder / "frames").string(),
+                folder / "run.log"),
+            0)
+      << slurp(folder / "run.log");
 }
 
 TEST(RunCli, AnImportedSphericalMirrorMeshRendersAtItsDefaultTolerance) {
@@ -214,6 +215,7 @@ TEST(RunCli, TheRealSimcadDomeImportsAsShippedAndRendersEveryChannel) {
     EXPECT_GT(lit_fraction(png), 0.1) << channel;
   }
 }
+#endif
 
 TEST(RunCli, BadDisplaysExitWithStatusTwoNamingTheProblem) {
   const fs::path folder = fresh_folder("bad");

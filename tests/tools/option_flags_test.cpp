@@ -240,12 +240,10 @@ TEST(OptionFlags, TheCliShowsALibraryOptionUnderItsCommandsFlag) {
   EXPECT_EQ(facet::cli::flag_of_option("run", "no_such_option"), "");
 }
 
+#ifndef FACET_TEST_WITHOUT_DRIVER
 // The scene-view rows (view_flags.hpp) are one list shared by render, run, bench and depth-image;
 // once the commands have declared their options, each keeps only the rows of flags it has.
 TEST(OptionFlags, ACommandKeepsOnlyTheSharedRowsOfTheFlagsItDeclares) {
-#ifndef FACET_TEST_HAS_DRIVER
-  GTEST_SKIP() << "a build without the driver has none of the commands that render a scene";
-#else
   using facet::cli::flag_of_option;
   CLI::App app;
   for (auto& [order, setup] : facet::cli::CommandRegistry::commands()) setup(app);
@@ -263,28 +261,24 @@ TEST(OptionFlags, ACommandKeepsOnlyTheSharedRowsOfTheFlagsItDeclares) {
   EXPECT_EQ(flag_of_option("bench", "frames"), "--frames");
   for (const char* option : {"material", "camera", "eye_world", "look_at_world", "size"})
     EXPECT_EQ(flag_of_option("bench", option), "") << option;
-#endif
 }
+#endif
 
+#ifndef FACET_TEST_WITHOUT_DRIVER
 // What the user of the facet executable reads when a library refuses an option: its flag.
 TEST(OptionFlags, TheFacetExecutableNamesTheFlagOfALibrarysOption) {
-#ifndef FACET_TEST_HAS_DRIVER
-  GTEST_SKIP() << "a build without the driver has no depth-image command";
-#else
   const fs::path out = facet::test_paths::scratch_path("option_flags") / "depth.exr";
   std::string output;
   EXPECT_EQ(facet::test::run_facet("depth-image --kind sphere --out " + out.string(), &output), 2);
   EXPECT_EQ(output,
             "facet: error: command line: field '--kind': expected planar or dpci; got 'sphere'\n");
   EXPECT_FALSE(fs::exists(out));
-#endif
 }
+#endif
 
+#if !defined(FACET_TEST_WITHOUT_DRIVER) && !defined(FACET_TEST_WITHOUT_CALIBRATION)
 // The same for an option a library names as the error's source.
 TEST(OptionFlags, TheFacetExecutableNamesTheFlagOfALibrarysOptionAsTheSource) {
-#if !defined(FACET_TEST_HAS_DRIVER) || !defined(FACET_TEST_HAS_CALIBRATION)
-  GTEST_SKIP() << "a build without the driver or calibration has no capture command";
-#else
   const fs::path display =
       fs::path(FACET_SOURCE_DIR) / "configs/displays/sample_two_projectors.display.json";
   const fs::path out = facet::test_paths::scratch_path("option_flags") / "capture";
@@ -297,7 +291,7 @@ TEST(OptionFlags, TheFacetExecutableNamesTheFlagOfALibrarysOptionAsTheSource) {
             2);
   EXPECT_EQ(output, "facet: error: --max-clipped: a fraction of camera pixels from 0 to 1\n");
   EXPECT_FALSE(fs::exists(out));
-#endif
 }
+#endif
 
 }  // namespace

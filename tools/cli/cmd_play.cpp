@@ -12,6 +12,7 @@
 #include <sstream>
 #include <string>
 
+#include "cluster_flags.hpp"
 #include "command.hpp"
 #include "console_log.hpp"
 #include "display_flags.hpp"

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "cluster_flags.hpp"
 #include "command.hpp"
 #include "console_log.hpp"
 #include "display_flags.hpp"

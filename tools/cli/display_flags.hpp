@@ -6,7 +6,6 @@
 #include <optional>
 #include <string>
 
-#include "facet/driver/cluster.hpp"
 #include "facet/projection/dome_orientation.hpp"
 #include "facet/projection/facets.hpp"
 #include "facet/projection/warp.hpp"
@@ -61,12 +60,5 @@ std::optional<DomeOrientation> builtin_dome_orientation(const DomeOrientationFla
 
 // "WxH" → (W, H); InputError naming the flag otherwise.
 glm::ivec2 parse_size(const std::string& text, const std::string& flag);
-
-// --node's check (run, play): a name, not empty (an empty one would run every projector alone).
-CLI::Validator cluster_node_name();
-
-// --node NAME, --join-timeout S and --rate HZ of run and play into `request` (frames_given is the
-// command's to set); `verb` begins --node's help ("Run", "Play").
-void add_cluster_flags(CLI::App& command, driver::ClusterRequest& request, const std::string& verb);
 
 }  // namespace facet::cli
