@@ -2,7 +2,6 @@
 // procam-board capture: no pin-holes in the output.
 #include <OpenImageIO/imageio.h>
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 
 #include <array>
 #include <cstdint>
@@ -22,17 +21,14 @@
 #include "facet/projection/facets.hpp"
 #include "facet/projection_io/blend_file.hpp"
 #include "facet/projection_io/warp_file.hpp"
-#include "test_folder.hpp"
+#include "support/facet_cli.hpp"
 
 namespace fs = std::filesystem;
 
-namespace {
+using facet::test::run_facet;
+using facet::test::slurp;
 
-int run(const std::string& arguments) {
-  const std::string command = std::string(FACET_CLI) + " " + arguments + " 2>/dev/null";
-  const int status = std::system(command.c_str());
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
+namespace {
 
 // The real procam-board capture, with its images referenced from the shared folder.
 nlohmann::json board_capture(const fs::path& into) {
@@ -103,28 +99,30 @@ TEST(CliCalibrate, BadCapturesExitWithStatusTwoAndWriteNothing) {
   fs::create_directories(capture);
   const nlohmann::json good = board_capture(capture);
 
-  EXPECT_EQ(run("calibrate " + (temp.path() / "none").string() + " --out " + out.string()), 2);
+  EXPECT_EQ(run_facet("calibrate " + (temp.path() / "none").string() + " --out " + out.string()),
+            2);
 
   nlohmann::json missing_frame = good;
   // The most significant column bit and its inverse.
   missing_frame["projectors"][0]["frames"].erase(1);
   missing_frame["projectors"][0]["frames"].erase(0);
   write(capture / "capture.json", missing_frame);
-  EXPECT_EQ(run("calibrate " + capture.string() + " --out " + out.string()), 2);
+  EXPECT_EQ(run_facet("calibrate " + capture.string() + " --out " + out.string()), 2);
 
   nlohmann::json missing_model = good;
   missing_model["camera"]["model"] = "nowhere.cameramodel";
   write(capture / "capture.json", missing_model);
-  EXPECT_EQ(run("calibrate " + capture.string() + " --out " + out.string()), 2);
+  EXPECT_EQ(run_facet("calibrate " + capture.string() + " --out " + out.string()), 2);
 
   nlohmann::json unreadable = good;
   std::ofstream(capture / "broken.png") << "not a png";
   unreadable["projectors"][0]["frames"][0]["file"] = "broken.png";
   write(capture / "capture.json", unreadable);
-  EXPECT_EQ(run("calibrate " + capture.string() + " --out " + out.string()), 2);
+  EXPECT_EQ(run_facet("calibrate " + capture.string() + " --out " + out.string()), 2);
 
   write(capture / "capture.json", good);
-  EXPECT_EQ(run("calibrate " + capture.string() + " --out " + out.string() + " --grid 1x5"), 2);
+  EXPECT_EQ(run_facet("calibrate " + capture.string() + " --out " + out.string() + " --grid 1x5"),
+            2);
 
   EXPECT_FALSE(fs::exists(out));
   for (const auto& entry : fs::directory_iterator(temp.path())) {
@@ -252,13 +250,11 @@ TEST(Verdict, RealBoardIsCheckInJsonAndText) {
 
   const facet::test::TempFolder temp;
   const fs::path text = temp.path() / "summary.txt";
-  const std::string command = std::string(FACET_CLI) + " calibrate " + FACET_SHARED_DATA_DIR +
-                              "/captures/procam-board --out " + (temp.path() / "out").string() +
-                              " > " + text.string() + " 2>&1";
-  ASSERT_EQ(std::system(command.c_str()), 0);
-  std::ifstream stream(text);
-  const std::string summary((std::istreambuf_iterator<char>(stream)),
-                            std::istreambuf_iterator<char>());
+  ASSERT_EQ(run_facet("calibrate " + std::string(FACET_SHARED_DATA_DIR) +
+                          "/captures/procam-board --out " + (temp.path() / "out").string(),
+                      text),
+            0);
+  const std::string summary = slurp(text);
   std::printf("%s", summary.c_str());
   for (const char* expected :
        {"projector    coverage", "p50 px", "p99 px", "worst region", "verdict",
@@ -412,11 +408,6 @@ fs::path board_display_with_tolerance(const fs::path& folder, double tolerance_p
   write(folder / "display.json", display);
   return folder / "display.json";
 }
-
-std::string slurp_file(const fs::path& path) {
-  std::ifstream stream(path);
-  return {std::istreambuf_iterator<char>(stream), std::istreambuf_iterator<char>()};
-}
 #endif
 
 }  // namespace
@@ -470,15 +461,13 @@ TEST(NearMiss, RunRendersANearMissWithAWarningAndNamesTheDisplaysField) {
   const facet::test::TempFolder temp;
   const fs::path display = board_display_with_tolerance(temp.path(), kNearMissPx);
   const fs::path log = temp.path() / "run.log";
-  const std::string arguments = " run " + display.string() +
-                                " --headless --scale 0.5 --frames 1 --out " +
-                                (temp.path() / "frames").string();
-  const std::string command = std::string(FACET_CLI) + arguments + " > " + log.string() + " 2>&1";
-  const int status = std::system(command.c_str());
-  const std::string output = slurp_file(log);
+  const int status =
+      run_facet("run " + display.string() + " --headless --scale 0.5 --frames 1 --out " +
+                    (temp.path() / "frames").string(),
+                log);
+  const std::string output = slurp(log);
   std::printf("%s", output.c_str());
-  ASSERT_TRUE(WIFEXITED(status));
-  EXPECT_EQ(WEXITSTATUS(status), 0) << output;
+  EXPECT_EQ(status, 0) << output;
   EXPECT_TRUE(fs::exists(temp.path() / "frames/projector/00000.png")) << output;
   const std::string warning = "facet run: warning: " + display.string() +
                               ": field 'render.tolerance_px': output 'projector': 0.29 px not met";
@@ -489,14 +478,12 @@ TEST(NearMiss, RunRendersANearMissWithAWarningAndNamesTheDisplaysField) {
   const fs::path tight = board_display_with_tolerance(far.path(), 1e-9);
   const fs::path far_log = far.path() / "run.log";
   const int far_status =
-      std::system((std::string(FACET_CLI) + " run " + tight.string() +
-                   " --headless --scale 0.5 --frames 1 --out " + (far.path() / "frames").string() +
-                   " > " + far_log.string() + " 2>&1")
-                      .c_str());
-  const std::string far_output = slurp_file(far_log);
+      run_facet("run " + tight.string() + " --headless --scale 0.5 --frames 1 --out " +
+                    (far.path() / "frames").string(),
+                far_log);
+  const std::string far_output = slurp(far_log);
   std::printf("%s", far_output.c_str());
-  ASSERT_TRUE(WIFEXITED(far_status));
-  EXPECT_EQ(WEXITSTATUS(far_status), 2) << far_output;
+  EXPECT_EQ(far_status, 2) << far_output;
   EXPECT_NE(
       far_output.find(tight.string() + ": field 'render.tolerance_px': for output 'projector'"),
       std::string::npos)

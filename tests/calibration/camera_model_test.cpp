@@ -10,7 +10,7 @@
 #include <string>
 
 #include "facet/projection/errors.hpp"
-#include "test_folder.hpp"
+#include "support/files.hpp"
 
 namespace fc = facet::calibration;
 

@@ -8,7 +8,7 @@
 
 #include "facet/calibration/image_io.hpp"
 #include "facet/projection/errors.hpp"
-#include "test_folder.hpp"
+#include "support/files.hpp"
 
 namespace fc = facet::calibration;
 

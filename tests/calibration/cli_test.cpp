@@ -9,26 +9,18 @@
 
 #include "facet/calibration/image_io.hpp"
 #include "facet/calibration/patterns.hpp"
-#include "test_folder.hpp"
+#include "support/facet_cli.hpp"
 
 namespace fc = facet::calibration;
 
-namespace {
-
-int run(const std::string& arguments) {
-  const std::string command = std::string(FACET_CLI) + " " + arguments + " 2>/dev/null";
-  const int status = std::system(command.c_str());
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
-
-}  // namespace
+using facet::test::run_facet;
 
 TEST(CliPatterns, WritesImagesAndManifest) {
   const facet::test::TempFolder temp;
   const auto out = temp.path() / "p";
-  ASSERT_EQ(
-      run("patterns --size 48x20 --out " + out.string() + " --phase-period 6.5 --phase-steps 3"),
-      0);
+  ASSERT_EQ(run_facet("patterns --size 48x20 --out " + out.string() +
+                      " --phase-period 6.5 --phase-steps 3"),
+            0);
   std::ifstream stream(out / "manifest.json");
   const auto manifest = nlohmann::json::parse(stream);
   EXPECT_EQ(manifest["size"], nlohmann::json({48, 20}));
@@ -46,13 +38,13 @@ TEST(CliPatterns, WritesImagesAndManifest) {
 TEST(CliPatterns, BadArgumentsExitWithStatusTwoAndWriteNothing) {
   const facet::test::TempFolder temp;
   const auto out = temp.path() / "p";
-  EXPECT_EQ(run("patterns --size 48by20 --out " + out.string()), 2);
-  EXPECT_EQ(run("patterns --size 0x20 --out " + out.string()), 2);
-  EXPECT_EQ(run("patterns --size 48x20 --out " + out.string() + " --phase-period -3"), 2);
-  EXPECT_EQ(run("patterns --size 48x20 --out " + out.string() + " --phase-steps 2"), 2);
+  EXPECT_EQ(run_facet("patterns --size 48by20 --out " + out.string()), 2);
+  EXPECT_EQ(run_facet("patterns --size 0x20 --out " + out.string()), 2);
+  EXPECT_EQ(run_facet("patterns --size 48x20 --out " + out.string() + " --phase-period -3"), 2);
+  EXPECT_EQ(run_facet("patterns --size 48x20 --out " + out.string() + " --phase-steps 2"), 2);
   EXPECT_TRUE(std::filesystem::is_empty(temp.path()));
   std::filesystem::create_directories(out);
   std::ofstream(out / "keep.txt") << "x";
-  EXPECT_EQ(run("patterns --size 48x20 --out " + out.string()), 2);
+  EXPECT_EQ(run_facet("patterns --size 48x20 --out " + out.string()), 2);
   EXPECT_FALSE(std::filesystem::exists(out / "manifest.json"));
 }

@@ -19,7 +19,7 @@
 #include "facet/calibration/simulate.hpp"
 #include "facet/calibration/video_camera.hpp"
 #include "facet/projection/errors.hpp"
-#include "test_folder.hpp"
+#include "support/files.hpp"
 
 namespace facet::calibration {
 namespace {

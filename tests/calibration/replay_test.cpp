@@ -14,7 +14,6 @@
 // of view, which the fit's grid refinement has to handle. The 8 px border of §5 is kept: it
 // leaves 112×80 pixel centres per projector.
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 
 #include <cstdio>
 #include <cstdlib>
@@ -30,7 +29,7 @@
 #include "facet/calibration/simulate.hpp"
 #include "facet/projection/errors.hpp"
 #include "facet/projection_io/blend_file.hpp"
-#include "test_folder.hpp"
+#include "support/facet_cli.hpp"
 
 namespace facet::calibration {
 namespace {
@@ -162,13 +161,6 @@ TEST(Replay, BlendSumsToOneWhereTheCameraViewEndsInsideAnOverlap) {
   EXPECT_LE(report.blend_sum_max_err, 0.005) << report.blend_worst;
 }
 
-// Runs the `facet` command; its exit status.
-int run_cli(const std::string& arguments) {
-  const std::string command = std::string(FACET_CLI) + " " + arguments + " 2>/dev/null";
-  const int status = std::system(command.c_str());
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
-
 // A copy of the replay capture whose frames are links to the originals.
 nlohmann::json copy_capture(const fs::path& from, const fs::path& to) {
   fs::create_directories(to);
@@ -195,7 +187,7 @@ void expect_input_error_naming(const fs::path& capture, const fs::path& out,
     EXPECT_NE(std::string(e.what()).find(name), std::string::npos) << e.what();
   }
   EXPECT_FALSE(fs::exists(out));
-  EXPECT_EQ(run_cli("calibrate " + capture.string() + " --out " + out.string()), 2);
+  EXPECT_EQ(test::run_facet("calibrate " + capture.string() + " --out " + out.string()), 2);
   EXPECT_FALSE(fs::exists(out));
   for (const auto& entry : fs::directory_iterator(out.parent_path())) {
     EXPECT_EQ(entry.path().filename().string().find(".tmp"), std::string::npos)

@@ -1,7 +1,6 @@
 #include "facet/calibration/simulate.hpp"
 
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 
 #include <algorithm>
 #include <cmath>
@@ -14,7 +13,7 @@
 #include "facet/projection/errors.hpp"
 #include "facet/projection_io/rig_file.hpp"
 #include "facet/projection_io/warp_file.hpp"
-#include "test_folder.hpp"
+#include "support/facet_cli.hpp"
 
 namespace facet::calibration {
 namespace {
@@ -177,12 +176,9 @@ TEST(Simulate, TruthFilesReadBackAndAgreeWithTheRig) {
 
 // The CLI's exit status; `prefix` runs before it in the same shell (e.g. "cd DIR && ").
 int run_cli_in(const std::string& prefix, const std::string& arguments) {
-  const std::string command =
-      prefix + std::string(FACET_CLI) + " " + arguments + " 2>/dev/null >/dev/null";
-  const int status = std::system(command.c_str());
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  std::string dropped;
+  return test::run_shell(prefix + std::string(FACET_CLI) + " " + arguments, &dropped);
 }
-int run_cli(const std::string& arguments) { return run_cli_in("", arguments); }
 
 TEST(Simulate, BadRigsFailCleanlyWithNoOutput) {
   test::TempFolder folder;
@@ -200,10 +196,10 @@ TEST(Simulate, BadRigsFailCleanlyWithNoOutput) {
 
   const auto bad = folder.path() / "bad.json";
   std::ofstream(bad) << R"({"format": "facet-rig/1", "screen": {"type": "sphere", "radius": 4}})";
-  EXPECT_EQ(run_cli("simulate --rig " + bad.string() + " --out " + out.string()), 2);
+  EXPECT_EQ(test::run_facet("simulate --rig " + bad.string() + " --out " + out.string()), 2);
   EXPECT_FALSE(std::filesystem::exists(out));
-  EXPECT_EQ(run_cli("simulate --rig " + (folder.path() / "missing.json").string() + " --out " +
-                    out.string()),
+  EXPECT_EQ(test::run_facet("simulate --rig " + (folder.path() / "missing.json").string() +
+                            " --out " + out.string()),
             2);
   EXPECT_FALSE(std::filesystem::exists(out));
 
@@ -212,24 +208,25 @@ TEST(Simulate, BadRigsFailCleanlyWithNoOutput) {
   small.camera.size = {40, 30};
   const auto good = folder.path() / "good.json";
   write_rig(good, small);
-  EXPECT_EQ(run_cli("simulate --rig " + good.string() + " --out " + out.string() + " --bits 12"),
-            2);
-  EXPECT_FALSE(std::filesystem::exists(out));
   EXPECT_EQ(
-      run_cli("simulate --rig " + good.string() + " --out " + out.string() + " --camera-size 0x5"),
+      test::run_facet("simulate --rig " + good.string() + " --out " + out.string() + " --bits 12"),
       2);
+  EXPECT_FALSE(std::filesystem::exists(out));
+  EXPECT_EQ(test::run_facet("simulate --rig " + good.string() + " --out " + out.string() +
+                            " --camera-size 0x5"),
+            2);
   EXPECT_FALSE(std::filesystem::exists(out));
   // No partial folder is left beside the output either.
   for (const auto& entry : std::filesystem::directory_iterator(folder.path())) {
     EXPECT_EQ(entry.path().filename().string().find(".capture"), std::string::npos);
   }
-  EXPECT_EQ(run_cli("simulate --rig " + good.string() + " --out " + out.string() +
-                    " --no-phase --noise 0.02 --seed 3"),
+  EXPECT_EQ(test::run_facet("simulate --rig " + good.string() + " --out " + out.string() +
+                            " --no-phase --noise 0.02 --seed 3"),
             0);
   EXPECT_TRUE(std::filesystem::exists(out / "capture.json"));
   EXPECT_TRUE(std::filesystem::exists(out / "truth" / "p0.warp.exr"));
   // An existing, non-empty output folder is refused.
-  EXPECT_EQ(run_cli("simulate --rig " + good.string() + " --out " + out.string()), 2);
+  EXPECT_EQ(test::run_facet("simulate --rig " + good.string() + " --out " + out.string()), 2);
 }
 
 // A built-in rig (configs/rigs, compiled in) simulates from a folder that holds no configs/; an

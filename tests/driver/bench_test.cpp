@@ -20,35 +20,16 @@
 #include <string>
 #include <vector>
 
-#include "cli_process.hpp"
 #include "facet/projection/atomic_folder.hpp"
 #include "facet/projection/errors.hpp"
+#include "support/facet_cli.hpp"
 
 namespace facet {
 namespace {
 
 namespace fs = std::filesystem;
+using test::names_in;
 using test::slurp;
-
-int run(const std::string& arguments, const fs::path& log) {
-  return test::run_facet(arguments, log);
-}
-
-fs::path fresh_folder(const std::string& name) {
-  const fs::path folder = facet::test_paths::scratch_path("facet_bench_cli_" + name);
-  fs::remove_all(folder);
-  fs::create_directories(folder);
-  return folder;
-}
-
-// The names in `folder`, sorted (hidden temporaries included).
-std::vector<std::string> names_in(const fs::path& folder) {
-  std::vector<std::string> names;
-  for (const auto& entry : fs::directory_iterator(folder))
-    names.push_back(entry.path().filename().string());
-  std::sort(names.begin(), names.end());
-  return names;
-}
 
 // RFC 4180 fields: quoted fields may hold commas and doubled quotes.
 std::vector<std::string> split_csv_line(const std::string& line) {
@@ -77,11 +58,11 @@ std::vector<std::string> split_csv_line(const std::string& line) {
 }
 
 TEST(BenchCli, QuickWritesJsonCsvAndPlotWithEveryMethod) {
-  const fs::path folder = fresh_folder("quick");
+  const fs::path folder = test::fresh_folder("facet_bench_cli_quick");
   const fs::path out = folder / "bench";
-  ASSERT_EQ(
-      run("bench --quick --scenario cylinder --frames 1 --out " + out.string(), folder / "log.txt"),
-      0)
+  ASSERT_EQ(test::run_facet("bench --quick --scenario cylinder --frames 1 --out " + out.string(),
+                            folder / "log.txt"),
+            0)
       << slurp(folder / "log.txt");
 
   const nlohmann::json json = nlohmann::json::parse(slurp(out / "bench.json"));
@@ -214,7 +195,7 @@ OutputFolderRules bench_rules() {
 // tools/gpu-bench keeps beside it) is replaced whole, a folder holding anything else is refused
 // before writing, and a failure while writing leaves the earlier output and no temporary.
 TEST(BenchFiles, ReplaceOnlyAnEarlierBenchAndLeaveNothingOnFailure) {
-  const fs::path folder = fresh_folder("files");
+  const fs::path folder = test::fresh_folder("facet_bench_cli_files");
   const fs::path out = folder / "bench";
   driver::write_bench_files(small_report("first"), out, bench_rules());
   const std::vector<std::string> files = {"bench.csv", "bench.json", "bench.md", "bench.png"};
@@ -260,13 +241,14 @@ TEST(BenchFiles, ReplaceOnlyAnEarlierBenchAndLeaveNothingOnFailure) {
 }
 
 TEST(BenchCli, BadFlagsExitTwoAndWriteNothing) {
-  const fs::path folder = fresh_folder("bad");
+  const fs::path folder = test::fresh_folder("facet_bench_cli_bad");
   for (const std::string& flags :
        {std::string("--scenario moon"), std::string("--frames 0"), std::string("--frames -1"),
         std::string("--frames 99999999"), std::string("--size-scale -1"),
         std::string("--scenario dome --rig /nonexistent.json")}) {
     const fs::path out = folder / "bench";
-    EXPECT_EQ(run("bench --quick " + flags + " --out " + out.string(), folder / "log.txt"), 2)
+    EXPECT_EQ(
+        test::run_facet("bench --quick " + flags + " --out " + out.string(), folder / "log.txt"), 2)
         << flags << ": " << slurp(folder / "log.txt");
     EXPECT_FALSE(fs::exists(out)) << flags;
   }
@@ -274,16 +256,18 @@ TEST(BenchCli, BadFlagsExitTwoAndWriteNothing) {
   const fs::path foreign = folder / "foreign";
   fs::create_directories(foreign);
   std::ofstream(foreign / "notes.txt") << "mine";
-  EXPECT_EQ(run("bench --quick --scenario cylinder --frames 1 --out " + foreign.string(),
-                folder / "log.txt"),
-            2)
+  EXPECT_EQ(
+      test::run_facet("bench --quick --scenario cylinder --frames 1 --out " + foreign.string(),
+                      folder / "log.txt"),
+      2)
       << slurp(folder / "log.txt");
   EXPECT_NE(slurp(folder / "log.txt").find("--out"), std::string::npos)
       << slurp(folder / "log.txt");
   EXPECT_EQ(names_in(foreign), std::vector<std::string>{"notes.txt"});
   EXPECT_EQ(slurp(foreign / "notes.txt"), "mine");
   // So is the cluster scenario's, before any node starts.
-  EXPECT_EQ(run("bench --quick --scenario cluster --out " + foreign.string(), folder / "log.txt"),
+  EXPECT_EQ(test::run_facet("bench --quick --scenario cluster --out " + foreign.string(),
+                            folder / "log.txt"),
             2)
       << slurp(folder / "log.txt");
   EXPECT_NE(slurp(folder / "log.txt").find("--out"), std::string::npos)

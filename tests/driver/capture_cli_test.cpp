@@ -18,8 +18,6 @@
 #include <vector>
 
 #include "../calibration/capture_rig.hpp"
-#include "../calibration/test_folder.hpp"
-#include "cli_process.hpp"
 #include "facet/calibration/calibrate.hpp"
 #include "facet/calibration/capture.hpp"
 #include "facet/calibration/live_capture.hpp"
@@ -27,16 +25,12 @@
 #include "facet/projection/errors.hpp"
 #include "facet/projection_io/display_config.hpp"
 #include "facet/projection_io/rig_file.hpp"
+#include "support/facet_cli.hpp"
 
 namespace facet::calibration {
 namespace {
 
 namespace fs = std::filesystem;
-
-int run_cli(const std::string& arguments, std::string* output = nullptr) {
-  return test::run_facet(arguments, output);
-}
-std::string file_bytes(const fs::path& path) { return test::slurp(path); }
 
 // The rig as a file and a display.json naming its two projectors (no warps yet).
 struct RigFiles {
@@ -79,7 +73,7 @@ void expect_same_frames(const fs::path& a, const fs::path& b) {
   std::size_t compared = 0;
   for (const CaptureProjector& projector : first.projectors) {
     for (const CaptureFrame& frame : projector.frames) {
-      EXPECT_EQ(file_bytes(first.resolve(frame.file)), file_bytes(second.resolve(frame.file)))
+      EXPECT_EQ(test::slurp(first.resolve(frame.file)), test::slurp(second.resolve(frame.file)))
           << frame.file;
       ++compared;
     }
@@ -98,15 +92,15 @@ std::size_t journal_frames(const fs::path& out) {
 TEST(CaptureCli, AStoppedCaptureResumesToTheSameFrames) {
   const RigFiles setup;
   const fs::path whole = setup.temp.path() / "whole";
-  ASSERT_EQ(run_cli(setup.command(whole)), 0);
+  ASSERT_EQ(test::run_facet(setup.command(whole)), 0);
 
   // A deterministic stop: exit 3, nothing finished, then a resume that captures the rest.
   const fs::path stopped = setup.temp.path() / "stopped";
   std::string output;
-  ASSERT_EQ(run_cli(setup.command(stopped, "--stop-after 25"), &output), 3) << output;
+  ASSERT_EQ(test::run_facet(setup.command(stopped, "--stop-after 25"), &output), 3) << output;
   EXPECT_FALSE(fs::exists(stopped / "capture.json"));
   EXPECT_EQ(journal_frames(stopped), 25u);
-  ASSERT_EQ(run_cli(setup.command(stopped, "--json"), &output), 0) << output;
+  ASSERT_EQ(test::run_facet(setup.command(stopped, "--json"), &output), 0) << output;
   const nlohmann::json report = nlohmann::json::parse(output.substr(output.find('{')));
   EXPECT_EQ(report["kept"], 25);
   EXPECT_EQ(report["captured"], 2 * 38 - 25);
@@ -117,7 +111,7 @@ TEST(CaptureCli, AStoppedCaptureResumesToTheSameFrames) {
 TEST(CaptureCli, AKilledCaptureResumesToTheSameFrames) {
   const RigFiles setup;
   const fs::path whole = setup.temp.path() / "whole";
-  ASSERT_EQ(run_cli(setup.command(whole)), 0);
+  ASSERT_EQ(test::run_facet(setup.command(whole)), 0);
   std::string output;
   // A real interruption: SIGKILL once some frames exist.
   const fs::path killed = setup.temp.path() / "killed";
@@ -142,7 +136,7 @@ TEST(CaptureCli, AKilledCaptureResumesToTheSameFrames) {
   EXPECT_FALSE(fs::exists(killed / "capture.json"));
   const std::size_t before = journal_frames(killed);
   EXPECT_GE(before, 10u);
-  ASSERT_EQ(run_cli(setup.command(killed, "--json"), &output), 0) << output;
+  ASSERT_EQ(test::run_facet(setup.command(killed, "--json"), &output), 0) << output;
   const nlohmann::json resumed = nlohmann::json::parse(output.substr(output.find('{')));
   // At most one frame was renamed into place after its predecessor's journal line.
   EXPECT_GE(resumed["kept"].get<std::size_t>(), before);
@@ -187,7 +181,7 @@ TEST(CaptureCli, SigintStopsBetweenFramesAndLeavesTheCaptureResumable) {
   EXPECT_EQ(images, journaled);
   EXPECT_LT(journaled, 76u);
   std::string output;
-  ASSERT_EQ(run_cli(files.command(out, "--json"), &output), 0) << output;
+  ASSERT_EQ(test::run_facet(files.command(out, "--json"), &output), 0) << output;
   const nlohmann::json report = nlohmann::json::parse(output.substr(output.find('{')));
   EXPECT_EQ(report["kept"].get<std::size_t>(), journaled);
   EXPECT_EQ(report["kept"].get<std::size_t>() + report["captured"].get<std::size_t>(), 76u);
@@ -196,8 +190,8 @@ TEST(CaptureCli, SigintStopsBetweenFramesAndLeavesTheCaptureResumable) {
 TEST(CaptureCli, AResumedCaptureCalibratesLikeTheSimulatedOne) {
   const RigFiles setup;
   const fs::path live = setup.temp.path() / "live";
-  ASSERT_EQ(run_cli(setup.command(live, "--stop-after 40")), 3);
-  ASSERT_EQ(run_cli(setup.command(live)), 0);
+  ASSERT_EQ(test::run_facet(setup.command(live, "--stop-after 40")), 3);
+  ASSERT_EQ(test::run_facet(setup.command(live)), 0);
   const CalibrationReport live_report = calibrate(live, setup.temp.path() / "live-display");
   // The display the capture ran with comes back whole, its warps and blends filled in: name,
   // eye, outputs, gammas, render settings and missing_monitor as in the file given to capture.
@@ -266,36 +260,38 @@ TEST(CaptureCli, BadInputExitsTwoAndFinishesNothing) {
   std::string output;
   // An unknown camera device: nothing is created.
   const fs::path none = setup.temp.path() / "none";
-  EXPECT_EQ(run_cli("capture --display " + setup.display.string() +
-                        " --camera /dev/video-none-here --camera-model x.cameramodel --out " +
-                        none.string(),
-                    &output),
-            2)
+  EXPECT_EQ(
+      test::run_facet("capture --display " + setup.display.string() +
+                          " --camera /dev/video-none-here --camera-model x.cameramodel --out " +
+                          none.string(),
+                      &output),
+      2)
       << output;
   EXPECT_FALSE(fs::exists(none));
   // A real camera needs its lens model.
-  EXPECT_EQ(run_cli("capture --display " + setup.display.string() + " --camera /dev/video0 --out " +
-                        none.string(),
-                    &output),
+  EXPECT_EQ(test::run_facet("capture --display " + setup.display.string() +
+                                " --camera /dev/video0 --out " + none.string(),
+                            &output),
             2);
   EXPECT_NE(output.find("--camera-model"), std::string::npos) << output;
   EXPECT_FALSE(fs::exists(none));
   // A resume with other settings than the interrupted capture.
   const fs::path out = setup.temp.path() / "capture";
-  ASSERT_EQ(run_cli(setup.command(out, "--stop-after 3")), 3);
-  EXPECT_EQ(run_cli(setup.command(out, "--average 2"), &output), 2) << output;
+  ASSERT_EQ(test::run_facet(setup.command(out, "--stop-after 3")), 3);
+  EXPECT_EQ(test::run_facet(setup.command(out, "--average 2"), &output), 2) << output;
   EXPECT_NE(output.find("settings.average"), std::string::npos) << output;
-  EXPECT_EQ(run_cli(setup.command(out, "--bits 8"), &output), 2) << output;
+  EXPECT_EQ(test::run_facet(setup.command(out, "--bits 8"), &output), 2) << output;
   EXPECT_NE(output.find("settings.bits"), std::string::npos) << output;
   EXPECT_FALSE(fs::exists(out / "capture.json"));
   // Clipping on the white frame: exit 2 naming the projector, no capture.json.
   const RigFiles clipped(bright);
   const fs::path clipped_out = clipped.temp.path() / "capture";
-  EXPECT_EQ(run_cli(clipped.command(clipped_out), &output), 2) << output;
+  EXPECT_EQ(test::run_facet(clipped.command(clipped_out), &output), 2) << output;
   EXPECT_NE(output.find("projector 'left': field '--max-clipped'"), std::string::npos) << output;
   EXPECT_FALSE(fs::exists(clipped_out / "capture.json"));
   // ... unless accepted.
-  EXPECT_EQ(run_cli(clipped.command(clipped_out, "--allow-clipping --stop-after 2"), &output), 3)
+  EXPECT_EQ(
+      test::run_facet(clipped.command(clipped_out, "--allow-clipping --stop-after 2"), &output), 3)
       << output;
 }
 

@@ -17,8 +17,8 @@
 #include <thread>
 
 #include "../calibration/capture_rig.hpp"
-#include "cli_process.hpp"
 #include "facet/projection_io/rig_file.hpp"
+#include "support/facet_cli.hpp"
 #include "xorg_dummy.hpp"
 
 namespace facet {
@@ -26,8 +26,6 @@ namespace {
 
 namespace fs = std::filesystem;
 using test::run_shell;
-
-std::string file_bytes(const fs::path& path) { return test::slurp(path); }
 
 class CaptureWindows : public ::testing::Test {
  protected:
@@ -109,7 +107,7 @@ TEST_F(CaptureWindows, WindowedFramesEqualHeadlessOnesAcrossAResume) {
   for (const auto& entry : fs::recursive_directory_iterator(dir / "headless")) {
     if (entry.path().extension() != ".png") continue;
     const fs::path relative = fs::relative(entry.path(), dir / "headless");
-    EXPECT_EQ(file_bytes(entry.path()), file_bytes(dir / "windowed" / relative)) << relative;
+    EXPECT_EQ(test::slurp(entry.path()), test::slurp(dir / "windowed" / relative)) << relative;
     ++compared;
   }
   EXPECT_EQ(compared, 2u * 38);

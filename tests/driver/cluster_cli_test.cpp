@@ -24,7 +24,7 @@
 #include <string>
 #include <vector>
 
-#include "cli_process.hpp"
+#include "support/facet_cli.hpp"
 
 namespace facet {
 namespace {
@@ -37,19 +37,6 @@ using test::slurp;
 // so a long one costs test time only where a node is lost.
 constexpr int kDeadline_ms = 3000;
 const std::string kScale = "0.125";
-
-struct Scratch {
-  fs::path path;
-  explicit Scratch(const std::string& name)
-      : path(facet::test_paths::scratch_path("facet_cluster_cli_" + name)) {
-    fs::remove_all(path);
-    fs::create_directories(path);
-  }
-  ~Scratch() {
-    std::error_code ignored;
-    fs::remove_all(path, ignored);
-  }
-};
 
 // dome4 copied to `folder`/name with a cluster section (and only `projectors`, when given).
 fs::path write_display(const fs::path& folder, const std::string& name,
@@ -143,17 +130,17 @@ std::size_t lines_in(const fs::path& file) {
 }
 
 TEST(ClusterCli, ThreeNodesMakeTheOneProcessFramesInLockStep) {
-  const Scratch scratch("lock");
-  const fs::path display = write_display(scratch.path, "dome4", dome4_cluster(scratch.path));
+  const test::TempFolder scratch("facet_cluster_cli_lock");
+  const fs::path display = write_display(scratch.path(), "dome4", dome4_cluster(scratch.path()));
   // Without --node the cluster section changes nothing: one process, every projector.
   ASSERT_EQ(test::run_facet("run " + display.string() + " --headless --frames 30 --scale " +
-                                kScale + " --out " + (scratch.path / "one").string(),
-                            scratch.path / "one.log"),
+                                kScale + " --out " + (scratch.path() / "one").string(),
+                            scratch.path() / "one.log"),
             0)
-      << slurp(scratch.path / "one.log");
-  Node b = start_node(display, "b", scratch.path, "b");
-  Node c = start_node(display, "c", scratch.path, "c");
-  Node a = start_node(display, "a", scratch.path, "a", {"--frames", "30"});
+      << slurp(scratch.path() / "one.log");
+  Node b = start_node(display, "b", scratch.path(), "b");
+  Node c = start_node(display, "c", scratch.path(), "c");
+  Node a = start_node(display, "a", scratch.path(), "a", {"--frames", "30"});
   EXPECT_EQ(finish(a), 0) << slurp(a.log);
   EXPECT_EQ(finish(b), 0) << slurp(b.log);
   EXPECT_EQ(finish(c), 0) << slurp(c.log);
@@ -167,7 +154,7 @@ TEST(ClusterCli, ThreeNodesMakeTheOneProcessFramesInLockStep) {
     for (int frame = 0; frame < 30; ++frame) {
       char name[16];
       std::snprintf(name, sizeof name, "%05d.png", frame);
-      const std::string one = slurp(scratch.path / "one" / projector / name);
+      const std::string one = slurp(scratch.path() / "one" / projector / name);
       ASSERT_FALSE(one.empty()) << projector << "/" << name;
       EXPECT_TRUE(slurp(out / projector / name) == one) << projector << "/" << name << " differs";
       ++compared;
@@ -194,8 +181,8 @@ TEST(ClusterCli, ThreeNodesMakeTheOneProcessFramesInLockStep) {
 
 TEST(ClusterCli, EightNodesLoseNoFrame) {
   // dome4's four projectors twice over (q0..q3 are p0..p3 under other names), one node each.
-  const Scratch scratch("eight");
-  const fs::path display = write_display(scratch.path, "dome8", std::nullopt);
+  const test::TempFolder scratch("facet_cluster_cli_eight");
+  const fs::path display = write_display(scratch.path(), "dome8", std::nullopt);
   json document = json::parse(slurp(display));
   json doubled = document["projectors"];
   for (json projector : document["projectors"]) {
@@ -203,12 +190,12 @@ TEST(ClusterCli, EightNodesLoseNoFrame) {
     doubled.push_back(projector);
   }
   document["projectors"] = doubled;
-  fs::create_directories(scratch.path / "sockets");
+  fs::create_directories(scratch.path() / "sockets");
   json nodes = json::array();
   for (std::size_t k = 0; k < doubled.size(); ++k)
     nodes.push_back(
         {{"name", "n" + std::to_string(k)},
-         {"address", "ipc://" + (scratch.path / "sockets" / std::to_string(k)).string()},
+         {"address", "ipc://" + (scratch.path() / "sockets" / std::to_string(k)).string()},
          {"projectors", {doubled[k]["name"]}}});
   document["cluster"] = {{"nodes", nodes}, {"master", "n0"}, {"deadline_ms", kDeadline_ms}};
   std::ofstream(display) << document.dump(2);
@@ -216,9 +203,9 @@ TEST(ClusterCli, EightNodesLoseNoFrame) {
   constexpr int kFrames = 60;
   std::vector<Node> secondaries;
   for (int k = 1; k < 8; ++k)
-    secondaries.push_back(start_node(display, "n" + std::to_string(k), scratch.path,
+    secondaries.push_back(start_node(display, "n" + std::to_string(k), scratch.path(),
                                      "n" + std::to_string(k), {"--save-every", "1000"}));
-  const Node master = start_node(display, "n0", scratch.path, "n0",
+  const Node master = start_node(display, "n0", scratch.path(), "n0",
                                  {"--frames", std::to_string(kFrames), "--save-every", "1000"});
   EXPECT_EQ(finish(master), 0) << slurp(master.log);
   for (const Node& node : secondaries) EXPECT_EQ(finish(node), 0) << slurp(node.log);
@@ -226,7 +213,7 @@ TEST(ClusterCli, EightNodesLoseNoFrame) {
   std::vector<double> barrier_ms;
   for (int k = 0; k < 8; ++k) {
     const std::vector<json> lines =
-        stats_lines(scratch.path / ("n" + std::to_string(k)) / "stats.jsonl");
+        stats_lines(scratch.path() / ("n" + std::to_string(k)) / "stats.jsonl");
     ASSERT_EQ(lines.size(), std::size_t(kFrames)) << "node n" << k;
     std::vector<std::string> digests;
     for (const json& line : lines) {
@@ -253,8 +240,8 @@ TEST(ClusterCli, ALongRunKeepsEveryNodesResidentSetFlat) {
   constexpr int kFrames = 200;
   constexpr std::size_t kFrom = 40;
   constexpr std::uint64_t kGrowth_kib = 2 * 1024;
-  const Scratch scratch("soak");
-  const fs::path display = write_display(scratch.path, "dome4", dome4_cluster(scratch.path));
+  const test::TempFolder scratch("facet_cluster_cli_soak");
+  const fs::path display = write_display(scratch.path(), "dome4", dome4_cluster(scratch.path()));
   // ASan's quarantine of freed memory grows the resident set by design; without it what stays
   // resident is what the process holds, as in the normal build.
   const char* asan = std::getenv("ASAN_OPTIONS");
@@ -264,9 +251,9 @@ TEST(ClusterCli, ALongRunKeepsEveryNodesResidentSetFlat) {
             "quarantine_size_mb=0:thread_local_quarantine_size_kb=0")
                .c_str(),
            1);
-  Node b = start_node(display, "b", scratch.path, "b", {"--save-every", "1000"});
-  Node c = start_node(display, "c", scratch.path, "c", {"--save-every", "1000"});
-  Node a = start_node(display, "a", scratch.path, "a",
+  Node b = start_node(display, "b", scratch.path(), "b", {"--save-every", "1000"});
+  Node c = start_node(display, "c", scratch.path(), "c", {"--save-every", "1000"});
+  Node a = start_node(display, "a", scratch.path(), "a",
                       {"--frames", std::to_string(kFrames), "--save-every", "1000"});
   if (asan)
     ::setenv("ASAN_OPTIONS", saved.c_str(), 1);
@@ -293,22 +280,22 @@ TEST(ClusterCli, ALongRunKeepsEveryNodesResidentSetFlat) {
 }
 
 TEST(ClusterCli, AKilledSecondaryIsReportedAndRejoinsWithTheSameFrames) {
-  const Scratch scratch("rejoin");
-  const fs::path display = write_display(scratch.path, "dome4", dome4_cluster(scratch.path));
+  const test::TempFolder scratch("facet_cluster_cli_rejoin");
+  const fs::path display = write_display(scratch.path(), "dome4", dome4_cluster(scratch.path()));
   // 10 s at the master's pace: time for the restarted node to start (its scene, its GL), even
   // in a sanitizer build.
   constexpr int kFrames = 100;
   // The master paces the run (10 frames a second), so that the restarted node finds it going.
-  Node b = start_node(display, "b", scratch.path, "b");
-  Node c = start_node(display, "c", scratch.path, "c");
-  Node a = start_node(display, "a", scratch.path, "a",
+  Node b = start_node(display, "b", scratch.path(), "b");
+  Node c = start_node(display, "c", scratch.path(), "c");
+  Node a = start_node(display, "a", scratch.path(), "a",
                       {"--frames", std::to_string(kFrames), "--rate", "10"});
   ASSERT_TRUE(
       test::wait_until([&] { return lines_in(c.live_stats()) >= 10; }, std::chrono::seconds(120)))
       << slurp(c.log);
   ::kill(c.pid, SIGKILL);
   EXPECT_EQ(finish(c), -1);
-  Node c2 = start_node(display, "c", scratch.path, "c2");
+  Node c2 = start_node(display, "c", scratch.path(), "c2");
   EXPECT_EQ(finish(a), 0) << slurp(a.log);
   EXPECT_EQ(finish(b), 0) << slurp(b.log);
   EXPECT_EQ(finish(c2), 0) << slurp(c2.log);
@@ -363,28 +350,28 @@ TEST(ClusterCli, AKilledSecondaryIsReportedAndRejoinsWithTheSameFrames) {
   EXPECT_EQ(std::uint64_t(from_rejoin), kFrames - *rejoined_at)
       << "c missed frames after rejoining at " << *rejoined_at << "\n"
       << slurp(a.log) << slurp(c2.log);
-  const fs::path p3_only = write_display(scratch.path, "p3", std::nullopt, {"p3"});
+  const fs::path p3_only = write_display(scratch.path(), "p3", std::nullopt, {"p3"});
   ASSERT_EQ(test::run_facet("run " + p3_only.string() + " --headless --frames " +
                                 std::to_string(kFrames) + " --scale " + kScale + " --out " +
-                                (scratch.path / "one").string(),
-                            scratch.path / "one.log"),
+                                (scratch.path() / "one").string(),
+                            scratch.path() / "one.log"),
             0)
-      << slurp(scratch.path / "one.log");
+      << slurp(scratch.path() / "one.log");
   for (const std::uint64_t frame : shown) {
     char name[16];
     std::snprintf(name, sizeof name, "%05llu.png", static_cast<unsigned long long>(frame));
-    const std::string one = slurp(scratch.path / "one" / "p3" / name);
+    const std::string one = slurp(scratch.path() / "one" / "p3" / name);
     ASSERT_FALSE(one.empty()) << name;
     EXPECT_TRUE(slurp(c2.out / "p3" / name) == one) << "p3/" << name << " differs";
   }
 }
 
 TEST(ClusterCli, AKilledMasterStopsTheSecondariesWithStatusThree) {
-  const Scratch scratch("master");
-  const fs::path display = write_display(scratch.path, "dome4", dome4_cluster(scratch.path));
-  Node b = start_node(display, "b", scratch.path, "b");
-  Node c = start_node(display, "c", scratch.path, "c");
-  Node a = start_node(display, "a", scratch.path, "a", {"--frames", "100000", "--rate", "10"});
+  const test::TempFolder scratch("facet_cluster_cli_master");
+  const fs::path display = write_display(scratch.path(), "dome4", dome4_cluster(scratch.path()));
+  Node b = start_node(display, "b", scratch.path(), "b");
+  Node c = start_node(display, "c", scratch.path(), "c");
+  Node a = start_node(display, "a", scratch.path(), "a", {"--frames", "100000", "--rate", "10"});
   ASSERT_TRUE(
       test::wait_until([&] { return lines_in(b.live_stats()) >= 3; }, std::chrono::seconds(120)))
       << slurp(b.log);
@@ -417,12 +404,12 @@ struct HeldPort {
 };
 
 TEST(ClusterCli, BadInputIsStatusTwoWithAClearMessage) {
-  const Scratch scratch("bad");
-  const fs::path display = write_display(scratch.path, "dome4", dome4_cluster(scratch.path));
+  const test::TempFolder scratch("facet_cluster_cli_bad");
+  const fs::path display = write_display(scratch.path(), "dome4", dome4_cluster(scratch.path()));
   std::string output;
   // A node the cluster does not have.
   EXPECT_EQ(test::run_facet("run " + display.string() + " --node z --headless --out " +
-                                (scratch.path / "z").string(),
+                                (scratch.path() / "z").string(),
                             &output),
             2);
   EXPECT_NE(output.find("field '--node': the name of one of the cluster's nodes (a, b, c), got "
@@ -430,40 +417,40 @@ TEST(ClusterCli, BadInputIsStatusTwoWithAClearMessage) {
             std::string::npos)
       << output;
   // A display without a cluster section.
-  const fs::path plain = write_display(scratch.path, "plain", std::nullopt);
+  const fs::path plain = write_display(scratch.path(), "plain", std::nullopt);
   EXPECT_EQ(test::run_facet("run " + plain.string() + " --node a --headless --out " +
-                                (scratch.path / "p").string(),
+                                (scratch.path() / "p").string(),
                             &output),
             2);
   EXPECT_NE(output.find("field 'cluster': a cluster section for a cluster node"), std::string::npos)
       << output;
   // A bad address, and a node named twice, in display.json.
-  json cluster = dome4_cluster(scratch.path);
+  json cluster = dome4_cluster(scratch.path());
   cluster["nodes"][1]["address"] = "tcp://localhost";
-  const fs::path bad_address = write_display(scratch.path, "address", cluster);
+  const fs::path bad_address = write_display(scratch.path(), "address", cluster);
   EXPECT_EQ(test::run_facet("run " + bad_address.string() + " --node b --headless --out " +
-                                (scratch.path / "x").string(),
+                                (scratch.path() / "x").string(),
                             &output),
             2);
   EXPECT_NE(output.find("field 'cluster.nodes[1].address': expected tcp://HOST:PORT"),
             std::string::npos)
       << output;
-  cluster = dome4_cluster(scratch.path);
+  cluster = dome4_cluster(scratch.path());
   cluster["nodes"][2]["name"] = "b";
-  const fs::path twice = write_display(scratch.path, "twice", cluster);
+  const fs::path twice = write_display(scratch.path(), "twice", cluster);
   EXPECT_EQ(test::run_facet("run " + twice.string() + " --node b --headless --out " +
-                                (scratch.path / "x").string(),
+                                (scratch.path() / "x").string(),
                             &output),
             2);
   EXPECT_NE(output.find("'b' repeats"), std::string::npos) << output;
   // A port in use.
   const HeldPort held;
   ASSERT_GT(held.port, 0);
-  cluster = dome4_cluster(scratch.path);
+  cluster = dome4_cluster(scratch.path());
   cluster["nodes"][1]["address"] = "tcp://127.0.0.1:" + std::to_string(held.port);
-  const fs::path in_use = write_display(scratch.path, "in_use", cluster);
+  const fs::path in_use = write_display(scratch.path(), "in_use", cluster);
   EXPECT_EQ(test::run_facet("run " + in_use.string() + " --node b --headless --out " +
-                                (scratch.path / "x").string(),
+                                (scratch.path() / "x").string(),
                             &output),
             2);
   EXPECT_NE(output.find("an address node 'b' can listen on, but tcp://127.0.0.1:" +
@@ -471,22 +458,22 @@ TEST(ClusterCli, BadInputIsStatusTwoWithAClearMessage) {
             std::string::npos)
       << output;
   // The same node started twice: the second finds its address taken.
-  Node first = start_node(display, "b", scratch.path, "b1", {"--join-timeout", "20"});
+  Node first = start_node(display, "b", scratch.path(), "b1", {"--join-timeout", "20"});
   ASSERT_TRUE(
       test::wait_until([&] { return slurp(first.log).find("listening on") != std::string::npos; },
                        std::chrono::seconds(60)))
       << slurp(first.log);
   EXPECT_EQ(test::run_facet("run " + display.string() + " --node b --headless --scale " + kScale +
-                                " --out " + (scratch.path / "b2").string(),
+                                " --out " + (scratch.path() / "b2").string(),
                             &output),
             2);
   EXPECT_NE(output.find("is node 'b' running twice?"), std::string::npos) << output;
   // A node whose pictures would differ (another --scale) is refused by its own check of the
   // master's digest; the master, whose other nodes never come, starts without them.
   Node master =
-      start_node(display, "a", scratch.path, "a", {"--frames", "3", "--join-timeout", "5"});
+      start_node(display, "a", scratch.path(), "a", {"--frames", "3", "--join-timeout", "5"});
   EXPECT_EQ(test::run_facet("run " + display.string() + " --node c --headless --scale 0.25 --out " +
-                                (scratch.path / "c").string(),
+                                (scratch.path() / "c").string(),
                             &output),
             2);
   EXPECT_NE(output.find("but this node's differ"), std::string::npos) << output;

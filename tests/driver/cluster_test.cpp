@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "facet/projection/errors.hpp"
+#include "support/files.hpp"
 
 namespace facet::driver {
 namespace {
@@ -128,9 +129,8 @@ TEST(ClusterWire, DigestsTellContentsApart) {
 // load_node_display: a node keeps its own projectors at the asked scale; the flags that make no
 // sense for its role, or for no cluster, are refused by name.
 TEST(NodeDisplay, ANodeKeepsItsProjectorsAndItsRoleIsChecked) {
-  const fs::path folder =
-      fs::temp_directory_path() / ("facet-node-display-" + std::to_string(::getpid()));
-  fs::remove_all(folder);
+  const facet::test::TempFolder temp("facet-node-display");
+  const fs::path& folder = temp.path();
   write_session_display(load_session_display("builtin:wall2x2", glm::ivec2(64, 40)), "wall",
                         folder / "wall");
   const fs::path json = folder / "wall" / "display.json";
@@ -175,7 +175,6 @@ TEST(NodeDisplay, ANodeKeepsItsProjectorsAndItsRoleIsChecked) {
   EXPECT_EQ(master.display.outputs.size(), 2u);
   EXPECT_EQ(load_node_display(json.string(), std::nullopt, std::nullopt, {}).display.outputs.size(),
             4u);
-  fs::remove_all(folder);
 }
 
 // How often `path` is opened while `work` runs (inotify: an IN_OPEN event per open; closes are
@@ -207,9 +206,8 @@ int opens_of(const fs::path& path, Work work) {
 // A display.json is read once per run: for its outputs, render settings and blends, and for a
 // cluster node's section (it was read twice, and three times for a node).
 TEST(NodeDisplay, ADisplayJsonIsReadOnce) {
-  const fs::path folder =
-      fs::temp_directory_path() / ("facet-read-once-" + std::to_string(::getpid()));
-  fs::remove_all(folder);
+  const facet::test::TempFolder temp("facet-read-once");
+  const fs::path& folder = temp.path();
   write_session_display(load_session_display("builtin:wall2x2", glm::ivec2(64, 40)), "wall",
                         folder / "wall");
   const fs::path json = folder / "wall" / "display.json";
@@ -243,19 +241,9 @@ TEST(NodeDisplay, ADisplayJsonIsReadOnce) {
   ASSERT_TRUE(node.cluster->config.cluster);
   EXPECT_EQ(node.cluster->config.cluster->master, "a");
   EXPECT_EQ(node.display.outputs.size(), 2u);
-  fs::remove_all(folder);
 }
 
 // ---- The protocol, on threads -----------------------------------------------------------------
-
-struct Scratch {
-  fs::path path = fs::temp_directory_path() / ("facet-cluster-test-" + std::to_string(::getpid()));
-  Scratch() { fs::create_directories(path); }
-  ~Scratch() {
-    std::error_code ignored;
-    fs::remove_all(path, ignored);
-  }
-};
 
 // Nodes a (master), b and c on ipc:// sockets in `folder`; c critical when asked.
 pio::DisplayCluster test_cluster(const fs::path& folder, double deadline_ms,
@@ -378,8 +366,8 @@ std::vector<std::uint64_t> frames_upto(std::uint64_t count) {
 }
 
 TEST(ClusterProtocol, EveryNodeSwapsEveryFrameWithTheSameState) {
-  const Scratch scratch;
-  const pio::DisplayCluster cluster = test_cluster(scratch.path, 2000);
+  const facet::test::TempFolder scratch("facet-cluster-test");
+  const pio::DisplayCluster cluster = test_cluster(scratch.path(), 2000);
   Log log;
   NodeRun b, c, a;
   std::thread tb([&] { b = run_secondary(node_options(cluster, "b", log)); });
@@ -408,8 +396,8 @@ TEST(ClusterProtocol, EveryNodeSwapsEveryFrameWithTheSameState) {
 }
 
 TEST(ClusterProtocol, ASilentSecondaryIsDroppedAndRejoins) {
-  const Scratch scratch;
-  const pio::DisplayCluster cluster = test_cluster(scratch.path, 300);
+  const facet::test::TempFolder scratch("facet-cluster-test");
+  const pio::DisplayCluster cluster = test_cluster(scratch.path(), 300);
   Log log;
   NodeRun b, c1, c2, a;
   std::atomic<bool> c_gone = false;
@@ -456,8 +444,8 @@ TEST(ClusterProtocol, ASilentSecondaryIsDroppedAndRejoins) {
 }
 
 TEST(ClusterProtocol, LosingACriticalNodeStopsEveryone) {
-  const Scratch scratch;
-  const pio::DisplayCluster cluster = test_cluster(scratch.path, 300, true);
+  const facet::test::TempFolder scratch("facet-cluster-test");
+  const pio::DisplayCluster cluster = test_cluster(scratch.path(), 300, true);
   Log log;
   NodeRun b, c, a;
   std::thread tb([&] { b = run_secondary(node_options(cluster, "b", log)); });
@@ -473,8 +461,8 @@ TEST(ClusterProtocol, LosingACriticalNodeStopsEveryone) {
 
 TEST(ClusterProtocol, ASecondaryWithoutAMasterGivesUp) {
   // A master that is killed mid-run is the CLI test's (cluster_cli_test.cpp); here none comes.
-  const Scratch scratch;
-  const pio::DisplayCluster cluster = test_cluster(scratch.path, 100);
+  const facet::test::TempFolder scratch("facet-cluster-test");
+  const pio::DisplayCluster cluster = test_cluster(scratch.path(), 100);
   Log log;
   ClusterNodeOptions options = node_options(cluster, "b", log);
   options.join_timeout = std::chrono::milliseconds(300);
@@ -484,8 +472,8 @@ TEST(ClusterProtocol, ASecondaryWithoutAMasterGivesUp) {
 }
 
 TEST(ClusterProtocol, ANodeOfAnotherDisplayIsRefused) {
-  const Scratch scratch;
-  const pio::DisplayCluster cluster = test_cluster(scratch.path, 300);
+  const facet::test::TempFolder scratch("facet-cluster-test");
+  const pio::DisplayCluster cluster = test_cluster(scratch.path(), 300);
   Log log;
   NodeRun b, c, a;
   std::thread tb([&] { b = run_secondary(node_options(cluster, "b", log)); });
@@ -507,8 +495,8 @@ TEST(ClusterProtocol, ANodeOfAnotherDisplayIsRefused) {
 }
 
 TEST(ClusterProtocol, AnAddressInUseIsAnInputError) {
-  const Scratch scratch;
-  const pio::DisplayCluster cluster = test_cluster(scratch.path, 300);
+  const facet::test::TempFolder scratch("facet-cluster-test");
+  const pio::DisplayCluster cluster = test_cluster(scratch.path(), 300);
   Log log;
   const std::unique_ptr<FrameSync> first = make_cluster_secondary(node_options(cluster, "b", log));
   try {
@@ -522,11 +510,11 @@ TEST(ClusterProtocol, AnAddressInUseIsAnInputError) {
 }
 
 TEST(ClusterBench, ReportsEveryNodeCountAndBothLosses) {
-  const Scratch scratch;
+  const facet::test::TempFolder scratch("facet-cluster-test");
   ClusterBenchOptions options;
   options.node_counts = {2, 3};
   options.frames = 20;
-  options.folder = scratch.path;
+  options.folder = scratch.path();
   std::vector<std::string> lines;
   const std::vector<ClusterBenchRow> rows =
       bench_cluster(options, [&](const std::string& line) { lines.push_back(line); });

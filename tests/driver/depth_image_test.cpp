@@ -16,7 +16,6 @@
 #include <nlohmann/json.hpp>
 #include <random>
 
-#include "cli_process.hpp"
 #include "facet/driver/city.hpp"
 #include "facet/driver/display_outputs.hpp"
 #include "facet/driver/gpu_scene.hpp"
@@ -27,23 +26,13 @@
 #include "facet/projection/errors.hpp"
 #include "facet/projection/warp_inverse.hpp"
 #include "gl_test_context.hpp"
+#include "support/facet_cli.hpp"
 #include "test_scenes.hpp"
 
 namespace facet::driver {
 namespace {
 
 namespace fs = std::filesystem;
-
-struct Scratch {
-  fs::path dir;
-  explicit Scratch(const std::string& name)
-      : dir(fs::temp_directory_path() /
-            ("facet_depth_image_" + name + "_" + std::to_string(::getpid()))) {
-    fs::remove_all(dir);
-    fs::create_directories(dir);
-  }
-  ~Scratch() { fs::remove_all(dir); }
-};
 
 // A DPCI with every channel filled from a seeded generator, a quarter of the pixels seeing
 // nothing, and a pose that turns and moves.
@@ -67,9 +56,9 @@ DepthImage random_dpci(glm::ivec2 size) {
 }
 
 TEST(DepthImage, FileRoundTripKeepsEveryValue) {
-  const Scratch scratch("round_trip");
+  const facet::test::TempFolder scratch("facet_depth_image_round_trip");
   const DepthImage written = random_dpci({24, 10});
-  const fs::path file = scratch.dir / "image.exr";
+  const fs::path file = scratch.path() / "image.exr";
   write_depth_image(file, written);
   const DepthImage read = read_depth_image(file);
   EXPECT_EQ(read.kind, DepthImageKind::dpci);
@@ -94,8 +83,8 @@ TEST(DepthImage, FileRoundTripKeepsEveryValue) {
   DepthImage planar = make_planar({8, 6}, 70.0);
   planar.parts[0].distance_m[5] = 2.0f;
   planar.parts[0].normal[5] = {0, 0, 1};
-  write_depth_image(scratch.dir / "planar.exr", planar);
-  const DepthImage planar_read = read_depth_image(scratch.dir / "planar.exr");
+  write_depth_image(scratch.path() / "planar.exr", planar);
+  const DepthImage planar_read = read_depth_image(scratch.path() / "planar.exr");
   EXPECT_EQ(planar_read.kind, DepthImageKind::planar);
   EXPECT_TRUE(planar_read.parts[0].source_id.empty());
   EXPECT_EQ(planar_read.parts[0].distance_m, planar.parts[0].distance_m);
@@ -112,7 +101,7 @@ std::string error_of(const std::function<void()>& f) {
 }
 
 TEST(DepthImage, BadInputIsRefusedNamingTheField) {
-  const Scratch scratch("bad");
+  const facet::test::TempFolder scratch("facet_depth_image_bad");
   DepthImage image = make_planar({6, 4});
   image.parts[0].distance_m[9] = std::numeric_limits<float>::quiet_NaN();
   EXPECT_NE(error_of([&] { image.validate("x.exr"); }).find("'Z'"), std::string::npos);
@@ -122,9 +111,9 @@ TEST(DepthImage, BadInputIsRefusedNamingTheField) {
   image.parts[0].normal[9] = {0, 1, 0};
   EXPECT_NO_THROW(image.validate("x.exr"));
   image.parts[0].distance_m[2] = -1.0f;
-  EXPECT_NE(error_of([&] { write_depth_image(scratch.dir / "neg.exr", image); }).find("'Z'"),
+  EXPECT_NE(error_of([&] { write_depth_image(scratch.path() / "neg.exr", image); }).find("'Z'"),
             std::string::npos);
-  EXPECT_FALSE(fs::exists(scratch.dir / "neg.exr"));
+  EXPECT_FALSE(fs::exists(scratch.path() / "neg.exr"));
   image.parts[0].distance_m[2] = 1.0f;
   image.parts[0].normal[2] = {1, 0, 0};
 
@@ -141,7 +130,7 @@ TEST(DepthImage, BadInputIsRefusedNamingTheField) {
   EXPECT_NE(error_of([&] { scaled.validate("x.exr"); }).find("T_world_image"), std::string::npos);
 
   // A file without the normals: its channels named.
-  const fs::path valid = scratch.dir / "valid.exr";
+  const fs::path valid = scratch.path() / "valid.exr";
   write_depth_image(valid, image);
   auto input = OIIO::ImageInput::open(valid.string());
   ASSERT_TRUE(input);
@@ -149,7 +138,7 @@ TEST(DepthImage, BadInputIsRefusedNamingTheField) {
   spec.channelnames = {"R", "G", "B", "Z"};
   spec.attribute("facet:depth_image", input->spec().get_string_attribute("facet:depth_image"));
   input.reset();
-  const fs::path no_normals = scratch.dir / "no_normals.exr";
+  const fs::path no_normals = scratch.path() / "no_normals.exr";
   {
     std::vector<float> pixels(6 * 4 * 4, 1.0f);
     auto output = OIIO::ImageOutput::create("openexr");
@@ -161,7 +150,7 @@ TEST(DepthImage, BadInputIsRefusedNamingTheField) {
   EXPECT_NE(missing.find("no_normals.exr"), std::string::npos) << missing;
   EXPECT_NE(missing.find("missing N.x, N.y, N.z"), std::string::npos) << missing;
   // A header claiming 100000 × 4 pixels (its data window edited): refused by size, not read.
-  const fs::path wide = scratch.dir / "wide.exr";
+  const fs::path wide = scratch.path() / "wide.exr";
   {
     std::string bytes = facet::test::slurp(valid);
     for (const std::string window : {"dataWindow", "displayWindow"}) {
@@ -178,7 +167,7 @@ TEST(DepthImage, BadInputIsRefusedNamingTheField) {
   EXPECT_NE(wide_error.find("size"), std::string::npos) << wide_error;
 
   // Every channel there, one distance NaN.
-  const fs::path nan_depth = scratch.dir / "nan_depth.exr";
+  const fs::path nan_depth = scratch.path() / "nan_depth.exr";
   {
     OIIO::ImageSpec full(6, 4, 7, OIIO::TypeDesc::FLOAT);
     full.channelnames = {"R", "G", "B", "Z", "N.x", "N.y", "N.z"};
@@ -194,21 +183,21 @@ TEST(DepthImage, BadInputIsRefusedNamingTheField) {
   EXPECT_NE(error_of([&] { read_depth_image(nan_depth); }).find("pixel (1, 2)"), std::string::npos);
 
   // The CLI: exit 2, the file and field named, nothing written.
-  const fs::path log = scratch.dir / "log.txt";
+  const fs::path log = scratch.path() / "log.txt";
   for (const auto& [file, expected] : {std::pair{no_normals, "missing N.x"},
                                        std::pair{nan_depth, "'Z'"}, std::pair{wide, "size"}}) {
     EXPECT_EQ(facet::test::run_facet(
                   "render --display builtin:dome180 --size 32x32 --scene depth:" + file.string() +
-                      " --out " + (scratch.dir / "out").string(),
+                      " --out " + (scratch.path() / "out").string(),
                   log),
               2)
         << file;
     const std::string said = facet::test::slurp(log);
     EXPECT_NE(said.find(expected), std::string::npos) << said;
     EXPECT_NE(said.find(file.filename().string()), std::string::npos) << said;
-    EXPECT_FALSE(fs::exists(scratch.dir / "out"));
+    EXPECT_FALSE(fs::exists(scratch.path() / "out"));
   }
-  const fs::path out = scratch.dir / "city.exr";
+  const fs::path out = scratch.path() / "city.exr";
   EXPECT_EQ(facet::test::run_facet(
                 "depth-image --scene builtin:city --size 0x64 --out " + out.string(), log),
             2);
@@ -217,7 +206,7 @@ TEST(DepthImage, BadInputIsRefusedNamingTheField) {
   EXPECT_NE(facet::test::slurp(log).find("--kind"), std::string::npos) << facet::test::slurp(log);
   EXPECT_EQ(facet::test::run_facet("depth-image --size 16384x16384 --out " + out.string(), log), 2);
   EXPECT_FALSE(fs::exists(out));
-  for (const auto& entry : fs::directory_iterator(scratch.dir))
+  for (const auto& entry : fs::directory_iterator(scratch.path()))
     EXPECT_EQ(entry.path().filename().string().find(".tmp"), std::string::npos) << entry.path();
 }
 
@@ -361,14 +350,14 @@ TEST(DepthImage, SceneNamesTakeDepthImagesAloneAndHybrid) {
   EXPECT_THROW(parse_scene_name("builtin:town+depth:a.exr"), InputError);
 
   // A hybrid scene: the mesh's triangles numbered after the city's, its eye the default view.
-  const Scratch scratch("names");
+  const facet::test::TempFolder scratch("facet_depth_image_names");
   DepthImage image = make_planar({4, 3});
   image.T_world_image = glm::translate(glm::dmat4(1.0), glm::dvec3(0, 2, 0));
   for (std::size_t k = 0; k < 12; ++k) {
     image.parts[0].distance_m[k] = 5.0f;
     image.parts[0].normal[k] = {0, 0, 1};
   }
-  write_depth_image(scratch.dir / "a.exr", image);
+  write_depth_image(scratch.path() / "a.exr", image);
   CityOptions small;
   small.blocks_per_side = 1;
   const Scene city = build_city(small);
@@ -386,8 +375,8 @@ TEST(DepthImage, SceneNamesTakeDepthImagesAloneAndHybrid) {
 // The command line end to end: facet depth-image of the city, then facet render of the depth image
 // with the reference ray cast into the polygon city (--reference-scene).
 TEST(DepthImage, CliRendersTheCityDpciAgainstThePolygonCity) {
-  const Scratch scratch("cli");
-  const fs::path image = scratch.dir / "city.exr", log = scratch.dir / "log.txt";
+  const facet::test::TempFolder scratch("facet_depth_image_cli");
+  const fs::path image = scratch.path() / "city.exr", log = scratch.path() / "log.txt";
   ASSERT_EQ(facet::test::run_facet(
                 "depth-image --scene builtin:city --size 256x128 --out " + image.string(), log),
             0)

@@ -14,13 +14,13 @@
 #include <string>
 #include <vector>
 
-#include "cli_process.hpp"
 #include "facet/driver/city.hpp"
 #include "facet/driver/display_outputs.hpp"
 #include "facet/driver/material_shader.hpp"
 #include "facet/driver/render_method.hpp"
 #include "facet/projection/errors.hpp"
 #include "gl_test_context.hpp"
+#include "support/facet_cli.hpp"
 #include "test_scenes.hpp"
 
 namespace facet::driver {
@@ -28,20 +28,12 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// A scratch folder removed at the end of the test.
-struct Scratch {
-  fs::path path = fs::temp_directory_path() / ("facet_material_" + std::to_string(getpid()));
-  Scratch() {
-    fs::remove_all(path);
-    fs::create_directories(path);
-  }
-  ~Scratch() {
-    std::error_code error;
-    fs::remove_all(path, error);
-  }
+// A scratch folder removed at the end of the test, and files written into it.
+struct Scratch : facet::test::TempFolder {
+  Scratch() : TempFolder("facet_material") {}
   fs::path write(const std::string& name, const std::string& text) const {
-    std::ofstream(path / name) << text;
-    return path / name;
+    std::ofstream(path() / name) << text;
+    return path() / name;
   }
 };
 
@@ -144,7 +136,7 @@ TEST(Materials, UserFilesCompileAndBrokenOnesNameTheirFileAndLine) {
   EXPECT_THROW(load_material_shader(
                    scratch.write("depth.frag", "void f() { gl_FragDepth = 0.5; }").string()),
                InputError);
-  EXPECT_THROW(load_material_shader(scratch.path.string() + "/good.glsl"), InputError);
+  EXPECT_THROW(load_material_shader(scratch.path().string() + "/good.glsl"), InputError);
 }
 
 // The material shades; the replication and the IDs never see it.
@@ -476,11 +468,11 @@ TEST(Materials, RenderCliTakesMaterials) {
   EXPECT_EQ(facet::test::run_facet(
                 "render --display builtin:cylinder360 --size 64x48 --material pen-and-ink "
                 "--out " +
-                    (scratch.path / "out").string(),
+                    (scratch.path() / "out").string(),
                 &output),
             0)
       << output;
-  EXPECT_TRUE(fs::exists(scratch.path / "out" / "cylinder360.png"));
+  EXPECT_TRUE(fs::exists(scratch.path() / "out" / "cylinder360.png"));
   EXPECT_EQ(facet::test::run_facet(
                 "render --display builtin:cylinder360 --size 64x48 --material chalk", &output),
             2)
@@ -502,12 +494,12 @@ TEST(Materials, RenderCliTakesMaterials) {
   EXPECT_EQ(
       facet::test::run_facet("run builtin:cylinder360 --size 64x48 --headless --frames 1 "
                              "--material " +
-                                 broken.string() + " --out " + (scratch.path / "run").string(),
+                                 broken.string() + " --out " + (scratch.path() / "run").string(),
                              &output),
       2)
       << output;
   EXPECT_NE(output.find(broken.string()), std::string::npos) << output;
-  EXPECT_FALSE(fs::exists(scratch.path / "run"));
+  EXPECT_FALSE(fs::exists(scratch.path() / "run"));
 }
 
 }  // namespace

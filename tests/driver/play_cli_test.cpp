@@ -19,7 +19,7 @@
 #include <string>
 #include <vector>
 
-#include "cli_process.hpp"
+#include "support/facet_cli.hpp"
 #include "xorg_dummy.hpp"
 
 namespace facet {
@@ -43,15 +43,6 @@ cv::Point block_origin(int bit) { return {32 + (bit % 4) * kBlock, 48 + (bit / 4
 
 class PlayCli : public ::testing::Test {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("facet_play_test_" + std::to_string(::getpid()) + "_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-
   // A video of `frames` frames at `fps` whose frame k shows k in binary blocks (white = 1).
   fs::path write_video(const std::string& name, int frames, double fps,
                        int fourcc = cv::VideoWriter::fourcc('M', 'J', 'P', 'G')) {
@@ -101,7 +92,9 @@ class PlayCli : public ::testing::Test {
   }
   std::string log() const { return test::slurp(dir_ / "log.txt"); }
 
-  fs::path dir_;
+  // The test's own folder, made for each test and removed after it.
+  const test::TempFolder folder_{"facet_play_test"};
+  const fs::path& dir_ = folder_.path();
 };
 
 TEST_F(PlayCli, VideoPlaysFrameAccuratelyOnTheShowClock) {

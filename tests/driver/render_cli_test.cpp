@@ -15,7 +15,7 @@
 #include <string>
 #include <vector>
 
-#include "cli_process.hpp"
+#include "support/facet_cli.hpp"
 
 namespace {
 
@@ -25,14 +25,8 @@ struct Result {
 };
 
 Result run_cli(const std::string& arguments) {
-  const std::string command = std::string(FACET_CLI) + " " + arguments + " 2>&1";
   Result result;
-  FILE* pipe = popen(command.c_str(), "r");
-  if (!pipe) return result;
-  std::array<char, 4096> buffer{};
-  while (std::fgets(buffer.data(), int(buffer.size()), pipe)) result.output += buffer.data();
-  const int status = pclose(pipe);
-  result.status = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  result.status = facet::test::run_facet(arguments, &result.output);
   return result;
 }
 
@@ -112,10 +106,8 @@ int non_black_pixels(const std::filesystem::path& png) {
 // an unknown --camera or a malformed --eye exits 2 naming what was expected.
 TEST(RenderCli, GltfViewLeavesClosedGeometryAndTakesEyeAndCamera) {
   namespace fs = std::filesystem;
-  const fs::path folder =
-      fs::temp_directory_path() / ("facet_render_gltf_view_" + std::to_string(getpid()));
-  fs::remove_all(folder);
-  fs::create_directories(folder);
+  const facet::test::TempFolder temp("facet_render_gltf_view");
+  const fs::path& folder = temp.path();
   const fs::path gltf = folder / "box.gltf";
   write_box_gltf(gltf);
   const std::string common =
@@ -148,16 +140,13 @@ TEST(RenderCli, GltfViewLeavesClosedGeometryAndTakesEyeAndCamera) {
   const Result malformed = run_cli(common + " --eye 1,2");
   EXPECT_EQ(malformed.status, 2) << malformed.output;
   EXPECT_NE(malformed.output.find("--eye"), std::string::npos) << malformed.output;
-  fs::remove_all(folder);
 }
 
 // A glTF scene's view turns every frame, so the facet pipeline replicates every frame; with
 // --static-view it keeps frame 1's view and reuses passes 1 and 2 on the frames after it.
 TEST(RenderCli, TheViewMovesUnlessStatic) {
-  const std::filesystem::path folder =
-      std::filesystem::temp_directory_path() / ("facet_render_view_" + std::to_string(getpid()));
-  std::filesystem::remove_all(folder);
-  std::filesystem::create_directories(folder);
+  const facet::test::TempFolder temp("facet_render_view");
+  const std::filesystem::path& folder = temp.path();
   const std::filesystem::path gltf = folder / "walls.gltf";
   write_two_walls_gltf(gltf);
   const std::string common =
@@ -186,7 +175,6 @@ TEST(RenderCli, TheViewMovesUnlessStatic) {
   EXPECT_TRUE(g["triangle_list_on_gpu"].get<bool>());
   EXPECT_EQ(g["replicas"], m["replicas"]);
   EXPECT_EQ(g["triangles_in"], m["triangles_in"]);
-  std::filesystem::remove_all(folder);
 }
 
 // The cube map reports the memory of its faces and lookup textures: two 32-pixel cube maps
@@ -274,9 +262,8 @@ TEST(RenderCli, GlcCameraRendersWithItsMethodAndRefusesBadInput) {
 }
 
 TEST(RenderCli, JsonHasTheReportedFieldsAndOutWritesImages) {
-  const std::filesystem::path folder =
-      std::filesystem::temp_directory_path() / ("facet_render_cli_" + std::to_string(getpid()));
-  std::filesystem::remove_all(folder);
+  const facet::test::TempFolder temp("facet_render_cli");
+  const std::filesystem::path folder = temp / "out";
   const Result result = run_cli(
       "render --display builtin:cylinder360 --size 128x96 --scene builtin:city --method "
       "facets --pieces 16 --frames 2 --json --ids --depth --out " +
@@ -302,7 +289,6 @@ TEST(RenderCli, JsonHasTheReportedFieldsAndOutWritesImages) {
   EXPECT_TRUE(std::filesystem::is_regular_file(folder / "cylinder360.png"));
   EXPECT_TRUE(std::filesystem::is_regular_file(folder / "cylinder360.ids.exr"));
   EXPECT_TRUE(std::filesystem::is_regular_file(folder / "cylinder360.depth.exr"));
-  std::filesystem::remove_all(folder);
 }
 
 // --reference: the dome master at 0.25 px against the Embree ray cast of the same frame. The
@@ -311,9 +297,8 @@ TEST(RenderCli, JsonHasTheReportedFieldsAndOutWritesImages) {
 // reference image's edges can still differ where a sliver that meets no pixel centre passes
 // within 0.25 px of it (measured: 1 pixel here), so id_mismatch is only bounded loosely.
 TEST(RenderCli, ReferenceReportsTheEdgeDisplacement) {
-  const std::filesystem::path folder =
-      std::filesystem::temp_directory_path() / ("facet_render_ref_" + std::to_string(getpid()));
-  std::filesystem::remove_all(folder);
+  const facet::test::TempFolder temp("facet_render_ref");
+  const std::filesystem::path folder = temp / "out";
   const Result result = run_cli(
       "render --display builtin:dome180 --size 128x128 --scene builtin:city --tolerance 0.25 "
       "--reference --json --ids --out " +
@@ -328,7 +313,6 @@ TEST(RenderCli, ReferenceReportsTheEdgeDisplacement) {
   EXPECT_LE(reference["max_edge_px"].get<double>(), 0.25 + 0.02);
   EXPECT_EQ(report["texture_anisotropy"].get<double>(), 1.0);  // llvmpipe: automatic is off
   EXPECT_TRUE(std::filesystem::is_regular_file(folder / "dome180.reference.ids.exr"));
-  std::filesystem::remove_all(folder);
 }
 
 #ifndef FACET_TEST_WITHOUT_INTEROP
@@ -338,9 +322,8 @@ TEST(RenderCli, ReferenceReportsTheEdgeDisplacement) {
 // half), where the blend map hides them. Counted as drawn, they made 3,830 of 33,335 compared
 // pixels mismatched (19.8% of the right piece's); compared where the blend shows them, none.
 TEST(RenderCli, ReferenceComparesOnlyWhatTheBlendMapsShow) {
-  const std::filesystem::path folder =
-      std::filesystem::temp_directory_path() / ("facet_render_split_" + std::to_string(getpid()));
-  std::filesystem::remove_all(folder);
+  const facet::test::TempFolder temp("facet_render_split");
+  const std::filesystem::path folder = temp / "out";
   const std::filesystem::path tiles =
       std::filesystem::path(FACET_SOURCE_DIR) / "configs/tiles/split-tpts.json";
   const Result built = run_cli("tiles " + tiles.string() + " --size 200x100 --out " +
@@ -364,7 +347,6 @@ TEST(RenderCli, ReferenceComparesOnlyWhatTheBlendMapsShow) {
     hidden += output.value("blend_hidden_pixels", std::uint64_t(0));
   }
   EXPECT_EQ(reference.value("blend_hidden_pixels", std::uint64_t(0)), hidden);
-  std::filesystem::remove_all(folder);
 }
 #endif
 
@@ -372,10 +354,8 @@ TEST(RenderCli, ReferenceComparesOnlyWhatTheBlendMapsShow) {
 // saying how far it got, and neither --out nor a temporary folder beside it.
 TEST(RenderCli, SigintStopsBetweenFramesAndWritesNothing) {
   namespace fs = std::filesystem;
-  const fs::path folder =
-      fs::temp_directory_path() / ("facet_render_sigint_" + std::to_string(getpid()));
-  fs::remove_all(folder);
-  fs::create_directories(folder);
+  const facet::test::TempFolder temp("facet_render_sigint");
+  const fs::path& folder = temp.path();
   const fs::path out = folder / "out", log = folder / "log";
   const pid_t child =
       facet::test::start_facet({"render", "--display", "builtin:cylinder360", "--size", "64x32",
@@ -395,7 +375,6 @@ TEST(RenderCli, SigintStopsBetweenFramesAndWritesNothing) {
   EXPECT_FALSE(fs::exists(out));
   for (const fs::directory_entry& entry : fs::directory_iterator(folder))
     EXPECT_NE(entry.path().filename().string().front(), '.') << entry.path();
-  fs::remove_all(folder);
 }
 
 }  // namespace

@@ -17,17 +17,13 @@
 #include <string>
 #include <vector>
 
-#include "cli_process.hpp"
+#include "support/facet_cli.hpp"
 
 namespace facet {
 namespace {
 
 namespace fs = std::filesystem;
 using test::slurp;
-
-int run(const std::string& arguments, const fs::path& log) {
-  return test::run_facet(arguments, log);
-}
 
 struct Png {
   int width = 0, height = 0, channels = 0;
@@ -56,25 +52,18 @@ double lit_fraction(const Png& png) {
   return double(lit) / double(png.pixels.size() / std::size_t(png.channels));
 }
 
-fs::path fresh_folder(const std::string& name) {
-  const fs::path folder = facet::test_paths::scratch_path("facet_run_cli_" + name);
-  fs::remove_all(folder);
-  fs::create_directories(folder);
-  return folder;
-}
-
 TEST(RunCli, HeadlessSessionRendersTheSamePixelsAsRender) {
-  const fs::path folder = fresh_folder("same");
+  const fs::path folder = test::fresh_folder("facet_run_cli_same");
   const std::string common =
       "--size 160x120 --scene builtin:city --method facets --tolerance 0.25 --frames 1";
-  ASSERT_EQ(run("run builtin:cylinder360 --headless " + common + " --out " +
-                    (folder / "session").string(),
-                folder / "run.log"),
+  ASSERT_EQ(test::run_facet("run builtin:cylinder360 --headless " + common + " --out " +
+                                (folder / "session").string(),
+                            folder / "run.log"),
             0)
       << slurp(folder / "run.log");
-  ASSERT_EQ(run("render --display builtin:cylinder360 " + common + " --out " +
-                    (folder / "render").string(),
-                folder / "render.log"),
+  ASSERT_EQ(test::run_facet("render --display builtin:cylinder360 " + common + " --out " +
+                                (folder / "render").string(),
+                            folder / "render.log"),
             0)
       << slurp(folder / "render.log");
   const Png session = read_png(folder / "session" / "cylinder360" / "00000.png");
@@ -93,7 +82,7 @@ TEST(RunCli, HeadlessSessionRendersTheSamePixelsAsRender) {
 }
 
 TEST(RunCli, EverySampleDisplayRunsHeadlessWithNonEmptyFrames) {
-  const fs::path folder = fresh_folder("samples");
+  const fs::path folder = test::fresh_folder("facet_run_cli_samples");
   int displays = 0;
   for (const auto& entry :
        fs::directory_iterator(fs::path(FACET_SOURCE_DIR) / "configs/displays")) {
@@ -105,9 +94,9 @@ TEST(RunCli, EverySampleDisplayRunsHeadlessWithNonEmptyFrames) {
     const fs::path out = folder / name;
     // A sixteenth of the resolution keeps llvmpipe quick; the displays' geometry, blends and
     // sessions, rendered by the default facet pipeline, are what this checks.
-    ASSERT_EQ(run("run " + display.string() + " --headless --frames 1 --scale 0.0625 --out " +
-                      out.string(),
-                  folder / (name + ".log")),
+    ASSERT_EQ(test::run_facet("run " + display.string() +
+                                  " --headless --frames 1 --scale 0.0625 --out " + out.string(),
+                              folder / (name + ".log")),
               0)
         << slurp(folder / (name + ".log"));
     int images = 0;
@@ -128,12 +117,14 @@ TEST(RunCli, EverySampleDisplayRunsHeadlessWithNonEmptyFrames) {
 // imported display.json into FOLDER/frames (with `run_options`).
 void import_then_run(const fs::path& folder, const std::string& import_command,
                      const std::string& run_options = "") {
-  ASSERT_EQ(run(import_command + " --out " + (folder / "display").string(), folder / "import.log"),
+  ASSERT_EQ(test::run_facet(import_command + " --out " + (folder / "display").string(),
+                            folder / "import.log"),
             0)
       << slurp(folder / "import.log");
-  ASSERT_EQ(run("run " + (folder / "display" / "display.json").string() + " --headless --frames 1" +
-                    run_options + " --out " + (folder / "frames").string(),
-                folder / "run.log"),
+  ASSERT_EQ(test::run_facet("run " + (folder / "display" / "display.json").string() +
+                                " --headless --frames 1" + run_options + " --out " +
+                                (folder / "frames").string(),
+                            folder / "run.log"),
             0)
       << slurp(folder / "run.log");
 }
@@ -141,7 +132,7 @@ void import_then_run(const fs::path& folder, const std::string& import_command,
 TEST(RunCli, AnImportedSphericalMirrorMeshRendersAtItsDefaultTolerance) {
   // A real Paul Bourke mesh from another tool, imported as is: display.json asks for 0.25 px, which
   // only the bisection builder reaches at the mirror's crowded top corners.
-  const fs::path folder = fresh_folder("mirror");
+  const fs::path folder = test::fresh_folder("facet_run_cli_mirror");
   ASSERT_NO_FATAL_FAILURE(
       import_then_run(folder, "bourke import " + std::string(FACET_SHARED_DATA_DIR) +
                                   "/warps/sgct-mesh/standard_16x9.data --size 480x270"));
@@ -153,7 +144,7 @@ TEST(RunCli, AnImportedSphericalMirrorMeshRendersAtItsDefaultTolerance) {
 
 TEST(RunCli, AnImportedMpcdiFileOfAnotherToolRenders) {
   // SGCT's real MPCDI 3d container: one 512×540 region whose frustum looks up and to the left.
-  const fs::path folder = fresh_folder("mpcdi");
+  const fs::path folder = test::fresh_folder("facet_run_cli_mpcdi");
   ASSERT_NO_FATAL_FAILURE(import_then_run(folder,
                                           "mpcdi import " + std::string(FACET_SHARED_DATA_DIR) +
                                               "/warps/sgct-mpcdi/correction_mesh.mpcdi",
@@ -173,7 +164,7 @@ TEST(RunCli, AnImportedMpcdiFileOfAnotherToolRenders) {
 TEST(RunCli, AnImportedScissDomeRendersEveryChannel) {
   // The real six-channel SGCT dome configuration, with its windows made 240×150 so that the test
   // stays quick: the meshes are normalised, the masks are resampled to the output.
-  const fs::path folder = fresh_folder("sciss");
+  const fs::path folder = test::fresh_folder("facet_run_cli_sciss");
   const fs::path source = fs::path(FACET_SHARED_DATA_DIR) / "warps" / "sgct-dome" / "sciss";
   fs::create_directories(folder / "config");
   for (const auto& entry : fs::directory_iterator(source)) {
@@ -200,7 +191,7 @@ TEST(RunCli, AnImportedScissDomeRendersEveryChannel) {
 TEST(RunCli, TheRealSimcadDomeImportsAsShippedAndRendersEveryChannel) {
   // SimCAD's six-channel dome as shipped: its cluster file names no meshes, the .simcad files
   // beside it are found by their frustum tables. A sixteenth of 4096×2160 keeps llvmpipe quick.
-  const fs::path folder = fresh_folder("simcad");
+  const fs::path folder = test::fresh_folder("facet_run_cli_simcad");
   ASSERT_NO_FATAL_FAILURE(import_then_run(folder,
                                           "sgct import " + std::string(FACET_SHARED_DATA_DIR) +
                                               "/warps/sgct-dome/simcad/dome_bravo.xml",
@@ -218,7 +209,7 @@ TEST(RunCli, TheRealSimcadDomeImportsAsShippedAndRendersEveryChannel) {
 #endif
 
 TEST(RunCli, BadDisplaysExitWithStatusTwoNamingTheProblem) {
-  const fs::path folder = fresh_folder("bad");
+  const fs::path folder = test::fresh_folder("facet_run_cli_bad");
   struct Case {
     std::string name, json, expected;
   };
@@ -251,9 +242,9 @@ TEST(RunCli, BadDisplaysExitWithStatusTwoNamingTheProblem) {
     fs::create_directories(dir);
     std::ofstream(dir / "display.json") << c.json;
     const fs::path out = dir / "frames";
-    EXPECT_EQ(run("run " + (dir / "display.json").string() + " --headless --frames 1 --out " +
-                      out.string(),
-                  dir / "log"),
+    EXPECT_EQ(test::run_facet("run " + (dir / "display.json").string() +
+                                  " --headless --frames 1 --out " + out.string(),
+                              dir / "log"),
               2);
     const std::string log = slurp(dir / "log");
     EXPECT_NE(log.find(c.expected), std::string::npos) << log;
@@ -263,13 +254,13 @@ TEST(RunCli, BadDisplaysExitWithStatusTwoNamingTheProblem) {
 
 // The same limit as facet render and bench (render_cli_test, bench_test), named in the message.
 TEST(RunCli, FramesOutsideOneToAMillionExitWithStatusTwo) {
-  const fs::path folder = fresh_folder("frames");
+  const fs::path folder = test::fresh_folder("facet_run_cli_frames");
   for (const char* frames : {"-1", "0", "99999999"}) {
     SCOPED_TRACE(frames);
     const fs::path out = folder / "out";
-    EXPECT_EQ(run("run builtin:cylinder360 --headless --size 64x32 --frames " +
-                      std::string(frames) + " --out " + out.string(),
-                  folder / "log"),
+    EXPECT_EQ(test::run_facet("run builtin:cylinder360 --headless --size 64x32 --frames " +
+                                  std::string(frames) + " --out " + out.string(),
+                              folder / "log"),
               2);
     const std::string log = slurp(folder / "log");
     EXPECT_NE(
@@ -281,7 +272,7 @@ TEST(RunCli, FramesOutsideOneToAMillionExitWithStatusTwo) {
 }
 
 TEST(RunCli, WindowsWithoutADisplayServerExitWithStatusTwo) {
-  const fs::path folder = fresh_folder("no_display");
+  const fs::path folder = test::fresh_folder("facet_run_cli_no_display");
   for (const std::string& command :
        {std::string("run builtin:cylinder360 --windowed --frames 1 --size 64x32"),
         std::string("run --monitors")}) {
@@ -306,12 +297,12 @@ TEST(RunCli, WindowsWithoutADisplayServerExitWithStatusTwo) {
 // status (128 + the signal), one line saying how far it got, no output folder (or the earlier run
 // untouched) and no temporary folder beside it.
 TEST(RunCli, SigintAndSigtermStopAHeadlessRunAndLeaveNothing) {
-  const fs::path folder = fresh_folder("signals");
+  const fs::path folder = test::fresh_folder("facet_run_cli_signals");
   const fs::path earlier = folder / "earlier";
-  ASSERT_EQ(
-      run("run builtin:cylinder360 --headless --size 64x32 --frames 1 --out " + earlier.string(),
-          folder / "earlier.log"),
-      0)
+  ASSERT_EQ(test::run_facet("run builtin:cylinder360 --headless --size 64x32 --frames 1 --out " +
+                                earlier.string(),
+                            folder / "earlier.log"),
+            0)
       << slurp(folder / "earlier.log");
   for (const int signal : {SIGINT, SIGTERM}) {
     const std::string name = signal == SIGINT ? "SIGINT" : "SIGTERM";
@@ -358,7 +349,7 @@ TEST(RunCli, SigintAndSigtermStopAHeadlessRunAndLeaveNothing) {
 // stats.jsonl, and --save-every writes the images of frames 0, 100, 200 and the last only. The
 // 10,000-frame run of the README is the same command with more frames.
 TEST(RunCli, ALongHeadlessRunKeepsAFlatResidentSet) {
-  const fs::path folder = fresh_folder("soak");
+  const fs::path folder = test::fresh_folder("facet_run_cli_soak");
   // ASan's quarantine of freed memory grows the resident set by design; without it what stays
   // resident is what the process holds, as in the normal build.
   const char* asan = std::getenv("ASAN_OPTIONS");
@@ -366,10 +357,10 @@ TEST(RunCli, ALongHeadlessRunKeepsAFlatResidentSet) {
                                    "quarantine_size_mb=0:thread_local_quarantine_size_kb=0";
   ::setenv("ASAN_OPTIONS", asan_options.c_str(), 1);
   const fs::path out = folder / "out";
-  const int status =
-      run("run " + (fs::path(FACET_SOURCE_DIR) / "configs/displays/dome4/display.json").string() +
-              " --headless --scale 0.125 --frames 300 --save-every 100 --out " + out.string(),
-          folder / "log");
+  const int status = test::run_facet(
+      "run " + (fs::path(FACET_SOURCE_DIR) / "configs/displays/dome4/display.json").string() +
+          " --headless --scale 0.125 --frames 300 --save-every 100 --out " + out.string(),
+      folder / "log");
   if (asan)
     ::setenv("ASAN_OPTIONS", asan, 1);
   else
@@ -423,10 +414,11 @@ TEST(RunCli, ALongHeadlessRunKeepsAFlatResidentSet) {
       expected.push_back(std::string(projector) + "/" + frame + ".png");
   EXPECT_EQ(images, expected);
   // An interval below one frame is refused before anything is rendered.
-  EXPECT_EQ(run("run builtin:cylinder360 --headless --size 64x32 --save-every 0 --out " +
-                    (folder / "zero").string(),
-                folder / "log"),
-            2);
+  EXPECT_EQ(
+      test::run_facet("run builtin:cylinder360 --headless --size 64x32 --save-every 0 --out " +
+                          (folder / "zero").string(),
+                      folder / "log"),
+      2);
   EXPECT_NE(slurp(folder / "log").find("'--save-every'"), std::string::npos)
       << slurp(folder / "log");
   EXPECT_FALSE(fs::exists(folder / "zero"));
@@ -436,13 +428,14 @@ TEST(RunCli, ALongHeadlessRunKeepsAFlatResidentSet) {
 // facet preview of the shipped dome4 about its 30°-tilted zenith: every direction above the spring
 // line covered, blends summing to 1 within 0.005; bad flags are exit 2 with nothing written.
 TEST(PreviewCli, Dome4IsCoveredAndBadFlagsWriteNothing) {
-  const fs::path folder = fresh_folder("preview");
+  const fs::path folder = test::fresh_folder("facet_run_cli_preview");
   const std::string dome4 =
       (fs::path(FACET_SOURCE_DIR) / "configs/displays/dome4/display.json").string();
   const fs::path image = folder / "dome4.png";
-  ASSERT_EQ(run("preview " + dome4 + " --tilt 30 --preview-size 128 --show blend --json --out " +
-                    image.string(),
-                folder / "log"),
+  ASSERT_EQ(test::run_facet("preview " + dome4 +
+                                " --tilt 30 --preview-size 128 --show blend --json --out " +
+                                image.string(),
+                            folder / "log"),
             0)
       << slurp(folder / "log");
   const std::string log = slurp(folder / "log");
@@ -458,7 +451,9 @@ TEST(PreviewCli, Dome4IsCoveredAndBadFlagsWriteNothing) {
        {"--show colours", "--view cube", "--preview-size 4", "--fov 400"}) {
     SCOPED_TRACE(flags);
     const fs::path bad = folder / "bad.png";
-    EXPECT_EQ(run("preview " + dome4 + " " + flags + " --out " + bad.string(), folder / "log"), 2);
+    EXPECT_EQ(test::run_facet("preview " + dome4 + " " + flags + " --out " + bad.string(),
+                              folder / "log"),
+              2);
     EXPECT_NE(slurp(folder / "log").find(flags.substr(0, flags.find(' '))), std::string::npos)
         << slurp(folder / "log");
     EXPECT_FALSE(fs::exists(bad));
@@ -469,9 +464,10 @@ TEST(PreviewCli, Dome4IsCoveredAndBadFlagsWriteNothing) {
 // --pattern shows a test pattern instead of the scene; an unknown one is exit 2 naming the flag,
 // with nothing written.
 TEST(RunCli, APatternReplacesTheScene) {
-  const fs::path folder = fresh_folder("pattern");
+  const fs::path folder = test::fresh_folder("facet_run_cli_pattern");
   const fs::path out = folder / "out";
-  ASSERT_EQ(run("run builtin:wall2x2 --size 96x64 --headless --frames 1 --pattern projector-ids "
+  ASSERT_EQ(test::run_facet(
+                "run builtin:wall2x2 --size 96x64 --headless --frames 1 --pattern projector-ids "
                 "--out " +
                     out.string(),
                 folder / "log"),
@@ -480,7 +476,8 @@ TEST(RunCli, APatternReplacesTheScene) {
   const Png png = read_png(out / "wall_r1c1" / "00000.png");
   ASSERT_EQ(png.width, 96);
   EXPECT_EQ(lit_fraction(png), 1.0);
-  EXPECT_EQ(run("run builtin:wall2x2 --size 96x64 --headless --frames 1 --pattern stripes --out " +
+  EXPECT_EQ(test::run_facet(
+                "run builtin:wall2x2 --size 96x64 --headless --frames 1 --pattern stripes --out " +
                     (folder / "bad").string(),
                 folder / "log"),
             2);

@@ -18,18 +18,12 @@
 #include "facet/projection_io/blend_file.hpp"
 #include "facet/projection_io/warp_file.hpp"
 #include "gl_test_context.hpp"
+#include "support/files.hpp"
 
 namespace facet::driver {
 namespace {
 
 namespace fs = std::filesystem;
-
-fs::path fresh_folder(const std::string& name) {
-  const fs::path folder = facet::test_paths::scratch_path("facet_session_test_" + name);
-  fs::remove_all(folder);
-  fs::create_directories(folder);
-  return folder;
-}
 
 // A 20 m square wall facing +z at z = -5 (in front of an eye at the origin looking down -z).
 Scene wall_scene() {
@@ -278,7 +272,7 @@ fs::path write_two_projector_display(const fs::path& folder, bool with_blend) {
 
 TEST(Session, RendersOutputsThatSeeTheSceneAndSkipsTheOthers) {
   test::shared_context();
-  const fs::path folder = fresh_folder("skip");
+  const fs::path folder = facet::test::fresh_folder("facet_session_test_skip");
   SessionDisplay display =
       load_session_display(write_two_projector_display(folder, false).string());
   const Scene scene = wall_scene();
@@ -306,7 +300,8 @@ TEST(Session, RendersOutputsThatSeeTheSceneAndSkipsTheOthers) {
 
 TEST(Session, BlendsInLinearLightAfterRendering) {
   test::shared_context();
-  const fs::path plain_folder = fresh_folder("plain"), blend_folder = fresh_folder("blend");
+  const fs::path plain_folder = facet::test::fresh_folder("facet_session_test_plain"),
+                 blend_folder = facet::test::fresh_folder("facet_session_test_blend");
   const Scene scene = wall_scene();
   Session plain(load_session_display(write_two_projector_display(plain_folder, false).string()),
                 scene);
@@ -338,7 +333,7 @@ TEST(Session, BlendsInLinearLightAfterRendering) {
 
 TEST(HeadlessRun, WritesFramesPerOutputAndStatistics) {
   test::shared_context();
-  const fs::path folder = fresh_folder("headless");
+  const fs::path folder = facet::test::fresh_folder("facet_session_test_headless");
   const Scene scene = wall_scene();
   Session session(load_session_display(write_two_projector_display(folder, false).string()), scene);
   const fs::path out = folder / "run";

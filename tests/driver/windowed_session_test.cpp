@@ -17,9 +17,9 @@
 #include <string>
 #include <thread>
 
-#include "cli_process.hpp"
 #include "facet/projection_io/display_config.hpp"
 #include "facet/projection_io/warp_file.hpp"
+#include "support/facet_cli.hpp"
 #include "xorg_dummy.hpp"
 
 namespace facet {

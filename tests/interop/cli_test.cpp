@@ -22,35 +22,20 @@ namespace {
 namespace fs = std::filesystem;
 const std::string kWarps = std::string(FACET_SHARED_DATA_DIR) + "/warps/";
 
-struct CliRun {
-  int status;
-  std::string output;
-};
-
-// Runs the CLI with `arguments`; with limit_s > 0, under timeout(1), which exits 124 on expiry.
-CliRun run(const std::string& arguments, const fs::path& scratch, int limit_s = 0) {
-  const fs::path log = scratch / "cli.log";
-  const std::string limit = limit_s > 0 ? "timeout " + std::to_string(limit_s) + " " : "";
-  const std::string command =
-      limit + std::string(FACET_CLI) + " " + arguments + " > " + log.string() + " 2>&1";
-  const int raw = std::system(command.c_str());
-  std::ifstream stream(log);
-  std::ostringstream text;
-  text << stream.rdbuf();
-  return {WIFEXITED(raw) ? WEXITSTATUS(raw) : -1, text.str()};
-}
+using test::CliRun;
+using test::run;
 
 void write_file(const fs::path& path, const std::string& bytes) {
   std::ofstream(path, std::ios::binary) << bytes;
 }
 
 TEST(InteropCli, RealFilesFromOtherToolsImportToReadableDisplays) {
-  test::ScratchFolder scratch("cli-real");
+  test::TempFolder scratch("facet-interop-cli-real");
   for (const char* name : {"correction_mesh", "zero_distortion_mesh"}) {
-    const fs::path out = scratch.path / name;
+    const fs::path out = scratch.path() / name;
     const CliRun r =
         run("mpcdi import " + kWarps + "sgct-mpcdi/" + name + ".mpcdi --out " + out.string(),
-            scratch.path);
+            scratch.path());
     ASSERT_EQ(r.status, 0) << r.output;
     const auto display = projection_io::read_display_config(out / "display.json");
     ASSERT_EQ(display.projectors.size(), 1u);
@@ -59,13 +44,13 @@ TEST(InteropCli, RealFilesFromOtherToolsImportToReadableDisplays) {
     const CliRun error =
         run("error --warp " + display.resolve(display.projectors[0].warp).string() +
                 " --tolerance 0.25 --json",
-            scratch.path);
+            scratch.path());
     EXPECT_EQ(error.status, 0) << error.output;
   }
-  const fs::path mirror = scratch.path / "mirror";
+  const fs::path mirror = scratch.path() / "mirror";
   const CliRun r =
       run("bourke import " + kWarps + "sgct-mesh/standard_16x9.data --out " + mirror.string(),
-          scratch.path);
+          scratch.path());
   ASSERT_EQ(r.status, 0) << r.output;
   const auto display = projection_io::read_display_config(mirror / "display.json");
   EXPECT_NO_THROW(read_warp(display.resolve(display.projectors[0].warp).string()));
@@ -74,37 +59,38 @@ TEST(InteropCli, RealFilesFromOtherToolsImportToReadableDisplays) {
   // grid refining whole rows and columns there needs more than 2^20 cells for 0.25 px, bisection
   // refines the corners alone. Worst case over dense samples, output px.
   const std::string warp_path = display.resolve(display.projectors[0].warp).string();
-  const CliRun error = run("error --warp " + warp_path + " --tolerance 0.25 --json", scratch.path);
+  const CliRun error =
+      run("error --warp " + warp_path + " --tolerance 0.25 --json", scratch.path());
   ASSERT_EQ(error.status, 0) << error.output;
   EXPECT_NE(error.output.find("\"layout\":\"tolerance 0.25 px, bisection\""), std::string::npos)
       << error.output;
   const std::size_t max_at = error.output.find("\"max_px\":");
   ASSERT_NE(max_at, std::string::npos) << error.output;
   EXPECT_LE(std::strtod(error.output.c_str() + max_at + 9, nullptr), 0.25) << error.output;
-  EXPECT_EQ(
-      run("error --warp " + warp_path + " --tolerance 0.25 --builder tensor", scratch.path).status,
-      2);
+  EXPECT_EQ(run("error --warp " + warp_path + " --tolerance 0.25 --builder tensor", scratch.path())
+                .status,
+            2);
 }
 
 TEST(InteropCli, ExportImportRoundTripThroughTheCommands) {
-  test::ScratchFolder scratch("cli-roundtrip");
+  test::TempFolder scratch("facet-interop-cli-roundtrip");
   const Warp warp = test::calibrated_like_warp({320, 200}, {17, 11});
-  write_warp((scratch.path / "p0.warp.exr").string(), warp);
-  write_file(scratch.path / "display.json",
+  write_warp((scratch.path() / "p0.warp.exr").string(), warp);
+  write_file(scratch.path() / "display.json",
              R"({"format": "facet-display/1", "name": "t", "eye": [0, 0, 0],
                  "projectors": [{"name": "p0", "size": [320, 200], "warp": "p0.warp.exr",
                                  "output": {"window": [0, 0, 320, 200]}}]})");
   // Nodes every 2 px: the error of the PFM's bilinear interpolation shrinks with the square of
   // the spacing, and this small image bends faster per pixel than a full-size projector's.
-  CliRun r = run("mpcdi export --node-spacing 2 " + (scratch.path / "display.json").string() +
-                     " --out " + (scratch.path / "d.mpcdi").string(),
-                 scratch.path);
+  CliRun r = run("mpcdi export --node-spacing 2 " + (scratch.path() / "display.json").string() +
+                     " --out " + (scratch.path() / "d.mpcdi").string(),
+                 scratch.path());
   ASSERT_EQ(r.status, 0) << r.output;
-  r = run("mpcdi import " + (scratch.path / "d.mpcdi").string() + " --out " +
-              (scratch.path / "back").string(),
-          scratch.path);
+  r = run("mpcdi import " + (scratch.path() / "d.mpcdi").string() + " --out " +
+              (scratch.path() / "back").string(),
+          scratch.path());
   ASSERT_EQ(r.status, 0) << r.output;
-  const Warp back = read_warp((scratch.path / "back" / "p0.warp.exr").string());
+  const Warp back = read_warp((scratch.path() / "back" / "p0.warp.exr").string());
   double worst = 0;
   for (int j = 0; j <= 50; ++j) {
     for (int i = 0; i <= 50; ++i) {
@@ -115,16 +101,16 @@ TEST(InteropCli, ExportImportRoundTripThroughTheCommands) {
   }
   EXPECT_LT(worst, 0.01);
   // Importing into a folder that holds files is refused.
-  r = run("mpcdi import " + (scratch.path / "d.mpcdi").string() + " --out " +
-              (scratch.path / "back").string(),
-          scratch.path);
+  r = run("mpcdi import " + (scratch.path() / "d.mpcdi").string() + " --out " +
+              (scratch.path() / "back").string(),
+          scratch.path());
   EXPECT_EQ(r.status, 2) << r.output;
 }
 
 TEST(InteropCli, BadFilesExitWithStatus2AndLeaveNothingBehind) {
-  test::ScratchFolder scratch("cli-bad");
-  write_file(scratch.path / "text.mpcdi", "not a zip at all");
-  write_file(scratch.path / "bad.data", "2\n3 2\n-1.5 -1 0 0 1\n");
+  test::TempFolder scratch("facet-interop-cli-bad");
+  write_file(scratch.path() / "text.mpcdi", "not a zip at all");
+  write_file(scratch.path() / "bad.data", "2\n3 2\n-1.5 -1 0 0 1\n");
   PfmImage pfm;
   pfm.width = pfm.height = 2;
   pfm.values.assign(12, std::numeric_limits<float>::quiet_NaN());
@@ -137,47 +123,47 @@ TEST(InteropCli, BadFilesExitWithStatus2AndLeaveNothingBehind) {
                     "<fileset region=\"r\"><geometryWarpFile><path>w.pfm</path>"
                     "</geometryWarpFile></fileset></files></MPCDI>"},
                    {"w.pfm", format_pfm(pfm)}};  // every node NaN: a warp that shows nothing
-  write_zip_file(scratch.path / "collapsed.mpcdi", files);
+  write_zip_file(scratch.path() / "collapsed.mpcdi", files);
   const std::vector<std::string> commands{
-      "mpcdi import " + (scratch.path / "text.mpcdi").string(),
-      "mpcdi import " + (scratch.path / "collapsed.mpcdi").string(),
-      "mpcdi import " + (scratch.path / "missing.mpcdi").string(),
-      "bourke import " + (scratch.path / "bad.data").string(),
+      "mpcdi import " + (scratch.path() / "text.mpcdi").string(),
+      "mpcdi import " + (scratch.path() / "collapsed.mpcdi").string(),
+      "mpcdi import " + (scratch.path() / "missing.mpcdi").string(),
+      "bourke import " + (scratch.path() / "bad.data").string(),
       "bourke import " + kWarps + "sgct-mesh/standard_16x9.data --size 1000x1000",
-      "sgct import " + (scratch.path / "bad.data").string(),
+      "sgct import " + (scratch.path() / "bad.data").string(),
       "sgct import " + kWarps + "sgct-dome/sciss/channel1_planar.sgc " +
-          (scratch.path / "bad.data").string(),
+          (scratch.path() / "bad.data").string(),
       "sgct import " + kWarps + "sgct-dome/sciss/channel1_planar.sgc --size 0x10",
-      "sgct export " + (scratch.path / "missing.json").string(),
+      "sgct export " + (scratch.path() / "missing.json").string(),
       "sgct export " + std::string(FACET_SOURCE_DIR) +
           "/configs/displays/wall2x2/display.json --node-spacing 0",
   };
   for (const std::string& command : commands) {
-    const fs::path out = scratch.path / "out";
-    const CliRun r = run(command + " --out " + out.string(), scratch.path);
+    const fs::path out = scratch.path() / "out";
+    const CliRun r = run(command + " --out " + out.string(), scratch.path());
     EXPECT_EQ(r.status, 2) << command << "\n" << r.output;
     EXPECT_NE(r.output.find("facet: error:"), std::string::npos) << r.output;
     EXPECT_FALSE(fs::exists(out)) << command;
   }
   // Nothing but the inputs and the log: no temporary folders left over.
   int entries = 0;
-  for (const auto& entry : fs::directory_iterator(scratch.path)) {
+  for (const auto& entry : fs::directory_iterator(scratch.path())) {
     (void)entry;
     ++entries;
   }
   EXPECT_EQ(entries, 4);
-  const CliRun lookup = run("lookup --warp " + (scratch.path / "none.warp.exr").string() +
-                                " --out " + (scratch.path / "l.exr").string(),
-                            scratch.path);
+  const CliRun lookup = run("lookup --warp " + (scratch.path() / "none.warp.exr").string() +
+                                " --out " + (scratch.path() / "l.exr").string(),
+                            scratch.path());
   EXPECT_EQ(lookup.status, 2) << lookup.output;
-  EXPECT_FALSE(fs::exists(scratch.path / "l.exr"));
+  EXPECT_FALSE(fs::exists(scratch.path() / "l.exr"));
 }
 
 TEST(InteropCli, AnSgctDomeConfigurationAndBareSgcMeshesImport) {
-  test::ScratchFolder scratch("cli-sgct");
-  const fs::path dome = scratch.path / "dome";
+  test::TempFolder scratch("facet-interop-cli-sgct");
+  const fs::path dome = scratch.path() / "dome";
   CliRun r = run("sgct import " + kWarps + "sgct-dome/sciss/dome_alpha.xml --out " + dome.string(),
-                 scratch.path);
+                 scratch.path());
   ASSERT_EQ(r.status, 0) << r.output;
   EXPECT_NE(r.output.find("6 projectors"), std::string::npos) << r.output;
   const auto display = projection_io::read_display_config(dome / "display.json");
@@ -190,7 +176,7 @@ TEST(InteropCli, AnSgctDomeConfigurationAndBareSgcMeshesImport) {
   // The imported warps meet facet's default 0.25 px with facets (worst case, output px).
   const CliRun error =
       run("error --warp " + display.resolve(display.projectors[0].warp).string() + " --json",
-          scratch.path);
+          scratch.path());
   ASSERT_EQ(error.status, 0) << error.output;
   const std::size_t max_at = error.output.find("\"max_px\":");
   ASSERT_NE(max_at, std::string::npos) << error.output;
@@ -198,9 +184,9 @@ TEST(InteropCli, AnSgctDomeConfigurationAndBareSgcMeshesImport) {
 
   // SimCAD's dome as shipped: the cluster file names no meshes; the .simcad files beside it hold
   // them.
-  const fs::path simcad = scratch.path / "simcad";
+  const fs::path simcad = scratch.path() / "simcad";
   r = run("sgct import " + kWarps + "sgct-dome/simcad/dome_bravo.xml --out " + simcad.string(),
-          scratch.path);
+          scratch.path());
   ASSERT_EQ(r.status, 0) << r.output;
   EXPECT_NE(r.output.find("6 projectors"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("took \"channel6_warp.simcad\""), std::string::npos) << r.output;
@@ -210,10 +196,10 @@ TEST(InteropCli, AnSgctDomeConfigurationAndBareSgcMeshesImport) {
     EXPECT_EQ(projector.size, glm::ivec2(4096, 2160));
   }
 
-  const fs::path meshes = scratch.path / "meshes";
+  const fs::path meshes = scratch.path() / "meshes";
   r = run("sgct import " + kWarps + "sgct-dome/simcad/channel1_warp_u2.sgc " + kWarps +
               "sgct-dome/simcad/channel2_warp_u3.sgc --size 1024x640 --out " + meshes.string(),
-          scratch.path);
+          scratch.path());
   ASSERT_EQ(r.status, 0) << r.output;
   const auto bare = projection_io::read_display_config(meshes / "display.json");
   ASSERT_EQ(bare.projectors.size(), 2u);
@@ -221,20 +207,20 @@ TEST(InteropCli, AnSgctDomeConfigurationAndBareSgcMeshesImport) {
   EXPECT_FALSE(bare.projectors[0].blend);
 
   // A facet display out to SGCT and back.
-  const fs::path exported = scratch.path / "exported";
+  const fs::path exported = scratch.path() / "exported";
   r = run("sgct export " + std::string(FACET_SOURCE_DIR) +
               "/configs/displays/wall2x2/display.json --node-spacing 8 --out " + exported.string(),
-          scratch.path);
+          scratch.path());
   ASSERT_EQ(r.status, 0) << r.output;
   for (const char* name : {"cluster.xml", "wall_r0c0.sgc", "wall_r1c1_mask.png"}) {
     EXPECT_TRUE(fs::exists(exported / name)) << name;
   }
   r = run("sgct import " + (exported / "cluster.xml").string() + " --out " +
-              (scratch.path / "back").string(),
-          scratch.path);
+              (scratch.path() / "back").string(),
+          scratch.path());
   ASSERT_EQ(r.status, 0) << r.output;
   const projection_io::DisplayConfig back =
-      projection_io::read_display_config(scratch.path / "back" / "display.json");
+      projection_io::read_display_config(scratch.path() / "back" / "display.json");
   EXPECT_EQ(back.projectors.size(), 4u);
   // One SGCT node per projector, all on 127.0.0.1: a cluster section facet run --node takes.
   ASSERT_TRUE(back.cluster.has_value());
@@ -261,7 +247,7 @@ double angle_between(glm::dvec3 a, glm::dvec3 b) {
 // around the viewer (eye frame: x right, y up, −z ahead). Rotations are written as doubles, so the
 // directions hold within 1e-9 rad.
 TEST(InteropCli, DomesTakeTheirZenithTiltAndOrientation) {
-  test::ScratchFolder scratch("cli-orientation");
+  test::TempFolder scratch("facet-interop-cli-orientation");
   const std::string mirror =
       "bourke import " + kWarps + "sgct-mesh/standard_16x9.data --size 480x270";
   const glm::dvec2 centre{0.5, 0.5}, bottom_middle{0.5, 1.0};  // of the fisheye master
@@ -280,8 +266,8 @@ TEST(InteropCli, DomesTakeTheirZenithTiltAndOrientation) {
   int k = 0;
   for (const Case& c : cases) {
     SCOPED_TRACE(c.flags);
-    const fs::path out = scratch.path / ("mirror" + std::to_string(k++));
-    const CliRun r = run(mirror + " " + c.flags + " --out " + out.string(), scratch.path);
+    const fs::path out = scratch.path() / ("mirror" + std::to_string(k++));
+    const CliRun r = run(mirror + " " + c.flags + " --out " + out.string(), scratch.path());
     ASSERT_EQ(r.status, 0) << r.output;
     const Warp warp = first_warp(out);
     EXPECT_LE(angle_between(warp.v_eye_from_st(centre), c.zenith), 1e-9);
@@ -293,21 +279,23 @@ TEST(InteropCli, DomesTakeTheirZenithTiltAndOrientation) {
   // The analytic built-in dome, written out by facet display.
   for (const Case& c : {cases[0], cases[3], cases[4]}) {
     SCOPED_TRACE(c.flags);
-    const fs::path out = scratch.path / ("builtin" + std::to_string(k++));
-    const CliRun r = run(
-        "display builtin:dome180 --size 64x64 " + c.flags + " --out " + out.string(), scratch.path);
+    const fs::path out = scratch.path() / ("builtin" + std::to_string(k++));
+    const CliRun r =
+        run("display builtin:dome180 --size 64x64 " + c.flags + " --out " + out.string(),
+            scratch.path());
     ASSERT_EQ(r.status, 0) << r.output;
     EXPECT_LE(angle_between(first_warp(out).v_eye_from_st(centre), c.zenith), 1e-9);
   }
   // An SGCT import turned by 90°: every direction turns from ahead (−z) toward the right (+x).
   const std::string bravo = "sgct import " + kWarps + "sgct-dome/simcad/dome_bravo.xml";
-  CliRun r = run(bravo + " --out " + (scratch.path / "bravo").string(), scratch.path);
+  CliRun r = run(bravo + " --out " + (scratch.path() / "bravo").string(), scratch.path());
   ASSERT_EQ(r.status, 0) << r.output;
-  r = run(bravo + " --orientation 90 --out " + (scratch.path / "bravo90").string(), scratch.path);
+  r = run(bravo + " --orientation 90 --out " + (scratch.path() / "bravo90").string(),
+          scratch.path());
   ASSERT_EQ(r.status, 0) << r.output;
-  const glm::dvec3 v = first_warp(scratch.path / "bravo").v_eye_from_st(centre);
+  const glm::dvec3 v = first_warp(scratch.path() / "bravo").v_eye_from_st(centre);
   EXPECT_LE(
-      angle_between(first_warp(scratch.path / "bravo90").v_eye_from_st(centre), {-v.z, v.y, v.x}),
+      angle_between(first_warp(scratch.path() / "bravo90").v_eye_from_st(centre), {-v.z, v.y, v.x}),
       1e-9);
 
   // Bad values exit 2 naming the flag, writing nothing.
@@ -321,8 +309,8 @@ TEST(InteropCli, DomesTakeTheirZenithTiltAndOrientation) {
       {"display builtin:cylinder360 --tilt 10", "--tilt"},
   };
   for (const auto& [command, flag] : bad) {
-    const fs::path out = scratch.path / "bad";
-    const CliRun failed = run(command + " --out " + out.string(), scratch.path);
+    const fs::path out = scratch.path() / "bad";
+    const CliRun failed = run(command + " --out " + out.string(), scratch.path());
     EXPECT_EQ(failed.status, 2) << command << "\n" << failed.output;
     EXPECT_NE(failed.output.find("'" + flag + "'"), std::string::npos) << failed.output;
     EXPECT_FALSE(fs::exists(out)) << command;
@@ -331,27 +319,27 @@ TEST(InteropCli, DomesTakeTheirZenithTiltAndOrientation) {
 #endif
 
 TEST(InteropCli, ProfileA3ThroughTheCommands) {
-  test::ScratchFolder scratch("cli-a3");
+  test::TempFolder scratch("facet-interop-cli-a3");
   const std::string dome = std::string(FACET_SOURCE_DIR) + "/configs/displays/dome4";
-  const fs::path container = scratch.path / "dome4.mpcdi";
+  const fs::path container = scratch.path() / "dome4.mpcdi";
   CliRun r =
       run("mpcdi export " + dome + " --profile a3 --node-spacing 8 --out " + container.string(),
-          scratch.path);
+          scratch.path());
   ASSERT_EQ(r.status, 0) << r.output;
   r = run("mpcdi import " + container.string() + " --eye 0,0,0 --out " +
-              (scratch.path / "back").string(),
-          scratch.path);
+              (scratch.path() / "back").string(),
+          scratch.path());
   ASSERT_EQ(r.status, 0) << r.output;
-  const auto display = projection_io::read_display_config(scratch.path / "back" / "display.json");
+  const auto display = projection_io::read_display_config(scratch.path() / "back" / "display.json");
   EXPECT_EQ(display.projectors.size(), 4u);
   // Bad options and a bad unit: status 2 naming what is wrong, nothing written.
-  r = run("mpcdi export " + dome + " --profile 2d --out " + (scratch.path / "x.mpcdi").string(),
-          scratch.path);
+  r = run("mpcdi export " + dome + " --profile 2d --out " + (scratch.path() / "x.mpcdi").string(),
+          scratch.path());
   EXPECT_EQ(r.status, 2) << r.output;
   EXPECT_NE(r.output.find("--profile"), std::string::npos) << r.output;
   r = run(
-      "mpcdi import " + container.string() + " --eye 1,2 --out " + (scratch.path / "y").string(),
-      scratch.path);
+      "mpcdi import " + container.string() + " --eye 1,2 --out " + (scratch.path() / "y").string(),
+      scratch.path());
   EXPECT_EQ(r.status, 2) << r.output;
   EXPECT_NE(r.output.find("--eye"), std::string::npos) << r.output;
   MpcdiFiles files = read_zip_file(container);
@@ -359,49 +347,51 @@ TEST(InteropCli, ProfileA3ThroughTheCommands) {
   std::string& xml = files.at("mpcdi.xml");
   ASSERT_NE(xml.find(unit), std::string::npos) << xml;
   xml.replace(xml.find(unit), unit.size(), "<geometricUnit>parsec</geometricUnit>");
-  write_zip_file(scratch.path / "bad_unit.mpcdi", files);
-  r = run("mpcdi import " + (scratch.path / "bad_unit.mpcdi").string() + " --out " +
-              (scratch.path / "z").string(),
-          scratch.path);
+  write_zip_file(scratch.path() / "bad_unit.mpcdi", files);
+  r = run("mpcdi import " + (scratch.path() / "bad_unit.mpcdi").string() + " --out " +
+              (scratch.path() / "z").string(),
+          scratch.path());
   EXPECT_EQ(r.status, 2) << r.output;
   EXPECT_NE(r.output.find("geometryWarpFile/geometricUnit"), std::string::npos) << r.output;
-  EXPECT_FALSE(fs::exists(scratch.path / "x.mpcdi"));
-  EXPECT_FALSE(fs::exists(scratch.path / "y"));
-  EXPECT_FALSE(fs::exists(scratch.path / "z"));
+  EXPECT_FALSE(fs::exists(scratch.path() / "x.mpcdi"));
+  EXPECT_FALSE(fs::exists(scratch.path() / "y"));
+  EXPECT_FALSE(fs::exists(scratch.path() / "z"));
 }
 
 TEST(InteropCli, LookupOfAWarp) {
-  test::ScratchFolder scratch("cli-lookup");
-  write_warp((scratch.path / "w.warp.exr").string(), test::calibrated_like_warp({64, 40}, {5, 5}));
-  const CliRun r = run("lookup --warp " + (scratch.path / "w.warp.exr").string() + " --out " +
-                           (scratch.path / "l.exr").string(),
-                       scratch.path);
+  test::TempFolder scratch("facet-interop-cli-lookup");
+  write_warp((scratch.path() / "w.warp.exr").string(),
+             test::calibrated_like_warp({64, 40}, {5, 5}));
+  const CliRun r = run("lookup --warp " + (scratch.path() / "w.warp.exr").string() + " --out " +
+                           (scratch.path() / "l.exr").string(),
+                       scratch.path());
   EXPECT_EQ(r.status, 0) << r.output;
-  EXPECT_TRUE(fs::exists(scratch.path / "l.exr"));
+  EXPECT_TRUE(fs::exists(scratch.path() / "l.exr"));
   // Never over its input, nor over something that is not a regular file.
-  const auto size_before = fs::file_size(scratch.path / "w.warp.exr");
+  const auto size_before = fs::file_size(scratch.path() / "w.warp.exr");
   for (const std::string& out :
-       {(scratch.path / "w.warp.exr").string(), (scratch.path / "." / "w.warp.exr").string(),
+       {(scratch.path() / "w.warp.exr").string(), (scratch.path() / "." / "w.warp.exr").string(),
         std::string("/dev/null")}) {
-    const CliRun over = run(
-        "lookup --warp " + (scratch.path / "w.warp.exr").string() + " --out " + out, scratch.path);
+    const CliRun over =
+        run("lookup --warp " + (scratch.path() / "w.warp.exr").string() + " --out " + out,
+            scratch.path());
     EXPECT_EQ(over.status, 2) << over.output;
     EXPECT_NE(over.output.find(out), std::string::npos) << over.output;
   }
-  EXPECT_EQ(fs::file_size(scratch.path / "w.warp.exr"), size_before);
+  EXPECT_EQ(fs::file_size(scratch.path() / "w.warp.exr"), size_before);
   EXPECT_TRUE(fs::is_character_file("/dev/null"));
 }
 
 #ifndef FACET_TEST_WITHOUT_DRIVER
 TEST(InteropCli, LookupOfADisplayWritesNothingWhenOneWarpIsBad) {
-  test::ScratchFolder scratch("cli-lookup-display");
-  const fs::path wall = scratch.path / "wall", lookups = scratch.path / "lookups";
-  const CliRun made = run("display builtin:wall2x2 --out " + wall.string(), scratch.path);
+  test::TempFolder scratch("facet-interop-cli-lookup-display");
+  const fs::path wall = scratch.path() / "wall", lookups = scratch.path() / "lookups";
+  const CliRun made = run("display builtin:wall2x2 --out " + wall.string(), scratch.path());
   ASSERT_EQ(made.status, 0) << made.output;
   std::ofstream(wall / "wall_r1c1.warp.exr") << "not an EXR";
   const CliRun r =
       run("lookup --display " + (wall / "display.json").string() + " --out " + lookups.string(),
-          scratch.path);
+          scratch.path());
   EXPECT_EQ(r.status, 2) << r.output;
   EXPECT_NE(r.output.find("wall_r1c1.warp.exr"), std::string::npos) << r.output;
   EXPECT_FALSE(fs::exists(lookups));
@@ -411,12 +401,12 @@ TEST(InteropCli, LookupOfADisplayWritesNothingWhenOneWarpIsBad) {
 // folder; a folder holding anything else, or the display's own folder, is refused with exit 2 and
 // left as it was.
 TEST(InteropCli, LookupOfADisplayReplacesOnlyAnEarlierLookupFolder) {
-  test::ScratchFolder scratch("cli-lookup-folder");
-  const fs::path wall = scratch.path / "wall", lookups = scratch.path / "lookups";
-  ASSERT_EQ(run("display builtin:wall2x2 --out " + wall.string(), scratch.path).status, 0);
+  test::TempFolder scratch("facet-interop-cli-lookup-folder");
+  const fs::path wall = scratch.path() / "wall", lookups = scratch.path() / "lookups";
+  ASSERT_EQ(run("display builtin:wall2x2 --out " + wall.string(), scratch.path()).status, 0);
   const std::string command = "lookup --display " + (wall / "display.json").string() + " --out ";
   for (int round = 0; round < 2; ++round) {
-    const CliRun r = run(command + lookups.string(), scratch.path);
+    const CliRun r = run(command + lookups.string(), scratch.path());
     ASSERT_EQ(r.status, 0) << r.output;
     std::size_t files = 0;
     for (const auto& entry : fs::directory_iterator(lookups)) {
@@ -425,14 +415,14 @@ TEST(InteropCli, LookupOfADisplayReplacesOnlyAnEarlierLookupFolder) {
     }
     EXPECT_EQ(files, 4u);
   }
-  const fs::path mine = scratch.path / "mine";
+  const fs::path mine = scratch.path() / "mine";
   fs::create_directories(mine);
   std::ofstream(mine / "notes.txt") << "keep me";
-  const CliRun foreign = run(command + mine.string(), scratch.path);
+  const CliRun foreign = run(command + mine.string(), scratch.path());
   EXPECT_EQ(foreign.status, 2) << foreign.output;
   EXPECT_NE(foreign.output.find("--out"), std::string::npos) << foreign.output;
   EXPECT_EQ(std::distance(fs::directory_iterator(mine), fs::directory_iterator{}), 1);
-  const CliRun over_input = run(command + wall.string(), scratch.path);
+  const CliRun over_input = run(command + wall.string(), scratch.path());
   EXPECT_EQ(over_input.status, 2) << over_input.output;
   EXPECT_TRUE(fs::exists(wall / "display.json"));
 }
@@ -443,15 +433,15 @@ TEST(InteropCli, LookupOfADisplayReplacesOnlyAnEarlierLookupFolder) {
 // path that is not a regular file (require_regular_file). Each run is limited to 20 s by
 // timeout(1), whose status 124 would fail the test.
 TEST(InteropCli, InputsThatAreNotRegularFilesAreRefused) {
-  test::ScratchFolder scratch("cli-fifo");
-  const fs::path fifo_dir = scratch.path / "fifos";
+  test::TempFolder scratch("facet-interop-cli-fifo");
+  const fs::path fifo_dir = scratch.path() / "fifos";
   fs::create_directories(fifo_dir);
   const auto fifo = [&](const std::string& name) {
     const fs::path path = fifo_dir / name;
     EXPECT_EQ(::mkfifo(path.c_str(), 0600), 0) << path;
     return path.string();
   };
-  const std::string out = (scratch.path / "out").string();
+  const std::string out = (scratch.path() / "out").string();
   const std::string folder = fifo_dir.string();
   const std::vector<std::pair<std::string, std::string>> runs = {
       {"lookup --warp " + fifo("a.warp.exr") + " --out " + out + ".exr", "a.warp.exr"},
@@ -465,7 +455,7 @@ TEST(InteropCli, InputsThatAreNotRegularFilesAreRefused) {
       {"lookup --warp " + folder + " --out " + out + ".exr", "fifos"},
   };
   for (const auto& [arguments, named] : runs) {
-    const CliRun r = run(arguments, scratch.path, 20);
+    const CliRun r = run(arguments, scratch.path(), 20);
     EXPECT_EQ(r.status, 2) << arguments << ": " << r.output;
     EXPECT_NE(r.output.find(named), std::string::npos) << arguments << ": " << r.output;
     EXPECT_FALSE(fs::exists(out)) << arguments;
@@ -476,14 +466,14 @@ TEST(InteropCli, InputsThatAreNotRegularFilesAreRefused) {
 
 #ifndef FACET_TEST_WITHOUT_DRIVER
 TEST(InteropCli, AbsurdSizesAndGridsAreRefusedUpFront) {
-  test::ScratchFolder scratch("cli-sizes");
-  const std::string out = (scratch.path / "out").string();
+  test::TempFolder scratch("facet-interop-cli-sizes");
+  const std::string out = (scratch.path() / "out").string();
   for (const std::string& arguments :
        {"display builtin:cylinder360 --size 100000x100000 --out " + out,
         "display builtin:cylinder360 --size 16385x2 --out " + out,
         "display builtin:wall2x2 --grid 65536x1 --out " + out,
         std::string("error --base fisheye --size 9000x9000")}) {
-    const CliRun r = run(arguments, scratch.path, 20);
+    const CliRun r = run(arguments, scratch.path(), 20);
     EXPECT_EQ(r.status, 2) << arguments << ": " << r.output;
     EXPECT_FALSE(fs::exists(out)) << arguments;
   }
@@ -491,19 +481,19 @@ TEST(InteropCli, AbsurdSizesAndGridsAreRefusedUpFront) {
 #endif
 
 TEST(InteropCli, DevicesListsOrSaysThereAreNone) {
-  test::ScratchFolder scratch("cli-devices");
-  CliRun r = run("devices", scratch.path);
+  test::TempFolder scratch("facet-interop-cli-devices");
+  CliRun r = run("devices", scratch.path());
   EXPECT_EQ(r.status, 0) << r.output;
   EXPECT_TRUE(r.output.find("no USB devices") != std::string::npos ||
               r.output.find("VID:PID") != std::string::npos)
       << r.output;
-  r = run("devices --watch --for 1", scratch.path);
+  r = run("devices --watch --for 1", scratch.path());
   EXPECT_EQ(r.status, 0) << r.output;
   // It says how it follows hotplug.
   EXPECT_TRUE(r.output.find("(libusb hotplug events)") != std::string::npos ||
               r.output.find("(polling)") != std::string::npos)
       << r.output;
-  r = run("devices --find camera0", scratch.path);
+  r = run("devices --find camera0", scratch.path());
   EXPECT_EQ(r.status, 2) << r.output;
 }
 

@@ -11,9 +11,9 @@ namespace facet::interop {
 namespace {
 
 TEST(Lookup, EveryPixelHoldsTheStAndDirectionThatMapToItsCentre) {
-  test::ScratchFolder scratch("lookup");
+  test::TempFolder scratch("facet-interop-lookup");
   const Warp warp = test::calibrated_like_warp({160, 100}, {9, 7});
-  const auto path = scratch.path / "l.exr";
+  const auto path = scratch.path() / "l.exr";
   write_lookup(warp, path);
   auto in = OIIO::ImageInput::open(path.string());
   ASSERT_TRUE(in);

@@ -87,11 +87,11 @@ MpcdiExportOptions a3_options(double spacing = 4) {
 }
 
 TEST(MpcdiA3, ExportWritesScreenPointsInTheFilesAxes) {
-  test::ScratchFolder scratch("a3-axes");
+  test::TempFolder scratch("facet-interop-a3-axes");
   // Identity perspective: the output centre looks straight ahead (eye −z), the right edge
   // towards +x. In the file's axes (x left, z into the screen) those are +z and −x.
   const Warp warp = Warp::analytic(BaseProjection::perspective(-1, 1, 0.75, -0.75), {64, 48});
-  const MpcdiFiles files = export_mpcdi(one_projector_display(scratch.path, warp), a3_options(8));
+  const MpcdiFiles files = export_mpcdi(one_projector_display(scratch.path(), warp), a3_options(8));
   const MpcdiDocument document = parse_mpcdi_xml(files.at("mpcdi.xml"), "a3.xml");
   EXPECT_EQ(document.profile, MpcdiProfile::advanced_3d);
   EXPECT_EQ(document.regions[0].unit, MpcdiUnit::m);
@@ -111,11 +111,12 @@ TEST(MpcdiA3, ExportWritesScreenPointsInTheFilesAxes) {
 }
 
 TEST(MpcdiA3, RoundTripReproducesACalibratedWarpWithin001Px) {
-  test::ScratchFolder scratch("a3-roundtrip");
+  test::TempFolder scratch("facet-interop-a3-roundtrip");
   const Warp warp = test::calibrated_like_warp();
-  const auto config = one_projector_display(scratch.path, warp);
-  write_zip_file(scratch.path / "d.mpcdi", export_mpcdi(config, a3_options()));
-  const ImportedDisplay display = import_mpcdi(read_zip_file(scratch.path / "d.mpcdi"), "d.mpcdi");
+  const auto config = one_projector_display(scratch.path(), warp);
+  write_zip_file(scratch.path() / "d.mpcdi", export_mpcdi(config, a3_options()));
+  const ImportedDisplay display =
+      import_mpcdi(read_zip_file(scratch.path() / "d.mpcdi"), "d.mpcdi");
   ASSERT_EQ(display.projectors.size(), 1u);
   const Warp& back = display.projectors[0].warp;
   EXPECT_EQ(back.grid_size, warp.grid_size);
@@ -149,7 +150,7 @@ nlohmann::json exr_json(const std::filesystem::path& path, const char* name) {
 // double), and the a3 import lands on the same base (under 0.01 px) from facet.json's rows and
 // from the columns earlier containers stored.
 TEST(MpcdiA3, BaseRotationIsStoredAsRowsEverywhereAndRoundTrips) {
-  test::ScratchFolder scratch("a3-rotation");
+  test::TempFolder scratch("facet-interop-a3-rotation");
   const glm::dmat3 R = skew_rotation();
   ASSERT_GT(std::abs(R[0][1] - R[1][0]), 0.1);  // not symmetric
   const Warp warp =
@@ -161,12 +162,13 @@ TEST(MpcdiA3, BaseRotationIsStoredAsRowsEverywhereAndRoundTrips) {
     return m;
   };
 
-  const auto config = one_projector_display(scratch.path, warp);
-  EXPECT_EQ(rows_of(exr_json(scratch.path / "p0.warp.exr", "facet:warp")["rotation"]), R);
-  EXPECT_EQ(read_warp((scratch.path / "p0.warp.exr").string()).R_eye_base, R);
+  const auto config = one_projector_display(scratch.path(), warp);
+  EXPECT_EQ(rows_of(exr_json(scratch.path() / "p0.warp.exr", "facet:warp")["rotation"]), R);
+  EXPECT_EQ(read_warp((scratch.path() / "p0.warp.exr").string()).R_eye_base, R);
 
-  write_lookup(warp, scratch.path / "lookup.exr");
-  EXPECT_EQ(rows_of(exr_json(scratch.path / "lookup.exr", "facet:lookup")["warp"]["rotation"]), R);
+  write_lookup(warp, scratch.path() / "lookup.exr");
+  EXPECT_EQ(rows_of(exr_json(scratch.path() / "lookup.exr", "facet:lookup")["warp"]["rotation"]),
+            R);
 
   MpcdiFiles files = export_mpcdi(config, a3_options(2));
   nlohmann::json hints = nlohmann::json::parse(files.at("facet.json"));
@@ -188,13 +190,13 @@ TEST(MpcdiA3, BaseRotationIsStoredAsRowsEverywhereAndRoundTrips) {
 }
 
 TEST(MpcdiA3, FisheyeAndCylindricalBasesGoThroughAsTheyAre) {
-  test::ScratchFolder scratch("a3-bases");
+  test::TempFolder scratch("facet-interop-a3-bases");
   // 3d export needs a covering frustum for these; a3 carries them unchanged.
   for (const BaseProjection& base :
        {BaseProjection::fisheye(200), BaseProjection::cylindrical(-100, 100, 0.8, -0.6)}) {
     const Warp warp = Warp::analytic(base, {400, 300}, {33, 25});
-    const auto config = one_projector_display(scratch.path / to_string(base.kind), [&] {
-      std::filesystem::create_directories(scratch.path / to_string(base.kind));
+    const auto config = one_projector_display(scratch.path() / to_string(base.kind), [&] {
+      std::filesystem::create_directories(scratch.path() / to_string(base.kind));
       return warp;
     }());
     const Warp back =
@@ -283,9 +285,9 @@ TEST(MpcdiDome, SampleDomeRoundTripsThroughProfile3dToo) {
 TEST(MpcdiA3, OtherToolsFilesImportOnABaseOfTheirOwn) {
   // No facet.json: the import chooses a base that covers the region's directions, so compare
   // where directions land rather than base positions.
-  test::ScratchFolder scratch("a3-nohint");
+  test::TempFolder scratch("facet-interop-a3-nohint");
   const Warp warp = test::calibrated_like_warp();
-  MpcdiFiles files = export_mpcdi(one_projector_display(scratch.path, warp), a3_options(4));
+  MpcdiFiles files = export_mpcdi(one_projector_display(scratch.path(), warp), a3_options(4));
   files.erase("facet.json");
   MpcdiImportOptions options;
   options.warp_grid = glm::ivec2(65, 41);

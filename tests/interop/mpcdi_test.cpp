@@ -106,15 +106,16 @@ projection_io::DisplayConfig write_display(const std::filesystem::path& folder, 
 }
 
 TEST(MpcdiRoundTrip, ExportThenImportReproducesACalibratedWarpWithin001Px) {
-  test::ScratchFolder scratch("roundtrip");
+  test::TempFolder scratch("facet-interop-roundtrip");
   const Warp warp = test::calibrated_like_warp();
   projection_io::BlendMap blend = projection_io::BlendMap::constant(warp.output_size, 1.0f);
   for (int y = 0; y < blend.size.y; ++y) {
     for (int x = 0; x < blend.size.x; ++x) blend.at(x, y) = float(std::min(1.0, x / 200.0));
   }
-  const auto config = write_display(scratch.path, warp, &blend);
-  write_zip_file(scratch.path / "d.mpcdi", export_mpcdi(config));
-  const ImportedDisplay display = import_mpcdi(read_zip_file(scratch.path / "d.mpcdi"), "d.mpcdi");
+  const auto config = write_display(scratch.path(), warp, &blend);
+  write_zip_file(scratch.path() / "d.mpcdi", export_mpcdi(config));
+  const ImportedDisplay display =
+      import_mpcdi(read_zip_file(scratch.path() / "d.mpcdi"), "d.mpcdi");
   ASSERT_EQ(display.projectors.size(), 1u);
   const Warp& back = display.projectors[0].warp;
   EXPECT_EQ(back.grid_size, warp.grid_size);
@@ -153,9 +154,9 @@ TEST(MpcdiRoundTrip, ExportThenImportReproducesACalibratedWarpWithin001Px) {
 TEST(MpcdiRoundTrip, WithoutFacetsGridHintTheImportStillFollowsTheWarp) {
   // A container from another tool has no facet.json: the warp is resampled on the PFM's own
   // grid, so it no longer shares the original's node lines; error stays well under 0.05 px.
-  test::ScratchFolder scratch("nohint");
+  test::TempFolder scratch("facet-interop-nohint");
   const Warp warp = test::calibrated_like_warp();
-  const auto config = write_display(scratch.path, warp, nullptr);
+  const auto config = write_display(scratch.path(), warp, nullptr);
   MpcdiExportOptions options;
   options.node_spacing_px = 8;
   MpcdiFiles files = export_mpcdi(config, options);
@@ -166,9 +167,9 @@ TEST(MpcdiRoundTrip, WithoutFacetsGridHintTheImportStillFollowsTheWarp) {
 }
 
 TEST(MpcdiRoundTrip, FisheyeBaseExportsThroughACoveringFrustum) {
-  test::ScratchFolder scratch("fisheye");
+  test::TempFolder scratch("facet-interop-fisheye");
   Warp warp = Warp::analytic(BaseProjection::fisheye(100), {256, 256}, {17, 17});
-  const auto config = write_display(scratch.path, warp, nullptr);
+  const auto config = write_display(scratch.path(), warp, nullptr);
   // The fisheye is resampled into a perspective frustum twice (PFM nodes every 2 px, a 129×129
   // forward grid), so its bound is looser than a perspective warp's.
   MpcdiImportOptions options;

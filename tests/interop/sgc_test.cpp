@@ -333,7 +333,7 @@ TEST(SgctCluster, SimcadMeshesTakeTheirFrustumFromTheViewport) {
 // How viewports without a mesh attribute find their `.simcad` files: by the frustum in each
 // file's `_frustum.csv` where every file has one, else in order when the counts agree.
 TEST(SgctCluster, SimcadMeshesArePairedByTheirFrustumTablesElseInOrder) {
-  test::ScratchFolder scratch("simcad-pairing");
+  test::TempFolder scratch("facet-interop-simcad-pairing");
   const std::string shipped = read_bytes(kDome + "simcad/dome_bravo.xml");
   // The first two projectors' viewports swapped: the frustum tables still pair each file with
   // the viewport of its own frustum, so the first projector is channel 2.
@@ -345,38 +345,38 @@ TEST(SgctCluster, SimcadMeshesArePairedByTheirFrustumTablesElseInOrder) {
   swapped.replace(a, first.size(), second);
   for (int c = 1; c <= 6; ++c) {
     const std::string stem = "channel" + std::to_string(c) + "_warp";
-    fs::copy_file(kDome + "simcad/" + stem + ".simcad", scratch.path / (stem + ".simcad"));
+    fs::copy_file(kDome + "simcad/" + stem + ".simcad", scratch.path() / (stem + ".simcad"));
     fs::copy_file(kDome + "simcad/" + stem + "_frustum.csv",
-                  scratch.path / (stem + "_frustum.csv"));
+                  scratch.path() / (stem + "_frustum.csv"));
   }
-  std::ofstream(scratch.path / "swapped.xml") << swapped;
-  const ImportedDisplay by_frustum = import_sgct_cluster(scratch.path / "swapped.xml", {});
+  std::ofstream(scratch.path() / "swapped.xml") << swapped;
+  const ImportedDisplay by_frustum = import_sgct_cluster(scratch.path() / "swapped.xml", {});
   ASSERT_EQ(by_frustum.projectors.size(), 6u);
   EXPECT_EQ(by_frustum.projectors[0].name, "channel2_warp");
   EXPECT_EQ(by_frustum.projectors[1].name, "channel1_warp");
   EXPECT_EQ(by_frustum.projectors[2].name, "channel3_warp");
   // Without the tables, in order: the swapped viewports take channels 1 and 2 as they come.
   for (int c = 1; c <= 6; ++c) {
-    fs::remove(scratch.path / ("channel" + std::to_string(c) + "_warp_frustum.csv"));
+    fs::remove(scratch.path() / ("channel" + std::to_string(c) + "_warp_frustum.csv"));
   }
-  const ImportedDisplay in_order = import_sgct_cluster(scratch.path / "swapped.xml", {});
+  const ImportedDisplay in_order = import_sgct_cluster(scratch.path() / "swapped.xml", {});
   ASSERT_EQ(in_order.projectors.size(), 6u);
   EXPECT_EQ(in_order.projectors[0].name, "channel1_warp");
   EXPECT_EQ(in_order.projectors[1].name, "channel2_warp");
   // With the tables, one channel's mesh missing: the others pair, and the viewport left without
   // its projector is an error naming it, not a display with a projector quietly missing.
   {
-    test::ScratchFolder partial("simcad-one-missing");
+    test::TempFolder partial("facet-interop-simcad-one-missing");
     for (int c = 1; c <= 6; ++c) {
       if (c == 3) continue;
       const std::string stem = "channel" + std::to_string(c) + "_warp";
-      fs::copy_file(kDome + "simcad/" + stem + ".simcad", partial.path / (stem + ".simcad"));
+      fs::copy_file(kDome + "simcad/" + stem + ".simcad", partial.path() / (stem + ".simcad"));
       fs::copy_file(kDome + "simcad/" + stem + "_frustum.csv",
-                    partial.path / (stem + "_frustum.csv"));
+                    partial.path() / (stem + "_frustum.csv"));
     }
-    std::ofstream(partial.path / "dome_bravo.xml") << shipped;
+    std::ofstream(partial.path() / "dome_bravo.xml") << shipped;
     try {
-      import_sgct_cluster(partial.path / "dome_bravo.xml", {});
+      import_sgct_cluster(partial.path() / "dome_bravo.xml", {});
       ADD_FAILURE() << "imported without channel 3";
     } catch (const InputError& e) {
       EXPECT_EQ(e.field(), "Node[3]/Window[0]/Viewport[0]") << e.what();  // Node[0] drives none
@@ -387,9 +387,9 @@ TEST(SgctCluster, SimcadMeshesArePairedByTheirFrustumTablesElseInOrder) {
   }
   // With one file fewer than viewports nothing is paired, and the error says where meshes come
   // from.
-  fs::remove(scratch.path / "channel6_warp.simcad");
+  fs::remove(scratch.path() / "channel6_warp.simcad");
   try {
-    import_sgct_cluster(scratch.path / "swapped.xml", {});
+    import_sgct_cluster(scratch.path() / "swapped.xml", {});
     ADD_FAILURE() << "no error";
   } catch (const InputError& e) {
     EXPECT_EQ(e.field(), "Node/Window/Viewport@mesh") << e.what();
@@ -398,11 +398,11 @@ TEST(SgctCluster, SimcadMeshesArePairedByTheirFrustumTablesElseInOrder) {
         << e.what();
   }
   // Without a <PlanarProjection> a .simcad mesh cannot be placed.
-  std::ofstream(scratch.path / "bare.xml")
+  std::ofstream(scratch.path() / "bare.xml")
       << "<Cluster><Node><Window><Size x=\"640\" y=\"400\"/><Viewport "
          "mesh=\"channel1_warp.simcad\"/></Window></Node></Cluster>";
   try {
-    import_sgct_cluster(scratch.path / "bare.xml", {});
+    import_sgct_cluster(scratch.path() / "bare.xml", {});
     ADD_FAILURE() << "no error";
   } catch (const InputError& e) {
     EXPECT_EQ(e.field(), "Node[0]/Window[0]/Viewport[0]/PlanarProjection") << e.what();
@@ -574,8 +574,8 @@ TEST(SgctCluster, TheRealDomeConfigurationImportsEveryChannelWithItsMask) {
 }
 
 TEST(SgctCluster, BadConfigurationsNameTheElement) {
-  test::ScratchFolder scratch("sgct-bad");
-  fs::copy_file(kDome + "sciss/channel1_planar.sgc", scratch.path / "c1.sgc");
+  test::TempFolder scratch("facet-interop-sgct-bad");
+  fs::copy_file(kDome + "sciss/channel1_planar.sgc", scratch.path() / "c1.sgc");
   const auto cluster = [](const std::string& window) {
     return "<Cluster><Node><Window>" + window + "</Window></Node></Cluster>";
   };
@@ -599,7 +599,7 @@ TEST(SgctCluster, BadConfigurationsNameTheElement) {
       {cluster("<Size x=\"640\" y=\"400\"/><Viewport/>"), "Node/Window/Viewport@mesh"},
   };
   for (const auto& c : cases) {
-    const fs::path path = scratch.path / "cluster.xml";
+    const fs::path path = scratch.path() / "cluster.xml";
     std::ofstream(path) << c.xml;
     try {
       import_sgct_cluster(path, {});
@@ -610,10 +610,10 @@ TEST(SgctCluster, BadConfigurationsNameTheElement) {
     }
   }
   // A viewport's part of its window: the output is that part, at its place.
-  std::ofstream(scratch.path / "cluster.xml") << cluster(
+  std::ofstream(scratch.path() / "cluster.xml") << cluster(
       "<Pos x=\"100\" y=\"0\"/><Size x=\"1280\" y=\"400\"/><Viewport mesh=\"c1.sgc\">"
       "<Pos x=\"0.5\" y=\"0\"/><Size x=\"0.5\" y=\"1\"/></Viewport>");
-  const ImportedDisplay display = import_sgct_cluster(scratch.path / "cluster.xml", {});
+  const ImportedDisplay display = import_sgct_cluster(scratch.path() / "cluster.xml", {});
   ASSERT_EQ(display.projectors.size(), 1u);
   EXPECT_EQ(display.projectors[0].output.window, glm::ivec4(740, 0, 640, 400));
   EXPECT_EQ(display.projectors[0].warp.output_size, glm::ivec2(640, 400));
@@ -625,13 +625,13 @@ TEST(SgctExport, TheCalibratedDomeRoundTripsThroughSgct) {
   const auto config = projection_io::read_display_config(std::string(FACET_SOURCE_DIR) +
                                                          "/configs/displays/dome4/display.json");
   for (double spacing : {8.0, 4.0}) {
-    test::ScratchFolder scratch("sgct-export-" + std::to_string(int(spacing)));
+    test::TempFolder scratch("facet-interop-sgct-export-" + std::to_string(int(spacing)));
     SgctExportOptions options;
     options.node_spacing_px = spacing;
     for (const auto& [name, bytes] : export_sgct(config, options)) {
-      std::ofstream(scratch.path / name, std::ios::binary) << bytes;
+      std::ofstream(scratch.path() / name, std::ios::binary) << bytes;
     }
-    const ImportedDisplay back = import_sgct_cluster(scratch.path / "cluster.xml", {});
+    const ImportedDisplay back = import_sgct_cluster(scratch.path() / "cluster.xml", {});
     ASSERT_EQ(back.projectors.size(), config.projectors.size());
     for (std::size_t p = 0; p < config.projectors.size(); ++p) {
       const Warp original = read_warp(config.resolve(config.projectors[p].warp).string());

@@ -1,7 +1,5 @@
 #pragma once
-// Shared helpers of the interop tests: scratch folders and small synthetic warps.
-#include <unistd.h>
-
+// Shared helpers of the interop tests: running the CLI and small synthetic warps.
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
@@ -9,23 +7,23 @@
 #include <string>
 
 #include "facet/projection/warp.hpp"
+#include "support/facet_cli.hpp"
 
 namespace facet::interop::test {
 
-// A fresh folder under the system temp folder, removed when the object goes.
-struct ScratchFolder {
-  std::filesystem::path path;
-  explicit ScratchFolder(const std::string& name) {
-    path = std::filesystem::temp_directory_path() /
-           ("facet-interop-" + name + "-" + std::to_string(::getpid()));
-    std::filesystem::remove_all(path);
-    std::filesystem::create_directories(path);
-  }
-  ~ScratchFolder() {
-    std::error_code ignored;
-    std::filesystem::remove_all(path, ignored);
-  }
+using facet::test::TempFolder;
+
+// What `facet <arguments>` exited with and printed (stdout and stderr, also left in
+// SCRATCH/cli.log); with limit_s > 0 it runs under timeout(1), which exits 124 on expiry.
+struct CliRun {
+  int status;
+  std::string output;
 };
+inline CliRun run(const std::string& arguments, const std::filesystem::path& scratch,
+                  int limit_s = 0) {
+  const int status = facet::test::run_facet(arguments, scratch / "cli.log", limit_s);
+  return {status, facet::test::slurp(scratch / "cli.log")};
+}
 
 // A warp like a calibrated one: a perspective base lined up with the projector (asymmetric
 // extents, turned by yaw, pitch and roll) plus smooth offsets of up to about 12 px.

@@ -142,28 +142,15 @@ TEST(Tiles, SharedOrIdenticalVerticesKeepOnePiece) {
   EXPECT_EQ(tile_pieces(screen).size(), 1u);
 }
 
-struct CliRun {
-  int status;
-  std::string output;
-};
-
-CliRun run(const std::string& arguments, const fs::path& scratch) {
-  const fs::path log = scratch / "cli.log";
-  const std::string command =
-      std::string(FACET_CLI) + " " + arguments + " > " + log.string() + " 2>&1";
-  const int raw = std::system(command.c_str());
-  std::ifstream stream(log);
-  std::ostringstream text;
-  text << stream.rdbuf();
-  return {WIFEXITED(raw) ? WEXITSTATUS(raw) : -1, text.str()};
-}
+using test::CliRun;
+using test::run;
 
 TEST(Tiles, CliWritesADisplayAndReportsTheFacetError) {
-  test::ScratchFolder scratch("tiles-cli");
-  const fs::path out = scratch.path / "display";
+  test::TempFolder scratch("facet-interop-tiles-cli");
+  const fs::path out = scratch.path() / "display";
   const CliRun r = run("tiles " + (kTiles / "split-tpts.json").string() + " --size 400x200 --out " +
                            out.string() + " --json",
-                       scratch.path);
+                       scratch.path());
   ASSERT_EQ(r.status, 0) << r.output;
   EXPECT_NE(r.output.find("\"max_px\""), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("\"rms_px\""), std::string::npos) << r.output;
@@ -173,7 +160,7 @@ TEST(Tiles, CliWritesADisplayAndReportsTheFacetError) {
 }
 
 TEST(Tiles, BadInputExitsTwoNamingFileAndFieldAndWritesNothing) {
-  test::ScratchFolder scratch("tiles-bad");
+  test::TempFolder scratch("facet-interop-tiles-bad");
   const std::string grid = R"({"size": [64, 32], "rpts": {"grid": [2, 2], "features": [
     [0, 0, -20, 80], [1, 0, 20, 80], [0, 1, -20, 100], [1, 1, 20, 100]]}})";
   const std::string tris = R"({"size": [64, 32], "tpts": {
@@ -199,11 +186,11 @@ TEST(Tiles, BadInputExitsTwoNamingFileAndFieldAndWritesNothing) {
   };
   for (const Case& c : cases) {
     SCOPED_TRACE(c.name);
-    const fs::path file = scratch.path / (c.name + ".json");
+    const fs::path file = scratch.path() / (c.name + ".json");
     std::ofstream(file) << c.text;
-    const fs::path out = scratch.path / ("out_" + c.name);
+    const fs::path out = scratch.path() / ("out_" + c.name);
     const CliRun r =
-        run("tiles " + file.string() + " --out " + out.string() + " " + c.flags, scratch.path);
+        run("tiles " + file.string() + " --out " + out.string() + " " + c.flags, scratch.path());
     if (c.name == "good") {
       EXPECT_EQ(r.status, 0) << r.output;
       continue;

@@ -14,24 +14,13 @@
 
 #include "facet/projection/atomic_folder.hpp"
 #include "facet/projection/errors.hpp"
+#include "support/files.hpp"
 
 namespace facet {
 namespace {
 
 namespace fs = std::filesystem;
-
-fs::path fresh_folder(const std::string& name) {
-  const fs::path folder =
-      fs::temp_directory_path() / ("facet_atomic_" + name + "_" + std::to_string(::getpid()));
-  fs::remove_all(folder);
-  fs::create_directories(folder);
-  return folder;
-}
-
-std::string slurp_all(const fs::path& path) {
-  std::ifstream in(path);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
+using test::names_in;
 
 void write_text(const fs::path& path, const std::string& text) {
   write_atomically(path, [&](const fs::path& temporary) {
@@ -42,7 +31,7 @@ void write_text(const fs::path& path, const std::string& text) {
 }
 
 TEST(AtomicFile, ReplacesRegularFilesAndLeavesNothingOnFailure) {
-  const fs::path folder = fresh_folder("regular");
+  const fs::path folder = test::fresh_folder("facet_atomic_regular");
   const fs::path file = folder / "out.txt";
   write_text(file, "one");
   write_text(file, "two");
@@ -59,7 +48,7 @@ TEST(AtomicFile, ReplacesRegularFilesAndLeavesNothingOnFailure) {
 }
 
 TEST(AtomicFile, RefusesTargetsThatAreNotRegularFiles) {
-  const fs::path folder = fresh_folder("special");
+  const fs::path folder = test::fresh_folder("facet_atomic_special");
   const fs::path fifo = folder / "fifo.png";
   ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
   const fs::path sub = folder / "folder.png";
@@ -80,7 +69,7 @@ TEST(AtomicFile, RefusesTargetsThatAreNotRegularFiles) {
 }
 
 TEST(AtomicFile, RefusesAnOutputThatIsAnInput) {
-  const fs::path folder = fresh_folder("input");
+  const fs::path folder = test::fresh_folder("facet_atomic_input");
   const fs::path input = folder / "a.warp.exr";
   std::ofstream(input) << "warp";
   const fs::path link = folder / "b.warp.exr";
@@ -96,7 +85,7 @@ TEST(AtomicFile, RefusesAnOutputThatIsAnInput) {
 // A path the write could never take is refused up front, naming the flag; a new file in an
 // existing folder, or an existing regular file, is taken.
 TEST(AtomicFile, CheckOutputFileRefusesUnwritablePathsNamingTheFlag) {
-  const fs::path folder = fresh_folder("check");
+  const fs::path folder = test::fresh_folder("facet_atomic_check");
   std::ofstream(folder / "file") << "the user's";
   fs::create_directories(folder / "dir");
   fs::create_symlink(folder / "loop", folder / "loop");
@@ -120,7 +109,7 @@ TEST(AtomicFile, CheckOutputFileRefusesUnwritablePathsNamingTheFlag) {
   }
   EXPECT_NO_THROW(check_output_file(folder / "new.png", "--out"));
   EXPECT_NO_THROW(check_output_file(folder / "file", "--out"));
-  EXPECT_EQ(slurp_all(folder / "file"), "the user's");
+  EXPECT_EQ(test::slurp(folder / "file"), "the user's");
   fs::remove_all(folder);
 }
 
@@ -129,15 +118,6 @@ std::string slurp(const fs::path& path) {
   std::string text;
   std::getline(in, text);
   return text;
-}
-
-// The names in `folder`, hidden ones included.
-std::vector<std::string> names_in(const fs::path& folder) {
-  std::vector<std::string> names;
-  for (const auto& entry : fs::directory_iterator(folder))
-    names.push_back(entry.path().filename().string());
-  std::sort(names.begin(), names.end());
-  return names;
 }
 
 // A command whose output is a folder holding run.txt, and nothing else.
@@ -157,7 +137,7 @@ void write_run(const fs::path& out, const std::string& text) {
 }
 
 TEST(AtomicFolder, ReplacesItsOwnEarlierOutputAndAcceptsATrailingSlash) {
-  const fs::path folder = fresh_folder("folder_own");
+  const fs::path folder = test::fresh_folder("facet_atomic_folder_own");
   const fs::path out = folder / "deeper" / "out";
   write_run(out, "one");
   EXPECT_EQ(slurp(out / "run.txt"), "one");
@@ -174,7 +154,7 @@ TEST(AtomicFolder, ReplacesItsOwnEarlierOutputAndAcceptsATrailingSlash) {
 }
 
 TEST(AtomicFolder, RefusesAForeignFolderByNameBeforeWriting) {
-  const fs::path folder = fresh_folder("folder_foreign");
+  const fs::path folder = test::fresh_folder("facet_atomic_folder_foreign");
   const fs::path out = folder / "out";
   fs::create_directories(out);
   std::ofstream(out / "keep.txt") << "mine";
@@ -223,7 +203,7 @@ TEST(AtomicFolder, RefusesAForeignFolderByNameBeforeWriting) {
 }
 
 TEST(AtomicFolder, AFailureLeavesNoTemporaryAndTheEarlierOutputIntact) {
-  const fs::path folder = fresh_folder("folder_failure");
+  const fs::path folder = test::fresh_folder("facet_atomic_folder_failure");
   const fs::path out = folder / "out";
   write_run(out, "one");
   for (const fs::path& target : {out, folder / "new"}) {

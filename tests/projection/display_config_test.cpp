@@ -3,7 +3,6 @@
 
 #include <OpenImageIO/imageio.h>
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <cmath>
 #include <filesystem>
@@ -14,26 +13,13 @@
 
 #include "facet/projection/errors.hpp"
 #include "facet/projection_io/blend_file.hpp"
+#include "support/files.hpp"
 
 namespace fs = std::filesystem;
 namespace pio = facet::projection_io;
 using nlohmann::json;
 
 namespace {
-
-struct Folder {
-  fs::path path = fs::temp_directory_path() / ("facet-display-test-" + std::to_string(::getpid()) +
-                                               "-" + std::to_string(counter()++));
-  Folder() { fs::create_directories(path); }
-  ~Folder() {
-    std::error_code ignored;
-    fs::remove_all(path, ignored);
-  }
-  static int& counter() {
-    static int value = 0;
-    return value;
-  }
-};
 
 json sample_document() {
   std::ifstream stream(fs::path(FACET_SOURCE_DIR) /
@@ -66,11 +52,11 @@ TEST(DisplayConfig, SampleFileValidatesAndRoundTrips) {
   EXPECT_EQ(config.missing_monitor, pio::MissingMonitor::window);
   EXPECT_EQ(config.eye, glm::dvec3(0, 1.2, 0));
 
-  const Folder folder;
-  pio::write_display_config(config, folder.path / "display.json");
-  const pio::DisplayConfig again = pio::read_display_config(folder.path, false);
+  const facet::test::TempFolder folder("facet-display-test");
+  pio::write_display_config(config, folder.path() / "display.json");
+  const pio::DisplayConfig again = pio::read_display_config(folder.path(), false);
   pio::DisplayConfig expected = config;
-  expected.folder = folder.path;
+  expected.folder = folder.path();
   EXPECT_EQ(again, expected);
 }
 
@@ -130,9 +116,10 @@ TEST(DisplayConfig, BadFieldsNameFileFieldAndExpectation) {
   pio::DisplayConfig config = pio::parse_display_config(sample_document().dump(), "s", ".", false);
   config.eye.y = std::numeric_limits<double>::quiet_NaN();
   EXPECT_THROW(pio::validate_display_config(config, "s", false), facet::InputError);
-  const Folder folder;
-  EXPECT_THROW(pio::write_display_config(config, folder.path / "display.json"), facet::InputError);
-  EXPECT_TRUE(fs::is_empty(folder.path));
+  const facet::test::TempFolder folder("facet-display-test");
+  EXPECT_THROW(pio::write_display_config(config, folder.path() / "display.json"),
+               facet::InputError);
+  EXPECT_TRUE(fs::is_empty(folder.path()));
 }
 
 namespace {
@@ -244,16 +231,16 @@ TEST(DisplayConfig, ShippedDisplaysLoad) {
 }
 
 TEST(DisplayConfig, MissingFilesAreNamed) {
-  const Folder folder;
+  const facet::test::TempFolder folder("facet-display-test");
   for (const char* name : {"p0.warp.exr", "p0.blend.exr", "p1.warp.exr", "p1.blend.exr"}) {
-    std::ofstream(folder.path / name) << "x";
+    std::ofstream(folder.path() / name) << "x";
   }
   // p1.black.exr is missing.
-  EXPECT_EQ(failing_field(sample_document(), folder.path, true), "projectors[1].black");
-  std::ofstream(folder.path / "p1.black.exr") << "x";
-  EXPECT_EQ(failing_field(sample_document(), folder.path, true), "");
-  fs::remove(folder.path / "p0.warp.exr");
-  EXPECT_EQ(failing_field(sample_document(), folder.path, true), "projectors[0].warp");
+  EXPECT_EQ(failing_field(sample_document(), folder.path(), true), "projectors[1].black");
+  std::ofstream(folder.path() / "p1.black.exr") << "x";
+  EXPECT_EQ(failing_field(sample_document(), folder.path(), true), "");
+  fs::remove(folder.path() / "p0.warp.exr");
+  EXPECT_EQ(failing_field(sample_document(), folder.path(), true), "projectors[0].warp");
 }
 
 namespace {
@@ -289,15 +276,15 @@ TEST(DisplayCluster, ReadsValidatesAndRoundTrips) {
   EXPECT_EQ(pio::cluster_barrier_address("tcp://10.0.0.1:7000"), "tcp://10.0.0.1:7001");
   EXPECT_EQ(pio::cluster_barrier_address("ipc:///tmp/right"), "ipc:///tmp/right.barrier");
 
-  const Folder folder;
-  pio::write_display_config(config, folder.path / "display.json");
+  const facet::test::TempFolder folder("facet-display-test");
+  pio::write_display_config(config, folder.path() / "display.json");
   pio::DisplayConfig expected = config;
-  expected.folder = folder.path;
-  EXPECT_EQ(pio::read_display_config(folder.path, false), expected);
+  expected.folder = folder.path();
+  EXPECT_EQ(pio::read_display_config(folder.path(), false), expected);
   // Without a deadline, none is written and the reader leaves it to the default.
   expected.cluster->deadline_ms.reset();
-  pio::write_display_config(expected, folder.path / "display.json");
-  EXPECT_EQ(pio::read_display_config(folder.path, false), expected);
+  pio::write_display_config(expected, folder.path() / "display.json");
+  EXPECT_EQ(pio::read_display_config(folder.path(), false), expected);
 }
 
 TEST(DisplayCluster, BadSectionsSayWhatIsWrong) {
@@ -378,12 +365,12 @@ TEST(DisplayCluster, SchemaKnowsTheKeysTheReaderKnows) {
 }
 
 TEST(BlendFile, RoundTripsAndSamples) {
-  const Folder folder;
+  const facet::test::TempFolder folder("facet-display-test");
   pio::BlendMap map = pio::BlendMap::constant({5, 3}, 0.0f);
   for (int y = 0; y < 3; ++y) {
     for (int x = 0; x < 5; ++x) map.at(x, y) = float(x) / 4.0f;
   }
-  const std::string path = (folder.path / "p.blend.exr").string();
+  const std::string path = (folder.path() / "p.blend.exr").string();
   pio::write_blend_map(path, map);
   const pio::BlendMap again = pio::read_blend_map(path, glm::ivec2(5, 3));
   EXPECT_EQ(again.values, map.values);
@@ -394,22 +381,22 @@ TEST(BlendFile, RoundTripsAndSamples) {
 }
 
 TEST(BlendFile, BadMapsAreRejectedAndNothingIsWritten) {
-  const Folder folder;
+  const facet::test::TempFolder folder("facet-display-test");
   pio::BlendMap map = pio::BlendMap::constant({4, 4}, 0.5f);
   map.at(2, 1) = 1.5f;
   try {
-    pio::write_blend_map((folder.path / "bad.blend.exr").string(), map);
+    pio::write_blend_map((folder.path() / "bad.blend.exr").string(), map);
     FAIL() << "no error";
   } catch (const facet::InputError& e) {
     EXPECT_EQ(e.field(), "pixel (2, 1)");
   }
   map.at(2, 1) = std::numeric_limits<float>::quiet_NaN();
-  EXPECT_THROW(pio::write_blend_map((folder.path / "bad.blend.exr").string(), map),
+  EXPECT_THROW(pio::write_blend_map((folder.path() / "bad.blend.exr").string(), map),
                facet::InputError);
-  EXPECT_TRUE(fs::is_empty(folder.path));
+  EXPECT_TRUE(fs::is_empty(folder.path()));
 
   // An EXR without the facet:blend attribute.
-  const std::string plain = (folder.path / "plain.exr").string();
+  const std::string plain = (folder.path() / "plain.exr").string();
   {
     auto output = OIIO::ImageOutput::create("openexr");
     OIIO::ImageSpec spec(2, 2, 1, OIIO::TypeDesc::FLOAT);
@@ -426,6 +413,6 @@ TEST(BlendFile, BadMapsAreRejectedAndNothingIsWritten) {
     EXPECT_EQ(e.field(), "facet:blend");
     EXPECT_EQ(e.source(), plain);
   }
-  EXPECT_THROW(pio::read_blend_map((folder.path / "missing.blend.exr").string()),
+  EXPECT_THROW(pio::read_blend_map((folder.path() / "missing.blend.exr").string()),
                facet::InputError);
 }

@@ -16,9 +16,9 @@
 #include <vector>
 
 #include "../../tools/cli/command.hpp"
-#include "../driver/cli_process.hpp"
 #include "facet/projection/content_projection.hpp"
 #include "facet/projection/errors.hpp"
+#include "support/facet_cli.hpp"
 
 namespace {
 

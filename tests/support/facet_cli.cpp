@@ -1,39 +1,17 @@
-#pragma once
-// Running the facet CLI (or any shell command) from a test, and reading what it wrote.
+#include "support/facet_cli.hpp"
+
 #include <fcntl.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
-#include <chrono>
-#include <csignal>
 #include <cstdio>
 #include <cstdlib>
-#include <filesystem>
 #include <fstream>
-#include <functional>
-#include <iterator>
 #include <sstream>
-#include <string>
 #include <thread>
-#include <vector>
 
 namespace facet::test {
-
-// Exit status of a shell command, -1 when it did not exit normally. With `output`, its stdout and
-// stderr together; without, they go where the command sends them.
-inline int run_shell(const std::string& command, std::string* output = nullptr) {
-  if (output == nullptr) {
-    const int status = std::system(command.c_str());
-    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  }
-  output->clear();
-  FILE* pipe = ::popen((command + " 2>&1").c_str(), "r");
-  if (!pipe) return -1;
-  char buffer[512];
-  while (std::fgets(buffer, sizeof buffer, pipe)) *output += buffer;
-  const int status = ::pclose(pipe);
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
+namespace {
 
 // In the sanitizer build, LeakSanitizer's own tracer thread sometimes crashes at exit, after the
 // command did all its work ("Tracer caught signal 11", then "LeakSanitizer has encountered a fatal
@@ -44,16 +22,10 @@ inline int run_shell(const std::string& command, std::string* output = nullptr) 
 // a leak (a leak is reported as "LeakSanitizer: detected memory leaks"; use_tls=0 would avoid the
 // crash but reports what only thread-local storage holds as leaks), so such a run is made again,
 // up to kAttemptsAfterSanitizerFailure times in all, and said so.
-inline constexpr int kAttemptsAfterSanitizerFailure = 4;
-inline bool leak_sanitizer_tool_failed(int status, const std::string& output) {
+constexpr int kAttemptsAfterSanitizerFailure = 4;
+bool leak_sanitizer_tool_failed(int status, const std::string& output) {
   return status != 0 &&
          output.find("LeakSanitizer has encountered a fatal error") != std::string::npos;
-}
-
-// A file's bytes.
-inline std::string slurp(const std::filesystem::path& path) {
-  std::ifstream stream(path, std::ios::binary);
-  return {std::istreambuf_iterator<char>(stream), std::istreambuf_iterator<char>()};
 }
 
 // run() (an exit status) until it ends otherwise than in that failure, whose output() tells,
@@ -71,27 +43,43 @@ int run_past_sanitizer_tool_failures(const std::string& arguments, Run run, Outp
   return status;
 }
 
-// `facet <arguments>` (FACET_CLI), its stdout and stderr written to `log`.
-inline int run_facet(const std::string& arguments, const std::filesystem::path& log) {
-  const std::string command =
-      std::string(FACET_CLI) + " " + arguments + " > " + log.string() + " 2>&1";
+// The shell command that runs `facet <arguments>`, under timeout(1) with limit_s > 0.
+std::string facet_command(const std::string& arguments, int limit_s) {
+  const std::string limit = limit_s > 0 ? "timeout " + std::to_string(limit_s) + " " : "";
+  return limit + std::string(FACET_CLI) + " " + arguments;
+}
+
+}  // namespace
+
+int run_shell(const std::string& command, std::string* output) {
+  if (output == nullptr) {
+    const int status = std::system(command.c_str());
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  }
+  output->clear();
+  FILE* pipe = ::popen((command + " 2>&1").c_str(), "r");
+  if (!pipe) return -1;
+  char buffer[512];
+  while (std::fgets(buffer, sizeof buffer, pipe)) *output += buffer;
+  const int status = ::pclose(pipe);
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+int run_facet(const std::string& arguments, const std::filesystem::path& log, int limit_s) {
+  const std::string command = facet_command(arguments, limit_s) + " > " + log.string() + " 2>&1";
   return run_past_sanitizer_tool_failures(
       arguments, [&] { return run_shell(command); }, [&] { return slurp(log); });
 }
 
-// `facet <arguments>`, with its stdout and stderr in `output` when given.
-inline int run_facet(const std::string& arguments, std::string* output = nullptr) {
+int run_facet(const std::string& arguments, std::string* output, int limit_s) {
   std::string own;
   std::string& text = output ? *output : own;
-  const std::string command = std::string(FACET_CLI) + " " + arguments;
+  const std::string command = facet_command(arguments, limit_s);
   return run_past_sanitizer_tool_failures(
       arguments, [&] { return run_shell(command, &text); }, [&] { return text; });
 }
 
-// Starts `facet <arguments>` (FACET_CLI) without a shell, its stdout and stderr going to `log`;
-// returns its process id, or -1.
-inline pid_t start_facet(const std::vector<std::string>& arguments,
-                         const std::filesystem::path& log) {
+pid_t start_facet(const std::vector<std::string>& arguments, const std::filesystem::path& log) {
   std::vector<std::string> argv_storage{"facet"};
   argv_storage.insert(argv_storage.end(), arguments.begin(), arguments.end());
   std::vector<char*> argv;
@@ -111,8 +99,7 @@ inline pid_t start_facet(const std::vector<std::string>& arguments,
   return child;
 }
 
-// True once `process` has a handler installed for `signal` (its SigCgt mask in /proc).
-inline bool catches_signal(pid_t process, int signal) {
+bool catches_signal(pid_t process, int signal) {
   std::ifstream status("/proc/" + std::to_string(process) + "/status");
   std::string line;
   while (std::getline(status, line)) {
@@ -124,8 +111,7 @@ inline bool catches_signal(pid_t process, int signal) {
   return false;
 }
 
-// Polls `condition` every 10 ms until it holds (true) or `timeout` passes (false).
-inline bool wait_until(const std::function<bool()>& condition, std::chrono::seconds timeout) {
+bool wait_until(const std::function<bool()>& condition, std::chrono::seconds timeout) {
   const auto deadline = std::chrono::steady_clock::now() + timeout;
   while (!condition()) {
     if (std::chrono::steady_clock::now() > deadline) return false;
@@ -134,8 +120,7 @@ inline bool wait_until(const std::function<bool()>& condition, std::chrono::seco
   return true;
 }
 
-// The exit status of `process` once it ends; -1 when a signal ended it.
-inline int wait_for_exit(pid_t process) {
+int wait_for_exit(pid_t process) {
   int status = 0;
   if (::waitpid(process, &status, 0) != process) return -1;
   return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
