@@ -3,6 +3,7 @@
 #include <cmath>
 #include <vector>
 
+#include "../gl/image_rows.hpp"
 #include "facet/projection/warp_inverse.hpp"
 
 namespace facet::driver::detail {
@@ -19,7 +20,7 @@ Texture pixel_lookup_texture(
       const glm::dvec2 s = st[std::size_t(y) * size.x + x];
       if (std::isnan(s.x)) continue;
       if (const auto texel = value(warp.v_eye_from_st(s)))
-        lookup[std::size_t(size.y - 1 - y) * size.x + x] = *texel;
+        lookup[flipped_row_start(y, size.y, size.x) + x] = *texel;
     }
   }
   Texture texture = Texture::create_2d(GL_RGBA32F, size.x, size.y);

@@ -14,6 +14,7 @@
 #include <numbers>
 #include <string>
 
+#include "../gl/image_rows.hpp"
 #include "facet/driver/gpu_timer.hpp"
 #include "facet/driver/material_shader.hpp"
 #include "facet/driver/program.hpp"
@@ -131,7 +132,7 @@ OutputState make_output_state(const OutputSpec& output) {
       if (std::isnan(st[k].x)) continue;
       v_eye[k] = warp.v_eye_from_st(st[k]);
       sum += v_eye[k];
-      mask[std::size_t(size.y - 1 - y) * size.x + x] = 255;
+      mask[flipped_row_start(y, size.y, size.x) + x] = 255;
       ++covered;
     }
   }

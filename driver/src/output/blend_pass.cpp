@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "../gl/image_rows.hpp"
 #include "facet/driver/program.hpp"
 #include "facet/projection/errors.hpp"
 
@@ -13,7 +14,7 @@ namespace {
 Texture upload_map(glm::ivec2 size, int channels, const std::vector<float>& values) {
   std::vector<float> rgb(std::size_t(size.x) * size.y * 3);
   for (int y = 0; y < size.y; ++y) {
-    const int gl_row = size.y - 1 - y;
+    const int gl_row = flipped_row(y, size.y);
     for (int x = 0; x < size.x; ++x) {
       const std::size_t from = (std::size_t(y) * size.x + x) * channels;
       const std::size_t to = (std::size_t(gl_row) * size.x + x) * 3;
@@ -41,7 +42,7 @@ std::vector<glm::uvec2> BlendPass::tiles_needing_work(glm::ivec2 output_size, co
       // Tiles are in GL rows (from the bottom); the maps are in image rows (from the top).
       for (int gy = ty * kTile; !needs_work && gy < std::min(output_size.y, (ty + 1) * kTile);
            ++gy) {
-        const std::size_t row = std::size_t(output_size.y - 1 - gy) * output_size.x;
+        const std::size_t row = flipped_row_start(gy, output_size.y, output_size.x);
         for (int x = tx * kTile; !needs_work && x < std::min(output_size.x, (tx + 1) * kTile);
              ++x) {
           for (int c = 0; c < maps.channels; ++c) {

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <glm/gtc/type_ptr.hpp>
 
+#include "../gl/image_rows.hpp"
 #include "facet/driver/direction_cache.hpp"
 #include "facet/driver/program.hpp"
 #include "facet/projection/errors.hpp"
@@ -119,7 +120,7 @@ ContentLookups prepare_content_lookups(std::span<const OutputSpec> outputs,
     std::vector<glm::vec4> texels(v_eye.size(), glm::vec4(0));
     for (int y = 0; y < size.y; ++y) {
       const glm::vec3* from = v_eye.data() + std::size_t(y) * size.x;
-      glm::vec4* to = texels.data() + std::size_t(size.y - 1 - y) * size.x;
+      glm::vec4* to = texels.data() + flipped_row_start(y, size.y, size.x);
       for (int x = 0; x < size.x; ++x)
         if (!std::isnan(from[x].x)) to[x] = glm::vec4(from[x], 1.0f);
     }

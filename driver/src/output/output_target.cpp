@@ -2,22 +2,12 @@
 #include <cstring>
 #include <string>
 
+#include "../gl/image_rows.hpp"
 #include "facet/driver/render_method.hpp"
 #include "facet/projection/errors.hpp"
 
 namespace facet::driver {
 namespace {
-
-// GL rows start at the bottom; images here start at the top.
-template <typename T>
-void flip_rows(std::vector<T>& pixels, std::size_t row_values) {
-  const std::size_t rows = pixels.size() / row_values;
-  for (std::size_t j = 0; j < rows / 2; ++j) {
-    std::swap_ranges(pixels.begin() + std::ptrdiff_t(j * row_values),
-                     pixels.begin() + std::ptrdiff_t((j + 1) * row_values),
-                     pixels.begin() + std::ptrdiff_t((rows - 1 - j) * row_values));
-  }
-}
 
 void set_draw_buffers(const Framebuffer& framebuffer) {
   const GLenum buffers[2] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};

@@ -7,6 +7,7 @@
 #include <optional>
 #include <thread>
 
+#include "../gl/image_rows.hpp"
 #include "facet/driver/gl_context.hpp"
 #include "facet/driver/gl_objects.hpp"
 #include "facet/driver/monitors.hpp"
@@ -30,8 +31,8 @@ void upload_grey(const Texture& texture, glm::ivec2 size, std::span<const std::u
   FACET_ASSERT(grey.size() == std::size_t(size.x) * std::size_t(size.y));
   glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
   for (int y = 0; y < size.y; ++y) {
-    glTextureSubImage2D(texture.id(), 0, 0, size.y - 1 - y, size.x, 1, GL_RED, GL_UNSIGNED_BYTE,
-                        grey.data() + std::size_t(y) * std::size_t(size.x));
+    glTextureSubImage2D(texture.id(), 0, 0, flipped_row(y, size.y), size.x, 1, GL_RED,
+                        GL_UNSIGNED_BYTE, grey.data() + std::size_t(y) * std::size_t(size.x));
   }
 }
 
@@ -62,7 +63,7 @@ std::vector<std::uint8_t> read_grey(glm::ivec2 size, glm::ivec2 framebuffer) {
   glReadPixels(0, framebuffer.y - size.y, size.x, size.y, GL_RGBA, GL_UNSIGNED_BYTE, rgba.data());
   std::vector<std::uint8_t> grey(std::size_t(size.x) * std::size_t(size.y));
   for (int y = 0; y < size.y; ++y) {
-    const std::uint8_t* row = rgba.data() + std::size_t(size.y - 1 - y) * std::size_t(size.x) * 4;
+    const std::uint8_t* row = rgba.data() + flipped_row_start(y, size.y, std::size_t(size.x) * 4);
     for (int x = 0; x < size.x; ++x) grey[std::size_t(y) * std::size_t(size.x) + x] = row[4 * x];
   }
   return grey;

@@ -9,6 +9,7 @@
 #include <map>
 #include <numbers>
 
+#include "../gl/image_rows.hpp"
 #include "facet/driver/display_outputs.hpp"
 #include "facet/projection/atomic_folder.hpp"
 #include "facet/projection/errors.hpp"
@@ -494,7 +495,7 @@ void Session::set_pattern(std::optional<TestPattern> pattern) {
     const std::size_t row_bytes = std::size_t(size.x) * 4;
     std::vector<std::uint8_t> rows_up(rows_down.size());
     for (int y = 0; y < size.y; ++y)
-      std::copy_n(&rows_down[std::size_t(size.y - 1 - y) * row_bytes], row_bytes,
+      std::copy_n(&rows_down[flipped_row_start(y, size.y, row_bytes)], row_bytes,
                   &rows_up[std::size_t(y) * row_bytes]);
     pattern_rows_up_.push_back(std::move(rows_up));
   }

@@ -16,6 +16,7 @@
 #include <string>
 #include <string_view>
 
+#include "../gl/image_rows.hpp"
 #include "facet/driver/city.hpp"
 #include "facet/driver/cluster.hpp"
 #include "facet/driver/gl_context.hpp"
@@ -521,7 +522,7 @@ void run_windowed_session(const SessionDisplay& display, const Scene& scene, con
           for (int y = 0; y < v.w; ++y)
             for (int x = 0; x < v.z; ++x)
               for (int c = 0; c < 3; ++c)
-                mismatched += shown[(std::size_t(v.w - 1 - y) * v.z + x) * 4 + c] !=
+                mismatched += shown[(flipped_row_start(y, v.w, v.z) + x) * 4 + c] !=
                               expected[(std::size_t(y) * v.z + x) * 4 + c];
           report.mismatched_bytes.push_back(mismatched);
         }
