@@ -214,6 +214,8 @@ TEST(OptionFlags, ALibraryErrorNamesItsOptionByItsLibraryName) {
   }
 }
 
+#if !defined(FACET_TEST_WITHOUT_CALIBRATION) && !defined(FACET_TEST_WITHOUT_DRIVER) && \
+    !defined(FACET_TEST_WITHOUT_INTEROP)
 TEST(OptionFlags, TheCliShowsALibraryOptionUnderItsCommandsFlag) {
   using facet::InputError;
   using facet::OptionName;
@@ -239,6 +241,7 @@ TEST(OptionFlags, TheCliShowsALibraryOptionUnderItsCommandsFlag) {
   EXPECT_EQ(facet::cli::flag_of_option("mpcdi", "values"), "--warp-values");
   EXPECT_EQ(facet::cli::flag_of_option("run", "no_such_option"), "");
 }
+#endif
 
 #ifndef FACET_TEST_WITHOUT_DRIVER
 // The scene-view rows (view_flags.hpp) are one list shared by render, run, bench and depth-image;
