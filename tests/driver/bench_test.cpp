@@ -329,10 +329,11 @@ TEST(BenchScenarios, EveryScenarioHasValidOutputsAndEveryMethod) {
 
 // The GLC paper cases: three scenarios of one glc row each, matching the oracle's GLC rays.
 TEST(BenchCli, GlcScenarioHasARowPerPaperCase) {
-  const fs::path folder = fresh_folder("glc");
+  const fs::path folder = test::fresh_folder("facet_bench_cli_glc");
   const fs::path out = folder / "bench";
-  ASSERT_EQ(
-      run("bench --quick --scenario glc --frames 1 --out " + out.string(), folder / "log.txt"), 0)
+  ASSERT_EQ(test::run_facet("bench --quick --scenario glc --frames 1 --out " + out.string(),
+                            folder / "log.txt"),
+            0)
       << slurp(folder / "log.txt");
   const nlohmann::json json = nlohmann::json::parse(slurp(out / "bench.json"));
   std::set<std::string> scenarios;
