@@ -250,7 +250,7 @@ TEST(RenderCli, GlcCameraRendersWithItsMethodAndRefusesBadInput) {
       {"render --display builtin:dome180 --size 32x32 --method glc",
        "expected a GLC camera (FILE.glc.json) for --method glc"},
       {"render --display " + good + " --method glc --size 64x64", "expected the size of"},
-      {"run " + good + " --frames 1", "only facet render --method glc draws"},
+      {"run " + good + " --frames 1", "only the glc render method draws"},
   };
   for (const auto& [arguments, expected] : refused) {
     const Result result = run_cli(arguments);

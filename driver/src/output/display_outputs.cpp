@@ -77,7 +77,7 @@ LoadedDisplay load_display(std::string_view display, std::optional<glm::ivec2> s
     if (!allow_glc) {
       throw InputError("command line", OptionName{"display"},
                        "expected a display; " + std::string(display) +
-                           " is a GLC camera, which only facet render --method glc draws");
+                           " is a GLC camera, which only the glc render method draws");
     }
     auto camera = std::make_shared<const PiecewiseGlc>(read_glc_camera(std::string(display)));
     if (size && *size != camera->size) {
