@@ -8,6 +8,7 @@
 namespace facet {
 namespace {
 
+using json_fields::FieldPath;
 using json_fields::Fields;
 using json_fields::Json;
 using json_fields::to_dvec2;
@@ -15,11 +16,10 @@ using json_fields::to_dvec3;
 using json_fields::to_int;
 using json_fields::to_number;
 using json_fields::to_string;
-using At = json_fields::FieldPath;
 
 // The camera's frame in the eye frame, camera-like (x right, y down, z forward): "origin" (default
 // the eye), and "look_at" with an optional "up" (default: looking down the eye's -z, y up).
-GlcFrame frame_from_json(const Json* value, const At& at) {
+GlcFrame frame_from_json(const Json* value, const FieldPath& at) {
   GlcFrame frame;
   frame.axes = glm::dmat3(glm::dvec3(1, 0, 0), glm::dvec3(0, -1, 0), glm::dvec3(0, 0, -1));
   if (value == nullptr) return frame;
@@ -28,23 +28,14 @@ GlcFrame frame_from_json(const Json* value, const At& at) {
   glm::dvec3 up(0, 1, 0);
   if (const Json* u = fields.optional("up")) up = to_dvec3(*u, at["up"]);
   if (const Json* target = fields.optional("look_at")) {
-    const glm::dvec3 forward_raw = to_dvec3(*target, at["look_at"]) - frame.origin;
-    if (!(glm::length(forward_raw) > 1e-9)) {
-      at["look_at"].fail("a point other than the origin itself");
-    }
-    const glm::dvec3 forward = glm::normalize(forward_raw);
-    const glm::dvec3 right_raw = glm::cross(forward, up);
-    if (!(glm::length(right_raw) > 1e-9 * std::max(1.0, glm::length(up)))) {
-      at["up"].fail("an up vector that is not parallel to the viewing direction");
-    }
-    const glm::dvec3 right = glm::normalize(right_raw);
-    frame.axes = glm::dmat3(right, glm::cross(forward, right), forward);
+    frame.axes =
+        json_fields::look_at_axes(frame.origin, to_dvec3(*target, at["look_at"]), up, at, "origin");
   }
   fields.finish();
   return frame;
 }
 
-SlitLine line_from_json(const Json& value, const At& at) {
+SlitLine line_from_json(const Json& value, const FieldPath& at) {
   Fields fields(value, at);
   SlitLine line;
   line.point = to_dvec3(fields.required("point", "a point [x, y, z] in metres"), at["point"]);
@@ -54,13 +45,13 @@ SlitLine line_from_json(const Json& value, const At& at) {
 }
 
 double positive(Fields& fields, const std::string& key, const std::string& expected) {
-  const At at = fields.path(key);
+  const FieldPath at = fields.path(key);
   const double value = to_number(fields.required(key, expected), at);
   if (!(value > 0)) at.fail(expected, value);
   return value;
 }
 
-PiecewiseGlc camera_from_json(const Json& value, const At& at) {
+PiecewiseGlc camera_from_json(const Json& value, const FieldPath& at) {
   Fields fields(value, at);
   const std::string types =
       "\"generators\", \"cross-slit\", \"pushbroom\", \"pinhole\", \"panorama\" or "
@@ -83,7 +74,7 @@ PiecewiseGlc camera_from_json(const Json& value, const At& at) {
     std::array<EyeRay, 3> rays;
     std::array<glm::dvec2, 3> pixels;
     for (std::size_t k = 0; k < 3; ++k) {
-      const At g = at["generators"][k];
+      const FieldPath g = at["generators"][k];
       Fields ray(list[k], g);
       rays[k].origin =
           to_dvec3(ray.required("origin", "a point [x, y, z] in metres (frame)"), g["origin"]);
@@ -140,7 +131,7 @@ PiecewiseGlc camera_from_json(const Json& value, const At& at) {
 }
 
 PiecewiseGlc camera_from_root(const Json& root, const std::string& source) {
-  const At at(source);
+  const FieldPath at(source);
   Fields fields(root, at);
   const std::string expected_format = std::string("\"") + kGlcFormat + "\"";
   const Json& format = fields.required("format", expected_format);

@@ -206,6 +206,21 @@ Json from_dmat3(const glm::dmat3& m) {
   return rows;
 }
 
+glm::dmat3 look_at_axes(const glm::dvec3& from, const glm::dvec3& target, const glm::dvec3& up,
+                        const FieldPath& at, const std::string& from_name) {
+  const glm::dvec3 forward_raw = target - from;
+  if (!(glm::length(forward_raw) > 1e-9)) {
+    at["look_at"].fail("a point other than the " + from_name + " itself");
+  }
+  const glm::dvec3 forward = glm::normalize(forward_raw);
+  const glm::dvec3 right_raw = glm::cross(forward, up);
+  if (!(glm::length(right_raw) > 1e-9 * std::max(1.0, glm::length(up)))) {
+    at["up"].fail("an up vector that is not parallel to the viewing direction");
+  }
+  const glm::dvec3 right = glm::normalize(right_raw);
+  return glm::dmat3(right, glm::cross(forward, right), forward);
+}
+
 Screen to_screen(const Json& value, const FieldPath& at) {
   Fields fields(value, at);
   const std::string expected_type = "\"sphere\", \"cylinder\" or \"plane\"";

@@ -111,6 +111,13 @@ glm::dmat3 to_dmat3(const Json& value, const FieldPath& at);
 Json from_dvec3(const glm::dvec3& v);
 Json from_dmat3(const glm::dmat3& m);
 
+// The axes (columns right, down, forward) of a camera-like frame at `from` looking at `target`
+// with `up` (any length) towards the image's top: what "look_at" and "up" members give. Fails at
+// at["look_at"] ("a point other than the FROM_NAME itself") when target is `from`, and at at["up"]
+// when up is parallel to the viewing direction.
+glm::dmat3 look_at_axes(const glm::dvec3& from, const glm::dvec3& target, const glm::dvec3& up,
+                        const FieldPath& at, const std::string& from_name);
+
 // A screen surface, as display.json, rig files and capture.json all hold it:
 //   {"type": "sphere", "center": [x, y, z], "radius": r}
 //   {"type": "cylinder", "center": [x, y, z], "axis": [x, y, z], "radius": r}

@@ -43,18 +43,7 @@ glm::dmat3 rotation(Fields& fields, const std::string& matrix_key, const glm::dv
   glm::dvec3 up(0, 1, 0);
   if (const Json* u = fields.optional("up")) up = to_dvec3(*u, at["up"]);
   if (target == nullptr) return fallback;
-  const glm::dvec3 forward_raw = to_dvec3(*target, at["look_at"]) - position;
-  if (!(glm::length(forward_raw) > 1e-9)) {
-    at["look_at"].fail("a point other than the position itself");
-  }
-  const glm::dvec3 forward = glm::normalize(forward_raw);
-  const glm::dvec3 right_raw = glm::cross(forward, up);
-  if (!(glm::length(right_raw) > 1e-9 * std::max(1.0, glm::length(up)))) {
-    at["up"].fail("an up vector that is not parallel to the viewing direction");
-  }
-  const glm::dvec3 right = glm::normalize(right_raw);
-  const glm::dvec3 down = glm::cross(forward, right);
-  return glm::dmat3(right, down, forward);
+  return json_fields::look_at_axes(position, to_dvec3(*target, at["look_at"]), up, at, "position");
 }
 
 ProjectorModel projector_from_json(const Json& value, const FieldPath& at) {
