@@ -40,22 +40,7 @@ void write_lookup(const Warp& warp, const std::filesystem::path& path) {
     p[6] = float(v.z);
   }
   nlohmann::json base = {{"base", to_string(warp.base.kind)}};
-  switch (warp.base.kind) {
-    case BaseKind::perspective:
-      base["tan_extent"] = warp.base.tan_extent;
-      break;
-    case BaseKind::fisheye:
-      base["fov"] = warp.base.fov_deg;
-      break;
-    case BaseKind::cylindrical:
-      base["azimuth"] = warp.base.azimuth_deg;
-      base["tan_elevation"] = warp.base.tan_elevation;
-      break;
-    case BaseKind::equirectangular:
-      base["azimuth"] = warp.base.azimuth_deg;
-      base["elevation"] = warp.base.elevation_deg;
-      break;
-  }
+  json_fields::put_base_parameters(warp.base, base);
   base["rotation"] = json_fields::from_dmat3(warp.R_eye_base);
   base["output_size"] = {w, h};
   const nlohmann::json header = {{"format", "facet-lookup/1"}, {"warp", base}};

@@ -163,22 +163,7 @@ Warp region_warp(const RegionWarpInput& in, MpcdiWarpValues values, const std::s
 // round trip lands on the same base image (the a3 PFM itself only holds screen points).
 nlohmann::json base_hint(const BaseProjection& base, const glm::dmat3& R_eye_base) {
   nlohmann::json hint = {{"kind", to_string(base.kind)}};
-  switch (base.kind) {
-    case BaseKind::perspective:
-      hint["tan_extent"] = base.tan_extent;
-      break;
-    case BaseKind::fisheye:
-      hint["fov"] = base.fov_deg;
-      break;
-    case BaseKind::cylindrical:
-      hint["azimuth"] = base.azimuth_deg;
-      hint["tan_elevation"] = base.tan_elevation;
-      break;
-    case BaseKind::equirectangular:
-      hint["azimuth"] = base.azimuth_deg;
-      hint["elevation"] = base.elevation_deg;
-      break;
-  }
+  json_fields::put_base_parameters(base, hint);
   hint["rotation"] = json_fields::from_dmat3(R_eye_base);
   return hint;
 }
@@ -190,23 +175,9 @@ std::optional<BaseCover> base_from_hint(const nlohmann::json* hint) {
   const nlohmann::json& json = (*hint)["base"];
   try {
     BaseCover cover;
-    cover.base.kind = base_kind_from_string(json.at("kind").get<std::string>());
-    switch (cover.base.kind) {
-      case BaseKind::perspective:
-        cover.base.tan_extent = json.at("tan_extent").get<std::array<double, 4>>();
-        break;
-      case BaseKind::fisheye:
-        cover.base.fov_deg = json.at("fov").get<double>();
-        break;
-      case BaseKind::cylindrical:
-        cover.base.azimuth_deg = json.at("azimuth").get<std::array<double, 2>>();
-        cover.base.tan_elevation = json.at("tan_elevation").get<std::array<double, 2>>();
-        break;
-      case BaseKind::equirectangular:
-        cover.base.azimuth_deg = json.at("azimuth").get<std::array<double, 2>>();
-        cover.base.elevation_deg = json.at("elevation").get<std::array<double, 2>>();
-        break;
-    }
+    cover.base = json_fields::to_base_parameters(
+        json, base_kind_from_string(json.at("kind").get<std::string>()),
+        json_fields::FieldPath("facet.json", "base"));
     cover.base.validate();
     if (json.contains("rotation")) {
       cover.R_eye_base =

@@ -13,6 +13,7 @@
 #include "facet/projection/atomic_file.hpp"
 #include "facet/projection/errors.hpp"
 #include "facet/projection/input_file.hpp"
+#include "json_fields.hpp"
 
 namespace facet::driver {
 namespace {
@@ -48,35 +49,14 @@ json part_to_json(const DepthImage& image, const DepthImagePart& part) {
                {"kind", to_string(image.kind)},
                {"part", part.name},
                {"base", to_string(part.base.kind)}};
-  if (part.base.kind == BaseKind::perspective) {
-    meta["tan_extent"] = part.base.tan_extent;
-  } else {
-    meta["azimuth"] = part.base.azimuth_deg;
-    meta["tan_elevation"] = part.base.tan_elevation;
-  }
-  json rotation = json::array(), pose = json::array();
-  for (int r = 0; r < 3; ++r)
-    rotation.push_back({part.R_image_part[0][r], part.R_image_part[1][r], part.R_image_part[2][r]});
+  json_fields::put_base_parameters(part.base, meta);
+  json pose = json::array();
   for (int r = 0; r < 4; ++r)
     pose.push_back({image.T_world_image[0][r], image.T_world_image[1][r], image.T_world_image[2][r],
                     image.T_world_image[3][r]});
-  meta["rotation"] = rotation;
+  meta["rotation"] = json_fields::from_dmat3(part.R_image_part);
   meta["T_world_image"] = pose;
   return meta;
-}
-
-template <std::size_t N>
-std::array<double, N> numbers(const json& meta, const char* field, const std::string& source) {
-  const std::string name = std::string(kAttribute) + "." + field;
-  const auto it = meta.find(field);
-  if (it == meta.end() || !it->is_array() || it->size() != N)
-    throw InputError(source, name, "expected an array of " + std::to_string(N) + " numbers");
-  std::array<double, N> values{};
-  for (std::size_t k = 0; k < N; ++k) {
-    if (!(*it)[k].is_number()) throw InputError(source, name, "expected numbers");
-    values[k] = (*it)[k].get<double>();
-  }
-  return values;
 }
 
 template <int R, int C>
@@ -326,16 +306,13 @@ DepthImage read_depth_image(const std::filesystem::path& path) {
     part.name = string_field("part");
     part.base.kind =
         base_kind_from_string(string_field("base"), source, std::string(kAttribute) + ".base");
-    if (part.base.kind == BaseKind::perspective) {
-      part.base.tan_extent = numbers<4>(meta, "tan_extent", source);
-    } else if (part.base.kind == BaseKind::cylindrical) {
-      part.base.azimuth_deg = numbers<2>(meta, "azimuth", source);
-      part.base.tan_elevation = numbers<2>(meta, "tan_elevation", source);
-    } else {
+    if (part.base.kind != BaseKind::perspective && part.base.kind != BaseKind::cylindrical)
       throw InputError(source, std::string(kAttribute) + ".base",
                        "expected perspective or cylindrical");
-    }
-    part.R_image_part = matrix<3, 3>(meta, "rotation", source);
+    const json_fields::FieldPath at(source, kAttribute);
+    part.base = json_fields::to_base_parameters(meta, part.base.kind, at);
+    if (!meta.contains("rotation")) at["rotation"].fail("a 3x3 matrix (the field is missing)");
+    part.R_image_part = json_fields::to_dmat3(meta["rotation"], at["rotation"]);
     // Sizes before any pixel is allocated.
     part.size = {spec.width, spec.height};
     check_image_size(part.size, source, "size");

@@ -206,6 +206,61 @@ Json from_dmat3(const glm::dmat3& m) {
   return rows;
 }
 
+void put_base_parameters(const BaseProjection& base, Json& object) {
+  switch (base.kind) {
+    case BaseKind::perspective:
+      object["tan_extent"] = base.tan_extent;
+      break;
+    case BaseKind::fisheye:
+      object["fov"] = base.fov_deg;
+      break;
+    case BaseKind::cylindrical:
+      object["azimuth"] = base.azimuth_deg;
+      object["tan_elevation"] = base.tan_elevation;
+      break;
+    case BaseKind::equirectangular:
+      object["azimuth"] = base.azimuth_deg;
+      object["elevation"] = base.elevation_deg;
+      break;
+  }
+}
+
+BaseProjection to_base_parameters(const Json& object, BaseKind kind, const FieldPath& at) {
+  const auto member = [&](const char* key, const std::string& expected) -> const Json& {
+    if (!object.is_object()) at.fail("a JSON object", object);
+    const auto it = object.find(key);
+    if (it == object.end()) at[key].fail(expected + " (the field is missing)");
+    return *it;
+  };
+  const auto pair = [&](const char* key, const std::string& expected) {
+    const std::vector<double> v = to_numbers(member(key, expected), at[key], 2, 2, expected);
+    return std::array<double, 2>{v[0], v[1]};
+  };
+  BaseProjection base;
+  base.kind = kind;
+  switch (kind) {
+    case BaseKind::perspective: {
+      const std::string expected = "a list of 4 tangents [left, right, top, bottom]";
+      const std::vector<double> v =
+          to_numbers(member("tan_extent", expected), at["tan_extent"], 4, 4, expected);
+      base.tan_extent = {v[0], v[1], v[2], v[3]};
+      break;
+    }
+    case BaseKind::fisheye:
+      base.fov_deg = to_number(member("fov", "a number of degrees"), at["fov"]);
+      break;
+    case BaseKind::cylindrical:
+      base.azimuth_deg = pair("azimuth", "a list of 2 azimuths in degrees");
+      base.tan_elevation = pair("tan_elevation", "a list of 2 tangents [top, bottom]");
+      break;
+    case BaseKind::equirectangular:
+      base.azimuth_deg = pair("azimuth", "a list of 2 azimuths in degrees");
+      base.elevation_deg = pair("elevation", "a list of 2 elevations in degrees [top, bottom]");
+      break;
+  }
+  return base;
+}
+
 glm::dmat3 look_at_axes(const glm::dvec3& from, const glm::dvec3& target, const glm::dvec3& up,
                         const FieldPath& at, const std::string& from_name) {
   const glm::dvec3 forward_raw = target - from;

@@ -19,6 +19,7 @@
 #include <string_view>
 #include <vector>
 
+#include "facet/projection/base_projection.hpp"
 #include "facet/projection/screen.hpp"
 
 namespace facet::json_fields {
@@ -110,6 +111,16 @@ glm::dmat3 to_dmat3(const Json& value, const FieldPath& at);
 
 Json from_dvec3(const glm::dvec3& v);
 Json from_dmat3(const glm::dmat3& m);
+
+// A base projection's own parameters as every facet file stores them beside its kind:
+// perspective "tan_extent" [left, right, top, bottom]; fisheye "fov" (degrees); cylindrical
+// "azimuth" [s = 0, s = 1] (degrees) and "tan_elevation" [top, bottom]; equirectangular "azimuth"
+// and "elevation" [top, bottom] (degrees). The kind's own key differs by file and stays the
+// caller's.
+void put_base_parameters(const BaseProjection& base, Json& object);
+// The `kind` base whose parameters `object` holds, each failing at at[key]; not validated (the
+// caller's BaseProjection::validate says what is out of its domain).
+BaseProjection to_base_parameters(const Json& object, BaseKind kind, const FieldPath& at);
 
 // The axes (columns right, down, forward) of a camera-like frame at `from` looking at `target`
 // with `up` (any length) towards the image's top: what "look_at" and "up" members give. Fails at

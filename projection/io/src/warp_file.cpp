@@ -43,22 +43,7 @@ json base_to_json(const Warp& warp) {
                {"output_size", {warp.output_size.x, warp.output_size.y}},
                {"base", to_string(base.kind)}};
   meta["rotation"] = json_fields::from_dmat3(warp.R_eye_base);
-  switch (base.kind) {
-    case BaseKind::perspective:
-      meta["tan_extent"] = base.tan_extent;
-      break;
-    case BaseKind::fisheye:
-      meta["fov"] = base.fov_deg;
-      break;
-    case BaseKind::cylindrical:
-      meta["azimuth"] = base.azimuth_deg;
-      meta["tan_elevation"] = base.tan_elevation;
-      break;
-    case BaseKind::equirectangular:
-      meta["azimuth"] = base.azimuth_deg;
-      meta["elevation"] = base.elevation_deg;
-      break;
-  }
+  json_fields::put_base_parameters(base, meta);
   if (warp.eye) meta["eye"] = {warp.eye->x, warp.eye->y, warp.eye->z};
   return meta;
 }
@@ -84,25 +69,8 @@ void base_from_json(const json& meta, const std::string& path, Warp& warp) {
     warp.R_eye_base = json_fields::to_dmat3(
         meta["rotation"], json_fields::FieldPath(path, field_prefix + "rotation"));
   }
-  switch (warp.base.kind) {
-    case BaseKind::perspective:
-      warp.base.tan_extent = numbers<4>(meta, "tan_extent", path);
-      break;
-    case BaseKind::fisheye:
-      if (!meta.contains("fov") || !meta["fov"].is_number()) {
-        throw InputError(path, field_prefix + "fov", "expected a number of degrees");
-      }
-      warp.base.fov_deg = meta["fov"].get<double>();
-      break;
-    case BaseKind::cylindrical:
-      warp.base.azimuth_deg = numbers<2>(meta, "azimuth", path);
-      warp.base.tan_elevation = numbers<2>(meta, "tan_elevation", path);
-      break;
-    case BaseKind::equirectangular:
-      warp.base.azimuth_deg = numbers<2>(meta, "azimuth", path);
-      warp.base.elevation_deg = numbers<2>(meta, "elevation", path);
-      break;
-  }
+  warp.base = json_fields::to_base_parameters(meta, warp.base.kind,
+                                              json_fields::FieldPath(path, kAttribute));
   if (meta.contains("eye")) {
     const auto eye = numbers<3>(meta, "eye", path);
     warp.eye = glm::dvec3(eye[0], eye[1], eye[2]);
