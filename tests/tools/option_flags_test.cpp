@@ -268,6 +268,48 @@ TEST(OptionFlags, ACommandKeepsOnlyTheSharedRowsOfTheFlagsItDeclares) {
 #endif
 
 #ifndef FACET_TEST_WITHOUT_DRIVER
+// Every command that shows or writes for one display takes it the same way: as its positional
+// (after the content file for play), or by --display.
+TEST(DisplayArgument, EveryCommandTakesItsDisplayAsAPositionalOrByFlag) {
+  CLI::App app;
+  for (auto& [order, setup] : facet::cli::CommandRegistry::commands()) setup(app);
+  std::vector<std::string> commands = {"render", "run", "preview", "play", "capture"};
+#ifndef FACET_TEST_WITHOUT_INTEROP
+  commands.push_back("lookup");
+#endif
+  for (const std::string& name : commands) {
+    const CLI::App* command = app.get_subcommand(name);
+    const CLI::Option* display = command->get_option_no_throw("--display");
+    ASSERT_NE(display, nullptr) << name;
+    EXPECT_TRUE(display->get_positional()) << name;
+    EXPECT_TRUE(display->check_name("display")) << name;
+  }
+}
+
+TEST(DisplayArgument, ThePositionalAndTheFlagRenderTheSameAndNotBoth) {
+  const std::string size = " --size 48x32 --frames 1 --json";
+  std::string positional, flag, both;
+  ASSERT_EQ(facet::test::run_facet("render builtin:cylinder360" + size, &positional), 0)
+      << positional;
+  ASSERT_EQ(facet::test::run_facet("render --display builtin:cylinder360" + size, &flag), 0)
+      << flag;
+  // The line of the JSON report that holds `key`.
+  const auto line_of = [](const std::string& report, const std::string& key) {
+    const std::size_t at = report.find("\"" + key + "\": ");
+    return at == std::string::npos ? std::string() : report.substr(at, report.find('\n', at) - at);
+  };
+  EXPECT_EQ(line_of(positional, "display"), "\"display\": \"builtin:cylinder360\",");
+  EXPECT_EQ(line_of(flag, "display"), line_of(positional, "display"));
+  EXPECT_NE(line_of(positional, "facets"), "");
+  EXPECT_EQ(line_of(flag, "facets"), line_of(positional, "facets"));
+  EXPECT_EQ(
+      facet::test::run_facet("render builtin:cylinder360 --display builtin:dome180" + size, &both),
+      2)
+      << both;
+}
+#endif
+
+#ifndef FACET_TEST_WITHOUT_DRIVER
 // What the user of the facet executable reads when a library refuses an option: its flag.
 TEST(OptionFlags, TheFacetExecutableNamesTheFlagOfALibrarysOption) {
   const fs::path out = facet::test_paths::scratch_path("option_flags") / "depth.exr";

@@ -310,7 +310,7 @@ const Registration registration{
           "Live structured-light capture: show every pattern on every projector, grab camera "
           "frames, and write the capture folder (resumes an interrupted capture; exit 3 when "
           "stopped before the end)");
-      cmd->add_option("--display", args->display,
+      cmd->add_option("display,--display", args->display,
                       "display.json (or its folder) naming the projectors, their sizes and "
                       "outputs; warps may be absent")
           ->required();

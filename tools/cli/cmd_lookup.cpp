@@ -24,7 +24,7 @@ const Registration registration{
       };
       auto options = std::make_shared<Options>();
       auto* warp = command->add_option("--warp", options->warp, "A .warp.exr");
-      auto* display = command->add_option("--display", options->display,
+      auto* display = command->add_option("display,--display", options->display,
                                           "A display.json: one <projector>.lookup.exr each");
       warp->excludes(display);
       command

@@ -257,7 +257,7 @@ const Registration registration{
           "on a display through its exact warp and blend");
       command->add_option("file", options->file, "Still image (.png .jpg .exr ...) or video")
           ->required();
-      command->add_option("--display", options->display,
+      command->add_option("display,--display", options->display,
                           "builtin:dome180 (default), builtin:cylinder360, builtin:wall2x2, a "
                           ".warp.exr or a display.json");
       command->add_option("--size", options->size, "Output size WxH of a built-in display");

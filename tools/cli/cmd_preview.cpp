@@ -148,7 +148,7 @@ const Registration registration{
           "What the audience sees from the eye: every projector of a display composited, blended, "
           "on a fisheye (domes) or equirectangular image, coloured by projector, overlap count, "
           "blend sum or uncovered directions, with the coverage figures");
-      command->add_option("display", options->display,
+      command->add_option("display,--display", options->display,
                           "builtin:dome180 (default), builtin:cylinder360, builtin:wall2x2, a "
                           ".warp.exr or a display.json");
       command->add_option("--size", options->size, "Output size WxH of a built-in display");

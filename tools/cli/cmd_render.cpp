@@ -465,7 +465,7 @@ const Registration registration{
           app.add_subcommand("render", "Render a scene into a display's outputs with one method");
       auto options = std::make_shared<RenderOptions>();
       command
-          ->add_option("--display", options->display,
+          ->add_option("display,--display", options->display,
                        "builtin:cylinder360 | builtin:dome180 | FILE.warp.exr | display.json | "
                        "FILE.glc.json (a GLC camera, --method glc)")
           ->required();

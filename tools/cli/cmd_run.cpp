@@ -239,7 +239,7 @@ const Registration registration{
           "run",
           "Run an immersive session: a window per projector (or one spanning window), or "
           "headless frames to files when there is no display server");
-      command->add_option("display", options->display,
+      command->add_option("display,--display", options->display,
                           "builtin:dome180 (default), builtin:cylinder360, a .warp.exr or a "
                           "display.json");
       command->add_option("--scene", options->scene, driver::kSceneNameSyntax)
