@@ -41,21 +41,22 @@ void read_usb_identity(const fs::path& start, VideoDevice& device) {
       const auto product = parse_int(read_attribute(directory / "idProduct"), 16);
       const auto bus = parse_int(read_attribute(directory / "busnum"));
       if (!vendor || !product || !bus) return;
-      device.usb = true;
-      device.vendor_id = std::uint16_t(*vendor);
-      device.product_id = std::uint16_t(*product);
-      device.bus = *bus;
-      device.serial = read_attribute(directory / "serial");
+      UsbIdentity usb;
+      usb.vendor_id = std::uint16_t(*vendor);
+      usb.product_id = std::uint16_t(*product);
+      usb.bus = std::uint8_t(*bus);
+      usb.serial = read_attribute(directory / "serial");
       // devpath is "2" or "2.3.1": the ports from the root hub down.
       const std::string devpath = read_attribute(directory / "devpath");
       std::size_t begin = 0;
       while (begin <= devpath.size() && !devpath.empty()) {
         const std::size_t end = std::min(devpath.find('.', begin), devpath.size());
         if (const auto port = parse_int(devpath.substr(begin, end - begin))) {
-          device.ports.push_back(std::uint8_t(*port));
+          usb.ports.push_back(std::uint8_t(*port));
         }
         begin = end + 1;
       }
+      device.usb = std::move(usb);
       return;
     }
     directory = directory.parent_path();
@@ -145,14 +146,6 @@ class VideoCaptureCamera : public LiveCamera {
 
 }  // namespace
 
-std::string VideoDevice::bus_path() const {
-  std::string path = std::to_string(bus) + "-";
-  for (std::size_t k = 0; k < ports.size(); ++k) {
-    path += (k ? "." : "") + std::to_string(ports[k]);
-  }
-  return path;
-}
-
 std::vector<VideoDevice> list_video_devices(const fs::path& sysfs_root, const fs::path& dev_root) {
   std::vector<VideoDevice> devices;
   const fs::path class_dir = sysfs_root / "class" / "video4linux";
@@ -177,6 +170,30 @@ std::unique_ptr<LiveCamera> open_video_camera(const std::string& device,
                                               const std::string& identity,
                                               const VideoCameraOptions& options) {
   return std::make_unique<VideoCaptureCamera>(device, identity, options);
+}
+
+std::string find_video_node(const std::string& camera, const std::vector<VideoDevice>& devices) {
+  if (!camera.starts_with("usb:")) return camera;
+  if (const std::string problem = stable_id_problem(camera); !problem.empty()) {
+    throw InputError(OptionName{"device"}, problem);
+  }
+  std::vector<std::string> matched;
+  std::string seen;
+  for (const VideoDevice& device : devices) {
+    if (!device.usb || device.index != 0) continue;
+    seen += (seen.empty() ? "" : ", ") + device.node.string() + " = " + stable_id(*device.usb);
+    if (matches(camera, *device.usb)) matched.push_back(device.node.string());
+  }
+  if (matched.size() == 1) return matched.front();
+  if (matched.empty()) {
+    throw InputError(OptionName{"device"},
+                     "a connected USB camera with the id " + camera +
+                         " (video devices: " + (seen.empty() ? "none" : seen) + ")");
+  }
+  std::string list;
+  for (const std::string& node : matched) list += (list.empty() ? "" : ", ") + node;
+  throw InputError(OptionName{"device"}, "an id that names one camera, but " + camera + " names " +
+                                             list + ": add the serial number or bus path");
 }
 
 }  // namespace facet::calibration

@@ -326,16 +326,59 @@ TEST(VideoDevices, SysfsNodesCarryTheirUsbIdentity) {
   const std::vector<VideoDevice> devices = list_video_devices(sys, "/dev");
   ASSERT_EQ(devices.size(), 3u);
   EXPECT_EQ(devices[0].node, fs::path("/dev/video0"));
-  EXPECT_TRUE(devices[0].usb);
+  ASSERT_TRUE(devices[0].usb);
   EXPECT_EQ(devices[0].index, 0);
-  EXPECT_EQ(devices[0].vendor_id, 0x046d);
-  EXPECT_EQ(devices[0].product_id, 0x085c);
-  EXPECT_EQ(devices[0].serial, "C0FFEE");
-  EXPECT_EQ(devices[0].bus_path(), "3-1.4");
+  EXPECT_EQ(devices[0].usb->vendor_id, 0x046d);
+  EXPECT_EQ(devices[0].usb->product_id, 0x085c);
+  EXPECT_EQ(devices[0].usb->serial, "C0FFEE");
+  EXPECT_EQ(bus_path(*devices[0].usb), "3-1.4");
+  EXPECT_EQ(stable_id(*devices[0].usb), "usb:046d:085c:C0FFEE");
   EXPECT_EQ(devices[0].name, "USB Camera");
   EXPECT_EQ(devices[1].index, 1);
   EXPECT_FALSE(devices[2].usb);
   EXPECT_TRUE(list_video_devices(temp.path() / "nothing").empty());
+}
+
+// A stable USB id finds the main capture node of the one camera it names; anything else is a node
+// or an index and passes as it is.
+TEST(VideoDevices, AStableIdFindsItsCamerasMainNode) {
+  const auto camera = [](const char* node, int index, std::uint8_t port, const char* serial) {
+    VideoDevice device;
+    device.node = node;
+    device.index = index;
+    device.usb = UsbIdentity{0x046d, 0x085c, 3, {1, port}, serial};
+    return device;
+  };
+  VideoDevice grabber;
+  grabber.node = "/dev/video9";
+  const std::vector<VideoDevice> devices = {camera("/dev/video0", 0, 4, "A1"),
+                                            camera("/dev/video1", 1, 4, "A1"),
+                                            camera("/dev/video2", 0, 5, ""), grabber};
+  EXPECT_EQ(find_video_node("usb:046d:085c:A1", devices), "/dev/video0");
+  EXPECT_EQ(find_video_node("usb:046D:085C@3-1.5", devices), "/dev/video2");
+  EXPECT_EQ(find_video_node("/dev/video7", devices), "/dev/video7");
+  EXPECT_EQ(find_video_node("2", devices), "2");
+  const auto error_of = [&](const std::string& id) {
+    try {
+      find_video_node(id, devices);
+    } catch (const InputError& e) {
+      EXPECT_EQ(e.option(), "device") << id;
+      return std::string(e.what());
+    }
+    return std::string("no InputError");
+  };
+  EXPECT_NE(error_of("usb:046d:085c").find("names /dev/video0, /dev/video2"), std::string::npos);
+  EXPECT_NE(error_of("usb:046d:085c:B2")
+                .find("(video devices: /dev/video0 = usb:046d:085c:A1, "
+                      "/dev/video2 = usb:046d:085c@3-1.5)"),
+            std::string::npos);
+  EXPECT_NE(error_of("usb:46d:85c").find("expected usb:VVVV:PPPP"), std::string::npos);
+  try {
+    find_video_node("usb:046d:085c:A1", {});
+    ADD_FAILURE() << "no InputError without devices";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("(video devices: none)"), std::string::npos) << e.what();
+  }
 }
 
 TEST(VideoDevices, AMissingDeviceIsAnInputError) {

@@ -23,11 +23,6 @@
 #include "facet/projection_io/display_config.hpp"
 #include "facet/projection_io/rig_file.hpp"
 #include "option_flags.hpp"
-#if __has_include("facet/interop/usb_devices.hpp")
-#include "facet/interop/usb_devices.hpp"
-#include "facet/projection/input_file.hpp"
-#define FACET_CAPTURE_HAS_USB_IDS 1
-#endif
 
 namespace facet::cli {
 namespace {
@@ -52,44 +47,6 @@ struct CaptureArgs {
   std::optional<std::size_t> stop_after;
   bool windowed = false, headless = false, json = false, quiet = false;
 };
-
-// The device node a --camera value names: /dev/videoN and indices as they are, usb: stable ids
-// through sysfs.
-std::string resolve_camera_device(const std::string& camera) {
-  if (!camera.starts_with("usb:")) return camera;
-#ifdef FACET_CAPTURE_HAS_USB_IDS
-  if (const std::string problem = interop::stable_id_problem(camera); !problem.empty()) {
-    throw InputError("--camera", "", problem);
-  }
-  std::vector<std::string> matched;
-  std::string seen;
-  for (const calibration::VideoDevice& device : calibration::list_video_devices()) {
-    if (!device.usb || device.index != 0) continue;
-    interop::UsbDevice usb;
-    usb.vendor_id = device.vendor_id;
-    usb.product_id = device.product_id;
-    usb.bus = std::uint8_t(device.bus);
-    usb.ports = device.ports;
-    usb.serial = device.serial;
-    seen += (seen.empty() ? "" : ", ") + device.node.string() + " = " + interop::stable_id(usb);
-    if (interop::matches(camera, usb)) matched.push_back(device.node.string());
-  }
-  if (matched.size() == 1) return matched.front();
-  if (matched.empty()) {
-    throw InputError("--camera", "",
-                     "a connected USB camera with the id " + camera +
-                         " (video devices: " + (seen.empty() ? "none" : seen) + ")");
-  }
-  std::string list;
-  for (const auto& node : matched) list += (list.empty() ? "" : ", ") + node;
-  throw InputError("--camera", "",
-                   "an id that names one camera, but " + camera + " names " + list +
-                       ": add the serial number or bus path (see 'facet devices')");
-#else
-  throw InputError("--camera", "",
-                   "/dev/videoN or an index: this facet was built without USB ids (interop/)");
-#endif
-}
 
 // The calibration side's view of the presenter: pattern values in [0,1] go out as 8-bit levels.
 class PresenterOutputs : public calibration::PatternOutputs {
@@ -239,7 +196,8 @@ int run_capture(const CaptureArgs& args) {
     calibration::VideoCameraOptions video;
     if (!args.camera_size.empty()) video.size = parse_size(args.camera_size, "--camera-size");
     video.discard = args.discard;
-    const std::string device = resolve_camera_device(args.camera);
+    const std::string device =
+        calibration::find_video_node(args.camera, calibration::list_video_devices());
     camera = calibration::open_video_camera(device, args.camera, video);
   }
   presenter = fake && !args.windowed

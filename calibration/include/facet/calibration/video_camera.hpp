@@ -1,7 +1,7 @@
 #pragma once
 // Real cameras for live capture: V4L2/UVC devices through OpenCV's VideoCapture, and the lookup of
 // a device's /dev/videoN node from sysfs so that configs can name a USB camera by its stable
-// identity (the interop library's `usb:VVVV:PPPP:SERIAL` or `usb:VVVV:PPPP@BUS-PATH`).
+// identity (`usb:VVVV:PPPP:SERIAL` or `usb:VVVV:PPPP@BUS-PATH`, projection/usb_identity.hpp).
 #include <cstdint>
 #include <filesystem>
 #include <memory>
@@ -10,20 +10,16 @@
 #include <vector>
 
 #include "facet/calibration/live_capture.hpp"
+#include "facet/projection/usb_identity.hpp"
 
 namespace facet::calibration {
 
 // A video4linux capture node and, for USB devices, the USB device it belongs to.
 struct VideoDevice {
-  std::filesystem::path node;  // e.g. /dev/video0
-  std::string name;            // the driver's name for the node (sysfs `name`)
-  int index = 0;               // sysfs `index`: 0 is a device's main capture node
-  bool usb = false;            // the fields below are set only for USB devices
-  std::uint16_t vendor_id = 0, product_id = 0;
-  std::string serial;               // empty when the device reports none
-  int bus = 0;                      // USB bus number
-  std::vector<std::uint8_t> ports;  // port numbers from the root hub down
-  std::string bus_path() const;     // "BUS-P1.P2…", the sysfs name of the USB port
+  std::filesystem::path node;      // e.g. /dev/video0
+  std::string name;                // the driver's name for the node (sysfs `name`)
+  int index = 0;                   // sysfs `index`: 0 is a device's main capture node
+  std::optional<UsbIdentity> usb;  // set for the nodes of a USB device
 };
 
 // The video4linux nodes under `sysfs_root`/class/video4linux, sorted by node name, with their USB
@@ -32,6 +28,12 @@ struct VideoDevice {
 // no video4linux class (no cameras, or no sysfs).
 std::vector<VideoDevice> list_video_devices(const std::filesystem::path& sysfs_root = "/sys",
                                             const std::filesystem::path& dev_root = "/dev");
+
+// The device node `camera` names among `devices`: a USB stable id (usb:VVVV:PPPP[:SERIAL|@BUS-
+// PATH]) is matched against the USB devices' main capture nodes (index 0); anything else (a node,
+// an index) is returned as it is. Throws InputError(OptionName "device", ...) for a malformed id,
+// an id that matches no device (listing the ids there are) or one that matches several.
+std::string find_video_node(const std::string& camera, const std::vector<VideoDevice>& devices);
 
 struct VideoCameraOptions {
   std::optional<glm::ivec2> size;  // ask the driver for this frame size (W, H)

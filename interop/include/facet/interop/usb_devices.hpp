@@ -9,15 +9,16 @@
 #include <string>
 #include <vector>
 
+#include "facet/projection/usb_identity.hpp"
+
 namespace facet::interop {
 
-struct UsbDevice {
-  std::uint16_t vendor_id = 0, product_id = 0;
-  std::uint8_t bus = 0;
-  std::vector<std::uint8_t> ports;  // port numbers from the root hub down
+// A device as libusb lists it: who it is (UsbIdentity: stable_id, matches and bus_path take it as
+// one) and what it says of itself.
+struct UsbDevice : UsbIdentity {
   std::uint8_t device_class = 0;
   std::vector<std::uint8_t> interface_classes;
-  std::string serial, manufacturer, product;  // empty when the device has none or denies access
+  std::string manufacturer, product;  // empty when the device has none or denies access
 
   bool operator==(const UsbDevice&) const = default;
 };
@@ -30,19 +31,13 @@ const char* to_string(UsbRole role);
 // WCH) as used for RS-232 projector control, and communications-class (0x02) devices.
 UsbRole classify(const UsbDevice& device);
 
-// "BUS-P1.P2…", the Linux sysfs name of the port: stable while the cabling stays the same.
-std::string bus_path(const UsbDevice& device);
-// "VVVV:PPPP" in lower-case hex.
-std::string vid_pid(const UsbDevice& device);
+// The identity's functions (facet/projection/usb_identity.hpp), under interop's name too.
+using facet::bus_path;
+using facet::matches;
+using facet::stable_id;
+using facet::stable_id_problem;
+using facet::vid_pid;
 
-// The identity a config names a device by: "usb:VVVV:PPPP:SERIAL" when the device reports a
-// serial number (it survives re-plugging into another port), else "usb:VVVV:PPPP@BUS-PATH".
-std::string stable_id(const UsbDevice& device);
-// What is wrong with `id` as a device id usb:VVVV:PPPP[:SERIAL|@BUS-PATH] (VVVV and PPPP four hex
-// digits each, SERIAL printable ASCII, BUS-PATH as bus_path writes it), or "" when nothing is.
-std::string stable_id_problem(const std::string& id);
-// Whether `id` (a stable_id, or just "usb:VVVV:PPPP" for any such device) names `device`.
-bool matches(const std::string& id, const UsbDevice& device);
 // The devices `id` names; several only for the bare VID:PID form.
 std::vector<UsbDevice> find_devices(const std::string& id, const std::vector<UsbDevice>& devices);
 
