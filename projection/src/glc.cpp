@@ -327,11 +327,14 @@ std::optional<double> Glc::intersect(const EyeRay& ray, const glm::dvec3& a, con
   return t;
 }
 
-std::optional<EyeRay> PiecewiseGlc::ray(int x, int y) const {
-  if (x < 0 || y < 0 || x >= size.x || y >= size.y) return std::nullopt;
-  const std::int32_t piece = piece_of_pixel[std::size_t(y) * std::size_t(size.x) + std::size_t(x)];
+std::optional<EyeRay> PiecewiseGlc::ray(int x, int y) const { return ray_at({x + 0.5, y + 0.5}); }
+
+std::optional<EyeRay> PiecewiseGlc::ray_at(glm::dvec2 q) const {
+  if (!(q.x >= 0 && q.y >= 0 && q.x < size.x && q.y < size.y)) return std::nullopt;
+  const std::size_t x = std::size_t(q.x), y = std::size_t(q.y);
+  const std::int32_t piece = piece_of_pixel[y * std::size_t(size.x) + x];
   if (piece < 0) return std::nullopt;
-  return pieces[std::size_t(piece)].ray({x + 0.5, y + 0.5});
+  return pieces[std::size_t(piece)].ray(q);
 }
 
 void PiecewiseGlc::update_boxes() {

@@ -297,6 +297,58 @@ TEST(EdgeDisplacement, ShiftedRectangleIsMeasuredAgainstTheExactEdges) {
                InputError);
 }
 
+// The same rectangle through a pinhole GLC at the eye with the same 200×200 image: the camera's
+// own rays cast at lattice points (no warp inverse applies) find the shifted edges where they
+// are, within one lattice step: 1/32 px within the first pixel, 1/8 px beyond.
+TEST(EdgeDisplacement, AGlcCameraIsMeasuredThroughItsOwnRays) {
+  Scene scene;
+  add_rectangle(scene, {-1, -0.5f}, {1, 0.5f}, -2);
+  const ReferenceRaycaster raycaster(scene);
+  // Frame: x right, y down, z forward (the eye's −z), its image plane 1 m ahead of the eye.
+  GlcFrame frame;
+  frame.origin = {0, 0, -1};
+  frame.axes = glm::dmat3(glm::dvec3(1, 0, 0), glm::dvec3(0, -1, 0), glm::dvec3(0, 0, -1));
+  const PiecewiseGlc camera =
+      single_glc(pinhole_glc(frame, {0, 0, -1}, {2, 2}, {200, 200}, "test", "camera"), {200, 200});
+  constexpr double kZNear = 0.01;
+  const std::vector<std::uint32_t> reference = raycaster.ids(camera, glm::dmat4(1), kZNear);
+  for (int y = 0; y < 200; y += 7) {
+    for (int x = 0; x < 200; x += 7) {
+      ASSERT_EQ(reference[std::size_t(y) * 200 + x], expected_rectangle_id(x, y, 1))
+          << x << "," << y;
+    }
+  }
+  EdgeDisplacement e =
+      raycaster.edge_displacement(camera, glm::dmat4(1), kZNear, reference, reference, {});
+  EXPECT_EQ(e.differing_pixels, 0u);
+
+  std::vector<std::uint32_t> tested(reference.size());
+  for (int y = 0; y < 200; ++y) {
+    for (int x = 0; x < 200; ++x) {
+      tested[std::size_t(y) * 200 + x] = x < 2 ? 0 : expected_rectangle_id(x - 2, y, 1);
+    }
+  }
+  e = raycaster.edge_displacement(camera, glm::dmat4(1), kZNear, reference, tested, {});
+  EXPECT_GT(e.differing_pixels, 4u * 50u);
+  EXPECT_EQ(e.beyond_window, 0u);
+  EXPECT_EQ(e.measured_pixels, e.differing_pixels);
+  EXPECT_GE(e.max_px, 1.5 - 1e-9);
+  EXPECT_LE(e.max_px, 1.5 + 1.0 / 8 + 1e-9);
+
+  // 29.5 px off: beyond the 4 px window, and found with a wider one.
+  tested[100 * 200 + 20] = 2;
+  e = raycaster.edge_displacement(camera, glm::dmat4(1), kZNear, reference, tested, {});
+  EXPECT_EQ(e.beyond_window, 1u);
+  e = raycaster.edge_displacement(camera, glm::dmat4(1), kZNear, reference, tested,
+                                  {.window_px = 32});
+  EXPECT_EQ(e.beyond_window, 0u);
+  EXPECT_NEAR(e.max_px, 29.5, 1.0 / 8 + 1e-9);
+
+  EXPECT_THROW(raycaster.edge_displacement(camera, glm::dmat4(1), kZNear, reference,
+                                           std::vector<std::uint32_t>(10), {}),
+               InputError);
+}
+
 // A sliver: a rectangle 0.2 px tall, whose two triangles meet along a diagonal 100 px long. The
 // reference image shows few of its pixel centres; a tested image that gives the diagonal's
 // pixels to the other triangle, as a renderer moving the diagonal by a fraction of a pixel

@@ -111,8 +111,7 @@ nlohmann::json compare_with_reference(const Scene& scene, const std::vector<Outp
   nlohmann::json per_output = nlohmann::json::array();
   for (std::size_t i = 0; i < outputs.size(); ++i) {
     throw_if_interrupted(stopped);
-    // A GLC camera's pixels cast its own rays (no warp inverse applies); the edge displacement,
-    // which walks a warp's inverse, is not measured for it.
+    // A GLC camera's pixels cast its own rays: no warp inverse applies.
     const OutputSpec& output = outputs[i];
     std::optional<WarpInverse> inverse;
     if (!output.glc) inverse.emplace(output.warp);
@@ -139,10 +138,11 @@ nlohmann::json compare_with_reference(const Scene& scene, const std::vector<Outp
       }
     }
     const IdComparison c = compare_ids(shown, tested, targets[i].size(), {.wrap_x = wrap_x});
-    EdgeDisplacement e = inverse ? raycaster.edge_displacement(*inverse, T_eye_world, shown, tested,
-                                                               {.wrap_x = wrap_x})
-                                 : EdgeDisplacement{};
-    if (!inverse) e.differing_pixels = c.differing_pixels;
+    const EdgeDisplacement e =
+        inverse
+            ? raycaster.edge_displacement(*inverse, T_eye_world, shown, tested, {.wrap_x = wrap_x})
+            : raycaster.edge_displacement(*output.glc, T_eye_world, z_near, shown, tested,
+                                          {.wrap_x = wrap_x});
     per_output.push_back({{"name", outputs[i].name},
                           {"id_mismatch", c.id_mismatch},
                           {"compared_pixels", c.compared_pixels},

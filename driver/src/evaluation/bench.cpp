@@ -644,11 +644,12 @@ BenchReport run_bench(const BenchOptions& options, const std::string& renderer,
         ids.push_back(targets[i].read_ids());
         const IdComparison c =
             compare_ids(reference[i], ids.back(), targets[i].size(), {.wrap_x = wrap_x});
-        // The edge displacement walks a warp's inverse: not measured for a GLC camera.
         const EdgeDisplacement e =
-            scenario.outputs[i].glc ? EdgeDisplacement{}
-                                    : raycaster.edge_displacement(inverses[i], T0, reference[i],
-                                                                  ids.back(), {.wrap_x = wrap_x});
+            scenario.outputs[i].glc
+                ? raycaster.edge_displacement(*scenario.outputs[i].glc, T0, RenderSettings{}.z_near,
+                                              reference[i], ids.back(), {.wrap_x = wrap_x})
+                : raycaster.edge_displacement(inverses[i], T0, reference[i], ids.back(),
+                                              {.wrap_x = wrap_x});
         pooled.compared_pixels += c.compared_pixels;
         pooled.mismatched_pixels += c.mismatched_pixels;
         if (e.max_px > pooled.max_edge_px) {

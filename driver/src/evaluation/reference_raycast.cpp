@@ -42,6 +42,110 @@ void for_each_row(int rows, Body&& body) {
   }
 }
 
+// The pixels where `tested` differs from `reference` (both size.x · size.y, row-major), after
+// the checks every edge displacement makes of its input.
+std::vector<glm::ivec2> differing_pixels(glm::ivec2 size,
+                                         const std::vector<std::uint32_t>& reference,
+                                         const std::vector<std::uint32_t>& tested,
+                                         const EdgeDisplacementOptions& options) {
+  const std::size_t pixels = std::size_t(size.x) * std::size_t(size.y);
+  for (const auto* image : {&reference, &tested}) {
+    if (image->size() != pixels) {
+      throw InputError(image == &reference ? "reference ID image" : "tested ID image", "size",
+                       "expected " + std::to_string(size.x) + "×" + std::to_string(size.y) +
+                           " pixels, got " + std::to_string(image->size()));
+    }
+  }
+  if (options.subsamples < 1 || options.coarse_subsamples < 1 || !(options.window_px > 0)) {
+    throw InputError("edge displacement", "options",
+                     "expected subsamples and coarse_subsamples >= 1 and window_px > 0");
+  }
+  std::vector<glm::ivec2> differing;
+  for (int y = 0; y < size.y; ++y) {
+    for (int x = 0; x < size.x; ++x) {
+      const std::size_t i = std::size_t(y) * size.x + x;
+      if (tested[i] != reference[i]) differing.push_back({x, y});
+    }
+  }
+  return differing;
+}
+
+// The distance from `centre` to the nearest point of a lattice of 1/subsamples px where
+// `marks_the_edge` holds, searched ring by ring out to radius_px; nullopt when none is that near.
+// Every lattice point on Chebyshev ring r is at least r steps away, so a search ends once r²
+// passes the best squared distance found.
+template <typename Marks>
+std::optional<double> lattice_distance(glm::dvec2 centre, int subsamples, double radius_px,
+                                       Marks&& marks_the_edge) {
+  const double lattice_step = 1.0 / subsamples;
+  const int rings = int(std::ceil(radius_px * subsamples));
+  long best = std::numeric_limits<long>::max();
+  for (int r = 1; r <= rings && long(r) * r <= best; ++r) {
+    for (int dy = -r; dy <= r; ++dy) {
+      const int stride = (dy == -r || dy == r) ? 1 : 2 * r;
+      for (int dx = -r; dx <= r; dx += stride) {
+        const long d2 = long(dx) * dx + long(dy) * dy;
+        if (d2 >= best || d2 > long(rings) * rings) continue;
+        if (marks_the_edge(centre + lattice_step * glm::dvec2(dx, dy))) best = d2;
+      }
+    }
+  }
+  if (best > long(rings) * rings) return std::nullopt;
+  return lattice_step * std::sqrt(double(best));
+}
+
+// A differing pixel's edge displacement: the lattice search (options.subsamples out to
+// fine_radius_px, coarse_subsamples beyond) for a point nearer than `limit_px`, a distance known
+// to bound it from above (window_px when none is known). Negative: nothing within the window.
+template <typename Marks>
+double searched_distance(glm::dvec2 centre, double limit_px, const EdgeDisplacementOptions& options,
+                         Marks&& marks_the_edge) {
+  auto found = lattice_distance(centre, options.subsamples,
+                                std::min(limit_px, options.fine_radius_px), marks_the_edge);
+  if (!found && limit_px > options.fine_radius_px) {
+    found = lattice_distance(centre, options.coarse_subsamples, limit_px, marks_the_edge);
+  }
+  if (found) return std::min(limit_px, *found);
+  return limit_px < options.window_px ? limit_px : -1.0;
+}
+
+// The summary of the differing pixels' distances (negative: none within the window; NaN: a depth
+// tie), those drawn outside the display (`outside`) kept apart.
+EdgeDisplacement summarize_edges(const std::vector<glm::ivec2>& differing,
+                                 const std::vector<double>& distance,
+                                 const std::vector<char>& outside,
+                                 const EdgeDisplacementOptions& options) {
+  EdgeDisplacement result;
+  result.differing_pixels = differing.size();
+  std::vector<double> measured;
+  for (std::size_t k = 0; k < distance.size(); ++k) {
+    const double d = distance[k];
+    if (std::isnan(d)) {
+      ++result.depth_ties;
+    } else if (outside[k]) {
+      ++result.outside_display;
+      result.outside_display_max_px =
+          std::max(result.outside_display_max_px, d < 0 ? options.window_px : d);
+    } else if (d < 0) {
+      ++result.beyond_window;
+    } else {
+      measured.push_back(d);
+      if (d > result.max_px || result.worst_pixel.x < 0) {
+        result.max_px = d;
+        result.worst_pixel = differing[k];
+      }
+    }
+  }
+  result.measured_pixels = measured.size();
+  if (!measured.empty()) {
+    const std::size_t k =
+        std::min(measured.size() - 1, std::size_t(0.99 * double(measured.size())));
+    std::nth_element(measured.begin(), measured.begin() + std::ptrdiff_t(k), measured.end());
+    result.p99_px = measured[k];
+  }
+  return result;
+}
+
 [[noreturn]] void throw_embree_error(RTCDevice device, const char* what) {
   throw std::runtime_error(std::string("Embree: ") + what + " failed (error " +
                            std::to_string(int(rtcGetDeviceError(device))) + ")");
@@ -58,6 +162,36 @@ struct ReferenceRaycaster::Impl {
   ~Impl() {
     if (scene) rtcReleaseScene(scene);
     if (device) rtcReleaseDevice(device);
+  }
+
+  // Distance along the world ray (origin, unit v) to triangle `id`, in its plane and within its
+  // edges up to a relative 1e-6; empty when the ray misses it.
+  std::optional<double> ray_distance(const glm::dvec3& origin, const glm::dvec3& v,
+                                     std::uint32_t id) const {
+    const glm::dvec3 a(p_world[3 * std::size_t(id - 1)]);
+    const glm::dvec3 b(p_world[3 * std::size_t(id - 1) + 1]);
+    const glm::dvec3 c(p_world[3 * std::size_t(id - 1) + 2]);
+    const glm::dvec3 n = glm::cross(b - a, c - a);
+    const double along = glm::dot(n, v);
+    if (!(std::abs(along) > 1e-12 * glm::length(n))) return std::nullopt;
+    const double d = glm::dot(n, a - origin) / along;
+    if (!(d > 0)) return std::nullopt;
+    const glm::dvec3 x = origin + d * v;
+    const double slack = -1e-6 * glm::dot(n, n);
+    if (glm::dot(glm::cross(b - a, x - a), n) < slack ||
+        glm::dot(glm::cross(c - b, x - b), n) < slack ||
+        glm::dot(glm::cross(a - c, x - c), n) < slack) {
+      return std::nullopt;
+    }
+    return d;
+  }
+  // Both triangles (IDs, 0 for none) on the world ray at the same distance: surfaces that
+  // coincide there, where either ID is right.
+  bool depth_tie(const glm::dvec3& origin, const glm::dvec3& v, std::uint32_t a,
+                 std::uint32_t b) const {
+    if (a == 0 || b == 0) return false;
+    const auto da = ray_distance(origin, v, a), db = ray_distance(origin, v, b);
+    return da && db && std::abs(*da - *db) <= 1e-5 * std::max(*da, *db);
   }
 
   // Rejects hits on back faces: the triangle's counter-clockwise normal points along the ray.
@@ -204,17 +338,7 @@ EdgeDisplacement ReferenceRaycaster::edge_displacement(
     const std::vector<std::uint32_t>& reference, const std::vector<std::uint32_t>& tested,
     const EdgeDisplacementOptions& options) const {
   const glm::ivec2 size = inverse.warp().output_size;
-  const std::size_t pixels = std::size_t(size.x) * std::size_t(size.y);
-  for (const auto* image : {&reference, &tested}) {
-    if (image->size() != pixels) {
-      throw InputError(image == &reference ? "reference ID image" : "tested ID image", "size",
-                       "expected " + std::to_string(size.x) + "×" + std::to_string(size.y) +
-                           " pixels, got " + std::to_string(image->size()));
-    }
-  }
-  if (options.subsamples < 1 || !(options.window_px > 0)) {
-    throw InputError("edge displacement", "options", "expected subsamples >= 1 and window_px > 0");
-  }
+  const std::vector<glm::ivec2> differing = differing_pixels(size, reference, tested, options);
   const glm::dmat4 T_world_eye = glm::inverse(T_eye_world);
   const glm::dvec3 p_eye_world(T_world_eye[3]);
   const glm::dmat3 R_world_eye(T_world_eye);
@@ -234,13 +358,6 @@ EdgeDisplacement ReferenceRaycaster::edge_displacement(
     return found ? id_along(p_eye_world, R_world_eye * found->v_eye) : 0u;
   };
 
-  std::vector<glm::ivec2> differing;
-  for (int y = 0; y < size.y; ++y) {
-    for (int x = 0; x < size.x; ++x) {
-      const std::size_t i = std::size_t(y) * size.x + x;
-      if (tested[i] != reference[i]) differing.push_back({x, y});
-    }
-  }
   const glm::dmat3 R_eye_world(T_eye_world);
   const glm::dvec3 p_world_eye(T_eye_world[3]);
 
@@ -343,35 +460,10 @@ EdgeDisplacement ReferenceRaycaster::edge_displacement(
     return glm::length(point - q);
   };
 
-  // Distance along the world ray (origin, unit v) to triangle `id`, in its plane and within its
-  // edges up to a relative 1e-6; empty when the ray misses it.
-  auto ray_distance = [&](const glm::dvec3& origin, const glm::dvec3& v,
-                          std::uint32_t id) -> std::optional<double> {
-    const glm::dvec3 a(impl_->p_world[3 * std::size_t(id - 1)]);
-    const glm::dvec3 b(impl_->p_world[3 * std::size_t(id - 1) + 1]);
-    const glm::dvec3 c(impl_->p_world[3 * std::size_t(id - 1) + 2]);
-    const glm::dvec3 n = glm::cross(b - a, c - a);
-    const double along = glm::dot(n, v);
-    if (!(std::abs(along) > 1e-12 * glm::length(n))) return std::nullopt;
-    const double d = glm::dot(n, a - origin) / along;
-    if (!(d > 0)) return std::nullopt;
-    const glm::dvec3 x = origin + d * v;
-    const double slack = -1e-6 * glm::dot(n, n);
-    if (glm::dot(glm::cross(b - a, x - a), n) < slack ||
-        glm::dot(glm::cross(c - b, x - b), n) < slack ||
-        glm::dot(glm::cross(a - c, x - c), n) < slack) {
-      return std::nullopt;
-    }
-    return d;
-  };
   // Both triangles on the pixel centre's ray at the same distance: surfaces that coincide there.
   auto depth_tie = [&](glm::dvec2 q, std::uint32_t a, std::uint32_t b) {
-    if (a == 0 || b == 0) return false;
     const auto found = inverse.invert(q);
-    if (!found) return false;
-    const glm::dvec3 v = glm::normalize(R_world_eye * found->v_eye);
-    const auto da = ray_distance(p_eye_world, v, a), db = ray_distance(p_eye_world, v, b);
-    return da && db && std::abs(*da - *db) <= 1e-5 * std::max(*da, *db);
+    return found && impl_->depth_tie(p_eye_world, glm::normalize(R_world_eye * found->v_eye), a, b);
   };
 
   // Negative: nothing within the window; NaN: a depth tie.
@@ -410,63 +502,10 @@ EdgeDisplacement ReferenceRaycaster::edge_displacement(
       const std::uint32_t seen = id_at(q);
       return id != 0 ? seen == id : seen != expected;
     };
-    // Every lattice point on Chebyshev ring r is at least r steps away, so a search ends once r²
-    // passes the best squared distance found.
-    auto search = [&](int subsamples, double radius_px) -> std::optional<double> {
-      const double lattice_step = 1.0 / subsamples;
-      const int rings = int(std::ceil(radius_px * subsamples));
-      long best = std::numeric_limits<long>::max();
-      for (int r = 1; r <= rings && long(r) * r <= best; ++r) {
-        for (int dy = -r; dy <= r; ++dy) {
-          const int stride = (dy == -r || dy == r) ? 1 : 2 * r;
-          for (int dx = -r; dx <= r; dx += stride) {
-            const long d2 = long(dx) * dx + long(dy) * dy;
-            if (d2 >= best || d2 > long(rings) * rings) continue;
-            if (marks_the_edge(centre + lattice_step * glm::dvec2(dx, dy))) best = d2;
-          }
-        }
-      }
-      if (best > long(rings) * rings) return std::nullopt;
-      return lattice_step * std::sqrt(double(best));
-    };
-    auto found = search(options.subsamples, std::min(limit, options.fine_radius_px));
-    if (!found && limit > options.fine_radius_px) found = search(options.coarse_subsamples, limit);
-    if (found) {
-      distance[std::size_t(k)] = std::min(limit, *found);
-    } else if (limit < options.window_px) {
-      distance[std::size_t(k)] = limit;
-    }
+    distance[std::size_t(k)] = searched_distance(centre, limit, options, marks_the_edge);
   });
 
-  EdgeDisplacement result;
-  result.differing_pixels = differing.size();
-  std::vector<double> measured;
-  for (std::size_t k = 0; k < distance.size(); ++k) {
-    const double d = distance[k];
-    if (std::isnan(d)) {
-      ++result.depth_ties;
-    } else if (outside[k]) {
-      ++result.outside_display;
-      result.outside_display_max_px =
-          std::max(result.outside_display_max_px, d < 0 ? options.window_px : d);
-    } else if (d < 0) {
-      ++result.beyond_window;
-    } else {
-      measured.push_back(d);
-      if (d > result.max_px || result.worst_pixel.x < 0) {
-        result.max_px = d;
-        result.worst_pixel = differing[k];
-      }
-    }
-  }
-  result.measured_pixels = measured.size();
-  if (!measured.empty()) {
-    const std::size_t k =
-        std::min(measured.size() - 1, std::size_t(0.99 * double(measured.size())));
-    std::nth_element(measured.begin(), measured.begin() + std::ptrdiff_t(k), measured.end());
-    result.p99_px = measured[k];
-  }
-  return result;
+  return summarize_edges(differing, distance, outside, options);
 }
 
 IdComparison compare_ids(const std::vector<std::uint32_t>& reference,
@@ -567,6 +606,52 @@ IdComparison compare_ids(const std::vector<std::uint32_t>& reference,
     result.p99_edge_px = edge_px[k];
   }
   return result;
+}
+
+EdgeDisplacement ReferenceRaycaster::edge_displacement(
+    const PiecewiseGlc& camera, const glm::dmat4& T_eye_world, double z_near,
+    const std::vector<std::uint32_t>& reference, const std::vector<std::uint32_t>& tested,
+    const EdgeDisplacementOptions& options) const {
+  const glm::ivec2 size = camera.size;
+  const std::vector<glm::ivec2> differing = differing_pixels(size, reference, tested, options);
+  const glm::dmat4 T_world_eye = glm::inverse(T_eye_world);
+  const glm::dmat3 R_world_eye(T_world_eye);
+  // The camera's ray through q in the world frame; its direction's frame-z component is 1, so
+  // the distance along it is the frame depth, as ids() casts.
+  auto ray_at = [&](glm::dvec2 q) -> std::optional<EyeRay> {
+    if (options.wrap_x) q.x -= std::floor(q.x / size.x) * size.x;
+    auto ray = camera.ray_at(q);
+    if (!ray) return std::nullopt;
+    return EyeRay{glm::dvec3(T_world_eye * glm::dvec4(ray->origin, 1.0)),
+                  R_world_eye * ray->direction};
+  };
+  auto id_at = [&](glm::dvec2 q) -> std::uint32_t {
+    const auto ray = ray_at(q);
+    return ray ? id_between(ray->origin, ray->direction, z_near) : 0u;
+  };
+
+  std::vector<double> distance(differing.size(), -1.0);
+  std::vector<char> outside(differing.size(), 0);
+  for_each_row(int(differing.size()), [&](int k) {
+    const glm::ivec2 pixel = differing[std::size_t(k)];
+    const std::size_t i = std::size_t(pixel.y) * size.x + pixel.x;
+    const std::uint32_t id = tested[i], expected = reference[i];
+    const glm::dvec2 centre = glm::dvec2(pixel) + 0.5;
+    const auto ray = ray_at(centre);
+    if (ray && impl_->depth_tie(ray->origin, glm::normalize(ray->direction), id, expected)) {
+      distance[std::size_t(k)] = std::numeric_limits<double>::quiet_NaN();
+      return;
+    }
+    const bool outside_display = id != 0 && !ray;
+    outside[std::size_t(k)] = outside_display;
+    distance[std::size_t(k)] =
+        searched_distance(centre, options.window_px, options, [&](glm::dvec2 q) {
+          if (outside_display) return ray_at(q).has_value();
+          const std::uint32_t seen = id_at(q);
+          return id != 0 ? seen == id : seen != expected;
+        });
+  });
+  return summarize_edges(differing, distance, outside, options);
 }
 
 }  // namespace facet::driver

@@ -69,6 +69,15 @@ class ReferenceRaycaster {
                                      const std::vector<std::uint32_t>& reference,
                                      const std::vector<std::uint32_t>& tested,
                                      const EdgeDisplacementOptions& options) const;
+  // The same for a (piecewise) GLC camera, whose pixels have no common centre: `reference` is
+  // ids(camera, T_eye_world, z_near). The camera's ray through any image point (its pixel's
+  // piece) says what is seen there, so every differing pixel is measured by the lattice search
+  // alone, out to window_px; a pixel drawn where no piece covers its centre is outside the
+  // display. InputError when either image is not camera.size.
+  EdgeDisplacement edge_displacement(const PiecewiseGlc& camera, const glm::dmat4& T_eye_world,
+                                     double z_near, const std::vector<std::uint32_t>& reference,
+                                     const std::vector<std::uint32_t>& tested,
+                                     const EdgeDisplacementOptions& options) const;
 
  private:
   // The nearest hit along p_world + t·v_world (v_world as given, not normalised) for t >= t_near.

@@ -158,6 +158,9 @@ struct PiecewiseGlc {
 
   // The ray of pixel (x, y)'s centre, nullopt where no piece covers it.
   std::optional<EyeRay> ray(int x, int y) const;
+  // The ray through image point q (pixels, (0, 0) the top-left corner) of the piece that owns
+  // q's pixel, nullopt where none does or q lies outside the image.
+  std::optional<EyeRay> ray_at(glm::dvec2 q) const;
   // Recomputes piece_boxes from piece_of_pixel.
   void update_boxes();
 };
