@@ -2299,6 +2299,10 @@ void add_flags_render(std::vector<Variant>& out) {
 
 void add_flags_run(std::vector<Variant>& out) {
   const Base b = run_base();
+  const Base by_flag{
+      {"run", "--size", "64x64", "--headless", "--frames", "1", "--out", "@out"}, "out", {}};
+  add_flag_values(out, "run", by_flag, "--display",
+                  inputs(".json") + std::vector<std::string>{"builtin:", "builtin:bogus"});
   add_flag_values(out, "run", b, "--scene", scenes());
   add_flag_values(out, "run", b, "--size", sizes());
   add_flag_values(out, "run", b, "--eye", points());
@@ -2405,6 +2409,9 @@ void add_flags_play(std::vector<Variant>& out) {
 void add_flags_preview_display_depth(std::vector<Variant>& out) {
   const Base preview{{"preview", kDome180, "--out", "@out.png"}, "out.png", {}};
   const Base builtin{{"preview", "builtin:dome180", "--out", "@out.png"}, "out.png", {}};
+  const Base preview_by_flag{{"preview", "--out", "@out.png"}, "out.png", {}};
+  add_flag_values(out, "preview", preview_by_flag, "--display",
+                  inputs(".json") + std::vector<std::string>{"builtin:", "builtin:bogus"});
   add_flag_values(out, "preview", builtin, "--size", sizes());
   add_flag_values(out, "preview", preview, "--tilt", angles("91"));
   add_flag_values(out, "preview", preview, "--orientation", angles("361"));
@@ -2414,6 +2421,9 @@ void add_flags_preview_display_depth(std::vector<Variant>& out) {
   add_flag_values(out, "preview", preview, "--preview-size", counts({"7", "8193"}));
   add_flag_values(out, "preview", preview, "--out", out_files(".png"));
   const Base display{{"display", "builtin:dome180", "--out", "@out"}, "out", {}};
+  const Base display_by_flag{{"display", "--out", "@out"}, "out", {}};
+  add_flag_values(out, "display", display_by_flag, "--display",
+                  inputs(".json") + std::vector<std::string>{"builtin:", "builtin:bogus"});
   add_flag_values(out, "display", display, "--size", sizes());
   add_flag_values(out, "display", display, "--name", names());
   add_flag_values(out, "display", display, "--out", out_folders());
@@ -2573,6 +2583,8 @@ void add_flags_interop(std::vector<Variant>& out) {
   // A display both exports take (dome180's footprints are wider than one frustum holds).
   const std::string wall = (kSource / "configs/displays/wall2x2/display.json").string();
   const Base mpcdi_export{{"mpcdi", "export", wall, "--out", "@out.mpcdi"}, "out.mpcdi", {}};
+  const Base mpcdi_export_by_flag{{"mpcdi", "export", "--out", "@out.mpcdi"}, "out.mpcdi", {}};
+  add_flag_values(out, "mpcdi export", mpcdi_export_by_flag, "--display", inputs(".json"));
   add_flag_values(out, "mpcdi export", mpcdi_export, "--out", out_files(".mpcdi"));
   add_flag_values(out, "mpcdi export", mpcdi_export, "--node-spacing", positives({"1e-9"}));
   add_flag_values(out, "mpcdi export", mpcdi_export, "--profile", choices("3d"));
@@ -2584,6 +2596,8 @@ void add_flags_interop(std::vector<Variant>& out) {
   add_flag_values(out, "mpcdi import", mpcdi_import, "--tilt", angles("91"));
   add_flag_values(out, "mpcdi import", mpcdi_import, "--orientation", angles("361"));
   const Base sgct_export{{"sgct", "export", wall, "--out", "@out"}, "out", {}};
+  const Base sgct_export_by_flag{{"sgct", "export", "--out", "@out"}, "out", {}};
+  add_flag_values(out, "sgct export", sgct_export_by_flag, "--display", inputs(".json"));
   add_flag_values(out, "sgct export", sgct_export, "--out", out_folders());
   add_flag_values(out, "sgct export", sgct_export, "--node-spacing", positives({"1e-9"}));
   add_flag_values(out, "sgct export", sgct_export, "--mask-gamma", positives({"1000"}));

@@ -273,12 +273,14 @@ TEST(OptionFlags, ACommandKeepsOnlyTheSharedRowsOfTheFlagsItDeclares) {
 TEST(DisplayArgument, EveryCommandTakesItsDisplayAsAPositionalOrByFlag) {
   CLI::App app;
   for (auto& [order, setup] : facet::cli::CommandRegistry::commands()) setup(app);
-  std::vector<std::string> commands = {"render", "run", "preview", "play", "capture"};
+  std::vector<std::string> commands = {"render", "run", "preview", "play", "capture", "display"};
 #ifndef FACET_TEST_WITHOUT_INTEROP
-  commands.push_back("lookup");
+  for (const char* name : {"lookup", "mpcdi export", "sgct export"}) commands.push_back(name);
 #endif
   for (const std::string& name : commands) {
-    const CLI::App* command = app.get_subcommand(name);
+    const CLI::App* command = app.get_subcommand(name.substr(0, name.find(' ')));
+    if (name.find(' ') != std::string::npos)
+      command = command->get_subcommand(name.substr(name.find(' ') + 1));
     const CLI::Option* display = command->get_option_no_throw("--display");
     ASSERT_NE(display, nullptr) << name;
     EXPECT_TRUE(display->get_positional()) << name;

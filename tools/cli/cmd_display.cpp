@@ -33,7 +33,8 @@ const Registration registration{
           "display",
           "Write a display (builtin:cylinder360, builtin:dome180, builtin:wall2x2, a .warp.exr or "
           "a display.json) as a folder holding display.json, the warps and the blends");
-      command->add_option("display", options->display, "The display to write")->required();
+      command->add_option("display,--display", options->display, "The display to write")
+          ->required();
       command->add_option("--size", options->size, "Output size WxH of a built-in display");
       command->add_option("--name", options->name, "Name in display.json (default: the folder's)")
           ->each([options](const std::string&) { options->name_given = true; });

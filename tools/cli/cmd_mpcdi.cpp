@@ -30,7 +30,8 @@ const Registration registration{
       auto* export_command = command->add_subcommand(
           "export",
           "Write a display.json's warps and blends as an MPCDI container (profile 3d or a3)");
-      export_command->add_option("display", exporting->display, "display.json (or its folder)")
+      export_command
+          ->add_option("display,--display", exporting->display, "display.json (or its folder)")
           ->required();
       export_command->add_option("--out", exporting->out, "The .mpcdi file to write")->required();
       export_command->add_option("--node-spacing", exporting->spacing,

@@ -40,7 +40,8 @@ const Registration registration{
           "export",
           "Write a display.json as an SGCT cluster: cluster.xml, a SCISS .sgc mesh and a mask "
           "PNG per projector, into DIR");
-      export_command->add_option("display", exporting->display, "display.json (or its folder)")
+      export_command
+          ->add_option("display,--display", exporting->display, "display.json (or its folder)")
           ->required();
       export_command->add_option("--out", exporting->out, "The folder to create")->required();
       export_command->add_option("--node-spacing", exporting->spacing,
