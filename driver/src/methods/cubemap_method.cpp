@@ -22,6 +22,7 @@
 #include "facet/projection/content_projection.hpp"
 #include "facet/projection/errors.hpp"
 #include "material_programs.hpp"
+#include "object_baseline.hpp"
 #include "pixel_lookup.hpp"
 #include "render_methods_internal.hpp"
 
@@ -64,7 +65,7 @@ unsigned faces_of_sphere(const glm::dvec3& centre, double radius, double z_near)
   return mask;
 }
 
-class CubemapMethod final : public RenderMethod {
+class CubemapMethod final : public ObjectBaseline {
  public:
   std::string_view name() const override { return "cubemap"; }
 
@@ -76,13 +77,7 @@ class CubemapMethod final : public RenderMethod {
                        "expected a face edge of 1 to 16384 pixels, got " +
                            std::to_string(settings.cube_face_size));
     }
-    if (!(settings.z_near > 0)) {
-      throw InputError("render settings", "z_near", "expected a positive near distance");
-    }
-    scene_ = &scene;
-    gpu_scene_ = &gpu_scene;
-    settings_ = settings;
-    triangle_base_ = scene_triangle_base(scene);
+    keep_scene(scene, gpu_scene, settings);
     face_needed_.fill(false);
     lookups_.clear();
     for (const OutputSpec& output : outputs) {
@@ -139,19 +134,13 @@ class CubemapMethod final : public RenderMethod {
       face_framebuffer_.attach(GL_DEPTH_ATTACHMENT, face_depth_);
     }
     if (!primitives_query_) primitives_query_ = Query::create(GL_PRIMITIVES_GENERATED);
-    if (!empty_vao_) empty_vao_ = VertexArray::create();
 
     if (linked_gs_ != use_gs_) face_programs_.clear();
     linked_gs_ = use_gs_;
     face_programs_.prepare(scene, settings.material, [this](const MaterialShader& shader) {
       return link_perspective_scene_program(shader, use_gs_);
     });
-    if (!lookup_program_) {
-      lookup_program_ = ProgramBuilder()
-                            .shader("baselines/fullscreen.vert")
-                            .shader("baselines/cube_lookup.frag")
-                            .link();
-    }
+    if (!lookup_program_) lookup_program_ = link_fullscreen_program("baselines/cube_lookup.frag");
     check_gl_error("cubemap prepare");
   }
 
@@ -159,21 +148,16 @@ class CubemapMethod final : public RenderMethod {
                      GpuTimer* timer) override {
     FACET_ASSERT(scene_ && targets.size() == lookups_.size());
     const Scene& scene = *scene_;
-    RenderStats stats;
-    stats.triangles_in = scene.triangle_count();
-    stats.triangles_visible = stats.triangles_in;
-    stats.gpu_buffer_bytes = buffer_bytes_;
+    RenderStats stats = whole_scene_stats(buffer_bytes_);
 
     if (timer) timer->begin("faces");
     glEnable(GL_TEXTURE_CUBE_MAP_SEAMLESS);
     glEnable(GL_FRAMEBUFFER_SRGB);
-    begin_reversed_z_scene(settings_.cull_back_faces);
+    begin_pulling(settings_.cull_back_faces);
     // Every face of GL's cube keeps the same handedness, so one winding serves all (layered).
     const CubeFaceAxes& first = kCubeFaces[0];
     const bool mirrored = glm::dot(glm::cross(first.a_s, first.a_t), first.a_m) > 0;
     glFrontFace(mirrored ? GL_CW : GL_CCW);
-    glBindVertexArray(empty_vao_.id());
-    gpu_scene_->bind_for_pulling();
     const int n = settings_.cube_face_size;
     glViewport(0, 0, n, n);
     unsigned needed_mask = 0;
@@ -243,28 +227,13 @@ class CubemapMethod final : public RenderMethod {
     }
     if (settings_.cube_mipmaps) glGenerateTextureMipmap(colour_cube_.id());
     glFrontFace(GL_CCW);
-    glDisable(GL_CULL_FACE);
-    glClipControl(GL_LOWER_LEFT, GL_NEGATIVE_ONE_TO_ONE);
+    end_reversed_z_scene();
     if (timer) timer->end();
 
-    if (timer) timer->begin("lookup");
-    glDisable(GL_DEPTH_TEST);
-    lookup_program_.use();
     colour_cube_.bind_unit(1);
     id_cube_.bind_unit(2);
-    for (std::size_t i = 0; i < targets.size(); ++i) {
-      targets[i].clear();
-      targets[i].bind();
-      lookups_[i].bind_unit(0);
-      glDrawArrays(GL_TRIANGLES, 0, 3);
-      targets[i].resolve();
-    }
-    glBindVertexArray(0);
-    glDepthFunc(GL_LESS);
-    if (timer) {
-      timer->end();
-      timer->end_frame();
-    }
+    draw_lookup_pass(
+        lookup_program_, targets, [this](std::size_t i) { lookups_[i].bind_unit(0); }, timer);
     check_gl_error("cubemap render");
     return stats;
   }
@@ -301,16 +270,11 @@ class CubemapMethod final : public RenderMethod {
     }
   }
 
-  const Scene* scene_ = nullptr;
-  const GpuScene* gpu_scene_ = nullptr;
-  RenderSettings settings_;
-  std::vector<std::uint32_t> triangle_base_;
   std::array<bool, 6> face_needed_{};
   std::vector<Texture> lookups_;
   Texture colour_cube_, id_cube_, face_depth_;
   std::uint64_t buffer_bytes_ = 0;  // RenderStats::gpu_buffer_bytes
   Framebuffer face_framebuffer_;
-  VertexArray empty_vao_;
   MaterialPrograms face_programs_;
   Program lookup_program_;
   bool linked_gs_ = false;              // face_programs_ have the geometry stage

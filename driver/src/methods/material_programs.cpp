@@ -79,6 +79,13 @@ void begin_reversed_z_scene(bool cull_back_faces) {
   }
 }
 
+void end_reversed_z_scene() {
+  glDisable(GL_CULL_FACE);
+  glDepthFunc(GL_LESS);
+  glDisable(GL_DEPTH_TEST);
+  glClipControl(GL_LOWER_LEFT, GL_NEGATIVE_ONE_TO_ONE);
+}
+
 Program link_perspective_scene_program(const MaterialShader& shader, bool layered_cube) {
   ProgramBuilder builder;
   builder.define("WRITE_TRIANGLE_ID", "1")

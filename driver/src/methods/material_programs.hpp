@@ -56,6 +56,9 @@ std::uint64_t draw_object_primitives(const Scene& scene, const GpuScene& gpu, st
 // reversed Z (GL_GREATER against depth cleared to 0), and GL's back-face culling on exactly when
 // `cull_back_faces` (the caller sets glFrontFace).
 void begin_reversed_z_scene(bool cull_back_faces);
+// GL's defaults again after a scene pass: clip z in [-1, 1], depth test off with GL_LESS, no face
+// culling.
+void end_reversed_z_scene();
 
 // A perspective image of the scene shaded by `shader` (baselines/cube_face.vert pulling the
 // scene's vertices, WRITE_TRIANGLE_ID 1): the cube map's faces, in one layered pass through

@@ -17,6 +17,7 @@
 #include "facet/projection/content_projection.hpp"
 #include "facet/projection/errors.hpp"
 #include "material_programs.hpp"
+#include "object_baseline.hpp"
 #include "pixel_lookup.hpp"
 #include "render_methods_internal.hpp"
 
@@ -55,7 +56,7 @@ std::optional<glm::dvec2> perspective_image_st(const Frustum& frustum, const glm
 namespace detail {
 namespace {
 
-class PerspectiveMethod final : public RenderMethod {
+class PerspectiveMethod final : public ObjectBaseline {
  public:
   std::string_view name() const override { return "perspective"; }
 
@@ -67,13 +68,7 @@ class PerspectiveMethod final : public RenderMethod {
                        "expected the perspective image's longer side, 1 to 16384 pixels, got " +
                            std::to_string(settings.cube_face_size));
     }
-    if (!(settings.z_near > 0)) {
-      throw InputError("render settings", "z_near", "expected a positive near distance");
-    }
-    scene_ = &scene;
-    gpu_scene_ = &gpu_scene;
-    settings_ = settings;
-    triangle_base_ = scene_triangle_base(scene);
+    keep_scene(scene, gpu_scene, settings);
     outputs_.clear();
     buffer_bytes_ = 0;
     for (const OutputSpec& output : outputs) {
@@ -110,15 +105,11 @@ class PerspectiveMethod final : public RenderMethod {
                        12ull * std::uint64_t(n.x) * std::uint64_t(n.y);
       outputs_.push_back(std::move(out));
     }
-    if (!empty_vao_) empty_vao_ = VertexArray::create();
     scene_programs_.prepare(scene, settings.material, [](const MaterialShader& shader) {
       return link_perspective_scene_program(shader, false);
     });
     if (!lookup_program_) {
-      lookup_program_ = ProgramBuilder()
-                            .shader("baselines/fullscreen.vert")
-                            .shader("baselines/perspective_lookup.frag")
-                            .link();
+      lookup_program_ = link_fullscreen_program("baselines/perspective_lookup.frag");
     }
     check_gl_error("perspective prepare");
   }
@@ -126,16 +117,10 @@ class PerspectiveMethod final : public RenderMethod {
   RenderStats render(const glm::dmat4& T_eye_world, std::span<OutputTarget> targets,
                      GpuTimer* timer) override {
     FACET_ASSERT(scene_ && targets.size() == outputs_.size());
-    const Scene& scene = *scene_;
-    RenderStats stats;
-    stats.triangles_in = scene.triangle_count();
-    stats.triangles_visible = stats.triangles_in;
-    stats.gpu_buffer_bytes = buffer_bytes_;
+    RenderStats stats = whole_scene_stats(buffer_bytes_);
     if (timer) timer->begin("image");
     glEnable(GL_FRAMEBUFFER_SRGB);
-    begin_reversed_z_scene(settings_.cull_back_faces);
-    glBindVertexArray(empty_vao_.id());
-    gpu_scene_->bind_for_pulling();
+    begin_pulling(settings_.cull_back_faces);
     const float background[4] = {0, 0, 0, 1};
     const GLuint zero_id[4] = {0, 0, 0, 0};
     const float far_depth = 0;
@@ -148,28 +133,17 @@ class PerspectiveMethod final : public RenderMethod {
       const glm::dmat4 T_clip_eye = perspective_image_clip_from_eye(out.frustum, settings_.z_near);
       stats.replicas += draw_objects(T_eye_world, T_clip_eye);
     }
-    glDisable(GL_CULL_FACE);
-    glClipControl(GL_LOWER_LEFT, GL_NEGATIVE_ONE_TO_ONE);
+    end_reversed_z_scene();
     if (timer) timer->end();
 
-    if (timer) timer->begin("lookup");
-    glDisable(GL_DEPTH_TEST);
-    lookup_program_.use();
-    for (std::size_t i = 0; i < targets.size(); ++i) {
-      targets[i].clear();
-      targets[i].bind();
-      outputs_[i].lookup.bind_unit(0);
-      outputs_[i].colour.bind_unit(1);
-      outputs_[i].ids.bind_unit(2);
-      glDrawArrays(GL_TRIANGLES, 0, 3);
-      targets[i].resolve();
-    }
-    glBindVertexArray(0);
-    glDepthFunc(GL_LESS);
-    if (timer) {
-      timer->end();
-      timer->end_frame();
-    }
+    draw_lookup_pass(
+        lookup_program_, targets,
+        [this](std::size_t i) {
+          outputs_[i].lookup.bind_unit(0);
+          outputs_[i].colour.bind_unit(1);
+          outputs_[i].ids.bind_unit(2);
+        },
+        timer);
     check_gl_error("perspective render");
     return stats;
   }
@@ -220,13 +194,8 @@ class PerspectiveMethod final : public RenderMethod {
     return drawn;
   }
 
-  const Scene* scene_ = nullptr;
-  const GpuScene* gpu_scene_ = nullptr;
-  RenderSettings settings_;
-  std::vector<std::uint32_t> triangle_base_;
   std::vector<OutputState> outputs_;
   std::uint64_t buffer_bytes_ = 0;  // RenderStats::gpu_buffer_bytes
-  VertexArray empty_vao_;
   MaterialPrograms scene_programs_;
   Program lookup_program_;
 };

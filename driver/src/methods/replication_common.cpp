@@ -519,10 +519,7 @@ void FacetMethodBase::begin_facet_drawing(bool cull_back_faces) {
 
 void FacetMethodBase::end_facet_drawing() {
   for (int k = 0; k < 4; ++k) glDisable(GL_CLIP_DISTANCE0 + k);
-  glDisable(GL_CULL_FACE);
-  glDepthFunc(GL_LESS);
-  glDisable(GL_DEPTH_TEST);
-  glClipControl(GL_LOWER_LEFT, GL_NEGATIVE_ONE_TO_ONE);
+  end_reversed_z_scene();
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
 }
 

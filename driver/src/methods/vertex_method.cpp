@@ -22,6 +22,7 @@
 #include "facet/projection/errors.hpp"
 #include "facet/projection/warp_inverse.hpp"
 #include "material_programs.hpp"
+#include "object_baseline.hpp"
 #include "render_methods_internal.hpp"
 
 namespace facet::driver::detail {
@@ -171,7 +172,7 @@ OutputState make_output_state(const OutputSpec& output) {
   return out;
 }
 
-class VertexMethod final : public RenderMethod {
+class VertexMethod final : public ObjectBaseline {
  public:
   std::string_view name() const override { return "vertex"; }
 
@@ -184,17 +185,10 @@ class VertexMethod final : public RenderMethod {
                            std::to_string(kMaxTessellation) + ", got " +
                            std::to_string(settings.max_tessellation));
     }
-    if (!(settings.z_near > 0)) {
-      throw InputError("render settings", "z_near", "expected a positive near distance");
-    }
-    scene_ = &scene;
-    gpu_scene_ = &gpu_scene;
-    settings_ = settings;
-    triangle_base_ = scene_triangle_base(scene);
+    keep_scene(scene, gpu_scene, settings);
     outputs_.clear();
     for (const OutputSpec& output : outputs) outputs_.push_back(make_output_state(output));
 
-    if (!empty_vao_) empty_vao_ = VertexArray::create();
     if (!counters_) counters_ = Buffer::create(kCounters * sizeof(std::uint32_t));
     const bool tessellated = settings.max_tessellation > 1;
     MaterialPrograms& draw = tessellated ? tess_programs_ : plain_programs_;
@@ -208,12 +202,7 @@ class VertexMethod final : public RenderMethod {
                                         "baselines/vertex.geom"},
                                        false, shader);
     });
-    if (!mask_program_) {
-      mask_program_ = ProgramBuilder()
-                          .shader("baselines/fullscreen.vert")
-                          .shader("baselines/vertex_mask.frag")
-                          .link();
-    }
+    if (!mask_program_) mask_program_ = link_fullscreen_program("baselines/vertex_mask.frag");
     check_gl_error("vertex prepare");
   }
 
@@ -233,11 +222,9 @@ class VertexMethod final : public RenderMethod {
     if (timer) timer->begin("draw");
     glClearNamedBufferData(counters_.id(), GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, counters_.id());
-    gpu_scene_->bind_for_pulling();
     // Back faces are culled in 3D by the shaders: a large triangle's projected winding is not
     // reliable.
-    begin_reversed_z_scene(false);
-    glBindVertexArray(empty_vao_.id());
+    begin_pulling(false);
     if (tessellated) glPatchParameteri(GL_PATCH_VERTICES, 3);
 
     for (std::size_t i = 0; i < outputs_.size(); ++i) {
@@ -284,9 +271,7 @@ class VertexMethod final : public RenderMethod {
       target.resolve();
     }
     glBindVertexArray(0);
-    glDisable(GL_DEPTH_TEST);
-    glDepthFunc(GL_LESS);
-    glClipControl(GL_LOWER_LEFT, GL_NEGATIVE_ONE_TO_ONE);
+    end_reversed_z_scene();
     if (timer) {
       timer->end();
       timer->end_frame();
@@ -325,12 +310,7 @@ class VertexMethod final : public RenderMethod {
     glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
   }
 
-  const Scene* scene_ = nullptr;
-  const GpuScene* gpu_scene_ = nullptr;
-  RenderSettings settings_;
-  std::vector<std::uint32_t> triangle_base_;
   std::vector<OutputState> outputs_;
-  VertexArray empty_vao_;
   Buffer counters_;
   MaterialPrograms plain_programs_, tess_programs_;
   Program mask_program_;
