@@ -15,6 +15,7 @@
 #include <cmath>
 #include <glm/gtc/type_ptr.hpp>
 
+#include "../gl/scene_framebuffer.hpp"
 #include "facet/driver/gpu_timer.hpp"
 #include "facet/driver/material_shader.hpp"
 #include "facet/driver/program.hpp"
@@ -123,8 +124,7 @@ class CubemapMethod final : public ObjectBaseline {
                        std::uint64_t(output.warp.output_size.y);
     }
     face_framebuffer_ = Framebuffer::create();
-    const GLenum buffers[2] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
-    glNamedFramebufferDrawBuffers(face_framebuffer_.id(), 2, buffers);
+    draw_to_colour_and_ids(face_framebuffer_);
     if (layered_) {
       glNamedFramebufferTexture(face_framebuffer_.id(), GL_COLOR_ATTACHMENT0, colour_cube_.id(), 0);
       glNamedFramebufferTexture(face_framebuffer_.id(), GL_COLOR_ATTACHMENT1, id_cube_.id(), 0);

@@ -10,6 +10,7 @@
 #include <cmath>
 #include <glm/gtc/type_ptr.hpp>
 
+#include "../gl/scene_framebuffer.hpp"
 #include "facet/driver/gpu_timer.hpp"
 #include "facet/driver/material_shader.hpp"
 #include "facet/driver/perspective_image.hpp"
@@ -88,17 +89,9 @@ class PerspectiveMethod final : public ObjectBaseline {
       glTextureParameteri(out.colour.id(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
       glTextureParameteri(out.colour.id(), GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
       glTextureParameteri(out.colour.id(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-      out.ids = Texture::create_2d(GL_R32UI, n.x, n.y);
-      glTextureParameteri(out.ids.id(), GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-      glTextureParameteri(out.ids.id(), GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+      out.ids = create_id_texture(n);
       out.depth = Texture::create_2d(GL_DEPTH_COMPONENT32F, n.x, n.y);
-      out.framebuffer = Framebuffer::create();
-      out.framebuffer.attach(GL_COLOR_ATTACHMENT0, out.colour);
-      out.framebuffer.attach(GL_COLOR_ATTACHMENT1, out.ids);
-      out.framebuffer.attach(GL_DEPTH_ATTACHMENT, out.depth);
-      const GLenum buffers[2] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
-      glNamedFramebufferDrawBuffers(out.framebuffer.id(), 2, buffers);
-      out.framebuffer.check_complete();
+      out.framebuffer = scene_framebuffer(out.colour, out.ids, out.depth);
       // Held for every frame: the lookup (RGBA32F per output pixel) and the image's colour
       // (SRGB8_ALPHA8), IDs (R32UI) and depth (DEPTH32F).
       buffer_bytes_ += 16ull * std::uint64_t(size.x) * std::uint64_t(size.y) +

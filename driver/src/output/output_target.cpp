@@ -3,18 +3,11 @@
 #include <string>
 
 #include "../gl/image_rows.hpp"
+#include "../gl/scene_framebuffer.hpp"
 #include "facet/driver/render_method.hpp"
 #include "facet/projection/errors.hpp"
 
 namespace facet::driver {
-namespace {
-
-void set_draw_buffers(const Framebuffer& framebuffer) {
-  const GLenum buffers[2] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
-  glNamedFramebufferDrawBuffers(framebuffer.id(), 2, buffers);
-}
-
-}  // namespace
 
 OutputTarget OutputTarget::create(glm::ivec2 size, int msaa_samples) {
   FACET_ASSERT(size.x > 0 && size.y > 0);
@@ -46,27 +39,16 @@ OutputTarget OutputTarget::create(glm::ivec2 size, int msaa_samples) {
   target.size_ = size;
   target.msaa_samples_ = msaa_samples > 1 ? msaa_samples : 0;
   target.colour_ = Texture::create_2d(GL_SRGB8_ALPHA8, size.x, size.y);
-  target.ids_ = Texture::create_2d(GL_R32UI, size.x, size.y);
-  glTextureParameteri(target.ids_.id(), GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-  glTextureParameteri(target.ids_.id(), GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+  target.ids_ = detail::create_id_texture(size);
   target.depth_ = Texture::create_2d(GL_DEPTH_COMPONENT32F, size.x, size.y);
-  target.framebuffer_ = Framebuffer::create();
-  target.framebuffer_.attach(GL_COLOR_ATTACHMENT0, target.colour_);
-  target.framebuffer_.attach(GL_COLOR_ATTACHMENT1, target.ids_);
-  target.framebuffer_.attach(GL_DEPTH_ATTACHMENT, target.depth_);
-  set_draw_buffers(target.framebuffer_);
-  target.framebuffer_.check_complete();
+  target.framebuffer_ = detail::scene_framebuffer(target.colour_, target.ids_, target.depth_);
   if (target.msaa_samples_ > 0) {
     const int s = target.msaa_samples_;
     target.msaa_colour_ = Renderbuffer::create(GL_SRGB8_ALPHA8, size.x, size.y, s);
     target.msaa_ids_ = Renderbuffer::create(GL_R32UI, size.x, size.y, s);
     target.msaa_depth_ = Renderbuffer::create(GL_DEPTH_COMPONENT32F, size.x, size.y, s);
-    target.msaa_framebuffer_ = Framebuffer::create();
-    target.msaa_framebuffer_.attach(GL_COLOR_ATTACHMENT0, target.msaa_colour_);
-    target.msaa_framebuffer_.attach(GL_COLOR_ATTACHMENT1, target.msaa_ids_);
-    target.msaa_framebuffer_.attach(GL_DEPTH_ATTACHMENT, target.msaa_depth_);
-    set_draw_buffers(target.msaa_framebuffer_);
-    target.msaa_framebuffer_.check_complete();
+    target.msaa_framebuffer_ =
+        detail::scene_framebuffer(target.msaa_colour_, target.msaa_ids_, target.msaa_depth_);
   }
   return target;
 }
@@ -104,7 +86,7 @@ void OutputTarget::resolve() const {
   glBlitNamedFramebuffer(msaa_framebuffer_.id(), framebuffer_.id(), 0, 0, w, h, 0, 0, w, h,
                          GL_DEPTH_BUFFER_BIT, GL_NEAREST);
   glNamedFramebufferReadBuffer(msaa_framebuffer_.id(), GL_COLOR_ATTACHMENT0);
-  set_draw_buffers(framebuffer_);
+  detail::draw_to_colour_and_ids(framebuffer_);
 }
 
 std::vector<std::uint8_t> OutputTarget::read_colour_rgba8() const {
