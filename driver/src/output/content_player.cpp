@@ -19,6 +19,7 @@
 #include "facet/driver/program.hpp"
 #include "facet/projection/errors.hpp"
 #include "facet/projection/interrupt.hpp"
+#include "window_outputs.hpp"
 
 namespace facet::driver {
 
@@ -193,13 +194,6 @@ void on_play_key(GLFWwindow* window, int key, int, int action, int) {
   if (key == GLFW_KEY_SPACE) keys.paused = !keys.paused;
 }
 
-struct PlayWindow {
-  std::unique_ptr<GlfwWindowContext> context;
-  std::vector<std::size_t> outputs;
-  std::vector<glm::ivec4> viewports;  // GL viewport per output: x, y from the bottom-left, w, h
-  VertexArray vertex_array;
-};
-
 }  // namespace
 
 void run_windowed_play(const SessionDisplay& display, std::unique_ptr<ContentMedia> media,
@@ -207,42 +201,18 @@ void run_windowed_play(const SessionDisplay& display, std::unique_ptr<ContentMed
                        PendingLookups lookups) {
   const auto entered = std::chrono::steady_clock::now();
   const std::vector<MonitorInfo> monitors = list_monitors();
-  std::vector<OutputPlacement> placements;
-  for (std::size_t i = 0; i < display.outputs.size(); ++i)
-    placements.push_back(place_output(display.outputs[i].placement, monitors,
-                                      display.missing_monitor,
-                                      display.outputs[i].spec.warp.output_size, display.source,
-                                      "projectors[" + std::to_string(i) + "].output.monitor"));
+  const std::vector<OutputPlacement> placements = detail::place_display_outputs(display, monitors);
   PlayKeys keys;
-  std::vector<PlayWindow> windows;
-  auto open_window = [&](WindowOptions o) {
-    PlayWindow window;
-    o.share = windows.empty() ? nullptr : windows.front().context.get();
-    o.title = "facet play";
-    window.context = std::make_unique<GlfwWindowContext>(o);
-    auto* native = static_cast<GLFWwindow*>(window.context->native_window());
-    glfwSetWindowUserPointer(native, &keys);
-    glfwSetKeyCallback(native, on_play_key);
-    return window;
-  };
-  for (const OutputWindow& layout : output_windows(placements, window_options.span)) {
-    PlayWindow window = open_window(layout.options);
-    window.outputs = layout.outputs;
-    for (glm::ivec4 viewport : layout.viewports) {
-      if (viewport.z == 0) viewport = glm::ivec4(0, 0, window.context->framebuffer_size());
-      window.viewports.push_back(viewport);
-    }
-    windows.push_back(std::move(window));
-  }
+  std::vector<detail::OutputsWindow> windows = detail::open_outputs_windows(
+      placements, window_options.span, "facet play", [&keys](GLFWwindow* native) {
+        glfwSetWindowUserPointer(native, &keys);
+        glfwSetKeyCallback(native, on_play_key);
+      });
 
   windows.front().context->make_current();
   ContentPlayer player(display, std::move(media), options, std::move(lookups));
-  std::vector<Texture> raw_views;
-  for (const OutputTarget& target : player.targets())
-    raw_views.push_back(Texture::create_view(target.colour(), GL_RGBA8));
-  const Program present =
-      ProgramBuilder().shader("output/present.vert").shader("output/present.frag").link();
-  for (PlayWindow& window : windows) {
+  const detail::WindowPresenter presenter(player.targets());
+  for (detail::OutputsWindow& window : windows) {
     window.context->make_current();
     window.vertex_array = VertexArray::create();
   }
@@ -268,12 +238,7 @@ void run_windowed_play(const SessionDisplay& display, std::unique_ptr<ContentMed
   std::uint64_t frames_shown = 0;
   std::int64_t dropped_total = 0;
   for (std::uint64_t frame = 0; !window_options.frames || frame < *window_options.frames; ++frame) {
-    glfwPollEvents();
-    interrupted_by = interrupt_signal();
-    if (interrupted_by) break;
-    bool closing = keys.quit;
-    for (const PlayWindow& window : windows) closing = closing || window.context->should_close();
-    if (closing) break;
+    if (detail::poll_run_ends(windows, keys.quit, interrupted_by)) break;
     const auto now = std::chrono::steady_clock::now();
     const double dt = std::chrono::duration<double>(now - last).count();
     last = now;
@@ -304,39 +269,23 @@ void run_windowed_play(const SessionDisplay& display, std::unique_ptr<ContentMed
     if (stats_file.is_open()) stats_file << line.dump() << '\n';
     GLsync rendered = glFenceSync(GL_SYNC_GPU_COMMANDS_COMPLETE, 0);
     glFlush();
-    for (PlayWindow& window : windows) {
+    for (detail::OutputsWindow& window : windows) {
       if (!show) break;  // a frame the cluster's barrier did not let swap
       window.context->make_current();
       glWaitSync(rendered, 0, GL_TIMEOUT_IGNORED);
-      glBindFramebuffer(GL_FRAMEBUFFER, 0);
-      glDisable(GL_FRAMEBUFFER_SRGB);
-      const glm::ivec2 size = window.context->framebuffer_size();
-      glViewport(0, 0, size.x, size.y);
-      glClearColor(0, 0, 0, 1);
-      glClear(GL_COLOR_BUFFER_BIT);
-      present.use();
-      glBindVertexArray(window.vertex_array.id());
-      for (std::size_t k = 0; k < window.outputs.size(); ++k) {
-        const glm::ivec4& v = window.viewports[k];
-        const glm::ivec2 output_size = player.targets()[window.outputs[k]].size();
-        glViewport(v.x, v.y, v.z, v.w);
-        glUniform2i(0, v.x, v.y);
-        glUniform2f(1, float(output_size.x) / float(v.z), float(output_size.y) / float(v.w));
-        raw_views[window.outputs[k]].bind_unit(0);
-        glDrawArrays(GL_TRIANGLES, 0, 3);
-      }
+      presenter.present(window.context->framebuffer_size(), window.vertex_array, window.outputs,
+                        window.viewports);
       window.context->swap_buffers();
     }
     windows.front().context->make_current();
     glDeleteSync(rendered);
     frames_shown = frame + 1;
   }
-  for (PlayWindow& window : windows) {
+  for (detail::OutputsWindow& window : windows) {
     window.context->make_current();
     window.vertex_array.reset();
   }
   windows.front().context->make_current();
-  raw_views.clear();
   if (window_options.log)
     window_options.log(LogLevel::info, std::to_string(frames_shown) + " frames shown, " +
                                            std::to_string(dropped_total) +

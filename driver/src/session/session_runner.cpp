@@ -17,6 +17,7 @@
 #include <string_view>
 
 #include "../gl/image_rows.hpp"
+#include "../output/window_outputs.hpp"
 #include "facet/driver/city.hpp"
 #include "facet/driver/cluster.hpp"
 #include "facet/driver/gl_context.hpp"
@@ -265,15 +266,6 @@ void on_monitor(GLFWmonitor* monitor, int event) {
   if (monitor_messages) monitor_messages->messages.push_back(message);
 }
 
-struct Window {
-  std::unique_ptr<GlfwWindowContext> context;
-  std::vector<std::size_t> outputs;   // indices of the outputs it shows
-  std::vector<glm::ivec4> viewports;  // where each shows, framebuffer pixels (GL, from bottom)
-  std::vector<OutputPlacement> placements;
-  VertexArray vertex_array;  // per context: vertex arrays are not shared
-  Buffer overlay_vertices;
-};
-
 // Moves the eye with the held keys and the dragged mouse, scaled by the frame time.
 void steer(Navigation& nav, GLFWwindow* window, double dt, const glm::dmat4& T_world_eye_now) {
   const double speed = 6.0, turn = 1.2;  // m/s, rad/s
@@ -329,19 +321,13 @@ std::vector<float> overlay_triangles(const std::string& text, float x, float y) 
 void run_windowed_session(const SessionDisplay& display, const Scene& scene, const CameraPath& path,
                           const WindowRunOptions& options) {
   const std::vector<MonitorInfo> monitors = list_monitors();
-  std::vector<OutputPlacement> placements;
-  for (std::size_t i = 0; i < display.outputs.size(); ++i) {
-    placements.push_back(place_output(display.outputs[i].placement, monitors,
-                                      display.missing_monitor,
-                                      display.outputs[i].spec.warp.output_size, display.source,
-                                      "projectors[" + std::to_string(i) + "].output.monitor"));
-  }
+  const std::vector<OutputPlacement> placements = detail::place_display_outputs(display, monitors);
 
   Navigation nav;
   nav.play_path = options.play_path;
   nav.overlay = options.overlay;
 
-  std::vector<Window> windows;
+  std::vector<detail::OutputsWindow> windows;
   // Until the windows close, also when the run ends by an exception (a lost cluster master).
   monitor_messages = &nav;
   monitor_log = &options.log;
@@ -352,28 +338,12 @@ void run_windowed_session(const SessionDisplay& display, const Scene& scene, con
       monitor_log = nullptr;
     }
   } stop_monitor_messages;
-  auto open_window = [&](WindowOptions window_options) {
-    Window window;
-    window_options.share = windows.empty() ? nullptr : windows.front().context.get();
-    window_options.title = "facet";
-    window.context = std::make_unique<GlfwWindowContext>(window_options);
-    auto* native = static_cast<GLFWwindow*>(window.context->native_window());
-    glfwSetWindowUserPointer(native, &nav);
-    glfwSetKeyCallback(native, on_key);
-    glfwSetMouseButtonCallback(native, on_mouse_button);
-    return window;
-  };
-  for (const OutputWindow& layout : output_windows(placements, options.span)) {
-    Window window = open_window(layout.options);
-    window.outputs = layout.outputs;
-    for (std::size_t k = 0; k < layout.outputs.size(); ++k) {
-      glm::ivec4 viewport = layout.viewports[k];
-      if (viewport.z == 0) viewport = glm::ivec4(0, 0, window.context->framebuffer_size());
-      window.viewports.push_back(viewport);
-      window.placements.push_back(placements[layout.outputs[k]]);
-    }
-    windows.push_back(std::move(window));
-  }
+  windows =
+      detail::open_outputs_windows(placements, options.span, "facet", [&nav](GLFWwindow* native) {
+        glfwSetWindowUserPointer(native, &nav);
+        glfwSetKeyCallback(native, on_key);
+        glfwSetMouseButtonCallback(native, on_mouse_button);
+      });
   glfwSetMonitorCallback(on_monitor);
   if (options.log) {
     std::string line = std::to_string(windows.size()) + " windows open:";
@@ -389,17 +359,14 @@ void run_windowed_session(const SessionDisplay& display, const Scene& scene, con
   windows.front().context->make_current();
   Session session(display, scene);
   session.set_pattern(options.pattern);
-  std::vector<Texture> raw_views;
-  for (const OutputTarget& target : session.targets())
-    raw_views.push_back(Texture::create_view(target.colour(), GL_RGBA8));
-  const Program present =
-      ProgramBuilder().shader("output/present.vert").shader("output/present.frag").link();
+  const detail::WindowPresenter presenter(session.targets());
   const Program overlay =
       ProgramBuilder().shader("output/overlay.vert").shader("output/overlay.frag").link();
-  for (Window& window : windows) {
+  for (detail::OutputsWindow& window : windows) {
     window.context->make_current();
     window.vertex_array = VertexArray::create();
   }
+  std::vector<Buffer> overlay_vertices(windows.size());  // per window: the overlay's triangles
 
   struct WindowReport {
     glm::ivec2 position{0}, framebuffer{0};
@@ -415,12 +382,7 @@ void run_windowed_session(const SessionDisplay& display, const Scene& scene, con
   std::uint64_t frames_shown = 0;
   int interrupted_by = 0;
   for (std::uint64_t frame = 0; !options.frames || frame < *options.frames; ++frame) {
-    glfwPollEvents();
-    interrupted_by = interrupt_signal();
-    if (interrupted_by) break;
-    bool closing = nav.quit;
-    for (const Window& window : windows) closing = closing || window.context->should_close();
-    if (closing) break;
+    if (detail::poll_run_ends(windows, nav.quit, interrupted_by)) break;
     const auto now = std::chrono::steady_clock::now();
     const double dt = std::chrono::duration<double>(now - last).count();
     last = now;
@@ -475,28 +437,11 @@ void run_windowed_session(const SessionDisplay& display, const Scene& scene, con
     const bool last_frame = options.frames && frame + 1 == *options.frames;
     // A frame the cluster went on without is not shown.
     for (std::size_t w = 0; show && w < windows.size(); ++w) {
-      Window& window = windows[w];
+      detail::OutputsWindow& window = windows[w];
       window.context->make_current();
       glWaitSync(rendered, 0, GL_TIMEOUT_IGNORED);
-      glBindFramebuffer(GL_FRAMEBUFFER, 0);
-      glDisable(GL_FRAMEBUFFER_SRGB);  // the views hold the encoded bytes already
-      glDisable(GL_DEPTH_TEST);
-      glDisable(GL_BLEND);
       const glm::ivec2 size = window.context->framebuffer_size();
-      glViewport(0, 0, size.x, size.y);
-      glClearColor(0, 0, 0, 1);
-      glClear(GL_COLOR_BUFFER_BIT);
-      present.use();
-      glBindVertexArray(window.vertex_array.id());
-      for (std::size_t k = 0; k < window.outputs.size(); ++k) {
-        const glm::ivec4& v = window.viewports[k];
-        const glm::ivec2 output_size = session.targets()[window.outputs[k]].size();
-        glViewport(v.x, v.y, v.z, v.w);
-        glUniform2i(0, v.x, v.y);
-        glUniform2f(1, float(output_size.x) / float(v.z), float(output_size.y) / float(v.w));
-        raw_views[window.outputs[k]].bind_unit(0);
-        glDrawArrays(GL_TRIANGLES, 0, 3);
-      }
+      presenter.present(size, window.vertex_array, window.outputs, window.viewports);
       if (last_frame && options.report) {
         // Exactly the output's bytes, as the projector would receive them?
         WindowReport& report = reports[w];
@@ -529,12 +474,12 @@ void run_windowed_session(const SessionDisplay& display, const Scene& scene, con
       }
       if (!overlay_text.empty()) {
         const std::vector<float> triangles = overlay_triangles(overlay_text, 12, 12);
-        window.overlay_vertices = Buffer::create_from(triangles);
+        overlay_vertices[w] = Buffer::create_from(triangles);
         glViewport(0, 0, size.x, size.y);
         overlay.use();
         glUniform2f(0, float(size.x), float(size.y));
         glBindVertexArray(window.vertex_array.id());
-        window.overlay_vertices.bind_base(GL_SHADER_STORAGE_BUFFER, 0);
+        overlay_vertices[w].bind_base(GL_SHADER_STORAGE_BUFFER, 0);
         glDrawArrays(GL_TRIANGLES, 0, GLsizei(triangles.size() / 2));
       }
       window.context->swap_buffers();
@@ -549,8 +494,8 @@ void run_windowed_session(const SessionDisplay& display, const Scene& scene, con
     for (std::size_t w = 0; w < windows.size(); ++w) {
       nlohmann::json outputs_json = nlohmann::json::array();
       for (std::size_t k = 0; k < windows[w].outputs.size(); ++k) {
-        const OutputPlacement& p = windows[w].placements[k];
         const std::size_t index = windows[w].outputs[k];
+        const OutputPlacement& p = placements[index];
         outputs_json.push_back(
             {{"name", display.outputs[index].spec.name},
              {"placement", p.kind == OutputPlacement::Kind::fullscreen ? "fullscreen" : "window"},
@@ -572,13 +517,12 @@ void run_windowed_session(const SessionDisplay& display, const Scene& scene, con
     });
   }
   // Vertex arrays belong to their own context: delete each with its context current.
-  for (Window& window : windows) {
-    window.context->make_current();
-    window.vertex_array.reset();
-    window.overlay_vertices.reset();
+  for (std::size_t w = 0; w < windows.size(); ++w) {
+    windows[w].context->make_current();
+    windows[w].vertex_array.reset();
+    overlay_vertices[w].reset();
   }
   windows.front().context->make_current();
-  raw_views.clear();
   if (interrupted_by)
     throw Interrupted(interrupted_by,
                       "stopped after " + std::to_string(frames_shown) + " frames" +
