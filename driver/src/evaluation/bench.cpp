@@ -515,9 +515,336 @@ std::vector<BenchScenario> make_bench_scenarios(const BenchOptions& options) {
   return scenarios;
 }
 
+namespace {
+
+using Say = std::function<void(const std::string&)>;
+
+// A scenario's scene with its oracle and views. Scenarios with one scene follow each other (the
+// scale scenarios) or share BenchOptions::scene, so each scene is built once.
+struct LoadedScene {
+  std::string name;
+  Scene scene;
+  GpuScene gpu;
+  std::unique_ptr<ReferenceRaycaster> raycaster;
+  std::unique_ptr<FrameViews> views;
+};
+
+// Makes `loaded` hold the scene named `scene_text`, building it unless it holds it already (the
+// last scene's GPU and CPU memory freed first).
+void load_scene_once(std::unique_ptr<LoadedScene>& loaded, const std::string& scene_text,
+                     const BenchOptions& options, const Say& say) {
+  if (loaded && loaded->name == scene_text) return;
+  loaded.reset();
+  const auto start = std::chrono::steady_clock::now();
+  const SceneName scene_name = parse_scene_name(scene_text);
+  auto next = std::make_unique<LoadedScene>();
+  next->name = scene_text;
+  next->scene = load_scene(scene_name);
+  next->gpu = upload_scene(next->scene);
+  next->raycaster = std::make_unique<ReferenceRaycaster>(next->scene);
+  // The view facet render takes by default: outside a closed model, else at its centre.
+  const SceneView view = choose_scene_view(next->scene, {}, scene_name.builtin_city());
+  next->views = std::make_unique<FrameViews>(view, kBenchFrameStepS, options.static_view);
+  loaded = std::move(next);
+  say(format("scene %s: %zu triangles, %zu objects, ready in %.0f ms", scene_text.c_str(),
+             loaded->scene.triangle_count(), loaded->scene.objects.size(), wall_ms_since(start)));
+  if (!view.message.empty()) say("scene " + scene_text + ": " + view.message);
+}
+
+// One scenario's bench, in the order run_bench calls it: the setup (each output's warp inverse,
+// reference IDs at the first view and target), then per setting a runner prepared and measured
+// for accuracy on its warm-up frame, then the timed frames of all runners interleaved, then a
+// report row per runner.
+class ScenarioBench {
+ public:
+  ScenarioBench(const BenchScenario& scenario, std::string scene_text, const LoadedScene& loaded,
+                const BenchOptions& options, const Say& say)
+      : scenario_(scenario),
+        scene_text_(std::move(scene_text)),
+        loaded_(loaded),
+        options_(options),
+        say_(say),
+        T0_(loaded.views->T_eye_world(0)) {
+    const OutputSpec& first = scenario.outputs[0];
+    wrap_x_ = first.glc ? first.glc->wraps_horizontally : first.warp.base.wraps_horizontally();
+    for (const OutputSpec& output : scenario.outputs) {
+      inverses_.emplace_back(output.warp);
+      // A GLC camera's pixels cast its own rays (the default near distance of RenderSettings).
+      reference_.push_back(output.glc
+                               ? loaded.raycaster->ids(*output.glc, T0_, RenderSettings{}.z_near)
+                               : loaded.raycaster->ids(inverses_.back(), T0_));
+    }
+    for (const OutputSpec& output : scenario.outputs) {
+      targets_.push_back(OutputTarget::create(output.warp.output_size));
+    }
+  }
+
+  // The cube map's geometric max error at the scenario's matched face edge, worst over the
+  // outputs (0 without one): with_matched_tolerance's argument.
+  double matched_cube_max_px() const {
+    double cube_max_px = 0;
+    for (std::size_t i = 0; scenario_.matched_cube_face > 0 && i < scenario_.outputs.size(); ++i) {
+      cube_max_px = std::max(cube_max_px, cube_texel_error(scenario_.outputs[i].warp, inverses_[i],
+                                                           scenario_.matched_cube_face)
+                                              .first);
+    }
+    return cube_max_px;
+  }
+
+  // Prepares `setting`'s method and measures its accuracy on the warm-up frame; a setting whose
+  // prepare throws InputError keeps a row with the error and is not timed.
+  void prepare(const BenchSetting& setting) {
+    Runner runner;
+    runner.setting = setting;
+    runner.row = first_columns(setting);
+    BenchRow& row = runner.row;
+    const auto start = std::chrono::steady_clock::now();
+    try {
+      runner.method = make_render_method(setting.method);
+      runner.method->prepare(loaded_.scene, loaded_.gpu, scenario_.outputs, setting.settings);
+    } catch (const InputError& error) {
+      row.error = error.what();
+      say_("  " + setting.method + " " + setting.label + ": not run: " + row.error);
+      runner.method.reset();
+      runners_.push_back(std::move(runner));
+      return;
+    }
+    const double prepare_ms = wall_ms_since(start);
+    measure_ids(runner);
+    measure_geometric_error(setting, row);
+    say_(format(
+        "  %-11s %-12s prepared in %7.0f ms: id_mismatch %.5f, edges max %.2f px (output "
+        "%zu pixel %d,%d) p99 %.2f px, %llu depth ties, %llu drawn outside the display "
+        "(up to %.2f px), geometric max %.3f px",
+        setting.method.c_str(), setting.label.c_str(), prepare_ms, row.id_mismatch, row.max_edge_px,
+        row.worst_edge_output, row.worst_edge_pixel.x, row.worst_edge_pixel.y, row.p99_edge_px,
+        static_cast<unsigned long long>(row.depth_tie_pixels),
+        static_cast<unsigned long long>(row.outside_display_pixels), row.outside_display_max_px,
+        row.geometric_max_px));
+    runners_.push_back(std::move(runner));
+  }
+
+  // Timed frames, interleaved: every setting once per frame, the starting setting rotating.
+  void time_frames() {
+    for (int k = 1; k <= options_.frames; ++k) {
+      const glm::dmat4 T = loaded_.views->T_eye_world(k);
+      for (std::size_t j = 0; j < runners_.size(); ++j) {
+        Runner& runner = runners_[(j + std::size_t(k)) % runners_.size()];
+        if (!runner.method) continue;
+        const auto start = std::chrono::steady_clock::now();
+        runner.stats.push_back(runner.method->render(T, targets_, &runner.timer));
+        glFinish();
+        runner.frame_ms.push_back(wall_ms_since(start));
+        if (runner.setting.method == "facets" || runner.setting.method == "facets-gs") {
+          // The same view again: the pipeline keeps passes 1 and 2 and draws only.
+          const auto again = std::chrono::steady_clock::now();
+          const RenderStats reused = runner.method->render(T, targets_);
+          glFinish();
+          if (reused.reused_replication) runner.reused_ms.push_back(wall_ms_since(again));
+        }
+      }
+      say_(format("  timed frame %d of %d done", k, options_.frames));
+    }
+  }
+
+  // Appends each runner's row, with its timings and last frame's figures when it ran.
+  void add_rows(std::vector<BenchRow>& rows) {
+    for (Runner& runner : runners_) {
+      if (runner.method) summarize_timing(runner);
+      rows.push_back(runner.row);
+    }
+  }
+
+ private:
+  // The columns a row has whether or not its setting runs.
+  BenchRow first_columns(const BenchSetting& setting) const {
+    BenchRow row;
+    row.scenario = scenario_.name;
+    row.scene = scene_text_;
+    row.scale_group = scenario_.scale_group;
+    row.triangles_scene = loaded_.scene.triangle_count();
+    row.method = setting.method;
+    row.setting = setting.label;
+    row.fit_label = setting.fit_label.empty() ? setting.label : setting.fit_label;
+    row.outputs = int(scenario_.outputs.size());
+    row.output_size = size_text(scenario_.outputs[0].warp.output_size);
+    row.frames = options_.frames;
+    return row;
+  }
+
+  // Renders the accuracy frame (also the warm-up) and compares its IDs with the reference:
+  // mismatch, edge displacement, and the pixels differing from a facets setting's IDs.
+  void measure_ids(Runner& runner) {
+    const BenchSetting& setting = runner.setting;
+    BenchRow& row = runner.row;
+    const ReferenceRaycaster& raycaster = *loaded_.raycaster;
+    runner.method->render(T0_, targets_);
+    glFinish();
+    IdComparison pooled;
+    std::vector<std::vector<std::uint32_t>> ids;
+    for (std::size_t i = 0; i < targets_.size(); ++i) {
+      ids.push_back(targets_[i].read_ids());
+      const IdComparison c =
+          compare_ids(reference_[i], ids.back(), targets_[i].size(), {.wrap_x = wrap_x_});
+      const EdgeDisplacement e =
+          scenario_.outputs[i].glc
+              ? raycaster.edge_displacement(*scenario_.outputs[i].glc, T0_, RenderSettings{}.z_near,
+                                            reference_[i], ids.back(), {.wrap_x = wrap_x_})
+              : raycaster.edge_displacement(inverses_[i], T0_, reference_[i], ids.back(),
+                                            {.wrap_x = wrap_x_});
+      pooled.compared_pixels += c.compared_pixels;
+      pooled.mismatched_pixels += c.mismatched_pixels;
+      if (e.max_px > pooled.max_edge_px) {
+        pooled.max_edge_px = e.max_px;
+        row.worst_edge_pixel = e.worst_pixel;
+        row.worst_edge_output = i;
+      }
+      pooled.p99_edge_px = std::max(pooled.p99_edge_px, e.p99_px);
+      row.edge_beyond_window_pixels += e.beyond_window;
+      row.depth_tie_pixels += e.depth_ties;
+      row.outside_display_pixels += e.outside_display;
+      row.outside_display_max_px = std::max(row.outside_display_max_px, e.outside_display_max_px);
+    }
+    row.id_mismatch = pooled.compared_pixels
+                          ? double(pooled.mismatched_pixels) / double(pooled.compared_pixels)
+                          : 0.0;
+    row.max_edge_px = pooled.max_edge_px;
+    row.p99_edge_px = pooled.p99_edge_px;
+    if (setting.method == "facets") facet_ids_[setting.label] = ids;
+    if (!setting.same_ids_as.empty()) {
+      const auto match = facet_ids_.find(setting.same_ids_as);
+      if (match != facet_ids_.end()) {
+        std::uint64_t differing = 0;
+        for (std::size_t i = 0; i < ids.size(); ++i) {
+          for (std::size_t p = 0; p < ids[i].size(); ++p) {
+            differing += ids[i][p] != match->second[i][p];
+          }
+        }
+        row.id_pixels_differing_from_facets = differing;
+      }
+    }
+  }
+
+  // The geometric error of the method's approximation, by the method's kind: facet error,
+  // intermediate image texels, none (exact rays), else the reference edges.
+  void measure_geometric_error(const BenchSetting& setting, BenchRow& row) {
+    if (setting.method == "facets" || setting.method == "facets-gs" ||
+        setting.method == "tessellated" || setting.method == "naive") {
+      std::tie(row.geometric_max_px, row.geometric_rms_px) = facet_error_of(setting);
+      row.geometric_source = "facet error";
+    } else if (setting.method == "cubemap" || setting.method == "perspective") {
+      // The texel error of the intermediate image, worst and RMS pooled over the outputs.
+      const bool cube = setting.method == "cubemap";
+      double max_px = 0, sum_sq = 0;
+      for (std::size_t i = 0; i < scenario_.outputs.size(); ++i) {
+        const Warp& warp = scenario_.outputs[i].warp;
+        const int size = setting.settings.cube_face_size;
+        const auto [m, rms] = cube ? cube_texel_error(warp, inverses_[i], size)
+                                   : perspective_texel_error(warp, inverses_[i], size);
+        max_px = std::max(max_px, m);
+        sum_sq += rms * rms;
+      }
+      row.geometric_max_px = max_px;
+      row.geometric_rms_px = std::sqrt(sum_sq / double(scenario_.outputs.size()));
+      row.geometric_source = cube ? "cube texel" : "image texel";
+    } else if (setting.method == "glc") {
+      // Each pixel's own ray is cast at the triangles: no geometric approximation.
+      row.geometric_source = "exact rays";
+    } else {
+      row.geometric_max_px = row.max_edge_px;
+      row.geometric_rms_px = row.p99_edge_px;
+      row.geometric_source = "reference edges";
+    }
+  }
+
+  // Worst and RMS facet error over the outputs at `setting`'s layout: they depend only on the
+  // outputs and the layout, so the facet methods at one layout share them.
+  std::pair<double, double> facet_error_of(const BenchSetting& setting) {
+    auto found = facet_errors_.find(setting.label);
+    if (found != facet_errors_.end()) return found->second;
+    double max_px = 0, sum_sq = 0;
+    std::size_t n = 0;
+    for (const OutputSpec& output : scenario_.outputs) {
+      const FacetMesh mesh = build_facets(output.warp, setting.settings.facets);
+      const FacetError error = evaluate_facet_error(output.warp, mesh);
+      max_px = std::max(max_px, error.max_px);
+      sum_sq += error.rms_px * error.rms_px * double(error.samples);
+      n += error.samples;
+    }
+    const std::pair<double, double> result{max_px, n ? std::sqrt(sum_sq / double(n)) : 0.0};
+    facet_errors_.emplace(setting.label, result);
+    return result;
+  }
+
+  // The row's timings (medians over the timed frames, per pass from the GPU timer) and the last
+  // frame's figures.
+  void summarize_timing(Runner& runner) const {
+    BenchRow& row = runner.row;
+    row.frame_ms = median(runner.frame_ms);
+    row.frame_ms_min = *std::min_element(runner.frame_ms.begin(), runner.frame_ms.end());
+    row.frame_ms_max = *std::max_element(runner.frame_ms.begin(), runner.frame_ms.end());
+    std::map<std::string, std::vector<double>> passes;
+    std::vector<double> totals, shares;
+    while (auto frame = runner.timer.poll(true)) {
+      std::map<std::string, double> sums;
+      double total = 0;
+      for (const PassTime& pass : *frame) {
+        sums[pass.pass] += pass.milliseconds;
+        total += pass.milliseconds;
+      }
+      for (const auto& [pass, ms] : sums) passes[pass].push_back(ms);
+      totals.push_back(total);
+      if (sums.contains("pass1 coverage") && total > 0) {
+        shares.push_back((sums["pass1 coverage"] + sums["pass2 replicate"]) / total);
+      }
+    }
+    for (const auto& [pass, times] : passes) row.pass_ms[pass] = median(times);
+    row.gpu_ms = median(totals);
+    if (!shares.empty()) row.passes12_share_gpu = median(shares);
+    if (!runner.reused_ms.empty() && row.frame_ms > 0) {
+      row.pass3_only_ms = median(runner.reused_ms);
+      row.passes12_share = std::max(0.0, 1.0 - *row.pass3_only_ms / row.frame_ms);
+    }
+    double ratio_sum = 0;
+    for (const RenderStats& s : runner.stats) ratio_sum += s.replication_ratio();
+    row.replication_ratio = ratio_sum / double(runner.stats.size());
+    const RenderStats& last = runner.stats.back();
+    row.facets = last.facets;
+    row.triangles_in = last.triangles_in;
+    row.triangles_visible = last.triangles_visible;
+    row.replicas = last.replicas;
+    row.dropped_triangles = last.dropped_triangles;
+    row.seam_copies = last.seam_copies;
+    row.gpu_buffer_bytes = last.gpu_buffer_bytes;
+    say_(
+        format("  %-11s %-12s %9.2f ms/frame (median of %d), GPU %8.2f ms, ratio %.3f, "
+               "%.1f MiB buffers",
+               row.method.c_str(), row.setting.c_str(), row.frame_ms, options_.frames, row.gpu_ms,
+               row.replication_ratio, double(row.gpu_buffer_bytes) / (1024.0 * 1024.0)));
+  }
+
+  const BenchScenario& scenario_;
+  const std::string scene_text_;
+  const LoadedScene& loaded_;
+  const BenchOptions& options_;
+  const Say& say_;
+  const glm::dmat4 T0_;  // the first view: the accuracy frame's
+  bool wrap_x_ = false;  // the first output wraps horizontally (compare_ids, edge_displacement)
+  std::vector<WarpInverse> inverses_;
+  std::vector<std::vector<std::uint32_t>> reference_;  // per output: the oracle's IDs at T0_
+  std::vector<OutputTarget> targets_;
+  std::vector<Runner> runners_;
+  // The facets settings' IDs by label (BenchSetting::same_ids_as), and the facet errors by
+  // layout label (facet_error_of).
+  std::map<std::string, std::vector<std::vector<std::uint32_t>>> facet_ids_;
+  std::map<std::string, std::pair<double, double>> facet_errors_;
+};
+
+}  // namespace
+
 BenchReport run_bench(const BenchOptions& options, const std::string& renderer,
                       const std::function<void(const std::string&)>& progress) {
-  auto say = [&](const std::string& line) {
+  const Say say = [&](const std::string& line) {
     if (progress) progress(line);
   };
   const std::vector<BenchScenario> scenarios = make_bench_scenarios(options);
@@ -526,270 +853,17 @@ BenchReport run_bench(const BenchOptions& options, const std::string& renderer,
   report.frames = options.frames;
   report.size_scale = options.size_scale;
   report.quick = options.quick;
-
-  // The scene of the scenarios run so far; scenarios with one scene follow each other (the scale
-  // scenarios) or share options.scene, so each scene is built once.
-  struct LoadedScene {
-    std::string name;
-    Scene scene;
-    GpuScene gpu;
-    std::unique_ptr<ReferenceRaycaster> raycaster;
-    std::unique_ptr<FrameViews> views;
-  };
   std::unique_ptr<LoadedScene> loaded;
-
   for (const BenchScenario& scenario : scenarios) {
     const std::string scene_text = scenario.scene.empty() ? options.scene : scenario.scene;
-    if (!loaded || loaded->name != scene_text) {
-      loaded.reset();  // the last scene's GPU and CPU memory first
-      const auto start = std::chrono::steady_clock::now();
-      const SceneName scene_name = parse_scene_name(scene_text);
-      auto next = std::make_unique<LoadedScene>();
-      next->name = scene_text;
-      next->scene = load_scene(scene_name);
-      next->gpu = upload_scene(next->scene);
-      next->raycaster = std::make_unique<ReferenceRaycaster>(next->scene);
-      // The view facet render takes by default: outside a closed model, else at its centre.
-      const SceneView view = choose_scene_view(next->scene, {}, scene_name.builtin_city());
-      next->views = std::make_unique<FrameViews>(view, kBenchFrameStepS, options.static_view);
-      loaded = std::move(next);
-      say(format("scene %s: %zu triangles, %zu objects, ready in %.0f ms", scene_text.c_str(),
-                 loaded->scene.triangle_count(), loaded->scene.objects.size(),
-                 wall_ms_since(start)));
-      if (!view.message.empty()) say("scene " + scene_text + ": " + view.message);
-    }
-    const Scene& scene = loaded->scene;
-    const GpuScene& gpu_scene = loaded->gpu;
-    const ReferenceRaycaster& raycaster = *loaded->raycaster;
-    const FrameViews& views = *loaded->views;
+    load_scene_once(loaded, scene_text, options, say);
     say("scenario " + scenario.name + ": " + scenario.description);
-    const bool wrap_x = scenario.outputs[0].glc
-                            ? scenario.outputs[0].glc->wraps_horizontally
-                            : scenario.outputs[0].warp.base.wraps_horizontally();
-    std::vector<WarpInverse> inverses;
-    std::vector<std::vector<std::uint32_t>> reference;
-    const glm::dmat4 T0 = views.T_eye_world(0);
-    for (const OutputSpec& output : scenario.outputs) {
-      inverses.emplace_back(output.warp);
-      // A GLC camera's pixels cast its own rays (the default near distance of RenderSettings).
-      reference.push_back(output.glc ? raycaster.ids(*output.glc, T0, RenderSettings{}.z_near)
-                                     : raycaster.ids(inverses.back(), T0));
-    }
-    std::vector<OutputTarget> targets;
-    for (const OutputSpec& output : scenario.outputs) {
-      targets.push_back(OutputTarget::create(output.warp.output_size));
-    }
-
-    // Geometric errors that depend only on the outputs and the layout, shared by the facet
-    // methods at one layout.
-    std::map<std::string, std::pair<double, double>> facet_errors;
-    auto facet_error_of = [&](const BenchSetting& setting) {
-      auto found = facet_errors.find(setting.label);
-      if (found != facet_errors.end()) return found->second;
-      double max_px = 0, sum_sq = 0;
-      std::size_t n = 0;
-      for (const OutputSpec& output : scenario.outputs) {
-        const FacetMesh mesh = build_facets(output.warp, setting.settings.facets);
-        const FacetError error = evaluate_facet_error(output.warp, mesh);
-        max_px = std::max(max_px, error.max_px);
-        sum_sq += error.rms_px * error.rms_px * double(error.samples);
-        n += error.samples;
-      }
-      const std::pair<double, double> result{max_px, n ? std::sqrt(sum_sq / double(n)) : 0.0};
-      facet_errors.emplace(setting.label, result);
-      return result;
-    };
-
-    std::vector<Runner> runners;
-    std::map<std::string, std::vector<std::vector<std::uint32_t>>> facet_ids;
-    double cube_max_px = 0;
-    for (std::size_t i = 0; scenario.matched_cube_face > 0 && i < scenario.outputs.size(); ++i) {
-      cube_max_px = std::max(cube_max_px, cube_texel_error(scenario.outputs[i].warp, inverses[i],
-                                                           scenario.matched_cube_face)
-                                              .first);
-    }
-    for (const BenchSetting& setting : with_matched_tolerance(scenario, cube_max_px)) {
-      Runner runner;
-      runner.setting = setting;
-      BenchRow& row = runner.row;
-      row.scenario = scenario.name;
-      row.scene = scene_text;
-      row.scale_group = scenario.scale_group;
-      row.triangles_scene = scene.triangle_count();
-      row.method = setting.method;
-      row.setting = setting.label;
-      row.fit_label = setting.fit_label.empty() ? setting.label : setting.fit_label;
-      row.outputs = int(scenario.outputs.size());
-      row.output_size = size_text(scenario.outputs[0].warp.output_size);
-      row.frames = options.frames;
-      const auto start = std::chrono::steady_clock::now();
-      try {
-        runner.method = make_render_method(setting.method);
-        runner.method->prepare(scene, gpu_scene, scenario.outputs, setting.settings);
-      } catch (const InputError& error) {
-        row.error = error.what();
-        say("  " + setting.method + " " + setting.label + ": not run: " + row.error);
-        runner.method.reset();
-        runners.push_back(std::move(runner));
-        continue;
-      }
-      const double prepare_ms = wall_ms_since(start);
-
-      // The accuracy frame, which is also the warm-up.
-      runner.method->render(T0, targets);
-      glFinish();
-      IdComparison pooled;
-      std::vector<std::vector<std::uint32_t>> ids;
-      for (std::size_t i = 0; i < targets.size(); ++i) {
-        ids.push_back(targets[i].read_ids());
-        const IdComparison c =
-            compare_ids(reference[i], ids.back(), targets[i].size(), {.wrap_x = wrap_x});
-        const EdgeDisplacement e =
-            scenario.outputs[i].glc
-                ? raycaster.edge_displacement(*scenario.outputs[i].glc, T0, RenderSettings{}.z_near,
-                                              reference[i], ids.back(), {.wrap_x = wrap_x})
-                : raycaster.edge_displacement(inverses[i], T0, reference[i], ids.back(),
-                                              {.wrap_x = wrap_x});
-        pooled.compared_pixels += c.compared_pixels;
-        pooled.mismatched_pixels += c.mismatched_pixels;
-        if (e.max_px > pooled.max_edge_px) {
-          pooled.max_edge_px = e.max_px;
-          row.worst_edge_pixel = e.worst_pixel;
-          row.worst_edge_output = i;
-        }
-        pooled.p99_edge_px = std::max(pooled.p99_edge_px, e.p99_px);
-        row.edge_beyond_window_pixels += e.beyond_window;
-        row.depth_tie_pixels += e.depth_ties;
-        row.outside_display_pixels += e.outside_display;
-        row.outside_display_max_px = std::max(row.outside_display_max_px, e.outside_display_max_px);
-      }
-      row.id_mismatch = pooled.compared_pixels
-                            ? double(pooled.mismatched_pixels) / double(pooled.compared_pixels)
-                            : 0.0;
-      row.max_edge_px = pooled.max_edge_px;
-      row.p99_edge_px = pooled.p99_edge_px;
-      if (setting.method == "facets") facet_ids[setting.label] = ids;
-      if (!setting.same_ids_as.empty()) {
-        const auto match = facet_ids.find(setting.same_ids_as);
-        if (match != facet_ids.end()) {
-          std::uint64_t differing = 0;
-          for (std::size_t i = 0; i < ids.size(); ++i) {
-            for (std::size_t p = 0; p < ids[i].size(); ++p) {
-              differing += ids[i][p] != match->second[i][p];
-            }
-          }
-          row.id_pixels_differing_from_facets = differing;
-        }
-      }
-      if (setting.method == "facets" || setting.method == "facets-gs" ||
-          setting.method == "tessellated" || setting.method == "naive") {
-        std::tie(row.geometric_max_px, row.geometric_rms_px) = facet_error_of(setting);
-        row.geometric_source = "facet error";
-      } else if (setting.method == "cubemap" || setting.method == "perspective") {
-        // The texel error of the intermediate image, worst and RMS pooled over the outputs.
-        const bool cube = setting.method == "cubemap";
-        double max_px = 0, sum_sq = 0;
-        for (std::size_t i = 0; i < scenario.outputs.size(); ++i) {
-          const Warp& warp = scenario.outputs[i].warp;
-          const int size = setting.settings.cube_face_size;
-          const auto [m, rms] = cube ? cube_texel_error(warp, inverses[i], size)
-                                     : perspective_texel_error(warp, inverses[i], size);
-          max_px = std::max(max_px, m);
-          sum_sq += rms * rms;
-        }
-        row.geometric_max_px = max_px;
-        row.geometric_rms_px = std::sqrt(sum_sq / double(scenario.outputs.size()));
-        row.geometric_source = cube ? "cube texel" : "image texel";
-      } else if (setting.method == "glc") {
-        // Each pixel's own ray is cast at the triangles: no geometric approximation.
-        row.geometric_source = "exact rays";
-      } else {
-        row.geometric_max_px = row.max_edge_px;
-        row.geometric_rms_px = row.p99_edge_px;
-        row.geometric_source = "reference edges";
-      }
-      say(format(
-          "  %-11s %-12s prepared in %7.0f ms: id_mismatch %.5f, edges max %.2f px (output "
-          "%zu pixel %d,%d) p99 %.2f px, %llu depth ties, %llu drawn outside the display "
-          "(up to %.2f px), geometric max %.3f px",
-          setting.method.c_str(), setting.label.c_str(), prepare_ms, row.id_mismatch,
-          row.max_edge_px, row.worst_edge_output, row.worst_edge_pixel.x, row.worst_edge_pixel.y,
-          row.p99_edge_px, static_cast<unsigned long long>(row.depth_tie_pixels),
-          static_cast<unsigned long long>(row.outside_display_pixels), row.outside_display_max_px,
-          row.geometric_max_px));
-      runners.push_back(std::move(runner));
-    }
-
-    // Timed frames, interleaved: every setting once per frame, the starting setting rotating.
-    for (int k = 1; k <= options.frames; ++k) {
-      const glm::dmat4 T = views.T_eye_world(k);
-      for (std::size_t j = 0; j < runners.size(); ++j) {
-        Runner& runner = runners[(j + std::size_t(k)) % runners.size()];
-        if (!runner.method) continue;
-        const auto start = std::chrono::steady_clock::now();
-        runner.stats.push_back(runner.method->render(T, targets, &runner.timer));
-        glFinish();
-        runner.frame_ms.push_back(wall_ms_since(start));
-        if (runner.setting.method == "facets" || runner.setting.method == "facets-gs") {
-          // The same view again: the pipeline keeps passes 1 and 2 and draws only.
-          const auto again = std::chrono::steady_clock::now();
-          const RenderStats reused = runner.method->render(T, targets);
-          glFinish();
-          if (reused.reused_replication) runner.reused_ms.push_back(wall_ms_since(again));
-        }
-      }
-      say(format("  timed frame %d of %d done", k, options.frames));
-    }
-
-    for (Runner& runner : runners) {
-      BenchRow& row = runner.row;
-      if (!runner.method) {
-        report.rows.push_back(row);
-        continue;
-      }
-      row.frame_ms = median(runner.frame_ms);
-      row.frame_ms_min = *std::min_element(runner.frame_ms.begin(), runner.frame_ms.end());
-      row.frame_ms_max = *std::max_element(runner.frame_ms.begin(), runner.frame_ms.end());
-      std::map<std::string, std::vector<double>> passes;
-      std::vector<double> totals, shares;
-      while (auto frame = runner.timer.poll(true)) {
-        std::map<std::string, double> sums;
-        double total = 0;
-        for (const PassTime& pass : *frame) {
-          sums[pass.pass] += pass.milliseconds;
-          total += pass.milliseconds;
-        }
-        for (const auto& [pass, ms] : sums) passes[pass].push_back(ms);
-        totals.push_back(total);
-        if (sums.contains("pass1 coverage") && total > 0) {
-          shares.push_back((sums["pass1 coverage"] + sums["pass2 replicate"]) / total);
-        }
-      }
-      for (const auto& [pass, times] : passes) row.pass_ms[pass] = median(times);
-      row.gpu_ms = median(totals);
-      if (!shares.empty()) row.passes12_share_gpu = median(shares);
-      if (!runner.reused_ms.empty() && row.frame_ms > 0) {
-        row.pass3_only_ms = median(runner.reused_ms);
-        row.passes12_share = std::max(0.0, 1.0 - *row.pass3_only_ms / row.frame_ms);
-      }
-      double ratio_sum = 0;
-      for (const RenderStats& s : runner.stats) ratio_sum += s.replication_ratio();
-      row.replication_ratio = ratio_sum / double(runner.stats.size());
-      const RenderStats& last = runner.stats.back();
-      row.facets = last.facets;
-      row.triangles_in = last.triangles_in;
-      row.triangles_visible = last.triangles_visible;
-      row.replicas = last.replicas;
-      row.dropped_triangles = last.dropped_triangles;
-      row.seam_copies = last.seam_copies;
-      row.gpu_buffer_bytes = last.gpu_buffer_bytes;
-      say(
-          format("  %-11s %-12s %9.2f ms/frame (median of %d), GPU %8.2f ms, ratio %.3f, "
-                 "%.1f MiB buffers",
-                 row.method.c_str(), row.setting.c_str(), row.frame_ms, options.frames, row.gpu_ms,
-                 row.replication_ratio, double(row.gpu_buffer_bytes) / (1024.0 * 1024.0)));
-      report.rows.push_back(row);
-    }
+    ScenarioBench bench(scenario, scene_text, *loaded, options, say);
+    for (const BenchSetting& setting :
+         with_matched_tolerance(scenario, bench.matched_cube_max_px()))
+      bench.prepare(setting);
+    bench.time_frames();
+    bench.add_rows(report.rows);
   }
   report.scale_fits = bench_scale_fits(report.rows);
   report.notes = bench_notes(report.rows, renderer);
