@@ -316,6 +316,134 @@ std::vector<float> overlay_triangles(const std::string& text, float x, float y) 
   return triangles;
 }
 
+// The log line that says where the outputs' windows opened.
+std::string windows_open_line(const SessionDisplay& display,
+                              std::span<const OutputPlacement> placements, std::size_t windows) {
+  std::string line = std::to_string(windows) + " windows open:";
+  for (std::size_t i = 0; i < placements.size(); ++i) {
+    const glm::ivec4& r = placements[i].rect;
+    line += " " + display.outputs[i].spec.name + " at " + std::to_string(r.x) + "," +
+            std::to_string(r.y) + " " + std::to_string(r.z) + "x" + std::to_string(r.w) + " (" +
+            placements[i].how + ")";
+  }
+  return line;
+}
+
+// Acts on the presses of T since the last frame: the scene, then every pattern in order, then
+// the scene again.
+void step_patterns(Session& session, Navigation& nav, const LogSink& log) {
+  for (; nav.pattern_steps > 0; --nav.pattern_steps) {
+    const auto& patterns = all_test_patterns();
+    const auto at = session.pattern()
+                        ? std::find(patterns.begin(), patterns.end(), *session.pattern())
+                        : patterns.end();
+    const auto next = at == patterns.end() ? patterns.begin() : at + 1;
+    session.set_pattern(next == patterns.end() ? std::nullopt : std::optional<TestPattern>(*next));
+    if (log)
+      log(LogLevel::info,
+          "showing " + (session.pattern() ? to_string(*session.pattern()) : "the scene"));
+  }
+}
+
+// The overlay's text: frame rate, replication ratio and frame, then a line per timed pass.
+std::string overlay_text(double fps, const FrameStats& stats, std::uint64_t frame) {
+  char line[160];
+  std::snprintf(line, sizeof line, "%.1f fps   replication %.2f   frame %llu\n", fps,
+                stats.replication_ratio(), static_cast<unsigned long long>(frame));
+  std::string text = line;
+  for (const PassTime& pass : stats.pass_ms) {
+    std::snprintf(line, sizeof line, "%-14s %7.3f ms\n", pass.pass.c_str(), pass.milliseconds);
+    text += line;
+  }
+  return text;
+}
+
+// Draws `text` over the current window's framebuffer of `size` pixels, its triangles in
+// `vertices`.
+void draw_overlay(const Program& overlay, const VertexArray& vertex_array, Buffer& vertices,
+                  const std::string& text, glm::ivec2 size) {
+  const std::vector<float> triangles = overlay_triangles(text, 12, 12);
+  vertices = Buffer::create_from(triangles);
+  glViewport(0, 0, size.x, size.y);
+  overlay.use();
+  glUniform2f(0, float(size.x), float(size.y));
+  glBindVertexArray(vertex_array.id());
+  vertices.bind_base(GL_SHADER_STORAGE_BUFFER, 0);
+  glDrawArrays(GL_TRIANGLES, 0, GLsizei(triangles.size() / 2));
+}
+
+// Where a window was and whether it showed exactly the outputs' bytes, as the projector would
+// receive them: per output the colour bytes that differ, -1 where the output is scaled.
+struct WindowReport {
+  glm::ivec2 position{0}, framebuffer{0};
+  std::vector<long long> mismatched_bytes;
+};
+
+// The report of `window` (current, `size` framebuffer pixels) just after presenting: reads its
+// back buffer, and each output's colour with `first`'s context current.
+WindowReport report_window(const detail::OutputsWindow& window, const detail::OutputsWindow& first,
+                           std::span<const OutputTarget> targets, glm::ivec2 size) {
+  WindowReport report;
+  glfwGetWindowPos(static_cast<GLFWwindow*>(window.context->native_window()), &report.position.x,
+                   &report.position.y);
+  report.framebuffer = size;
+  for (std::size_t k = 0; k < window.outputs.size(); ++k) {
+    const glm::ivec4& v = window.viewports[k];
+    const OutputTarget& target = targets[window.outputs[k]];
+    if (glm::ivec2(v.z, v.w) != target.size()) {
+      report.mismatched_bytes.push_back(-1);  // scaled: not comparable byte for byte
+      continue;
+    }
+    std::vector<std::uint8_t> shown(std::size_t(v.z) * v.w * 4);
+    glPixelStorei(GL_PACK_ALIGNMENT, 1);
+    glReadBuffer(GL_BACK);
+    glReadPixels(v.x, v.y, v.z, v.w, GL_RGBA, GL_UNSIGNED_BYTE, shown.data());
+    first.context->make_current();
+    const std::vector<std::uint8_t> expected = target.read_colour_rgba8();
+    window.context->make_current();
+    long long mismatched = 0;
+    for (int y = 0; y < v.w; ++y)
+      for (int x = 0; x < v.z; ++x)
+        for (int c = 0; c < 3; ++c)
+          mismatched += shown[(flipped_row_start(y, v.w, v.z) + x) * 4 + c] !=
+                        expected[(std::size_t(y) * v.z + x) * 4 + c];
+    report.mismatched_bytes.push_back(mismatched);
+  }
+  return report;
+}
+
+// The --report file's JSON: each window's position, framebuffer and outputs (placement and
+// mismatched bytes), the monitor events and the last frame's figures.
+nlohmann::json windowed_report(const SessionDisplay& display, std::span<const MonitorInfo> monitors,
+                               std::span<const OutputPlacement> placements,
+                               std::span<const detail::OutputsWindow> windows,
+                               std::span<const WindowReport> reports,
+                               const std::vector<std::string>& monitor_events,
+                               const FrameStats& last_frame) {
+  nlohmann::json windows_json = nlohmann::json::array();
+  for (std::size_t w = 0; w < windows.size(); ++w) {
+    nlohmann::json outputs_json = nlohmann::json::array();
+    for (std::size_t k = 0; k < windows[w].outputs.size(); ++k) {
+      const std::size_t index = windows[w].outputs[k];
+      const OutputPlacement& p = placements[index];
+      outputs_json.push_back(
+          {{"name", display.outputs[index].spec.name},
+           {"placement", p.kind == OutputPlacement::Kind::fullscreen ? "fullscreen" : "window"},
+           {"how", p.how},
+           {"monitor", p.monitor >= 0 ? monitors[std::size_t(p.monitor)].name : ""},
+           {"rect", {p.rect.x, p.rect.y, p.rect.z, p.rect.w}},
+           {"mismatched_bytes",
+            k < reports[w].mismatched_bytes.size() ? reports[w].mismatched_bytes[k] : -1}});
+    }
+    windows_json.push_back({{"position", {reports[w].position.x, reports[w].position.y}},
+                            {"framebuffer", {reports[w].framebuffer.x, reports[w].framebuffer.y}},
+                            {"outputs", outputs_json}});
+  }
+  return {{"windows", windows_json},
+          {"monitor_events", monitor_events},
+          {"last_frame", frame_stats_to_json(last_frame)}};
+}
+
 }  // namespace
 
 void run_windowed_session(const SessionDisplay& display, const Scene& scene, const CameraPath& path,
@@ -345,22 +473,14 @@ void run_windowed_session(const SessionDisplay& display, const Scene& scene, con
         glfwSetMouseButtonCallback(native, on_mouse_button);
       });
   glfwSetMonitorCallback(on_monitor);
-  if (options.log) {
-    std::string line = std::to_string(windows.size()) + " windows open:";
-    for (std::size_t i = 0; i < placements.size(); ++i) {
-      const glm::ivec4& r = placements[i].rect;
-      line += " " + display.outputs[i].spec.name + " at " + std::to_string(r.x) + "," +
-              std::to_string(r.y) + " " + std::to_string(r.z) + "x" + std::to_string(r.w) + " (" +
-              placements[i].how + ")";
-    }
-    options.log(LogLevel::info, line);
-  }
+  if (options.log)
+    options.log(LogLevel::info, windows_open_line(display, placements, windows.size()));
 
   windows.front().context->make_current();
   Session session(display, scene);
   session.set_pattern(options.pattern);
   const detail::WindowPresenter presenter(session.targets());
-  const Program overlay =
+  const Program overlay_program =
       ProgramBuilder().shader("output/overlay.vert").shader("output/overlay.frag").link();
   for (detail::OutputsWindow& window : windows) {
     window.context->make_current();
@@ -368,10 +488,6 @@ void run_windowed_session(const SessionDisplay& display, const Scene& scene, con
   }
   std::vector<Buffer> overlay_vertices(windows.size());  // per window: the overlay's triangles
 
-  struct WindowReport {
-    glm::ivec2 position{0}, framebuffer{0};
-    std::vector<long long> mismatched_bytes;
-  };
   std::vector<WindowReport> reports(windows.size());
   double time_s = 0;
   auto last = std::chrono::steady_clock::now();
@@ -393,19 +509,7 @@ void run_windowed_session(const SessionDisplay& display, const Scene& scene, con
     if (nav.play_path) time_s += options.frames ? kFramePeriod_s : dt;
 
     windows.front().context->make_current();
-    for (; nav.pattern_steps > 0; --nav.pattern_steps) {
-      // The scene, then every pattern in order, then the scene again.
-      const auto& patterns = all_test_patterns();
-      const auto at = session.pattern()
-                          ? std::find(patterns.begin(), patterns.end(), *session.pattern())
-                          : patterns.end();
-      const auto next = at == patterns.end() ? patterns.begin() : at + 1;
-      session.set_pattern(next == patterns.end() ? std::nullopt
-                                                 : std::optional<TestPattern>(*next));
-      if (options.log)
-        options.log(LogLevel::info,
-                    "showing " + (session.pattern() ? to_string(*session.pattern()) : "the scene"));
-    }
+    step_patterns(session, nav, options.log);
     FrameState state{frame, time_s, nav.play_path ? T_path : nav.T_world_eye(), {}};
     bool show = true;
     if (options.sync) {
@@ -423,17 +527,7 @@ void run_windowed_session(const SessionDisplay& display, const Scene& scene, con
     GLsync rendered = glFenceSync(GL_SYNC_GPU_COMMANDS_COMPLETE, 0);
     glFlush();
 
-    std::string overlay_text;
-    if (nav.overlay) {
-      char line[160];
-      std::snprintf(line, sizeof line, "%.1f fps   replication %.2f   frame %llu\n", fps,
-                    stats.replication_ratio(), static_cast<unsigned long long>(frame));
-      overlay_text = line;
-      for (const PassTime& pass : stats.pass_ms) {
-        std::snprintf(line, sizeof line, "%-14s %7.3f ms\n", pass.pass.c_str(), pass.milliseconds);
-        overlay_text += line;
-      }
-    }
+    const std::string overlay = nav.overlay ? overlay_text(fps, stats, frame) : std::string();
     const bool last_frame = options.frames && frame + 1 == *options.frames;
     // A frame the cluster went on without is not shown.
     for (std::size_t w = 0; show && w < windows.size(); ++w) {
@@ -443,44 +537,10 @@ void run_windowed_session(const SessionDisplay& display, const Scene& scene, con
       const glm::ivec2 size = window.context->framebuffer_size();
       presenter.present(size, window.vertex_array, window.outputs, window.viewports);
       if (last_frame && options.report) {
-        // Exactly the output's bytes, as the projector would receive them?
-        WindowReport& report = reports[w];
-        glfwGetWindowPos(static_cast<GLFWwindow*>(window.context->native_window()),
-                         &report.position.x, &report.position.y);
-        report.framebuffer = size;
-        report.mismatched_bytes.clear();
-        for (std::size_t k = 0; k < window.outputs.size(); ++k) {
-          const glm::ivec4& v = window.viewports[k];
-          const OutputTarget& target = session.targets()[window.outputs[k]];
-          if (glm::ivec2(v.z, v.w) != target.size()) {
-            report.mismatched_bytes.push_back(-1);  // scaled: not comparable byte for byte
-            continue;
-          }
-          std::vector<std::uint8_t> shown(std::size_t(v.z) * v.w * 4);
-          glPixelStorei(GL_PACK_ALIGNMENT, 1);
-          glReadBuffer(GL_BACK);
-          glReadPixels(v.x, v.y, v.z, v.w, GL_RGBA, GL_UNSIGNED_BYTE, shown.data());
-          windows.front().context->make_current();
-          const std::vector<std::uint8_t> expected = target.read_colour_rgba8();
-          window.context->make_current();
-          long long mismatched = 0;
-          for (int y = 0; y < v.w; ++y)
-            for (int x = 0; x < v.z; ++x)
-              for (int c = 0; c < 3; ++c)
-                mismatched += shown[(flipped_row_start(y, v.w, v.z) + x) * 4 + c] !=
-                              expected[(std::size_t(y) * v.z + x) * 4 + c];
-          report.mismatched_bytes.push_back(mismatched);
-        }
+        reports[w] = report_window(window, windows.front(), session.targets(), size);
       }
-      if (!overlay_text.empty()) {
-        const std::vector<float> triangles = overlay_triangles(overlay_text, 12, 12);
-        overlay_vertices[w] = Buffer::create_from(triangles);
-        glViewport(0, 0, size.x, size.y);
-        overlay.use();
-        glUniform2f(0, float(size.x), float(size.y));
-        glBindVertexArray(window.vertex_array.id());
-        overlay_vertices[w].bind_base(GL_SHADER_STORAGE_BUFFER, 0);
-        glDrawArrays(GL_TRIANGLES, 0, GLsizei(triangles.size() / 2));
+      if (!overlay.empty()) {
+        draw_overlay(overlay_program, window.vertex_array, overlay_vertices[w], overlay, size);
       }
       window.context->swap_buffers();
     }
@@ -490,28 +550,8 @@ void run_windowed_session(const SessionDisplay& display, const Scene& scene, con
   }
 
   if (options.report && !interrupted_by) {
-    nlohmann::json windows_json = nlohmann::json::array();
-    for (std::size_t w = 0; w < windows.size(); ++w) {
-      nlohmann::json outputs_json = nlohmann::json::array();
-      for (std::size_t k = 0; k < windows[w].outputs.size(); ++k) {
-        const std::size_t index = windows[w].outputs[k];
-        const OutputPlacement& p = placements[index];
-        outputs_json.push_back(
-            {{"name", display.outputs[index].spec.name},
-             {"placement", p.kind == OutputPlacement::Kind::fullscreen ? "fullscreen" : "window"},
-             {"how", p.how},
-             {"monitor", p.monitor >= 0 ? monitors[std::size_t(p.monitor)].name : ""},
-             {"rect", {p.rect.x, p.rect.y, p.rect.z, p.rect.w}},
-             {"mismatched_bytes",
-              k < reports[w].mismatched_bytes.size() ? reports[w].mismatched_bytes[k] : -1}});
-      }
-      windows_json.push_back({{"position", {reports[w].position.x, reports[w].position.y}},
-                              {"framebuffer", {reports[w].framebuffer.x, reports[w].framebuffer.y}},
-                              {"outputs", outputs_json}});
-    }
-    const nlohmann::json report = {{"windows", windows_json},
-                                   {"monitor_events", nav.messages},
-                                   {"last_frame", frame_stats_to_json(stats)}};
+    const nlohmann::json report =
+        windowed_report(display, monitors, placements, windows, reports, nav.messages, stats);
     write_atomically(*options.report, [&](const fs::path& temporary) {
       std::ofstream(temporary) << report.dump(2) << '\n';
     });
