@@ -30,7 +30,8 @@ function(facet_embed_shaders target)
     # Materials and the shading that calls them are compiled with the material interface in
     # front (driver/material_shader.hpp), and so validated.
     set(prelude "")
-    if(name STREQUAL "scene/material.frag" OR name MATCHES "^scene/materials/")
+    if(name MATCHES "^(scene/material|scene/sun_and_sky|glc/glc_hit)\\.frag$"
+       OR name MATCHES "^scene/materials/")
       set(prelude ${ARG_DIR}/scene/material_interface.frag)
     endif()
     add_custom_command(

@@ -3,7 +3,8 @@
 // material linked beside it as a second fragment shader object (scene/materials/*.frag or a
 // user's file: driver/material_shader.hpp), and writes the colour (linear RGB) and the triangle
 // ID. Knows nothing of facets or projections, so every method shades the same; compiled with the
-// interface in front, as every material is.
+// interface in front, as every material is. sun_and_sky() is scene/sun_and_sky.frag's. The GLC
+// ray cast gathers the same inputs from its ray's hit instead (glc/glc_hit.frag).
 in vec3 v_n_world;
 in vec2 v_uv;
 in vec3 v_p_world;
@@ -29,15 +30,6 @@ layout(location = 0) out vec4 out_colour;
 flat in uint v_triangle_id;
 layout(location = 1) out uint out_triangle_id;
 #endif
-
-const vec3 d_world_sun = normalize(vec3(0.35, 0.85, 0.4));
-
-vec3 sun_and_sky(MaterialInput m) {
-  if (m.unlit) return m.base_colour.rgb;
-  float sun = max(dot(m.n_world, d_world_sun), 0.0);
-  float sky = 0.55 + 0.45 * m.n_world.y;
-  return m.base_colour.rgb * (0.75 * sun + 0.35 * sky);
-}
 
 void main() {
   MaterialInput m;

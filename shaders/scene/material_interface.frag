@@ -7,8 +7,8 @@
 //
 // Frames and units as in DESIGN.md: metres, the world frame of the scene, the eye frame of the
 // view. "Output pixels" are the pixels of the image being rasterized: a projector's output for the
-// facet methods, naive and vertex; a cube face's pixels for the cube map, which are then resampled
-// into the output (so its strokes are not of the width asked for).
+// facet methods, naive and vertex, a GLC camera's image for glc; a cube face's pixels for the cube
+// map, which are then resampled into the output (so its strokes are not of the width asked for).
 struct MaterialInput {
   vec3 p_world;       // position, world frame, metres
   vec3 n_world;       // unit normal, world frame, turned towards the eye (two-sided)
@@ -27,5 +27,5 @@ struct MaterialInput {
 vec4 shade(MaterialInput m);
 
 // The default shading (the `lit` material): base colour under a fixed sun and sky, or as
-// authored when unlit. Defined in scene/material.frag; any material may call it.
+// authored when unlit. Defined in scene/sun_and_sky.frag; any material may call it.
 vec3 sun_and_sky(MaterialInput m);

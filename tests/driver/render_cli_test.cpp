@@ -243,6 +243,15 @@ TEST(RenderCli, GlcCameraRendersWithItsMethodAndRefusesBadInput) {
   // edge), the exact edge lies within a fraction of a pixel; 0.25 px worst case.
   EXPECT_LE(report["reference"]["max_edge_px"].get<double>(), 0.25);
   EXPECT_EQ(report["reference"]["edge_beyond_window_pixels"].get<int>(), 0);
+  // --material shades the GLC ray cast as every other method: the IDs, and so the mismatch, stay.
+  const std::string shaded = (folder / "shaded").string();
+  const Result styled =
+      run_cli("render --display " + good +
+              " --method glc --material pen-and-ink --reference --json --out " + shaded);
+  ASSERT_EQ(styled.status, 0) << styled.output;
+  EXPECT_EQ(nlohmann::json::parse(styled.output)["reference"]["id_mismatch"],
+            report["reference"]["id_mismatch"]);
+  EXPECT_TRUE(std::filesystem::exists(std::filesystem::path(shaded) / "small.png"));
 
   const struct {
     std::string arguments, expected;
@@ -254,6 +263,8 @@ TEST(RenderCli, GlcCameraRendersWithItsMethodAndRefusesBadInput) {
       {"render --display builtin:dome180 --size 32x32 --method glc",
        "expected a GLC camera (FILE.glc.json) for --method glc"},
       {"render --display " + good + " --method glc --size 64x64", "expected the size of"},
+      {"render --display " + good + " --method glc --material chalk",
+       "field '--material': expected lit, solid-wireframe, pen-and-ink, procedural or a GLSL file"},
       {"run " + good + " --frames 1", "only the glc render method draws"},
   };
   for (const auto& [arguments, expected] : refused) {

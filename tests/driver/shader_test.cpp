@@ -132,13 +132,17 @@ TEST(Shaders, StorageBufferBindingsMatchTheCpp) {
     EXPECT_GT(found[name], 0) << name << " is declared nowhere";
 }
 
-// The material shading block's binding exists twice, in gpu_scene.hpp and material.frag.
+// The material shading block's binding is written in gpu_scene.hpp and in each stage that gathers
+// MaterialInput: material.frag and the GLC ray cast's glc_hit.frag.
 TEST(Shaders, MaterialShadingBindingMatchesTheCpp) {
-  const std::string text(embedded_shader("scene/material.frag").text);
-  std::smatch match;
-  ASSERT_TRUE(std::regex_search(
-      text, match, std::regex(R"(layout\(std140, binding = (\d+)\) uniform MaterialShading)")));
-  EXPECT_EQ(std::stoul(match[1]), material_shading_binding);
+  for (const char* name : {"scene/material.frag", "glc/glc_hit.frag"}) {
+    const std::string text(embedded_shader(name).text);
+    std::smatch match;
+    ASSERT_TRUE(std::regex_search(
+        text, match, std::regex(R"(layout\(std140, binding = (\d+)\) uniform MaterialShading)")))
+        << name;
+    EXPECT_EQ(std::stoul(match[1]), material_shading_binding) << name;
+  }
 }
 
 TEST(Shaders, EveryEmbeddedShaderCompiles) {
@@ -147,7 +151,8 @@ TEST(Shaders, EveryEmbeddedShaderCompiles) {
     SCOPED_TRACE(std::string(shader.name));
     // Materials and the shading that calls them compile with the material interface in front.
     const std::string_view name = shader.name;
-    const bool material = name == "scene/material.frag" || name.starts_with("scene/materials/");
+    const bool material = name == "scene/material.frag" || name == "scene/sun_and_sky.frag" ||
+                          name == "glc/glc_hit.frag" || name.starts_with("scene/materials/");
     const std::string text = material ? material_stage_text(shader.text) : std::string(shader.text);
     EXPECT_NO_THROW({
       Shader compiled = compile_shader(stage_from_name(shader.name), shader.name, text);

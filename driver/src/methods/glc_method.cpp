@@ -13,17 +13,23 @@
 // belongs to that piece (the piece map, the same that the oracle reads) casts its pixel centre's
 // GLC ray and intersects the triangle exactly, writing depth from the hit. The image is therefore
 // the ray cast of the camera's own rays: hole-free, whatever the camera does to straight lines.
+// The hit is shaded through the material interface (glc/glc_hit.frag gathers MaterialInput), one
+// program per distinct material shader as in every method; the quads are drawn grouped by scene
+// material, each group with its material's uniforms and texture.
 #include <algorithm>
 #include <array>
 #include <atomic>
 #include <cmath>
 #include <exception>
+#include <glm/gtc/type_ptr.hpp>
 #include <memory>
 #include <thread>
 
 #include "facet/driver/gpu_timer.hpp"
+#include "facet/driver/material_shader.hpp"
 #include "facet/driver/program.hpp"
 #include "facet/projection/errors.hpp"
+#include "material_programs.hpp"
 #include "render_methods_internal.hpp"
 #include "replication_common.hpp"
 
@@ -32,9 +38,10 @@ namespace {
 
 struct GpuQuad {
   glm::vec4 box, a, b, c;
-  glm::uvec4 ids;  // triangle ID, piece, material
+  glm::uvec4 ids;     // triangle ID, piece, material
+  glm::uvec4 source;  // the triangle's first index in Scene::indices, its object
 };
-static_assert(sizeof(GpuQuad) == 80);
+static_assert(sizeof(GpuQuad) == 96);
 
 struct GpuPiece {
   glm::vec4 o0, ox, oy, d0, dx, dy;
@@ -96,7 +103,7 @@ class GlcMethod final : public RenderMethod {
  public:
   std::string_view name() const override { return "glc"; }
 
-  void prepare(const Scene& scene, const GpuScene&, std::span<const OutputSpec> outputs,
+  void prepare(const Scene& scene, const GpuScene& gpu, std::span<const OutputSpec> outputs,
                const RenderSettings& settings) override {
     for (const OutputSpec& output : outputs) {
       if (!output.glc) {
@@ -109,13 +116,15 @@ class GlcMethod final : public RenderMethod {
       throw InputError("render settings", "z_near", "expected a positive near distance");
     }
     scene_ = &scene;
+    gpu_ = &gpu;
     settings_ = settings;
     triangle_base_ = scene_triangle_base(scene);
-    program_ = ProgramBuilder().shader("glc/glc_quad.vert").shader("glc/glc_hit.frag").link();
-    std::vector<glm::vec4> colours;
-    for (const Material& m : scene.materials) colours.push_back(m.base_colour);
-    if (colours.empty()) colours.push_back(glm::vec4(1.0f));
-    materials_ = Buffer::create_from(colours);
+    programs_.prepare(scene, settings.material, [](const MaterialShader& shader) {
+      ProgramBuilder builder;
+      builder.shader("glc/glc_quad.vert");
+      add_material_stages(builder, shader, "glc/glc_hit.frag");
+      return link_with_material(builder, shader);
+    });
     outputs_.clear();
     for (const OutputSpec& output : outputs) {
       OutputState out;
@@ -154,6 +163,14 @@ class GlcMethod final : public RenderMethod {
       outputs_.push_back(std::move(out));
     }
     vao_ = VertexArray::create();
+    // Quad k of a draw: triangles (0, 1, 2) and (2, 1, 3) over its corners 4k..4k+3 (the draw's
+    // base vertex picks the first quad).
+    std::vector<std::uint32_t> corners;
+    for (std::uint32_t k = 0; k < kSoftwareReplicasPerDraw; ++k) {
+      for (std::uint32_t c : {0u, 1u, 2u, 2u, 1u, 3u}) corners.push_back(4 * k + c);
+    }
+    quad_corners_ = Buffer::create_from(corners);
+    glVertexArrayElementBuffer(vao_.id(), quad_corners_.id());
   }
 
   RenderStats render(const glm::dmat4& T_eye_world, std::span<OutputTarget> targets,
@@ -170,6 +187,7 @@ class GlcMethod final : public RenderMethod {
       const glm::mat4 T_eye_object = glm::mat4(T_eye_world * glm::dmat4(object.T_world_object));
       for (std::uint32_t k = 0; k < object.primitive_count; ++k) {
         const Primitive& primitive = scene.primitives[object.first_primitive + k];
+        FACET_ASSERT(primitive.material < scene.materials.size());
         for (std::uint32_t i = 0; i + 2 < primitive.index_count; i += 3) {
           EyeTriangle t;
           for (int v = 0; v < 3; ++v) {
@@ -177,6 +195,7 @@ class GlcMethod final : public RenderMethod {
             t.v[v] = glm::vec3(T_eye_object * glm::vec4(p, 1.0f));
           }
           t.material = primitive.material;
+          t.first_index = primitive.first_index + i;
           const glm::dvec3 centre =
               (glm::dvec3(t.v[0]) + glm::dvec3(t.v[1]) + glm::dvec3(t.v[2])) / 3.0;
           t.centre = centre;
@@ -225,9 +244,21 @@ class GlcMethod final : public RenderMethod {
       for (const std::exception_ptr& failure : failures) {
         if (failure) std::rethrow_exception(failure);
       }
-      quads_.clear();
+      // Joined by scene material (each group is drawn with its material's uniforms and
+      // texture), in piece order within a material.
+      material_first_.assign(scene.materials.size() + 1, 0);
       for (const std::vector<GpuQuad>& quads : piece_quads_) {
-        quads_.insert(quads_.end(), quads.begin(), quads.end());
+        for (const GpuQuad& quad : quads) ++material_first_[quad.ids.z + 1];
+      }
+      for (std::size_t m = 0; m < scene.materials.size(); ++m) {
+        material_first_[m + 1] += material_first_[m];
+      }
+      quads_.resize(material_first_.back());
+      {
+        std::vector<std::size_t> next(material_first_.begin(), material_first_.end() - 1);
+        for (const std::vector<GpuQuad>& quads : piece_quads_) {
+          for (const GpuQuad& quad : quads) quads_[next[quad.ids.z]++] = quad;
+        }
       }
       for (const GpuQuad& quad : quads_) visible[quad.ids.x - 1] = 1;
       stats.replicas += quads_.size();
@@ -239,22 +270,39 @@ class GlcMethod final : public RenderMethod {
       if (!quads_.empty()) {
         ensure_capacity(out.quads, quads_.size() * sizeof(GpuQuad));
         out.quads.sub_data(0, quads_.size() * sizeof(GpuQuad), quads_.data());
-        program_.use();
-        glUniform2f(0, float(camera.size.x), float(camera.size.y));
-        glUniform1f(1, float(settings_.z_near));
-        glUniform1i(2, settings_.cull_back_faces ? 1 : 0);
         out.quads.bind_base(GL_SHADER_STORAGE_BUFFER, 0);
         out.pieces.bind_base(GL_SHADER_STORAGE_BUFFER, 1);
-        materials_.bind_base(GL_SHADER_STORAGE_BUFFER, 2);
-        glBindTextureUnit(0, out.piece_map.id());
-        glBindSampler(0, 0);  // the scene's samplers would filter it
+        gpu_->bind_for_pulling();  // indices (binding 3) and vertex texels
+        gpu_->objects.bind_base(GL_SHADER_STORAGE_BUFFER, 4);
+        glBindTextureUnit(1, out.piece_map.id());
+        glBindSampler(1, 0);  // the scene's samplers would filter it
         glBindVertexArray(vao_.id());
-        // Draws of kSoftwareReplicasPerDraw quads: llvmpipe's draw module costs time quadratic
-        // in a draw's batch (replication_common.hpp).
-        const std::size_t per_draw = kSoftwareReplicasPerDraw;
-        for (std::size_t first = 0; first < quads_.size(); first += per_draw) {
-          const std::size_t count = std::min(per_draw, quads_.size() - first);
-          glDrawArrays(GL_TRIANGLES, GLint(6 * first), GLsizei(6 * count));
+        const glm::mat4 T_world_eye = glm::mat4(glm::inverse(T_eye_world));
+        const Program* in_use = nullptr;
+        for (std::size_t m = 0; m < scene.materials.size(); ++m) {
+          const std::size_t begin = material_first_[m], end = material_first_[m + 1];
+          if (begin == end) continue;
+          const Program& program = programs_.program_of(std::uint32_t(m));
+          if (&program != in_use) {
+            program.use();
+            in_use = &program;
+            glUniform2f(0, float(camera.size.x), float(camera.size.y));
+            glUniform1f(1, float(settings_.z_near));
+            glUniform1i(2, settings_.cull_back_faces ? 1 : 0);
+            glUniformMatrix4fv(3, 1, GL_FALSE, glm::value_ptr(T_world_eye));
+          }
+          const Material& material = scene.materials[m];
+          glUniform4fv(8, 1, glm::value_ptr(material.base_colour));
+          glUniform1i(9, material.texture >= 0 ? 1 : 0);
+          gpu_->bind_material_texture(std::uint32_t(m), 0);
+          // Draws of kSoftwareReplicasPerDraw quads: llvmpipe's draw module costs time quadratic
+          // in a draw's batch (replication_common.hpp).
+          const std::size_t per_draw = kSoftwareReplicasPerDraw;
+          for (std::size_t first = begin; first < end; first += per_draw) {
+            const std::size_t count = std::min(per_draw, end - first);
+            glDrawElementsBaseVertex(GL_TRIANGLES, GLsizei(6 * count), GL_UNSIGNED_INT, nullptr,
+                                     GLint(4 * first));
+          }
         }
         glBindVertexArray(0);
       }
@@ -269,7 +317,6 @@ class GlcMethod final : public RenderMethod {
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     if (timer) timer->end_frame();
     for (std::uint8_t v : visible) stats.triangles_visible += v;
-    stats.gpu_buffer_bytes += materials_.size();
     return stats;
   }
 
@@ -277,6 +324,7 @@ class GlcMethod final : public RenderMethod {
   struct EyeTriangle {
     std::array<glm::vec3, 3> v;
     std::uint32_t material = 0;
+    std::uint32_t first_index = 0;  // in Scene::indices
     glm::dvec3 centre{0.0};
     double radius = 0;
   };
@@ -313,7 +361,8 @@ class GlcMethod final : public RenderMethod {
         if (!(x0 < x1 && y0 < y1)) continue;
         quads.push_back({glm::vec4(float(x0), h - float(y1), float(x1), h - float(y0)),
                          glm::vec4(tri.v[0], 1), glm::vec4(tri.v[1], 1), glm::vec4(tri.v[2], 1),
-                         glm::uvec4(triangle_id(o, t), std::uint32_t(k), tri.material, 0)});
+                         glm::uvec4(triangle_id(o, t), std::uint32_t(k), tri.material, 0),
+                         glm::uvec4(tri.first_index, std::uint32_t(o), 0, 0)});
       }
     }
   }
@@ -324,15 +373,17 @@ class GlcMethod final : public RenderMethod {
   }
 
   const Scene* scene_ = nullptr;
+  const GpuScene* gpu_ = nullptr;
   RenderSettings settings_;
   std::vector<std::uint32_t> triangle_base_;
-  Program program_;
-  Buffer materials_;
+  MaterialPrograms programs_;
   VertexArray vao_;
+  Buffer quad_corners_;  // element indices of kSoftwareReplicasPerDraw quads
   std::vector<OutputState> outputs_;
   std::vector<EyeTriangle> triangles_;
   std::vector<std::uint32_t> object_ranges_;
-  std::vector<GpuQuad> quads_;
+  std::vector<GpuQuad> quads_;               // grouped by material
+  std::vector<std::size_t> material_first_;  // material m's quads: [first[m], first[m + 1])
   std::vector<std::vector<GpuQuad>> piece_quads_;
 };
 

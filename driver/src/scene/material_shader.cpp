@@ -159,9 +159,12 @@ std::string material_stage_text(std::string_view material_text) {
   return text;
 }
 
-void add_material_stages(ProgramBuilder& builder, const MaterialShader& material) {
-  builder.source(ShaderStage::fragment, "shaders/scene/material.frag",
-                 material_stage_text(embedded_shader("scene/material.frag").text));
+void add_material_stages(ProgramBuilder& builder, const MaterialShader& material,
+                         std::string_view gather) {
+  builder.source(ShaderStage::fragment, "shaders/" + std::string(gather),
+                 material_stage_text(embedded_shader(gather).text));
+  builder.source(ShaderStage::fragment, "shaders/scene/sun_and_sky.frag",
+                 material_stage_text(embedded_shader("scene/sun_and_sky.frag").text));
   if (material.text.empty()) {
     const MaterialShader builtin = load_material_shader(material.name);
     builder.source(ShaderStage::fragment, builtin.file, material_stage_text(builtin.text));

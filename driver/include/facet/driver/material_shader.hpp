@@ -29,9 +29,12 @@ MaterialShader load_material_shader(std::string_view name_or_file);
 // the material's own text (so that line numbers are the material file's).
 std::string material_stage_text(std::string_view material_text);
 
-// Adds scene/material.frag and the material as the program's fragment stage (two shader
-// objects).
-void add_material_stages(ProgramBuilder& builder, const MaterialShader& material);
+// Adds the fragment stage of a material program, three shader objects compiled with the
+// interface in front: `gather`, which defines main(), gathers MaterialInput, calls shade() and
+// writes colour and triangle ID (scene/material.frag, the rasterizing methods'; glc/glc_hit.frag,
+// the GLC ray cast's), scene/sun_and_sky.frag and the material.
+void add_material_stages(ProgramBuilder& builder, const MaterialShader& material,
+                         std::string_view gather = "scene/material.frag");
 
 // Links a program whose fragment stage add_material_stages made. A compile or link error that
 // names the material's file (a user's material that does not compile against the interface, or
