@@ -7,9 +7,10 @@
 // of the projection over the triangle clipped to z >= z_near: on each depth plane the map is
 // affine, so the extremes lie on the clipped triangle's edges; a slit depth inside the triangle
 // makes the box the whole piece). The box is clipped to the piece's pixel box. Per piece a triangle
-// is first tested against a cone that holds every ray of the piece (its axis the mean ray direction
-// at the piece box's corners, its apex behind their origins), with its bounding sphere, and objects
-// likewise with theirs. On the GPU: one quad per (triangle, piece) box; every fragment whose pixel
+// is first tested against a cone that holds every ray the piece casts (the rays at the pixel
+// centres it owns: its axis the mean direction of the rays at the ends of the piece's pixel runs in
+// each row, its apex behind their origins), with its bounding sphere, and objects likewise with
+// theirs. On the GPU: one quad per (triangle, piece) box; every fragment whose pixel
 // belongs to that piece (the piece map, the same that the oracle reads) casts its pixel centre's
 // GLC ray and intersects the triangle exactly, writing depth from the hit. The image is therefore
 // the ray cast of the camera's own rays: hole-free, whatever the camera does to straight lines.
@@ -68,17 +69,47 @@ struct RayCone {
   }
 };
 
-RayCone ray_cone(const Glc& glc, const glm::ivec4& box) {
-  RayCone cone;
-  std::array<EyeRay, 4> rays;
-  const std::array<glm::dvec2, 4> corners = {glm::dvec2(box.x, box.y), glm::dvec2(box.z, box.y),
-                                             glm::dvec2(box.x, box.w), glm::dvec2(box.z, box.w)};
-  glm::dvec3 axis(0.0), centre(0.0);
-  for (std::size_t k = 0; k < 4; ++k) {
-    rays[k] = glc.ray(corners[k]);
-    axis += glm::normalize(rays[k].direction);
-    centre += 0.25 * rays[k].origin;
+// The pixel centres of each piece at the ends of its runs in every row: their convex hull holds
+// every pixel centre the piece owns, the only ones whose rays are cast.
+std::vector<std::vector<glm::dvec2>> piece_row_ends(const PiecewiseGlc& camera) {
+  std::vector<std::vector<glm::dvec2>> ends(camera.pieces.size());
+  std::vector<int> first(camera.pieces.size()), last(camera.pieces.size());
+  std::vector<std::size_t> seen;  // pieces met in this row
+  for (int y = 0; y < camera.size.y; ++y) {
+    seen.clear();
+    for (int x = 0; x < camera.size.x; ++x) {
+      const std::int32_t piece = camera.piece_of_pixel[std::size_t(y) * camera.size.x + x];
+      if (piece < 0) continue;
+      const auto k = std::size_t(piece);
+      if (std::find(seen.begin(), seen.end(), k) == seen.end()) {
+        seen.push_back(k);
+        first[k] = x;
+      }
+      last[k] = x;
+    }
+    for (std::size_t k : seen) {
+      ends[k].push_back({first[k] + 0.5, y + 0.5});
+      if (last[k] != first[k]) ends[k].push_back({last[k] + 0.5, y + 0.5});
+    }
   }
+  return ends;
+}
+
+// The cone of the rays of a piece at `points` (pixels). A piece's rays are affine in the pixel,
+// so the pixels whose rays (from their origins on) lie in a cone form a convex set: a cone that
+// holds the rays at the points holds every ray of their convex hull.
+RayCone ray_cone(const Glc& glc, const std::vector<glm::dvec2>& points) {
+  RayCone cone;
+  if (points.empty()) return cone;
+  std::vector<EyeRay> rays;
+  rays.reserve(points.size());
+  glm::dvec3 axis(0.0), centre(0.0);
+  for (const glm::dvec2& p : points) {
+    rays.push_back(glc.ray(p));
+    axis += glm::normalize(rays.back().direction);
+    centre += rays.back().origin;
+  }
+  centre /= double(points.size());
   if (!(glm::length(axis) > 1e-9)) return cone;
   axis = glm::normalize(axis);
   double cos_angle = 1, reach = 0;
@@ -89,8 +120,7 @@ RayCone ray_cone(const Glc& glc, const glm::ivec4& box) {
   if (!(cos_angle > 0.17)) return cone;  // 80 degrees or more: no useful cone
   cone.all = false;
   cone.axis = axis;
-  // A margin for rounding: the rays' directions are affine in the pixel, their hull is the
-  // corners' (the frame-z components are all 1).
+  // A margin for rounding.
   cone.cos_angle = std::max(0.0, cos_angle - 1e-6);
   cone.sin_angle = std::sqrt(1 - cone.cos_angle * cone.cos_angle);
   // Every origin lies within `reach` of the centre: from an apex reach / sin behind it, every
@@ -132,6 +162,9 @@ class GlcMethod final : public RenderMethod {
       const PiecewiseGlc& camera = *out.camera;
       FACET_ASSERT(camera.size == output.warp.output_size);
       std::vector<GpuPiece> pieces;
+      const std::vector<std::vector<glm::dvec2>> row_ends =
+          camera.pieces.size() > 1 ? piece_row_ends(camera)
+                                   : std::vector<std::vector<glm::dvec2>>{};
       for (std::size_t k = 0; k < camera.pieces.size(); ++k) {
         const Glc& glc = camera.pieces[k];
         // Affine in the pixel: differences of rays one pixel apart, about the piece box's corner.
@@ -143,8 +176,7 @@ class GlcMethod final : public RenderMethod {
         pieces.push_back({glm::vec4(r0.origin - at.x * ox - at.y * oy, 0), glm::vec4(ox, 0),
                           glm::vec4(oy, 0), glm::vec4(r0.direction - at.x * dx - at.y * dy, 0),
                           glm::vec4(dx, 0), glm::vec4(dy, 0)});
-        out.cones.push_back(camera.pieces.size() > 1 ? ray_cone(glc, camera.piece_boxes[k])
-                                                     : RayCone{});
+        out.cones.push_back(camera.pieces.size() > 1 ? ray_cone(glc, row_ends[k]) : RayCone{});
       }
       out.pieces = Buffer::create_from(pieces);
       // The piece map in GL rows (row 0 at the bottom).
