@@ -6,16 +6,18 @@
 // Glc::triangle_bounds gives a conservative box of the pixels whose rays can hit it (exact extremes
 // of the projection over the triangle clipped to z >= z_near: on each depth plane the map is
 // affine, so the extremes lie on the clipped triangle's edges; a slit depth inside the triangle
-// makes the box the whole piece). The box is clipped to the piece's pixel box. Per piece a triangle
+// makes the box the whole piece), clipped to the piece's pixel box. Per piece a triangle
 // is first tested against a cone that holds every ray the piece casts (the rays at the pixel
 // centres it owns: its axis the mean direction of the rays at the ends of the piece's pixel runs in
 // each row, its apex behind their origins), with its bounding sphere, and objects likewise with
-// theirs. On the GPU: one quad per (triangle, piece) box; every fragment whose pixel
-// belongs to that piece (the piece map, the same that the oracle reads) casts its pixel centre's
-// GLC ray and intersects the triangle exactly, writing depth from the hit. The image is therefore
-// the ray cast of the camera's own rays: hole-free, whatever the camera does to straight lines.
-// The hit is shaded through the material interface (glc/glc_hit.frag gathers MaterialInput), one
-// program per distinct material shader as in every method; the quads are drawn grouped by scene
+// theirs; a triangle that passes is then tested against the cones of the piece's tiles (up to 16
+// about square parts of its box), and its box is clipped to the box of the tiles it may meet, or
+// dropped where it meets none. On the GPU: one quad per (triangle, piece) box; every fragment whose
+// pixel belongs to that piece (the piece map, the same that the oracle reads) casts its pixel
+// centre's GLC ray and intersects the triangle exactly, writing depth from the hit. The image is
+// therefore the ray cast of the camera's own rays: hole-free, whatever the camera does to straight
+// lines. The hit is shaded through the material interface (glc/glc_hit.frag gathers MaterialInput),
+// one program per distinct material shader as in every method; the quads are drawn grouped by scene
 // material, each group with its material's uniforms and texture.
 #include <algorithm>
 #include <array>
@@ -69,30 +71,62 @@ struct RayCone {
   }
 };
 
-// The pixel centres of each piece at the ends of its runs in every row: their convex hull holds
-// every pixel centre the piece owns, the only ones whose rays are cast.
-std::vector<std::vector<glm::dvec2>> piece_row_ends(const PiecewiseGlc& camera) {
-  std::vector<std::vector<glm::dvec2>> ends(camera.pieces.size());
-  std::vector<int> first(camera.pieces.size()), last(camera.pieces.size());
-  std::vector<std::size_t> seen;  // pieces met in this row
+// A piece's pixels cut into up to kTilesPerPiece tiles of its box (kMinTilePixels a side at
+// least), each with its owned pixels' box and the pixel centres at the ends of its runs in every
+// row: their convex hull holds every pixel centre of the tile that the piece owns, the only ones
+// whose rays are cast.
+constexpr int kTilesPerPiece = 16, kMinTilePixels = 16;
+struct PieceTile {
+  glm::ivec4 box{0};  // owned pixels, [x0, x1) x [y0, y1)
+  std::vector<glm::dvec2> run_ends;
+};
+
+std::vector<std::vector<PieceTile>> piece_tiles(const PiecewiseGlc& camera) {
+  const std::size_t n = camera.pieces.size();
+  // Piece k's box is cut into nx[k] x ny[k] tiles, about square.
+  std::vector<int> nx(n, 1), ny(n, 1);
+  std::vector<std::vector<PieceTile>> tiles(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    const glm::ivec4 b = camera.piece_boxes[k];
+    const double w = std::max(1, b.z - b.x), h = std::max(1, b.w - b.y);
+    nx[k] = std::clamp(int(std::lround(std::sqrt(kTilesPerPiece * w / h))), 1, kTilesPerPiece);
+    ny[k] = std::max(1, kTilesPerPiece / nx[k]);
+    nx[k] = std::min(nx[k], std::max(1, int(w) / kMinTilePixels));
+    ny[k] = std::min(ny[k], std::max(1, int(h) / kMinTilePixels));
+    tiles[k].resize(std::size_t(nx[k] * ny[k]));
+    for (PieceTile& tile : tiles[k]) tile.box = {camera.size.x, camera.size.y, 0, 0};
+  }
+  auto tile_of = [&](std::size_t k, int x, int y) -> PieceTile& {
+    const glm::ivec4 b = camera.piece_boxes[k];
+    const int tx = int(std::int64_t(x - b.x) * nx[k] / std::max(1, b.z - b.x));
+    const int ty = int(std::int64_t(y - b.y) * ny[k] / std::max(1, b.w - b.y));
+    return tiles[k][std::size_t(ty * nx[k] + tx)];
+  };
   for (int y = 0; y < camera.size.y; ++y) {
-    seen.clear();
-    for (int x = 0; x < camera.size.x; ++x) {
-      const std::int32_t piece = camera.piece_of_pixel[std::size_t(y) * camera.size.x + x];
-      if (piece < 0) continue;
-      const auto k = std::size_t(piece);
-      if (std::find(seen.begin(), seen.end(), k) == seen.end()) {
-        seen.push_back(k);
-        first[k] = x;
+    const std::int32_t* row = camera.piece_of_pixel.data() + std::size_t(y) * camera.size.x;
+    // Runs of pixels of one piece and one tile.
+    int start = 0;
+    for (int x = 1; x <= camera.size.x; ++x) {
+      const std::int32_t piece = row[start];
+      if (x < camera.size.x && row[x] == piece &&
+          (piece < 0 ||
+           &tile_of(std::size_t(piece), x, y) == &tile_of(std::size_t(piece), start, y))) {
+        continue;
       }
-      last[k] = x;
-    }
-    for (std::size_t k : seen) {
-      ends[k].push_back({first[k] + 0.5, y + 0.5});
-      if (last[k] != first[k]) ends[k].push_back({last[k] + 0.5, y + 0.5});
+      if (piece >= 0) {
+        PieceTile& tile = tile_of(std::size_t(piece), start, y);
+        tile.run_ends.push_back({start + 0.5, y + 0.5});
+        if (x - 1 > start) tile.run_ends.push_back({x - 0.5, y + 0.5});
+        tile.box = {std::min(tile.box.x, start), std::min(tile.box.y, y), std::max(tile.box.z, x),
+                    std::max(tile.box.w, y + 1)};
+      }
+      start = x;
     }
   }
-  return ends;
+  for (std::vector<PieceTile>& piece : tiles) {
+    std::erase_if(piece, [](const PieceTile& tile) { return tile.run_ends.empty(); });
+  }
+  return tiles;
 }
 
 // The cone of the rays of a piece at `points` (pixels). A piece's rays are affine in the pixel,
@@ -162,9 +196,9 @@ class GlcMethod final : public RenderMethod {
       const PiecewiseGlc& camera = *out.camera;
       FACET_ASSERT(camera.size == output.warp.output_size);
       std::vector<GpuPiece> pieces;
-      const std::vector<std::vector<glm::dvec2>> row_ends =
-          camera.pieces.size() > 1 ? piece_row_ends(camera)
-                                   : std::vector<std::vector<glm::dvec2>>{};
+      const std::vector<std::vector<PieceTile>> tiles =
+          camera.pieces.size() > 1 ? piece_tiles(camera) : std::vector<std::vector<PieceTile>>{};
+      out.tiles.resize(camera.pieces.size());
       for (std::size_t k = 0; k < camera.pieces.size(); ++k) {
         const Glc& glc = camera.pieces[k];
         // Affine in the pixel: differences of rays one pixel apart, about the piece box's corner.
@@ -176,7 +210,20 @@ class GlcMethod final : public RenderMethod {
         pieces.push_back({glm::vec4(r0.origin - at.x * ox - at.y * oy, 0), glm::vec4(ox, 0),
                           glm::vec4(oy, 0), glm::vec4(r0.direction - at.x * dx - at.y * dy, 0),
                           glm::vec4(dx, 0), glm::vec4(dy, 0)});
-        out.cones.push_back(camera.pieces.size() > 1 ? ray_cone(glc, row_ends[k]) : RayCone{});
+        if (camera.pieces.size() == 1) {
+          out.cones.push_back(RayCone{});
+          continue;
+        }
+        std::vector<glm::dvec2> run_ends;
+        for (const PieceTile& tile : tiles[k]) {
+          run_ends.insert(run_ends.end(), tile.run_ends.begin(), tile.run_ends.end());
+        }
+        out.cones.push_back(ray_cone(glc, run_ends));
+        if (tiles[k].size() > 1) {
+          for (const PieceTile& tile : tiles[k]) {
+            out.tiles[k].push_back({ray_cone(glc, tile.run_ends), tile.box});
+          }
+        }
       }
       out.pieces = Buffer::create_from(pieces);
       // The piece map in GL rows (row 0 at the bottom).
@@ -262,7 +309,7 @@ class GlcMethod final : public RenderMethod {
         try {
           for (std::size_t k = next_piece++; k < camera.pieces.size(); k = next_piece++) {
             piece_quads_[k].clear();
-            box_piece(camera, out.cones[k], k, spheres, piece_quads_[k]);
+            box_piece(camera, out.cones[k], out.tiles[k], k, spheres, piece_quads_[k]);
           }
         } catch (...) {
           failures[worker] = std::current_exception();
@@ -360,16 +407,23 @@ class GlcMethod final : public RenderMethod {
     glm::dvec3 centre{0.0};
     double radius = 0;
   };
+  struct TileCone {
+    RayCone cone;
+    glm::ivec4 box;  // the tile's owned pixels
+  };
   struct OutputState {
     std::shared_ptr<const PiecewiseGlc> camera;
-    std::vector<RayCone> cones;
+    std::vector<RayCone> cones;  // per piece
+    // Per piece, the cones of its tiles (none where the piece is one tile).
+    std::vector<std::vector<TileCone>> tiles;
     Buffer pieces, quads;
     Texture piece_map;
   };
 
   // Piece k's quads: for every triangle its cone lets through, the triangle's pixel box clipped
-  // to the piece's.
-  void box_piece(const PiecewiseGlc& camera, const RayCone& cone, std::size_t k,
+  // to the box of the piece's tiles whose cones let it through.
+  void box_piece(const PiecewiseGlc& camera, const RayCone& cone,
+                 const std::vector<TileCone>& tiles, std::size_t k,
                  const std::vector<BoundingSphere>& spheres, std::vector<GpuQuad>& quads) const {
     const Glc& glc = camera.pieces[k];
     const glm::ivec4 box = camera.piece_boxes[k];
@@ -380,16 +434,27 @@ class GlcMethod final : public RenderMethod {
         continue;
       for (std::uint32_t t = object_ranges_[o]; t < object_ranges_[o + 1]; ++t) {
         const EyeTriangle& tri = triangles_[t];
-        if (!cone.may_meet(tri.centre, tri.radius * 1.0001 + 1e-6)) continue;
+        const double radius = tri.radius * 1.0001 + 1e-6;
+        if (!cone.may_meet(tri.centre, radius)) continue;
+        glm::ivec4 reach = box;
+        if (!tiles.empty()) {
+          reach = {box.z, box.w, box.x, box.y};
+          for (const TileCone& tile : tiles) {
+            if (!tile.cone.may_meet(tri.centre, radius)) continue;
+            reach = {std::min(reach.x, tile.box.x), std::min(reach.y, tile.box.y),
+                     std::max(reach.z, tile.box.z), std::max(reach.w, tile.box.w)};
+          }
+          if (reach.x >= reach.z || reach.y >= reach.w) continue;
+        }
         const auto bounds = glc.triangle_bounds(glm::dvec3(tri.v[0]), glm::dvec3(tri.v[1]),
                                                 glm::dvec3(tri.v[2]), settings_.z_near, 0.5);
         if (!bounds) continue;
-        // Clip to the piece's box (whole pixels); the bound's box holds every pixel centre whose
+        // Clip to the tiles' box (whole pixels); the bound's box holds every pixel centre whose
         // ray can meet the triangle.
-        const double x0 = std::max<double>(box.x, bounds->min.x);
-        const double x1 = std::min<double>(box.z, bounds->max.x);
-        const double y0 = std::max<double>(box.y, bounds->min.y);
-        const double y1 = std::min<double>(box.w, bounds->max.y);
+        const double x0 = std::max<double>(reach.x, bounds->min.x);
+        const double x1 = std::min<double>(reach.z, bounds->max.x);
+        const double y0 = std::max<double>(reach.y, bounds->min.y);
+        const double y1 = std::min<double>(reach.w, bounds->max.y);
         if (!(x0 < x1 && y0 < y1)) continue;
         quads.push_back({glm::vec4(float(x0), h - float(y1), float(x1), h - float(y0)),
                          glm::vec4(tri.v[0], 1), glm::vec4(tri.v[1], 1), glm::vec4(tri.v[2], 1),
