@@ -4,10 +4,12 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cmath>
 #include <cstring>
 #include <limits>
 #include <nlohmann/json.hpp>
+#include <optional>
 
 #include "facet/driver/scene_view.hpp"
 #include "facet/projection/atomic_file.hpp"
@@ -392,95 +394,316 @@ std::uint8_t srgb_encode(float linear) {
 
 }  // namespace
 
+namespace {
+
+// The grid nodes of one axis inside a block from node `from` to node `to`: every step-th one
+// and the last.
+std::vector<int> block_nodes(int from, int to, int step) {
+  std::vector<int> nodes;
+  for (int k = from; k < to; k += step) nodes.push_back(k);
+  nodes.push_back(to);
+  return nodes;
+}
+
+// The nodes of `nodes` strictly between a and b (a < b), in order.
+std::vector<int> nodes_between(const std::vector<int>& nodes, int a, int b) {
+  std::vector<int> inside;
+  for (int n : nodes)
+    if (n > a && n < b) inside.push_back(n);
+  return inside;
+}
+
+}  // namespace
+
 DepthMesh depth_image_mesh(const DepthImage& image, const DepthMeshOptions& options) {
   if (options.step < 1 || options.step > 64)
     throw InputError(
         "command line", OptionName{"step"},
         "expected a depth image grid step in 1..64; got " + std::to_string(options.step));
+  if (!std::isfinite(options.lod_angle_rad) || options.lod_angle_rad < 0 ||
+      options.lod_angle_rad > 1)
+    throw InputError("command line", OptionName{"lod"},
+                     "expected a level-of-detail angle in [0, 1] rad; got " +
+                         std::to_string(options.lod_angle_rad));
+  const bool lod = options.lod_angle_rad > 0;
+  if (lod && options.step != 1)
+    throw InputError("command line", OptionName{"lod"},
+                     "expected grid step 1 with level of detail (it chooses the steps); got " +
+                         std::to_string(options.step));
   image.validate();
   DepthMesh mesh;
   Scene& scene = mesh.scene;
   scene.name = "depth image";
   const double tangent_sin = std::sin(glm::radians(options.edge_tangent_deg));
+  constexpr int kLevels = std::countr_zero(unsigned(kDepthLodBlock)) + 1;
+  if (lod) mesh.lod_blocks_by_level.assign(kLevels, 0);
+  const glm::dvec3 lod_eye =
+      lod && options.lod_eye_world
+          ? glm::dvec3(glm::inverse(image.T_world_image) * glm::dvec4(*options.lod_eye_world, 1.0))
+          : glm::dvec3(0.0);
+  // Per vertex of the scene (all parts): its point and normal in the image frame, its source ID.
+  std::vector<glm::dvec3> p_vertex, n_vertex;
+  std::vector<std::uint32_t> id_vertex;
   for (const DepthImagePart& part : image.parts) {
     const bool wraps = part.base.wraps_horizontally();
-    // Grid columns and rows: every step-th pixel and the last.
-    const auto samples = [&](int n) {
-      std::vector<int> s;
-      for (int k = 0; k < n; k += options.step) s.push_back(k);
-      if (s.back() != n - 1) s.push_back(n - 1);
-      return s;
+    const int W = part.size.x, H = part.size.y;
+    // Grid nodes: x in [0, last_x] (x = W, the cylinder's seam, is pixel column 0 again),
+    // y in [0, H - 1].
+    const int last_x = wraps ? W : W - 1, last_y = H - 1;
+    const auto pixel_x = [&](int x) { return x == W ? 0 : x; };
+    // Blocks: one for the whole part without level of detail.
+    const int block = lod ? kDepthLodBlock : std::max(last_x, last_y) + 1;
+    const int blocks_x = last_x > 0 ? (last_x + block - 1) / block : 0;
+    const int blocks_y = last_y > 0 ? (last_y + block - 1) / block : 0;
+    const auto block_from_x = [&](int bx) { return bx * block; };
+    const auto block_to_x = [&](int bx) { return std::min((bx + 1) * block, last_x); };
+    const auto block_from_y = [&](int by) { return by * block; };
+    const auto block_to_y = [&](int by) { return std::min((by + 1) * block, last_y); };
+
+    // Vertex index per node, -2 before it is looked at, -1 where the pixel sees nothing.
+    const std::size_t nodes_w = std::size_t(W) + 1;
+    std::vector<std::int64_t> vertex(nodes_w * std::size_t(std::max(H, 0)), -2);
+    const auto point = [&](int i, int j) {
+      return double(part.distance_m[part.pixel_index(i, j)]) * part.v_image(i, j);
     };
-    const std::vector<int> rows = samples(part.size.y);
-    std::vector<int> columns = samples(part.size.x);
-    const std::size_t grid_w = columns.size() + (wraps ? 1 : 0);
-    // Vertex index per grid node, or -1 where the pixel sees nothing.
-    std::vector<std::int64_t> vertex(grid_w * rows.size(), -1);
-    std::vector<glm::dvec3> p_node(vertex.size()), n_node(vertex.size());
-    for (std::size_t gj = 0; gj < rows.size(); ++gj) {
-      for (std::size_t gi = 0; gi < grid_w; ++gi) {
-        const bool seam = gi == columns.size();
-        const int i = seam ? columns[0] : columns[gi], j = rows[gj];
-        const std::size_t k = part.pixel_index(i, j);
-        if (std::isinf(part.distance_m[k])) continue;
-        const glm::dvec3 p = double(part.distance_m[k]) * part.v_image(i, j);
-        const std::size_t node = gj * grid_w + gi;
-        vertex[node] = std::int64_t(scene.positions.size());
-        p_node[node] = p;
-        n_node[node] = glm::dvec3(part.normal[k]);
-        scene.positions.push_back(glm::vec3(p));
-        scene.normals.push_back(glm::normalize(part.normal[k]));
-        scene.uvs.push_back({float((i + (seam ? part.size.x : 0) + 0.5) / part.size.x),
-                             float((j + 0.5) / part.size.y)});
+    const auto vertex_at = [&](int x, int y) -> std::int64_t {
+      std::int64_t& v = vertex[std::size_t(y) * nodes_w + std::size_t(x)];
+      if (v != -2) return v;
+      const int i = pixel_x(x);
+      const std::size_t k = part.pixel_index(i, y);
+      if (std::isinf(part.distance_m[k])) return v = -1;
+      v = std::int64_t(scene.positions.size());
+      const glm::dvec3 p = point(i, y);
+      p_vertex.push_back(p);
+      n_vertex.push_back(glm::dvec3(part.normal[k]));
+      id_vertex.push_back(part.source_id.empty() ? 0 : part.source_id[k]);
+      scene.positions.push_back(glm::vec3(p));
+      scene.normals.push_back(glm::normalize(part.normal[k]));
+      scene.uvs.push_back({float((x + 0.5) / W), float((y + 0.5) / H)});
+      return v;
+    };
+
+    // Each block's level (step 2^level).
+    std::vector<int> level(std::size_t(blocks_x) * std::size_t(blocks_y), 0);
+    const auto level_at = [&](int bx, int by) -> int& {
+      return level[std::size_t(by) * std::size_t(blocks_x) + std::size_t(bx)];
+    };
+    if (lod) {
+      // The largest angle, seen from the eye, between neighbouring pixels that join one surface.
+      std::vector<double> angle(level.size(), 0.0);
+      const auto seen = [&](int i, int j) {
+        return !std::isinf(part.distance_m[part.pixel_index(i, j)]);
+      };
+      for (int j = 0; j < H; ++j) {
+        for (int i = 0; i < W; ++i) {
+          if (!seen(i, j)) continue;
+          const glm::dvec3 p = point(i, j), n(part.normal[part.pixel_index(i, j)]);
+          const int bx = std::min(i / block, blocks_x - 1), by = std::min(j / block, blocks_y - 1);
+          if (bx < 0 || by < 0) continue;
+          for (const glm::ivec2 next : {glm::ivec2(i + 1, j), glm::ivec2(i, j + 1)}) {
+            int ni = next.x;
+            if (ni == W) {
+              if (!wraps) continue;
+              ni = 0;
+            }
+            if (next.y >= H || !seen(ni, next.y)) continue;
+            const glm::dvec3 q = point(ni, next.y), m(part.normal[part.pixel_index(ni, next.y)]);
+            if (!joins_one_surface(p, n, q, m, options.edge_footprints, tangent_sin)) continue;
+            const glm::dvec3 a = p - lod_eye, b = q - lod_eye;
+            double& worst = angle[std::size_t(by) * std::size_t(blocks_x) + std::size_t(bx)];
+            worst = std::max(worst, std::atan2(glm::length(glm::cross(a, b)), glm::dot(a, b)));
+          }
+        }
       }
+      for (std::size_t b = 0; b < level.size(); ++b) {
+        int l = 0;
+        while (l + 1 < kLevels && angle[b] * double(1 << (l + 1)) <= options.lod_angle_rad) ++l;
+        level[b] = l;
+      }
+      // Neighbours differ by one level at most: lower the coarser until none is two above.
+      for (bool changed = true; changed;) {
+        changed = false;
+        for (int by = 0; by < blocks_y; ++by)
+          for (int bx = 0; bx < blocks_x; ++bx) {
+            int& l = level_at(bx, by);
+            const auto limit = [&](int nx, int ny) {
+              if (nx < 0 || nx >= blocks_x) {
+                if (!wraps) return;
+                nx = (nx + blocks_x) % blocks_x;
+              }
+              if (ny < 0 || ny >= blocks_y) return;
+              if (l > level_at(nx, ny) + 1) {
+                l = level_at(nx, ny) + 1;
+                changed = true;
+              }
+            };
+            limit(bx - 1, by);
+            limit(bx + 1, by);
+            limit(bx, by - 1);
+            limit(bx, by + 1);
+          }
+      }
+      for (int l : level) ++mesh.lod_blocks_by_level[std::size_t(l)];
     }
+    // A block's nodes along x and y at its step. Without level of detail the cylinder keeps its
+    // last column before the seam (every step-th pixel and the last, then the seam).
+    const auto xs_of = [&](int bx, int by) {
+      if (!lod) {
+        std::vector<int> xs = block_nodes(0, W - 1, options.step);
+        if (wraps) xs.push_back(W);
+        return xs;
+      }
+      return block_nodes(block_from_x(bx), block_to_x(bx), 1 << level_at(bx, by));
+    };
+    const auto ys_of = [&](int bx, int by) {
+      if (!lod) return block_nodes(0, last_y, options.step);
+      return block_nodes(block_from_y(by), block_to_y(by), 1 << level_at(bx, by));
+    };
+
     Primitive primitive;
     primitive.first_index = std::uint32_t(scene.indices.size());
     primitive.material = std::uint32_t(scene.materials.size());
-    const auto id_at = [&](std::size_t node) -> std::uint32_t {
-      if (part.source_id.empty()) return 0;
-      const std::size_t gi = node % grid_w, gj = node / grid_w;
-      const int i = gi == columns.size() ? columns[0] : columns[gi];
-      return part.source_id[part.pixel_index(i, rows[gj])];
-    };
     // A triangle of grid nodes when all corners are seen and every edge joins one surface; wound
     // counter-clockwise seen from the eye.
-    const auto triangle = [&](std::size_t a, std::size_t b, std::size_t c,
-                              std::array<std::uint32_t, 3>& out) {
-      if (vertex[a] < 0 || vertex[b] < 0 || vertex[c] < 0) return false;
-      const std::array<std::size_t, 3> nodes{a, b, c};
+    using Node = glm::ivec2;
+    const auto triangle = [&](Node na, Node nb, Node nc, std::array<std::uint32_t, 3>& out,
+                              std::uint32_t& id) {
+      const std::int64_t a = vertex_at(na.x, na.y), b = vertex_at(nb.x, nb.y),
+                         c = vertex_at(nc.x, nc.y);
+      if (a < 0 || b < 0 || c < 0) return false;
+      const std::array<std::size_t, 3> v{std::size_t(a), std::size_t(b), std::size_t(c)};
       for (int e = 0; e < 3; ++e) {
-        const std::size_t u = nodes[std::size_t(e)], v = nodes[std::size_t((e + 1) % 3)];
-        if (!joins_one_surface(p_node[u], n_node[u], p_node[v], n_node[v], options.edge_footprints,
-                               tangent_sin))
+        const std::size_t u = v[std::size_t(e)], w = v[std::size_t((e + 1) % 3)];
+        if (!joins_one_surface(p_vertex[u], n_vertex[u], p_vertex[w], n_vertex[w],
+                               options.edge_footprints, tangent_sin))
           return false;
       }
-      const glm::dvec3 normal = glm::cross(p_node[b] - p_node[a], p_node[c] - p_node[a]);
+      const glm::dvec3 normal =
+          glm::cross(p_vertex[v[1]] - p_vertex[v[0]], p_vertex[v[2]] - p_vertex[v[0]]);
       if (glm::dot(normal, normal) == 0) return false;
-      const bool facing_eye = glm::dot(normal, p_node[a]) < 0;
-      out = {std::uint32_t(vertex[a]), std::uint32_t(vertex[facing_eye ? b : c]),
-             std::uint32_t(vertex[facing_eye ? c : b])};
+      const bool facing_eye = glm::dot(normal, p_vertex[v[0]]) < 0;
+      out = {std::uint32_t(a), std::uint32_t(facing_eye ? b : c),
+             std::uint32_t(facing_eye ? c : b)};
+      const std::uint32_t ia = id_vertex[v[0]], ib = id_vertex[v[1]], ic = id_vertex[v[2]];
+      id = ib == ic ? ib : ia;
       return true;
     };
-    for (std::size_t gj = 0; gj + 1 < rows.size(); ++gj) {
-      for (std::size_t gi = 0; gi + 1 < grid_w; ++gi) {
-        const std::size_t n00 = gj * grid_w + gi, n10 = n00 + 1, n01 = n00 + grid_w, n11 = n01 + 1;
-        // The diagonal that keeps more triangles (across a discontinuity one may survive).
-        std::array<std::array<std::uint32_t, 3>, 4> tri{};
-        std::array<std::array<std::size_t, 3>, 4> corners{
-            {{n00, n01, n11}, {n00, n11, n10}, {n00, n01, n10}, {n10, n01, n11}}};
-        std::array<bool, 4> ok{};
-        for (std::size_t t = 0; t < 4; ++t)
-          ok[t] = triangle(corners[t][0], corners[t][1], corners[t][2], tri[t]);
-        const int first = int(ok[0]) + int(ok[1]), second = int(ok[2]) + int(ok[3]);
-        const std::size_t from = second > first ? 2 : 0;
-        mesh.dropped_triangles += std::size_t(2 - std::max(first, second));
-        for (std::size_t t = from; t < from + 2; ++t) {
-          if (!ok[t]) continue;
-          scene.indices.insert(scene.indices.end(), tri[t].begin(), tri[t].end());
-          const std::uint32_t a = id_at(corners[t][0]), b = id_at(corners[t][1]),
-                              c = id_at(corners[t][2]);
-          mesh.source_id.push_back(b == c ? b : a);
+    const auto emit = [&](const std::array<std::uint32_t, 3>& tri, std::uint32_t id) {
+      scene.indices.insert(scene.indices.end(), tri.begin(), tri.end());
+      mesh.source_id.push_back(id);
+    };
+    for (int by = 0; by < blocks_y; ++by) {
+      for (int bx = 0; bx < blocks_x; ++bx) {
+        const std::vector<int> xs = xs_of(bx, by), ys = ys_of(bx, by);
+        // The finer neighbours' nodes along the shared edges (none without level of detail).
+        const auto neighbour = [&](int nx, int ny) -> std::optional<glm::ivec2> {
+          if (!lod) return std::nullopt;
+          if (nx < 0 || nx >= blocks_x) {
+            if (!wraps) return std::nullopt;
+            nx = (nx + blocks_x) % blocks_x;
+          }
+          if (ny < 0 || ny >= blocks_y) return std::nullopt;
+          if (level_at(nx, ny) >= level_at(bx, by)) return std::nullopt;
+          return glm::ivec2(nx, ny);
+        };
+        const auto left = neighbour(bx - 1, by), right = neighbour(bx + 1, by),
+                   top = neighbour(bx, by - 1), bottom = neighbour(bx, by + 1);
+        const std::vector<int> left_ys = left ? ys_of(left->x, left->y) : std::vector<int>{},
+                               right_ys = right ? ys_of(right->x, right->y) : std::vector<int>{},
+                               top_xs = top ? xs_of(top->x, top->y) : std::vector<int>{},
+                               bottom_xs =
+                                   bottom ? xs_of(bottom->x, bottom->y) : std::vector<int>{};
+        for (std::size_t gj = 0; gj + 1 < ys.size(); ++gj) {
+          for (std::size_t gi = 0; gi + 1 < xs.size(); ++gi) {
+            const int x0 = xs[gi], x1 = xs[gi + 1], y0 = ys[gj], y1 = ys[gj + 1];
+            // Extra nodes on the cell's sides from finer neighbours.
+            const std::vector<int> on_top =
+                top && gj == 0 ? nodes_between(top_xs, x0, x1) : std::vector<int>{};
+            const std::vector<int> on_bottom = bottom && gj + 2 == ys.size()
+                                                   ? nodes_between(bottom_xs, x0, x1)
+                                                   : std::vector<int>{};
+            const std::vector<int> on_left =
+                left && gi == 0 ? nodes_between(left_ys, y0, y1) : std::vector<int>{};
+            const std::vector<int> on_right =
+                right && gi + 2 == xs.size() ? nodes_between(right_ys, y0, y1) : std::vector<int>{};
+            std::array<std::uint32_t, 3> tri{};
+            std::uint32_t id = 0;
+            if (on_top.empty() && on_bottom.empty() && on_left.empty() && on_right.empty()) {
+              // The diagonal that keeps more triangles (across a discontinuity one may survive).
+              const Node n00(x0, y0), n10(x1, y0), n01(x0, y1), n11(x1, y1);
+              std::array<std::array<std::uint32_t, 3>, 4> tris{};
+              std::array<std::uint32_t, 4> ids{};
+              const std::array<std::array<Node, 3>, 4> corners{
+                  {{n00, n01, n11}, {n00, n11, n10}, {n00, n01, n10}, {n10, n01, n11}}};
+              std::array<bool, 4> ok{};
+              for (std::size_t t = 0; t < 4; ++t)
+                ok[t] = triangle(corners[t][0], corners[t][1], corners[t][2], tris[t], ids[t]);
+              const int first = int(ok[0]) + int(ok[1]), second = int(ok[2]) + int(ok[3]);
+              const std::size_t from = second > first ? 2 : 0;
+              mesh.dropped_triangles += std::size_t(2 - std::max(first, second));
+              for (std::size_t t = from; t < from + 2; ++t)
+                if (ok[t]) emit(tris[t], ids[t]);
+              continue;
+            }
+            // The cell's outline, counter-clockwise in the grid (x right, y down): top left to
+            // bottom left, bottom right, top right, with the finer neighbours' nodes.
+            std::vector<Node> outline;
+            outline.emplace_back(x0, y0);
+            for (int y : on_left) outline.emplace_back(x0, y);
+            outline.emplace_back(x0, y1);
+            for (int x : on_bottom) outline.emplace_back(x, y1);
+            outline.emplace_back(x1, y1);
+            for (auto it = on_right.rbegin(); it != on_right.rend(); ++it)
+              outline.emplace_back(x1, *it);
+            outline.emplace_back(x1, y0);
+            for (auto it = on_top.rbegin(); it != on_top.rend(); ++it)
+              outline.emplace_back(*it, y0);
+            const auto add = [&](Node a, Node b, Node c) {
+              if (triangle(a, b, c, tri, id))
+                emit(tri, id);
+              else
+                ++mesh.dropped_triangles;
+            };
+            if (x1 - x0 >= 2 && y1 - y0 >= 2) {
+              // A fan about the cell's centre pixel.
+              const Node centre((x0 + x1) / 2, (y0 + y1) / 2);
+              for (std::size_t k = 0; k < outline.size(); ++k)
+                add(centre, outline[k], outline[(k + 1) % outline.size()]);
+            } else {
+              // One pixel wide: the extra nodes lie on the two long sides; a strip between them.
+              const bool tall = x1 - x0 == 1;
+              std::vector<Node> a, b;  // the two long sides, in the same direction
+              if (tall) {
+                a.emplace_back(x0, y0);
+                for (int y : on_left) a.emplace_back(x0, y);
+                a.emplace_back(x0, y1);
+                b.emplace_back(x1, y0);
+                for (int y : on_right) b.emplace_back(x1, y);
+                b.emplace_back(x1, y1);
+              } else {
+                a.emplace_back(x0, y0);
+                for (int x : on_top) a.emplace_back(x, y0);
+                a.emplace_back(x1, y0);
+                b.emplace_back(x0, y1);
+                for (int x : on_bottom) b.emplace_back(x, y1);
+                b.emplace_back(x1, y1);
+              }
+              std::size_t ia = 0, ib = 0;
+              while (ia + 1 < a.size() || ib + 1 < b.size()) {
+                const int along_a =
+                    ia + 1 < a.size() ? (tall ? a[ia + 1].y : a[ia + 1].x) : 1 << 30;
+                const int along_b =
+                    ib + 1 < b.size() ? (tall ? b[ib + 1].y : b[ib + 1].x) : 1 << 30;
+                if (along_a <= along_b) {
+                  add(a[ia], a[ia + 1], b[ib]);
+                  ++ia;
+                } else {
+                  add(a[ia], b[ib + 1], b[ib]);
+                  ++ib;
+                }
+              }
+            }
+          }
         }
       }
     }

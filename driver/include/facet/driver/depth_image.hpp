@@ -106,7 +106,27 @@ struct DepthMeshOptions {
   // along the rays. Triangles with an edge that fails, or a corner not seen, are dropped.
   double edge_footprints = 4.0;
   double edge_tangent_deg = 15.0;
+  // View-dependent level of detail, off at 0 (one `step` for the whole image, which must then
+  // be 1 to turn it on). Each kDepthLodBlock × kDepthLodBlock block of a part takes the coarsest
+  // step of 1, 2, 4, ..., kDepthLodBlock at which neighbouring grid vertices, seen from
+  // lod_eye_world (the image's own eye when not given), stay within lod_angle_rad of each other:
+  // the block's largest angle between neighbouring pixels that join one surface, times the step.
+  // Neighbouring blocks (the cylinder's seam included) differ by one level at most, the finer
+  // one winning; a coarse cell next to a finer block takes the finer block's vertices on their
+  // shared edge (a fan about its centre pixel, or a strip where it is one pixel wide), so the
+  // mesh has no T-junctions. Discontinuity edges are judged as above on every triangle.
+  // From the image's own eye every surface is seen at the image's own resolution, so the step
+  // there follows only the pixels' angular pitch (finer near a cylinder's horizon than its top
+  // rows, finer at a cap's centre than its corners); moving towards a surface enlarges it (step
+  // 1 at the least: the image holds no more), moving away shrinks it.
+  double lod_angle_rad = 0;
+  std::optional<glm::dvec3> lod_eye_world = std::nullopt;
 };
+// The block side of DepthMeshOptions::lod_angle_rad, in pixels, and the coarsest step.
+inline constexpr int kDepthLodBlock = 16;
+// The angle `depth:FILE.exr@lod` takes (scene_names.hpp): 0.01 rad, about 1.6 pixels of the
+// 512² 180° dome.
+inline constexpr double kDepthLodDefaultRad = 0.01;
 
 // The source of every triangle of a depth image's mesh.
 struct DepthMesh {
@@ -116,13 +136,16 @@ struct DepthMesh {
   // when the image has no id channel. source_id[0 - 1] does not exist: ID 0 maps to 0.
   std::vector<std::uint32_t> source_id;
   std::size_t dropped_triangles = 0;  // cells' triangles dropped at discontinuities
+  // With level of detail: blocks (all parts) per step, index log2(step); else empty.
+  std::vector<std::size_t> lod_blocks_by_level;
 };
 
 // The grid mesh: the vertex of pixel (i, j) at eye + distance · v (McMillan's pre-warp), in the
 // world frame; per vertex the stored normal (world frame) and the colour image's texel centre as
 // uv. The cylinder's last column joins its first. Triangles face the eye (counter-clockwise seen
 // from it). The scene also holds a SceneCamera named kDepthImageEyeCamera at T_world_image.
-// InputError naming the option "step" for a step outside [1, 64].
+// InputError naming the option "step" for a step outside [1, 64], "lod" for an angle that is
+// not finite or outside [0, 1] rad, or an angle with a step other than 1.
 DepthMesh depth_image_mesh(const DepthImage& image, const DepthMeshOptions& options = {});
 
 // Several scenes in one: objects, primitives, materials, images and cameras appended in order
