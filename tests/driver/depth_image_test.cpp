@@ -551,6 +551,18 @@ TEST(DepthImage, SceneNamesTakeDepthImagesAloneAndHybrid) {
   EXPECT_EQ(coarse.depth_images[0].step, 4);
   EXPECT_THROW(parse_scene_name("depth:a.exr@0"), InputError);
   EXPECT_THROW(parse_scene_name("depth:a.exr@x"), InputError);
+  EXPECT_EQ(parse_scene_name("depth:a.exr@lod").depth_images[0].lod_angle_rad, kDepthLodDefaultRad);
+  const SceneName lod = parse_scene_name("builtin:city+depth:a.exr@lod=0.03");
+  EXPECT_EQ(lod.depth_images[0].lod_angle_rad, 0.03);
+  EXPECT_EQ(lod.depth_images[0].step, 1);
+  EXPECT_TRUE(uses_depth_lod(lod));
+  EXPECT_FALSE(uses_depth_lod(coarse));
+  for (const char* bad :
+       {"depth:a.exr@lod=0", "depth:a.exr@lod=-0.1", "depth:a.exr@lod=2", "depth:a.exr@lod=x",
+        "depth:a.exr@lod=", "depth:a.exr@lod=nan", "depth:a.exr@lods"})
+    EXPECT_NE(error_of([&] { parse_scene_name(bad); }).find("scene"), std::string::npos) << bad;
+  EXPECT_NE(error_of([&] { parse_scene_name("depth:a.exr@lod=2"); }).find("lod angle"),
+            std::string::npos);
   EXPECT_FALSE(alone.builtin_city());
   const SceneName hybrid = parse_scene_name("builtin:city+depth:a.exr");
   EXPECT_EQ(hybrid.kind, SceneName::Kind::city);
@@ -604,6 +616,32 @@ TEST(DepthImage, CliRendersTheCityDpciAgainstThePolygonCity) {
               reference["id_mismatch"].get<double>(), reference["p99_edge_px"].get<double>());
   EXPECT_LE(reference["id_mismatch"].get<double>(), 0.005);
   EXPECT_LE(reference["p99_edge_px"].get<double>(), 2.0);
+  // With level of detail: fewer triangles, the same bounds.
+  ASSERT_EQ(facet::test::run_facet(
+                "render --display builtin:dome180 --size 96x96 --scene depth:" + image.string() +
+                    "@lod=0.05 --reference --reference-scene builtin:city --json",
+                log),
+            0)
+      << facet::test::slurp(log);
+  const std::string lod_text = facet::test::slurp(log);
+  const nlohmann::json lod = nlohmann::json::parse(lod_text.substr(lod_text.find('{')));
+  std::printf("@lod=0.05: %llu of %llu triangles, id_mismatch %.5f, p99 %.2f px\n",
+              lod["triangles_scene"].get<unsigned long long>(),
+              report["triangles_scene"].get<unsigned long long>(),
+              lod["reference"]["id_mismatch"].get<double>(),
+              lod["reference"]["p99_edge_px"].get<double>());
+  EXPECT_LT(lod["triangles_scene"].get<std::uint64_t>(),
+            report["triangles_scene"].get<std::uint64_t>());
+  EXPECT_LE(lod["reference"]["id_mismatch"].get<double>(), 0.005);
+  EXPECT_LE(lod["reference"]["p99_edge_px"].get<double>(), 2.0);
+  // A bad angle: exit 2 naming --scene and the angle.
+  EXPECT_EQ(facet::test::run_facet("render --display builtin:dome180 --size 16x16 --scene depth:" +
+                                       image.string() + "@lod=3",
+                                   log),
+            2);
+  EXPECT_NE(facet::test::slurp(log).find("lod angle"), std::string::npos)
+      << facet::test::slurp(log);
+  EXPECT_NE(facet::test::slurp(log).find("--scene"), std::string::npos) << facet::test::slurp(log);
   EXPECT_EQ(facet::test::run_facet("render --display builtin:dome180 --size 16x16 --scene depth:" +
                                        image.string() + " --reference-scene builtin:city",
                                    log),

@@ -298,12 +298,20 @@ void run(const RenderOptions& options) {
         as_reference_scene([&] { return parse_scene_name(options.reference_scene); });
   }
   std::vector<std::uint32_t> source_ids;
-  const Scene scene = load_scene(scene_name, &source_ids);
+  Scene scene = load_scene(scene_name, &source_ids);
   std::optional<Scene> reference_scene;
   if (reference_scene_name) {
     reference_scene = as_reference_scene([&] { return load_scene(*reference_scene_name); });
   }
   const SceneView view = choose_view(scene, view_request, scene_name.builtin_city(), "render");
+  if (uses_depth_lod(scene_name)) {
+    // Depth images with @lod take their steps as seen from the first frame's eye (the view comes
+    // from the scene, so the scene is built twice). The scene is uploaded once: later frames
+    // keep these steps; a turning view keeps the eye's position and so the right ones.
+    const glm::dvec3 eye(FrameViews(view, kFrameStepS, options.static_view).T_world_eye(0)[3]);
+    source_ids.clear();
+    scene = load_scene(scene_name, &source_ids, eye);
+  }
 
   auto context = create_headless_context();
   check_material_shader(settings.material);  // its own compile errors name its file (exit 2)

@@ -1,6 +1,7 @@
 #include "facet/driver/scene_names.hpp"
 
 #include <charconv>
+#include <cmath>
 #include <glm/gtc/matrix_transform.hpp>
 
 #include "facet/driver/depth_image.hpp"
@@ -30,6 +31,15 @@ int parse_count(std::string_view text, std::string_view digits) {
   return value;
 }
 
+double parse_lod_angle(std::string_view text, std::string_view digits) {
+  double value = 0;
+  const auto [end, error] = std::from_chars(digits.data(), digits.data() + digits.size(), value);
+  if (digits.empty() || error != std::errc() || end != digits.data() + digits.size() ||
+      !std::isfinite(value) || value <= 0 || value > 1)
+    refuse(text, "the lod angle must be a number of radians in (0, 1]");
+  return value;
+}
+
 std::uint64_t city_triangles() {
   static const std::uint64_t count = build_city().triangle_count();
   return count;
@@ -51,11 +61,20 @@ SceneName parse_scene_name(std::string_view text) {
       DepthImageName image;
       const std::size_t at = file.rfind(".exr@");
       if (at != std::string_view::npos) {
-        image.step = parse_count(text, file.substr(at + 5));
+        const std::string_view suffix = file.substr(at + 5);
+        if (suffix == "lod") {
+          image.lod_angle_rad = kDepthLodDefaultRad;
+        } else if (suffix.starts_with("lod=")) {
+          image.lod_angle_rad = parse_lod_angle(text, suffix.substr(4));
+        } else {
+          image.step = parse_count(text, suffix);
+        }
         file = file.substr(0, at + 4);
       }
       if (!file.ends_with(".exr") || file.size() <= 4)
-        refuse(text, "a depth image is a .exr file: depth:FILE.exr or depth:FILE.exr@STEP");
+        refuse(text,
+               "a depth image is a .exr file: depth:FILE.exr, depth:FILE.exr@STEP or "
+               "depth:FILE.exr@lod[=RADIANS]");
       image.file = std::filesystem::path(file);
       files.push_back(image);
       if (next == std::string_view::npos) break;
@@ -133,7 +152,14 @@ Scene load_polygons(const SceneName& name) {
 
 }  // namespace
 
-Scene load_scene(const SceneName& name, std::vector<std::uint32_t>* source_ids) {
+bool uses_depth_lod(const SceneName& name) {
+  for (const DepthImageName& image : name.depth_images)
+    if (image.lod_angle_rad > 0) return true;
+  return false;
+}
+
+Scene load_scene(const SceneName& name, std::vector<std::uint32_t>* source_ids,
+                 const std::optional<glm::dvec3>& lod_eye_world) {
   Scene scene = load_polygons(name);
   if (source_ids) {
     source_ids->resize(scene.triangle_count() + 1);
@@ -141,7 +167,9 @@ Scene load_scene(const SceneName& name, std::vector<std::uint32_t>* source_ids) 
   }
   for (std::size_t k = 0; k < name.depth_images.size(); ++k) {
     const DepthImageName& image = name.depth_images[k];
-    DepthMesh mesh = depth_image_mesh(read_depth_image(image.file), {.step = image.step});
+    DepthMesh mesh = depth_image_mesh(
+        read_depth_image(image.file),
+        {.step = image.step, .lod_angle_rad = image.lod_angle_rad, .lod_eye_world = lod_eye_world});
     mesh.scene.name = image.file.filename().string();
     if (source_ids)
       source_ids->insert(source_ids->end(), mesh.source_id.begin(), mesh.source_id.end());

@@ -11,7 +11,10 @@
 //   FILE.gltf, FILE.glb   a glTF 2.0 file (load_gltf)
 //   depth:FILE.exr        a depth image (depth_image.hpp) drawn as its grid mesh; several as
 //                         depth:A.exr+depth:B.exr; FILE.exr@N takes every N-th pixel (N in
-//                         1..64, DepthMeshOptions::step)
+//                         1..64, DepthMeshOptions::step); FILE.exr@lod chooses the step per
+//                         block from the eye (DepthMeshOptions::lod_angle_rad,
+//                         kDepthLodDefaultRad), FILE.exr@lod=RADIANS with its own angle in
+//                         (0, 1]
 //   SCENE+depth:FILE.exr  hybrid: any scene above and depth images, in one z-buffer (the depth
 //                         images' triangles numbered after the scene's)
 // Names that would give more than kMaxSceneTriangles triangles are refused before anything is
@@ -19,6 +22,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <glm/mat4x4.hpp>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -33,12 +37,14 @@ inline constexpr std::uint64_t kMaxSceneTriangles = 64'000'000;
 // The --scene values, for command-line help.
 inline constexpr const char* kSceneNameSyntax =
     "builtin:city | builtin:city:K (KxK tiles) | builtin:city-fine:N (each triangle in N^2) | "
-    "FILE.gltf | depth:FILE.exr[@STEP] (a depth image) | SCENE+depth:FILE.exr (hybrid)";
+    "FILE.gltf | depth:FILE.exr[@STEP|@lod[=RADIANS]] (a depth image) | SCENE+depth:FILE.exr "
+    "(hybrid)";
 
 // A depth image of a scene name, and the grid step its mesh takes.
 struct DepthImageName {
   std::filesystem::path file;
   int step = 1;
+  double lod_angle_rad = 0;  // DepthMeshOptions::lod_angle_rad; 0: one step for the image
 };
 
 struct SceneName {
@@ -65,12 +71,16 @@ SceneName parse_scene_name(std::string_view text);
 std::uint64_t builtin_scene_triangles(const SceneName& name);
 
 // Builds or loads the scene (load_gltf's and read_depth_image's InputError for a bad file), the
-// depth images' grid meshes (depth_image_mesh, default options) appended.
+// depth images' grid meshes (depth_image_mesh, default options) appended. Images named with @lod
+// choose their steps as seen from lod_eye_world, or from their own eye when it is not given.
 // With `source_ids`, also the table that maps every triangle ID of the result to the triangle ID
 // of the scene the pictures came from: the identity for the polygon scene's own triangles, and for
 // a depth image's triangles the source ID its id channel stored (DepthMesh::source_id; 0 when it
 // has none). Entry 0 is 0; the table has triangle_count() + 1 entries.
-Scene load_scene(const SceneName& name, std::vector<std::uint32_t>* source_ids = nullptr);
+Scene load_scene(const SceneName& name, std::vector<std::uint32_t>* source_ids = nullptr,
+                 const std::optional<glm::dvec3>& lod_eye_world = std::nullopt);
+// Whether any depth image of the name takes level of detail (@lod).
+bool uses_depth_lod(const SceneName& name);
 inline Scene load_scene(std::string_view text) { return load_scene(parse_scene_name(text)); }
 
 // The eye pose of frame k of `facet render` and `facet bench`, turning about world up (y) by 360°
