@@ -225,6 +225,26 @@ std::vector<std::uint32_t> render_ids(const Scene& scene, const std::vector<Outp
   return targets[0].read_ids();
 }
 
+// Pixels of `scene` drawn with facets onto the 128² 180° dome seen from T_eye_world that show
+// nothing, counted inside the dome circle less a 1 px rim; and how many pixels that circle holds.
+struct DomeHoles {
+  std::size_t holes = 0, inside = 0;
+};
+DomeHoles dome_holes(const Scene& scene, const glm::dmat4& T_eye_world) {
+  const glm::ivec2 size{128, 128};
+  const std::vector<OutputSpec> outputs = load_display_outputs("builtin:dome180", size);
+  const std::vector<std::uint32_t> ids = render_ids(scene, outputs, T_eye_world);
+  DomeHoles count;
+  for (int j = 0; j < size.y; ++j)
+    for (int i = 0; i < size.x; ++i) {
+      const double dx = i + 0.5 - size.x / 2.0, dy = j + 0.5 - size.y / 2.0;
+      if (std::hypot(dx, dy) >= size.x / 2.0 - 1.0) continue;
+      ++count.inside;
+      count.holes += ids[std::size_t(j * size.x + i)] == 0;
+    }
+  return count;
+}
+
 TEST(DepthImage, DpciOfABackgroundSphereLeavesNoHoleOnTheDome) {
   test::shared_context();
   const Scene sphere = background_sphere(64, 32, 20.0f);
@@ -240,21 +260,10 @@ TEST(DepthImage, DpciOfABackgroundSphereLeavesNoHoleOnTheDome) {
     }
   const DepthMesh mesh = depth_image_mesh(image);
   EXPECT_EQ(mesh.dropped_triangles, 0u);
-  const glm::ivec2 size{128, 128};
   for (const double tilt : {0.0, 40.0}) {
-    std::vector<OutputSpec> outputs = load_display_outputs("builtin:dome180", size);
-    const glm::dmat4 T_eye_world =
-        glm::rotate(glm::dmat4(1.0), glm::radians(tilt), glm::dvec3(1, 0, 0));
-    const std::vector<std::uint32_t> ids = render_ids(mesh.scene, outputs, T_eye_world);
-    std::size_t holes = 0, inside = 0;
-    for (int j = 0; j < size.y; ++j)
-      for (int i = 0; i < size.x; ++i) {
-        const double dx = i + 0.5 - size.x / 2.0, dy = j + 0.5 - size.y / 2.0;
-        if (std::hypot(dx, dy) >= size.x / 2.0 - 1.0) continue;
-        ++inside;
-        holes += ids[std::size_t(j * size.x + i)] == 0;
-      }
-    EXPECT_EQ(holes, 0u) << "tilt " << tilt << ", of " << inside;
+    const DomeHoles count = dome_holes(
+        mesh.scene, glm::rotate(glm::dmat4(1.0), glm::radians(tilt), glm::dvec3(1, 0, 0)));
+    EXPECT_EQ(count.holes, 0u) << "tilt " << tilt << ", of " << count.inside;
   }
 }
 
@@ -409,22 +418,12 @@ TEST(DepthImage, LodDpciOfABackgroundSphereLeavesNoHoleOnTheDome) {
   for (std::size_t n : mesh.lod_blocks_by_level) levels += n > 0;
   EXPECT_GE(levels, 2u);
   EXPECT_LT(mesh.scene.triangle_count(), depth_image_mesh(image).scene.triangle_count());
-  const glm::ivec2 size{128, 128};
   for (const double tilt : {0.0, 40.0}) {
-    std::vector<OutputSpec> outputs = load_display_outputs("builtin:dome180", size);
-    const glm::dmat4 T_eye_world =
+    const DomeHoles count = dome_holes(
+        mesh.scene,
         glm::inverse(glm::translate(glm::dmat4(1.0), eye) *
-                     glm::rotate(glm::dmat4(1.0), glm::radians(tilt), glm::dvec3(1, 0, 0)));
-    const std::vector<std::uint32_t> ids = render_ids(mesh.scene, outputs, T_eye_world);
-    std::size_t holes = 0, inside = 0;
-    for (int j = 0; j < size.y; ++j)
-      for (int i = 0; i < size.x; ++i) {
-        const double dx = i + 0.5 - size.x / 2.0, dy = j + 0.5 - size.y / 2.0;
-        if (std::hypot(dx, dy) >= size.x / 2.0 - 1.0) continue;
-        ++inside;
-        holes += ids[std::size_t(j * size.x + i)] == 0;
-      }
-    EXPECT_EQ(holes, 0u) << "tilt " << tilt << ", of " << inside;
+                     glm::rotate(glm::dmat4(1.0), glm::radians(tilt), glm::dvec3(1, 0, 0))));
+    EXPECT_EQ(count.holes, 0u) << "tilt " << tilt << ", of " << count.inside;
   }
 }
 
@@ -458,13 +457,19 @@ CityComparison compare_with_city(const Scene& city, const DepthMesh& mesh,
   return result;
 }
 
+// The city's DPCI of 512×256 (and its cap) from the first eye of its camera path.
+DepthImageRequest city_dpci_request() {
+  DepthImageRequest request;
+  request.size = {512, 256};
+  request.T_world_image =
+      glm::translate(glm::dmat4(1.0), glm::dvec3(CityCameraPath().T_world_eye(0.0)[3]));
+  return request;
+}
+
 TEST(DepthImage, CityDpciWarpedOntoTheDomeMatchesThePolygons) {
   test::shared_context();
   const Scene city = build_city();
-  const glm::dvec3 eye(CityCameraPath().T_world_eye(0.0)[3]);
-  DepthImageRequest request;
-  request.size = {512, 256};
-  request.T_world_image = glm::translate(glm::dmat4(1.0), eye);
+  const DepthImageRequest request = city_dpci_request();
   const DepthImage image = render_depth_image(city, request);
   const DepthMesh mesh = depth_image_mesh(image);
   const glm::ivec2 size{192, 192};
@@ -508,10 +513,7 @@ TEST(DepthImage, CityDpciWarpedOntoTheDomeMatchesThePolygons) {
 TEST(DepthImage, CityDpciWithLodKeepsAccuracyWithFewerTriangles) {
   test::shared_context();
   const Scene city = build_city();
-  const glm::dvec3 eye(CityCameraPath().T_world_eye(0.0)[3]);
-  DepthImageRequest request;
-  request.size = {512, 256};
-  request.T_world_image = glm::translate(glm::dmat4(1.0), eye);
+  const DepthImageRequest request = city_dpci_request();
   const DepthImage image = render_depth_image(city, request);
   const DepthMesh full = depth_image_mesh(image);
   const glm::ivec2 size{192, 192};
@@ -603,28 +605,27 @@ TEST(DepthImage, CliRendersTheCityDpciAgainstThePolygonCity) {
             0)
       << facet::test::slurp(log);
   ASSERT_TRUE(fs::is_regular_file(image));
-  ASSERT_EQ(facet::test::run_facet(
-                "render --display builtin:dome180 --size 96x96 --scene depth:" + image.string() +
-                    " --reference --reference-scene builtin:city --json",
-                log),
-            0)
-      << facet::test::slurp(log);
-  const std::string text = facet::test::slurp(log);
-  const nlohmann::json report = nlohmann::json::parse(text.substr(text.find('{')));
+  // The JSON report of the image (with `suffix`, e.g. "@lod=0.05") on the 96² dome against the
+  // polygon city; null when the render does not exit 0.
+  const auto render_report = [&](const std::string& suffix) {
+    const int status = facet::test::run_facet(
+        "render builtin:dome180 --size 96x96 --scene depth:" + image.string() + suffix +
+            " --reference --reference-scene builtin:city --json",
+        log);
+    const std::string text = facet::test::slurp(log);
+    EXPECT_EQ(status, 0) << text;
+    return status == 0 ? nlohmann::json::parse(text.substr(text.find('{'))) : nlohmann::json();
+  };
+  const nlohmann::json report = render_report("");
+  ASSERT_FALSE(report.is_null());
   const nlohmann::json& reference = report["reference"];
   std::printf("facet render --scene depth: against builtin:city: id_mismatch %.5f, p99 %.2f px\n",
               reference["id_mismatch"].get<double>(), reference["p99_edge_px"].get<double>());
   EXPECT_LE(reference["id_mismatch"].get<double>(), 0.005);
   EXPECT_LE(reference["p99_edge_px"].get<double>(), 2.0);
   // With level of detail: fewer triangles, the same bounds.
-  ASSERT_EQ(facet::test::run_facet(
-                "render --display builtin:dome180 --size 96x96 --scene depth:" + image.string() +
-                    "@lod=0.05 --reference --reference-scene builtin:city --json",
-                log),
-            0)
-      << facet::test::slurp(log);
-  const std::string lod_text = facet::test::slurp(log);
-  const nlohmann::json lod = nlohmann::json::parse(lod_text.substr(lod_text.find('{')));
+  const nlohmann::json lod = render_report("@lod=0.05");
+  ASSERT_FALSE(lod.is_null());
   std::printf("@lod=0.05: %llu of %llu triangles, id_mismatch %.5f, p99 %.2f px\n",
               lod["triangles_scene"].get<unsigned long long>(),
               report["triangles_scene"].get<unsigned long long>(),
