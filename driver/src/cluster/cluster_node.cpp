@@ -59,6 +59,8 @@ namespace {
 // own pub socket a kind and a frame number, its content digest and its name: join and 0 to
 // answer the question, ready and N once its outputs of frame N are rendered, unasked: frame N's
 // state is the question.
+constexpr std::chrono::milliseconds kRefusedNodeAnswersFor{1000};
+
 enum class Published : std::uint8_t {
   heartbeat = 1,
   frame = 2,
@@ -452,6 +454,7 @@ class Master final : public FrameSync {
       return std::nullopt;
     }
     if (digest != options_.content_digest) {
+      refused_.insert(name);
       if (complained_.insert("digest " + name).second)
         options_.report("node " + name + " runs another display or scene (content digest " +
                         digest_hex(digest) + ", the master's " +
@@ -469,37 +472,49 @@ class Master final : public FrameSync {
     if (!secondaries_.empty())
       options_.report("master " + options_.node + ": waiting up to " +
                       ms_text(double(options_.join_timeout.count())) + " for nodes" + names);
-    while (active_.size() < secondaries_.size() && Clock::now() - start < options_.join_timeout) {
+    // A node refused for its content digest runs another display or scene: it will not join
+    // before it is restarted, so the wait ends once every other node has joined.
+    const auto waiting = [this] {
+      return std::any_of(secondaries_.begin(), secondaries_.end(), [this](const ClusterNode* n) {
+        return !active_.contains(n->name) && !refused_.contains(n->name);
+      });
+    };
+    while (waiting() && Clock::now() - start < options_.join_timeout) {
       if (const int signal = interrupt_signal())
         throw Interrupted(signal, "stopped while waiting for the cluster's nodes");
       // Asked again every 100 ms: a node that has just come, or whose answer socket the master
       // has not reached yet, answers the next one. The question is also the sign of life.
       publish(Published::join, Bytes().put(std::uint64_t(0)).data);
       const Clock::time_point next_ask = Clock::now() + std::chrono::milliseconds(100);
-      while (active_.size() < secondaries_.size()) {
+      while (waiting()) {
         const auto reply = receive_answer(next_ask);
         if (!reply) break;
-        if (const auto name = parse_answer(*reply, Published::join, 0)) active_.insert(*name);
+        if (const auto name = parse_answer(*reply, Published::join, 0)) {
+          active_.insert(*name);
+          refused_.erase(*name);
+        }
       }
     }
-    std::string missing;
-    const ClusterNode* missing_critical = nullptr;
+    std::string missing, refused;
     for (const ClusterNode* node : secondaries_) {
       if (active_.contains(node->name)) continue;
-      missing += " " + node->name;
-      if (node->critical && !missing_critical) missing_critical = node;
-    }
-    if (missing_critical) {
-      const std::string reason = "critical node " + missing_critical->name +
-                                 " did not join within " +
-                                 ms_text(double(options_.join_timeout.count()));
+      const bool was_refused = refused_.contains(node->name);
+      (was_refused ? refused : missing) += " " + node->name;
+      if (!node->critical) continue;
+      const std::string reason =
+          "critical node " + node->name +
+          (was_refused ? " runs another display or scene"
+                       : " did not join within " + ms_text(double(options_.join_timeout.count())));
       stop(reason);
       throw PeerLost(reason);
     }
     if (!missing.empty())
       options_.report("starting without" + missing + " (not joined within " +
                       ms_text(double(options_.join_timeout.count())) + "; they join when ready)");
-    else if (!secondaries_.empty())
+    if (!refused.empty())
+      options_.report("starting without" + refused +
+                      " (refused: another display or scene; restarted with this one, they join)");
+    if (missing.empty() && refused.empty() && !secondaries_.empty())
       options_.report("all " + std::to_string(secondaries_.size() + 1) + " nodes joined in " +
                       ms_text(ms_since(start)) + "; deadline " + ms_text(deadline_ms_));
   }
@@ -528,7 +543,8 @@ class Master final : public FrameSync {
   // Main thread: both; heartbeat thread: publisher_, until the destructor has joined it.
   Socket publisher_, answers_;
   std::vector<const ClusterNode*> secondaries_;
-  std::set<std::string> active_;  // secondaries in the barrier
+  std::set<std::string> active_;   // secondaries in the barrier
+  std::set<std::string> refused_;  // secondaries that answered with another content digest
   std::set<std::string> complained_;
   bool joined_ = false, stopped_ = false;
   std::uint64_t frames_sent_ = 0, last_frame_ = 0;
@@ -584,7 +600,7 @@ class Secondary final : public FrameSync {
   std::optional<FrameState> next_frame(const FrameState&) override {
     std::unique_lock lock(mutex_);
     for (;;) {
-      check();
+      check(lock);
       // The newest frame state wins: a node that fell behind catches up at once.
       std::optional<std::vector<std::uint8_t>> newest;
       bool ended = false;
@@ -611,7 +627,7 @@ class Secondary final : public FrameSync {
     std::unique_lock lock(mutex_);
     rendered_ = state.frame;
     for (;;) {
-      check();
+      check(lock);
       while (!inbox_.empty()) {
         auto& [kind, body] = inbox_.front();
         if (kind == Published::frame || kind == Published::end) {
@@ -662,17 +678,25 @@ class Secondary final : public FrameSync {
   }
 
   // Throws for what the receive callback has seen: the master's stop, another display, silence.
-  void check() {
+  void check(std::unique_lock<std::mutex>& lock) {
     if (const int signal = interrupt_signal())
       throw Interrupted(signal, "stopped as a node of the cluster");
     if (!stop_reason_.empty()) throw PeerLost("master " + master_ + " stopped: " + stop_reason_);
-    if (foreign_digest_)
+    if (foreign_digest_) {
+      // A node of another display answers the master's "joined?" for a while before it stops
+      // (the receive callback answers), so that the master hears its digest, reports the
+      // refusal and stops waiting for it: NNG drops what is published before the master's
+      // subscription has connected. It takes no frame meanwhile.
+      inbox_changed_.wait_until(lock, foreign_since_ + kRefusedNodeAnswersFor, [this] {
+        return Clock::now() >= foreign_since_ + kRefusedNodeAnswersFor;
+      });
       throw InputError(options_.source, "cluster",
                        "the display and scene master " + master_ + " runs (content digest " +
                            digest_hex(*foreign_digest_) + "), but this node's differ (" +
                            digest_hex(options_.content_digest) +
                            "): run the same display.json, warps, blends, scene and options on "
                            "every node");
+    }
     if (!last_heard_) {
       if (ms_since(started_) > double(options_.join_timeout.count()))
         throw PeerLost("master " + master_ + " not heard from within " +
@@ -715,7 +739,10 @@ class Secondary final : public FrameSync {
     if (!in.ok) return;
     std::lock_guard lock(mutex_);
     last_heard_ = Clock::now();
-    if (digest != options_.content_digest) foreign_digest_ = digest;
+    if (digest != options_.content_digest) {
+      if (!foreign_digest_) foreign_since_ = Clock::now();
+      foreign_digest_ = digest;
+    }
     if (kind == Published::stop) stop_reason_ = in.rest_text();
     if (kind == Published::join) {
       // Answered here at once; the main thread waits for frame states and swaps only.
@@ -754,6 +781,7 @@ class Secondary final : public FrameSync {
   Clock::time_point started_ = Clock::now();
   std::optional<std::uint64_t> rendered_;
   std::optional<std::uint64_t> foreign_digest_;
+  Clock::time_point foreign_since_;
   std::string stop_reason_;
 };
 
