@@ -497,6 +497,28 @@ TEST(ClusterProtocol, ANodeOfAnotherDisplayIsRefused) {
   EXPECT_EQ(b.swapped, frames_upto(5));
 }
 
+TEST(ClusterProtocol, ARefusedCriticalNodeStopsEveryone) {
+  const facet::test::TempFolder scratch("facet-cluster-test");
+  const pio::DisplayCluster cluster = test_cluster(scratch.path(), 300, true);
+  Log log;
+  NodeRun b, c, a;
+  std::thread tb([&] { b = run_secondary(node_options(cluster, "b", log)); });
+  std::thread tc([&] { c = run_secondary(node_options(cluster, "c", log, 43)); });
+  ClusterNodeOptions master = node_options(cluster, "a", log);
+  master.join_timeout = std::chrono::milliseconds(60'000);
+  a = run_master(master, 5);
+  tb.join();
+  tc.join();
+  EXPECT_NE(a.error.find("PeerLost: critical node c runs another display or scene"),
+            std::string::npos)
+      << a.error << "\n"
+      << log.all();
+  EXPECT_NE(b.error.find("PeerLost: master a stopped: critical node c runs another display"),
+            std::string::npos)
+      << b.error;
+  EXPECT_TRUE(a.swapped.empty());
+}
+
 TEST(ClusterProtocol, AnAddressInUseIsAnInputError) {
   const facet::test::TempFolder scratch("facet-cluster-test");
   const pio::DisplayCluster cluster = test_cluster(scratch.path(), 300);
