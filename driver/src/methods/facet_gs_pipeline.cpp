@@ -86,11 +86,7 @@ class FacetGsPipeline final : public PairPipelineBase {
     scan_.run(out.scan, n + 1);
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
     bind_output(i);
-    set_list_uniforms(replicate_, i);
-    replicate_.use();
-    glBindBuffer(GL_DISPATCH_INDIRECT_BUFFER, out.list_args.id());
-    glDispatchComputeIndirect(kListArgsTriangleDispatch * sizeof(std::uint32_t));
-    glBindBuffer(GL_DISPATCH_INDIRECT_BUFFER, 0);
+    dispatch_for_output(replicate_, i, out.list_args, kListArgsTriangleDispatch);
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
     write_draw_commands(i, args_);
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_COMMAND_BARRIER_BIT);

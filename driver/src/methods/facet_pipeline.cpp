@@ -90,22 +90,15 @@ class FacetPipeline final : public PairPipelineBase {
       out.walk_queue.sub_data(0, sizeof empty_queue, empty_queue);
       bind_output(i);
       const Program& first = settings_.coverage == FacetCoverage::walk ? count_walk_ : count_;
-      set_list_uniforms(first, i);
-      first.use();
-      glBindBuffer(GL_DISPATCH_INDIRECT_BUFFER, out.list_args.id());
-      glDispatchComputeIndirect(kListArgsCullDispatch * sizeof(std::uint32_t));
+      dispatch_for_output(first, i, out.list_args, kListArgsCullDispatch);
       glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_COMMAND_BARRIER_BIT);
       const Program& grid = grid_programs_.at(grid_kind(out.facets.grid));
       for (const auto& [program, queue] :
            {std::pair<const Program*, const Buffer*>{&grid, &out.grid_queue},
             std::pair<const Program*, const Buffer*>{&walk_, &out.walk_queue}}) {
-        set_list_uniforms(*program, i);
-        program->use();
-        glBindBuffer(GL_DISPATCH_INDIRECT_BUFFER, queue->id());
-        glDispatchComputeIndirect(0);
+        dispatch_for_output(*program, i, *queue, 0);
         glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_COMMAND_BARRIER_BIT);
       }
-      glBindBuffer(GL_DISPATCH_INDIRECT_BUFFER, 0);
     }
     TimedPass scope(timer, "pass2 replicate");
     scan_.run(out.scan, n + 1);
@@ -116,11 +109,7 @@ class FacetPipeline final : public PairPipelineBase {
     out.stage_offset_texels.view(out.stage_offsets, GL_R32UI, 4)
         .bind_unit(texture_unit::stage_offsets);
     glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT);
-    set_list_uniforms(scatter_, i);
-    scatter_.use();
-    glBindBuffer(GL_DISPATCH_INDIRECT_BUFFER, out.list_args.id());
-    glDispatchComputeIndirect(kListArgsTriangleDispatch * sizeof(std::uint32_t));
-    glBindBuffer(GL_DISPATCH_INDIRECT_BUFFER, 0);
+    dispatch_for_output(scatter_, i, out.list_args, kListArgsTriangleDispatch);
     write_draw_commands(i, args_);
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_COMMAND_BARRIER_BIT);
     out.replication_valid = true;

@@ -416,6 +416,15 @@ void FacetMethodBase::set_list_uniforms(const Program& program, std::size_t i) c
   }
 }
 
+void FacetMethodBase::dispatch_for_output(const Program& program, std::size_t i, const Buffer& args,
+                                          std::uint32_t args_word) const {
+  set_list_uniforms(program, i);
+  program.use();
+  glBindBuffer(GL_DISPATCH_INDIRECT_BUFFER, args.id());
+  glDispatchComputeIndirect(GLintptr(args_word) * GLintptr(sizeof(std::uint32_t)));
+  glBindBuffer(GL_DISPATCH_INDIRECT_BUFFER, 0);
+}
+
 std::uint64_t FacetMethodBase::buffer_bytes(const OutputState& out) const {
   const FacetSet& set = out.facets;
   std::uint64_t bytes =

@@ -197,6 +197,10 @@ class FacetMethodBase : public RenderMethod {
   void add_output_stats(const OutputState& out, RenderStats& stats) const;
   // Program uniforms of replication_lib.comp for output i.
   void set_list_uniforms(const Program& program, std::size_t i) const;
+  // Runs compute `program` for output i, with its uniforms set, over the indirect dispatch at
+  // word `args_word` of `args` (output i's list arguments or one of its queues).
+  void dispatch_for_output(const Program& program, std::size_t i, const Buffer& args,
+                           std::uint32_t args_word) const;
 
   const Scene* scene_ = nullptr;
   const GpuScene* gpu_ = nullptr;
