@@ -272,7 +272,35 @@ double median(std::vector<double> values) {
   return n % 2 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
 }
 
-std::vector<BenchScenario> make_bench_scenarios(const BenchOptions& options) {
+namespace {
+
+// What every scenario of one bench run shares: the size scale (--size-scale, and 1/8 for the
+// quick run) and the cube faces, tessellation caps and matched face that follow from it.
+struct ScenarioSizes {
+  double scale = 1;
+  bool quick = false;
+  std::vector<int> tess;         // the vertex method's tessellation caps
+  std::vector<int> faces_sweep;  // the cube map's face edges, scaled
+  int matched_face = 0;          // the full sweeps' matched cube face (0 in the quick run)
+
+  explicit ScenarioSizes(const BenchOptions& options)
+      : scale(options.size_scale * (options.quick ? 0.125 : 1.0)), quick(options.quick) {
+    tess = quick ? std::vector<int>{1, 16} : std::vector<int>{1, 4, 16};
+    faces_sweep =
+        faces(quick ? std::vector<int>{256, 1024} : std::vector<int>{256, 512, 1024, 2048});
+    // The full sweeps match a facets build to the 512² cube map (the scale rows to their one cube).
+    matched_face = quick ? 0 : 512;
+  }
+  // Cube face edges scaled, at least 8 texels.
+  std::vector<int> faces(std::vector<int> edges) const {
+    for (int& e : edges) e = std::max(8, int(std::lround(e * scale)));
+    return edges;
+  }
+};
+
+// The names of options.scenarios (cylinder, deformation and dome when empty), after the checks
+// of every option that make_bench_scenarios refuses before any work.
+std::vector<std::string> checked_scenario_names(const BenchOptions& options) {
   // "deformation" and "dome" are groups; their parts can be run alone.
   static const std::set<std::string> known = {"cylinder",
                                               "deformation",
@@ -306,210 +334,246 @@ std::vector<BenchScenario> make_bench_scenarios(const BenchOptions& options) {
   }
   if (options.frames < 1)
     throw InputError("command line", OptionName{"frames"}, "expected at least 1");
-  const double scale = options.size_scale * (options.quick ? 0.125 : 1.0);
-  const bool quick = options.quick;
-  auto faces = [&](std::vector<int> edges) {
-    for (int& e : edges) e = std::max(8, int(std::lround(e * scale)));
-    return edges;
-  };
-  const std::vector<int> tess = quick ? std::vector<int>{1, 16} : std::vector<int>{1, 4, 16};
+  return names;
+}
 
-  const std::vector<int> faces_sweep =
-      faces(quick ? std::vector<int>{256, 1024} : std::vector<int>{256, 512, 1024, 2048});
+// A scenario of a built-in display (its default outputs at `size`, scaled), the city: `quick`'s
+// settings in the quick run, else `full`'s; matched to the sweep's cube face.
+void add_builtin_display_scenario(const std::string& name, const std::string& display,
+                                  glm::ivec2 size, const std::string& what,
+                                  const ScenarioSizes& sizes, std::vector<BenchSetting> quick,
+                                  std::vector<BenchSetting> full,
+                                  std::vector<BenchScenario>& scenarios) {
+  BenchScenario s;
+  s.name = name;
+  s.outputs = load_display_outputs(display, scaled(size, sizes.scale));
+  s.description = what + " at " + size_text(s.outputs[0].warp.output_size) + ", the city";
+  s.settings = sizes.quick ? std::move(quick) : std::move(full);
+  s.matched_cube_face = sizes.matched_face;
+  scenarios.push_back(std::move(s));
+}
+
+// "cylinder": the seed's 360x90 cylinder.
+void add_cylinder_scenario(const ScenarioSizes& sizes, std::vector<BenchScenario>& scenarios) {
+  add_builtin_display_scenario(
+      "cylinder", "builtin:cylinder360", {1600, 1200}, "the seed's 360x90 cylinder", sizes,
+      sweep({FacetStrips{16}, FacetTolerance{1}}, FacetStrips{16}, {FacetStrips{16}},
+            sizes.faces_sweep, sizes.tess),
+      sweep({FacetStrips{160}, FacetStrips{40}, FacetStrips{80}, FacetTolerance{1},
+             FacetTolerance{0.25}, FacetTolerance{0.1}},
+            FacetStrips{160},
+            {FacetStrips{160}, FacetStrips{40}, FacetTolerance{1}, FacetTolerance{0.25}},
+            sizes.faces_sweep, sizes.tess),
+      scenarios);
+}
+
+// "glc" (or one of its parts): the GLC cameras of Yu, Yu & McMillan's paper cases (configs/glc
+// holds the same as files): the cross-slit city, the 360° circular cross-slit panorama and the
+// mirror sphere, each drawn by the glc method alone.
+void add_glc_scenarios(const std::string& name, const ScenarioSizes& sizes,
+                       std::vector<BenchScenario>& scenarios) {
+  auto glc_scenario = [&](const std::string& part, const std::string& description,
+                          PiecewiseGlc camera) {
+    BenchScenario s;
+    s.name = part;
+    s.description = description + " at " + size_text(camera.size) + ", " +
+                    std::to_string(camera.pieces.size()) + " GLCs, the city";
+    const glm::ivec2 size = camera.size;
+    s.outputs.push_back({part, Warp::analytic(BaseProjection::perspective(-1, 1, 1, -1), size),
+                         std::make_shared<const PiecewiseGlc>(std::move(camera))});
+    BenchSetting setting;
+    setting.method = "glc";
+    setting.label = "camera";
+    s.settings.push_back(setting);
+    scenarios.push_back(std::move(s));
+  };
+  const bool all_parts = name == "glc";
+  if (all_parts || name == "glc-city") {
+    const glm::ivec2 size = scaled({1024, 320}, sizes.scale);
+    GlcFrame frame;
+    frame.axes = glm::dmat3(glm::dvec3(1, 0, 0), glm::dvec3(0, -1, 0), glm::dvec3(0, 0, -1));
+    glc_scenario("glc-city", "cross-slit camera (slits 1 and 4 m behind the image plane)",
+                 single_glc(cross_slit_glc(frame, {{0, 0, -1}, {0, 1, 0}}, {{0, 0, -4}, {1, 0, 0}},
+                                           {3.2, 2.0}, size, "bench", "glc-city"),
+                            size));
+  }
+  if (all_parts || name == "glc-panorama") {
+    const glm::ivec2 size = scaled({800, 600}, sizes.scale);
+    glc_scenario(
+        "glc-panorama", "360-degree circular cross-slit panorama",
+        circular_panorama(360, 0.25, 120, std::min(40, size.x), size, "bench", "glc-panorama"));
+  }
+  if (all_parts || name == "glc-mirror") {
+    const glm::ivec2 size = scaled({800, 800}, sizes.scale);
+    glc_scenario("glc-mirror", "mirror sphere (32 rings)",
+                 mirror_sphere({0, 0, -3}, 1.0, 50, 32, size, "bench", "glc-mirror"));
+  }
+}
+
+// Scene size: every method at one setting each, on the cylinder and the dome master, over
+// growing tiled cities (scene names and counts: scene_names.hpp). Ordered by scene, so run_bench
+// builds each scene once.
+void add_scale_scenes_scenarios(const ScenarioSizes& sizes, std::vector<BenchScenario>& scenarios) {
+  const std::vector<std::string> scenes =
+      sizes.quick ? std::vector<std::string>{"builtin:city", "builtin:city:2"}
+                  : std::vector<std::string>{"builtin:city", "builtin:city:4", "builtin:city:8"};
+  for (const std::string& scene : scenes) {
+    const std::uint64_t triangles = builtin_scene_triangles(parse_scene_name(scene));
+    for (const bool cylinder : {true, false}) {
+      BenchScenario s;
+      s.scale_group = cylinder ? "scale-cylinder" : "scale-dome";
+      s.name = s.scale_group + ":" + scene.substr(std::string("builtin:").size());
+      s.scene = scene;
+      s.outputs =
+          cylinder ? load_display_outputs("builtin:cylinder360", scaled({1600, 1200}, sizes.scale))
+                   : load_display_outputs("builtin:dome180", scaled({2048, 2048}, sizes.scale));
+      s.description = std::string(cylinder ? "the 360x90 cylinder" : "the 180-degree dome") +
+                      " at " + size_text(s.outputs[0].warp.output_size) + ", " + scene + " (" +
+                      std::to_string(triangles) + " triangles)";
+      s.settings = sweep({FacetTolerance{0.25}}, FacetTolerance{0.25}, {FacetTolerance{0.25}},
+                         sizes.faces({512}), {1});
+      s.matched_cube_face = sizes.quick ? 0 : sizes.faces({512})[0];
+      scenarios.push_back(std::move(s));
+    }
+  }
+}
+
+// Facet count: the facet methods over the seed's strips on the cylinder, the city, one output
+// size; each method's rows fitted together.
+void add_scale_facets_scenario(const ScenarioSizes& sizes, std::vector<BenchScenario>& scenarios) {
+  BenchScenario s;
+  s.scale_group = "scale-facets-cylinder";
+  s.name = s.scale_group;
+  s.scene = "builtin:city";
+  s.outputs = load_display_outputs("builtin:cylinder360", scaled({1600, 1200}, sizes.scale));
+  s.description = "the 360x90 cylinder at " + size_text(s.outputs[0].warp.output_size) +
+                  ", builtin:city, the facet methods over strip counts";
+  const std::vector<int> counts =
+      sizes.quick ? std::vector<int>{20, 40} : std::vector<int>{40, 80, 160, 320};
+  for (const char* method : {"facets", "facets-gs", "naive"}) {
+    for (const int count : counts) {
+      BenchSetting setting{method, layout_label(FacetStrips{count}), {}, {}, "pieces=N"};
+      setting.settings.facets.layout = FacetStrips{count};
+      if (std::string(method) == "facets-gs") setting.same_ids_as = setting.label;
+      s.settings.push_back(setting);
+    }
+  }
+  scenarios.push_back(std::move(s));
+}
+
+// Output width: every method at one setting (fixed strips, so the facet count stays) on the
+// cylinder at three sizes of one aspect, the city.
+void add_scale_width_scenarios(const ScenarioSizes& sizes, std::vector<BenchScenario>& scenarios) {
+  const std::vector<double> widths =
+      sizes.quick ? std::vector<double>{0.5, 1.0} : std::vector<double>{0.5, 0.7071, 1.0};
+  for (const double width : widths) {
+    BenchScenario s;
+    s.scale_group = "scale-width-cylinder";
+    s.scene = "builtin:city";
+    s.outputs =
+        load_display_outputs("builtin:cylinder360", scaled({1600, 1200}, sizes.scale * width));
+    s.name = s.scale_group + ":" + size_text(s.outputs[0].warp.output_size);
+    s.description = "the 360x90 cylinder at " + size_text(s.outputs[0].warp.output_size) +
+                    ", builtin:city, every method at one setting";
+    s.settings =
+        sweep({FacetStrips{80}}, FacetStrips{80}, {FacetStrips{80}}, sizes.faces({512}), {1});
+    scenarios.push_back(std::move(s));
+  }
+}
+
+// "scale" (or one of its parts): frame cost against what grows, each in a scale group of its own
+// (bench_scale_fits).
+void add_scale_scenarios(const std::string& name, const ScenarioSizes& sizes,
+                         std::vector<BenchScenario>& scenarios) {
+  const bool all_parts = name == "scale";
+  if (all_parts || name == "scale-scenes") add_scale_scenes_scenarios(sizes, scenarios);
+  if (all_parts || name == "scale-facets") add_scale_facets_scenario(sizes, scenarios);
+  if (all_parts || name == "scale-width") add_scale_width_scenarios(sizes, scenarios);
+}
+
+// "deformation" (or one of its parts): the view deformation on an 80x60 and (full sweep only) a
+// 128x128 camera texture.
+void add_deformation_scenarios(const std::string& name, const ScenarioSizes& sizes,
+                               std::vector<BenchScenario>& scenarios) {
+  for (const glm::ivec2 cells : {glm::ivec2(80, 60), glm::ivec2(128, 128)}) {
+    if (sizes.quick && cells.x == 128) continue;
+    if (name != "deformation" && name != "deformation-" + size_text(cells)) continue;
+    BenchScenario s;
+    s.name = "deformation-" + size_text(cells);
+    const glm::ivec2 size = scaled({1024, 768}, sizes.scale);
+    s.outputs.push_back({"deformation", deformation_warp(size, cells)});
+    s.description = "view deformation: perspective base, built-in smooth offset map on a " +
+                    size_text(cells) + " camera texture, " + size_text(size);
+    if (sizes.quick) {
+      s.settings = sweep({FacetGrid{8, 6}, FacetTolerance{1}}, FacetGrid{8, 6}, {FacetGrid{8, 6}},
+                         sizes.faces_sweep, sizes.tess);
+    } else {
+      // The seed's facets are the camera texture's cells.
+      const FacetGrid quarter{cells.x / 4, cells.y / 4};
+      s.settings = sweep({FacetGrid{cells.x, cells.y}, quarter, FacetTolerance{1}}, quarter,
+                         {quarter, FacetTolerance{1}}, sizes.faces_sweep, sizes.tess);
+    }
+    s.settings = with_perspective_images(std::move(s.settings), sizes.faces_sweep);
+    s.matched_cube_face = sizes.matched_face;
+    scenarios.push_back(std::move(s));
+  }
+}
+
+// "dome-master": the 180-degree dome master.
+void add_dome_master_scenario(const ScenarioSizes& sizes, std::vector<BenchScenario>& scenarios) {
+  add_builtin_display_scenario("dome", "builtin:dome180", {2048, 2048}, "180-degree dome master",
+                               sizes,
+                               sweep({FacetTolerance{1}, FacetGrid{4, 4}}, FacetGrid{4, 4},
+                                     {FacetGrid{4, 4}}, sizes.faces_sweep, sizes.tess),
+                               sweep({FacetTolerance{0.25}, FacetGrid{16, 16}, FacetTolerance{1},
+                                      FacetTolerance{0.5}, FacetTolerance{0.1}},
+                                     FacetGrid{16, 16}, {FacetGrid{16, 16}, FacetTolerance{1}},
+                                     sizes.faces_sweep, sizes.tess),
+                               scenarios);
+}
+
+// "dome4": the multi-projector dome rig of options.dome_rig, true warps.
+void add_dome_rig_scenario(const std::filesystem::path& dome_rig, const ScenarioSizes& sizes,
+                           std::vector<BenchScenario>& scenarios) {
+  BenchScenario s;
+  s.name = "dome4";
+  s.outputs = rig_outputs(dome_rig, sizes.scale);
+  s.description = "multi-projector dome rig " + dome_rig.filename().string() + ": " +
+                  std::to_string(s.outputs.size()) + " projectors at " +
+                  size_text(s.outputs[0].warp.output_size) + ", true warps";
+  if (sizes.quick) {
+    s.settings = sweep({FacetTolerance{1}}, FacetTolerance{1}, {FacetTolerance{1}},
+                       sizes.faces_sweep, sizes.tess);
+  } else {
+    s.settings =
+        sweep({FacetTolerance{0.25}, FacetTolerance{1}, FacetTolerance{0.5}, FacetTolerance{0.1}},
+              FacetTolerance{1}, {FacetTolerance{1}, FacetTolerance{0.25}}, sizes.faces_sweep,
+              sizes.tess);
+  }
+  s.settings = with_perspective_images(std::move(s.settings), sizes.faces_sweep);
+  s.matched_cube_face = sizes.matched_face;
+  scenarios.push_back(std::move(s));
+}
+
+}  // namespace
+
+std::vector<BenchScenario> make_bench_scenarios(const BenchOptions& options) {
+  const std::vector<std::string> names = checked_scenario_names(options);
+  const ScenarioSizes sizes(options);
   std::vector<BenchScenario> scenarios;
-  // The full sweeps match a facets build to the 512² cube map (the scale rows to their one cube).
-  const int matched_face = quick ? 0 : 512;
   for (const std::string& name : names) {
     if (name == "cylinder") {
-      BenchScenario s;
-      s.name = "cylinder";
-      s.outputs = load_display_outputs("builtin:cylinder360", scaled({1600, 1200}, scale));
-      s.description = "the seed's 360x90 cylinder at " + size_text(s.outputs[0].warp.output_size) +
-                      ", the city";
-      if (quick) {
-        s.settings = sweep({FacetStrips{16}, FacetTolerance{1}}, FacetStrips{16}, {FacetStrips{16}},
-                           faces_sweep, tess);
-      } else {
-        s.settings =
-            sweep({FacetStrips{160}, FacetStrips{40}, FacetStrips{80}, FacetTolerance{1},
-                   FacetTolerance{0.25}, FacetTolerance{0.1}},
-                  FacetStrips{160},
-                  {FacetStrips{160}, FacetStrips{40}, FacetTolerance{1}, FacetTolerance{0.25}},
-                  faces_sweep, tess);
-      }
-      s.matched_cube_face = matched_face;
-      scenarios.push_back(std::move(s));
+      add_cylinder_scenario(sizes, scenarios);
     } else if (name.starts_with("glc")) {
-      // The GLC cameras of Yu, Yu & McMillan's paper cases (configs/glc holds the same as
-      // files): the cross-slit city, the 360° circular cross-slit panorama and the mirror sphere,
-      // each drawn by the glc method alone.
-      auto glc_scenario = [&](const std::string& part, const std::string& description,
-                              PiecewiseGlc camera) {
-        BenchScenario s;
-        s.name = part;
-        s.description = description + " at " + size_text(camera.size) + ", " +
-                        std::to_string(camera.pieces.size()) + " GLCs, the city";
-        const glm::ivec2 size = camera.size;
-        s.outputs.push_back({part, Warp::analytic(BaseProjection::perspective(-1, 1, 1, -1), size),
-                             std::make_shared<const PiecewiseGlc>(std::move(camera))});
-        BenchSetting setting;
-        setting.method = "glc";
-        setting.label = "camera";
-        s.settings.push_back(setting);
-        scenarios.push_back(std::move(s));
-      };
-      const bool all_parts = name == "glc";
-      if (all_parts || name == "glc-city") {
-        const glm::ivec2 size = scaled({1024, 320}, scale);
-        GlcFrame frame;
-        frame.axes = glm::dmat3(glm::dvec3(1, 0, 0), glm::dvec3(0, -1, 0), glm::dvec3(0, 0, -1));
-        glc_scenario(
-            "glc-city", "cross-slit camera (slits 1 and 4 m behind the image plane)",
-            single_glc(cross_slit_glc(frame, {{0, 0, -1}, {0, 1, 0}}, {{0, 0, -4}, {1, 0, 0}},
-                                      {3.2, 2.0}, size, "bench", "glc-city"),
-                       size));
-      }
-      if (all_parts || name == "glc-panorama") {
-        const glm::ivec2 size = scaled({800, 600}, scale);
-        glc_scenario(
-            "glc-panorama", "360-degree circular cross-slit panorama",
-            circular_panorama(360, 0.25, 120, std::min(40, size.x), size, "bench", "glc-panorama"));
-      }
-      if (all_parts || name == "glc-mirror") {
-        const glm::ivec2 size = scaled({800, 800}, scale);
-        glc_scenario("glc-mirror", "mirror sphere (32 rings)",
-                     mirror_sphere({0, 0, -3}, 1.0, 50, 32, size, "bench", "glc-mirror"));
-      }
+      add_glc_scenarios(name, sizes, scenarios);
     } else if (name.starts_with("scale")) {
-      // Frame cost against what grows, each in a scale group of its own (bench_scale_fits).
-      const bool all_parts = name == "scale";
-      // Scene size: every method at one setting each, on the cylinder and the dome master, over
-      // growing tiled cities (scene names and counts: scene_names.hpp). Ordered by scene, so
-      // run_bench builds each scene once.
-      const std::vector<std::string> scenes =
-          quick ? std::vector<std::string>{"builtin:city", "builtin:city:2"}
-                : std::vector<std::string>{"builtin:city", "builtin:city:4", "builtin:city:8"};
-      for (const std::string& scene : scenes) {
-        if (!all_parts && name != "scale-scenes") break;
-        const std::uint64_t triangles = builtin_scene_triangles(parse_scene_name(scene));
-        for (const bool cylinder : {true, false}) {
-          BenchScenario s;
-          s.scale_group = cylinder ? "scale-cylinder" : "scale-dome";
-          s.name = s.scale_group + ":" + scene.substr(std::string("builtin:").size());
-          s.scene = scene;
-          s.outputs = cylinder
-                          ? load_display_outputs("builtin:cylinder360", scaled({1600, 1200}, scale))
-                          : load_display_outputs("builtin:dome180", scaled({2048, 2048}, scale));
-          s.description = std::string(cylinder ? "the 360x90 cylinder" : "the 180-degree dome") +
-                          " at " + size_text(s.outputs[0].warp.output_size) + ", " + scene + " (" +
-                          std::to_string(triangles) + " triangles)";
-          s.settings = sweep({FacetTolerance{0.25}}, FacetTolerance{0.25}, {FacetTolerance{0.25}},
-                             faces({512}), {1});
-          s.matched_cube_face = quick ? 0 : faces({512})[0];
-          scenarios.push_back(std::move(s));
-        }
-      }
-      // Facet count: the facet methods over the seed's strips on the cylinder, the city, one
-      // output size; each method's rows fitted together.
-      if (all_parts || name == "scale-facets") {
-        BenchScenario s;
-        s.scale_group = "scale-facets-cylinder";
-        s.name = s.scale_group;
-        s.scene = "builtin:city";
-        s.outputs = load_display_outputs("builtin:cylinder360", scaled({1600, 1200}, scale));
-        s.description = "the 360x90 cylinder at " + size_text(s.outputs[0].warp.output_size) +
-                        ", builtin:city, the facet methods over strip counts";
-        const std::vector<int> counts =
-            quick ? std::vector<int>{20, 40} : std::vector<int>{40, 80, 160, 320};
-        for (const char* method : {"facets", "facets-gs", "naive"}) {
-          for (const int count : counts) {
-            BenchSetting setting{method, layout_label(FacetStrips{count}), {}, {}, "pieces=N"};
-            setting.settings.facets.layout = FacetStrips{count};
-            if (std::string(method) == "facets-gs") setting.same_ids_as = setting.label;
-            s.settings.push_back(setting);
-          }
-        }
-        scenarios.push_back(std::move(s));
-      }
-      // Output width: every method at one setting (fixed strips, so the facet count stays) on
-      // the cylinder at three sizes of one aspect, the city.
-      const std::vector<double> widths =
-          quick ? std::vector<double>{0.5, 1.0} : std::vector<double>{0.5, 0.7071, 1.0};
-      for (const double width : widths) {
-        if (!all_parts && name != "scale-width") break;
-        BenchScenario s;
-        s.scale_group = "scale-width-cylinder";
-        s.scene = "builtin:city";
-        s.outputs =
-            load_display_outputs("builtin:cylinder360", scaled({1600, 1200}, scale * width));
-        s.name = s.scale_group + ":" + size_text(s.outputs[0].warp.output_size);
-        s.description = "the 360x90 cylinder at " + size_text(s.outputs[0].warp.output_size) +
-                        ", builtin:city, every method at one setting";
-        s.settings =
-            sweep({FacetStrips{80}}, FacetStrips{80}, {FacetStrips{80}}, faces({512}), {1});
-        scenarios.push_back(std::move(s));
-      }
+      add_scale_scenarios(name, sizes, scenarios);
     } else if (name.starts_with("deformation")) {
-      for (const glm::ivec2 cells : {glm::ivec2(80, 60), glm::ivec2(128, 128)}) {
-        if (quick && cells.x == 128) continue;
-        if (name != "deformation" && name != "deformation-" + size_text(cells)) continue;
-        BenchScenario s;
-        s.name = "deformation-" + size_text(cells);
-        const glm::ivec2 size = scaled({1024, 768}, scale);
-        s.outputs.push_back({"deformation", deformation_warp(size, cells)});
-        s.description = "view deformation: perspective base, built-in smooth offset map on a " +
-                        size_text(cells) + " camera texture, " + size_text(size);
-        if (quick) {
-          s.settings = sweep({FacetGrid{8, 6}, FacetTolerance{1}}, FacetGrid{8, 6},
-                             {FacetGrid{8, 6}}, faces_sweep, tess);
-        } else {
-          // The seed's facets are the camera texture's cells.
-          const FacetGrid quarter{cells.x / 4, cells.y / 4};
-          s.settings = sweep({FacetGrid{cells.x, cells.y}, quarter, FacetTolerance{1}}, quarter,
-                             {quarter, FacetTolerance{1}}, faces_sweep, tess);
-        }
-        s.settings = with_perspective_images(std::move(s.settings), faces_sweep);
-        s.matched_cube_face = matched_face;
-        scenarios.push_back(std::move(s));
-      }
+      add_deformation_scenarios(name, sizes, scenarios);
     } else {
-      if (name != "dome4") {
-        BenchScenario s;
-        s.name = "dome";
-        s.outputs = load_display_outputs("builtin:dome180", scaled({2048, 2048}, scale));
-        s.description =
-            "180-degree dome master at " + size_text(s.outputs[0].warp.output_size) + ", the city";
-        if (quick) {
-          s.settings = sweep({FacetTolerance{1}, FacetGrid{4, 4}}, FacetGrid{4, 4},
-                             {FacetGrid{4, 4}}, faces_sweep, tess);
-        } else {
-          s.settings =
-              sweep({FacetTolerance{0.25}, FacetGrid{16, 16}, FacetTolerance{1},
-                     FacetTolerance{0.5}, FacetTolerance{0.1}},
-                    FacetGrid{16, 16}, {FacetGrid{16, 16}, FacetTolerance{1}}, faces_sweep, tess);
-        }
-        s.matched_cube_face = matched_face;
-        scenarios.push_back(std::move(s));
-      }
-      if (name != "dome-master") {
-        BenchScenario s;
-        s.name = "dome4";
-        s.outputs = rig_outputs(options.dome_rig, scale);
-        s.description = "multi-projector dome rig " + options.dome_rig.filename().string() + ": " +
-                        std::to_string(s.outputs.size()) + " projectors at " +
-                        size_text(s.outputs[0].warp.output_size) + ", true warps";
-        if (quick) {
-          s.settings =
-              sweep({FacetTolerance{1}}, FacetTolerance{1}, {FacetTolerance{1}}, faces_sweep, tess);
-        } else {
-          s.settings = sweep(
-              {FacetTolerance{0.25}, FacetTolerance{1}, FacetTolerance{0.5}, FacetTolerance{0.1}},
-              FacetTolerance{1}, {FacetTolerance{1}, FacetTolerance{0.25}}, faces_sweep, tess);
-        }
-        s.settings = with_perspective_images(std::move(s.settings), faces_sweep);
-        s.matched_cube_face = matched_face;
-        scenarios.push_back(std::move(s));
-      }
+      // "dome" is the dome master and the rig; "dome-master" and "dome4" one of them.
+      if (name != "dome4") add_dome_master_scenario(sizes, scenarios);
+      if (name != "dome-master") add_dome_rig_scenario(options.dome_rig, sizes, scenarios);
     }
   }
   return scenarios;
