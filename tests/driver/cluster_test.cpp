@@ -19,6 +19,7 @@
 #include <random>
 #include <string>
 #include <thread>
+#include <utility>
 #include <vector>
 
 #include "facet/projection/errors.hpp"
@@ -559,6 +560,27 @@ TEST(ClusterBench, ReportsEveryNodeCountAndBothLosses) {
     }
     EXPECT_GE(row.master_loss_ms, options.deadline_ms * 0.5);
   }
+}
+
+// join_cluster gives the node's lines to the caller's log sink, as warnings (the CLI prints
+// them on stderr after "facet run: "); without a sink the node says nothing.
+TEST(ClusterProtocol, JoinClusterReportsToTheLogSink) {
+  const facet::test::TempFolder scratch("facet-cluster-test");
+  ClusterNodeShare share;
+  share.config.cluster = test_cluster(scratch.path(), 300);
+  share.node = "b";
+  std::vector<std::pair<LogLevel, std::string>> lines;
+  const LogSink log = [&lines](LogLevel level, const std::string& line) {
+    lines.emplace_back(level, line);
+  };
+  join_cluster(share, "display.json", ClusterRequest{}, 42, log).reset();
+  const std::string listening =
+      "node b: listening on ipc://" + (scratch.path() / "b").string() + " for master a";
+  const auto line = std::find_if(lines.begin(), lines.end(),
+                                 [&](const auto& l) { return l.second == listening; });
+  ASSERT_NE(line, lines.end()) << lines.size() << " lines";
+  EXPECT_EQ(line->first, LogLevel::warning);
+  for (const auto& [level, text] : lines) EXPECT_EQ(level, LogLevel::warning) << text;
 }
 
 }  // namespace

@@ -3,6 +3,9 @@
 #include <gtest/gtest.h>
 
 #include <cstdio>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "facet/driver/gl_objects.hpp"
 #include "gl_test_context.hpp"
@@ -93,6 +96,28 @@ TEST(GlContext, DebugContextCanBeRequested) {
   options.debug = true;
   auto context = create_headless_context(options);
   EXPECT_TRUE(context->info().debug);
+  context.reset();
+  test::shared_context();
+}
+
+// A debug context's messages reach its log sink, as warnings: here the one Mesa gives for an
+// error forced by binding a buffer name that glGenBuffers never returned (GL_INVALID_OPERATION
+// in a core profile).
+TEST(GlContext, DebugMessagesGoToTheContextsLogSink) {
+  std::vector<std::pair<LogLevel, std::string>> lines;
+  HeadlessOptions options;
+  options.debug = true;
+  options.debug_log = [&lines](LogLevel level, const std::string& line) {
+    lines.emplace_back(level, line);
+  };
+  auto context = create_headless_context(options);
+  ASSERT_TRUE(lines.empty());
+  glBindBuffer(GL_ARRAY_BUFFER, 4242);
+  EXPECT_EQ(glGetError(), GLenum(GL_INVALID_OPERATION));
+  ASSERT_EQ(lines.size(), 1u);
+  EXPECT_EQ(lines[0].first, LogLevel::warning);
+  EXPECT_TRUE(lines[0].second.starts_with("GL debug: ")) << lines[0].second;
+  EXPECT_GT(lines[0].second.size(), std::string("GL debug: ").size());
   context.reset();
   test::shared_context();
 }

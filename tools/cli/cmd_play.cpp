@@ -190,7 +190,8 @@ void play(const PlayOptions& options) {
     sync =
         driver::join_cluster(*cluster_share, options.display, cluster_request,
                              driver::content_digest(cluster_share->config, options.display, "play",
-                                                    std::nullopt, picture_settings(options)));
+                                                    std::nullopt, picture_settings(options)),
+                             console_log("facet play: "));
   }
 
   watch_interrupts();

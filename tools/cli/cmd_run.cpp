@@ -169,7 +169,8 @@ void run(const RunOptions& options) {
                                scene_name.kind == driver::SceneName::Kind::file
                                    ? std::optional<std::filesystem::path>(scene_name.file)
                                    : std::nullopt,
-                               picture_settings(options, display)));
+                               picture_settings(options, display)),
+        console_log("facet run: "));
   }
 
   // From here on SIGINT and SIGTERM stop the run cleanly (Interrupted, exit 128 + signal).

@@ -228,9 +228,8 @@ class Socket {
   bool open_ = false;
 };
 
-void default_report(const std::string& line) {
-  std::fprintf(stderr, "facet run: %s\n", line.c_str());
-}
+// An empty ClusterNodeOptions::report says nothing.
+void report_nowhere(const std::string&) {}
 
 void say_no_swap_group_once(const std::function<void(const std::string&)>& report) {
   static std::once_flag said;
@@ -264,7 +263,7 @@ class Master final : public FrameSync {
   explicit Master(const ClusterNodeOptions& options)
       : options_(options),
         deadline_ms_(cluster_deadline_ms(options.cluster, options.frame_period_s)) {
-    if (!options_.report) options_.report = default_report;
+    if (!options_.report) options_.report = report_nowhere;
     const ClusterNode& self = find_cluster_node(options_.cluster, options_.node, options_.source);
     publisher_.open(nng_pub0_open, "pub");
     answers_.open(nng_sub0_open, "sub");
@@ -566,7 +565,7 @@ class Secondary final : public FrameSync {
         deadline_ms_(cluster_deadline_ms(options.cluster, options.frame_period_s)),
         self_(find_cluster_node(options_.cluster, options_.node, options_.source)),
         master_(options_.cluster.master) {
-    if (!options_.report) options_.report = default_report;
+    if (!options_.report) options_.report = report_nowhere;
     subscriber_.open(nng_sub0_open, "sub");
     answers_.open(nng_pub0_open, "pub");
     nng_socket_set(subscriber_.get(), NNG_OPT_SUB_SUBSCRIBE, "", 0);
@@ -841,8 +840,8 @@ NodeDisplay load_node_display(const std::string& display, std::optional<glm::ive
 }
 
 std::unique_ptr<FrameSync> join_cluster(const ClusterNodeShare& share, const std::string& display,
-                                        const ClusterRequest& request,
-                                        std::uint64_t content_digest) {
+                                        const ClusterRequest& request, std::uint64_t content_digest,
+                                        const LogSink& log) {
   FACET_ASSERT(share.config.cluster);
   ClusterNodeOptions options;
   options.cluster = *share.config.cluster;
@@ -852,6 +851,7 @@ std::unique_ptr<FrameSync> join_cluster(const ClusterNodeShare& share, const std
   options.join_timeout = std::chrono::milliseconds(std::int64_t(request.join_timeout_s * 1000));
   options.rate_hz = request.rate_hz;
   options.content_digest = content_digest;
+  if (log) options.report = [log](const std::string& line) { log(LogLevel::warning, line); };
   return share.master ? make_cluster_master(options) : make_cluster_secondary(options);
 }
 

@@ -2,13 +2,12 @@
 
 #include <epoxy/gl.h>
 
-#include <cstdio>
+#include <string>
 #if defined(__GLIBC__)
 #include <malloc.h>
 #endif
 
 #include "facet/driver/gpu_scene.hpp"
-#include "gl_context_internal.hpp"
 
 namespace facet::driver {
 
@@ -32,11 +31,14 @@ void keep_freed_heap_for_software_rasterizer() {
 #endif
 }
 
-void GLAPIENTRY print_debug_message(GLenum /*source*/, GLenum /*type*/, GLuint /*id*/,
-                                    GLenum severity, GLsizei length, const GLchar* message,
-                                    const void* /*user*/) {
+// `user` is the context's LogSink.
+void GLAPIENTRY log_debug_message(GLenum /*source*/, GLenum /*type*/, GLuint /*id*/,
+                                  GLenum severity, GLsizei length, const GLchar* message,
+                                  const void* user) {
   if (severity != GL_DEBUG_SEVERITY_HIGH && severity != GL_DEBUG_SEVERITY_MEDIUM) return;
-  std::fprintf(stderr, "facet GL debug: %.*s\n", static_cast<int>(length), message);
+  const std::string text =
+      length < 0 ? std::string(message) : std::string(message, static_cast<std::size_t>(length));
+  (*static_cast<const LogSink*>(user))(LogLevel::warning, "GL debug: " + text);
 }
 
 }  // namespace
@@ -65,15 +67,13 @@ void GlContext::read_info_and_check(std::string platform) {
   if (is_software_renderer()) keep_freed_heap_for_software_rasterizer();
 }
 
-namespace detail {
-
-void install_debug_output() {
+void GlContext::install_debug_output(LogSink log) {
+  if (!log) return;
+  debug_log_ = std::move(log);
   glEnable(GL_DEBUG_OUTPUT);
   // Synchronous, so that a message's stack trace points at the offending call.
   glEnable(GL_DEBUG_OUTPUT_SYNCHRONOUS);
-  glDebugMessageCallback(print_debug_message, nullptr);
+  glDebugMessageCallback(log_debug_message, &debug_log_);
 }
-
-}  // namespace detail
 
 }  // namespace facet::driver

@@ -15,7 +15,6 @@
 #include <vector>
 
 #include "facet/driver/gl_context.hpp"
-#include "gl_context_internal.hpp"
 
 namespace facet::driver {
 
@@ -92,12 +91,13 @@ class DisplayRegistry {
 
 class EglHeadlessContext final : public GlContext {
  public:
-  EglHeadlessContext(EGLDisplay display, EGLContext context, std::string platform, bool debug)
+  EglHeadlessContext(EGLDisplay display, EGLContext context, std::string platform,
+                     const HeadlessOptions& options)
       : display_(display), context_(context) {
     try {
       make_current();
       read_info_and_check(std::move(platform));
-      if (debug) detail::install_debug_output();
+      if (options.debug) install_debug_output(options.debug_log);
     } catch (...) {
       destroy();
       throw;
@@ -137,7 +137,7 @@ struct Attempt {
 
 // Tries to make a GL 4.5 core context on one display. Returns null and appends to `failures`
 // when this display cannot; throws only for errors that are not about this display.
-std::unique_ptr<GlContext> try_display(const Attempt& attempt, bool debug,
+std::unique_ptr<GlContext> try_display(const Attempt& attempt, const HeadlessOptions& options,
                                        std::vector<std::string>& failures) {
   auto fail = [&](const std::string& why) {
     failures.push_back(attempt.label + ": " + why);
@@ -170,14 +170,15 @@ std::unique_ptr<GlContext> try_display(const Attempt& attempt, bool debug,
                                        EGL_CONTEXT_OPENGL_PROFILE_MASK_KHR,
                                        EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT_KHR,
                                        EGL_CONTEXT_FLAGS_KHR,
-                                       debug ? EGL_CONTEXT_OPENGL_DEBUG_BIT_KHR : 0,
+                                       options.debug ? EGL_CONTEXT_OPENGL_DEBUG_BIT_KHR : 0,
                                        EGL_NONE};
   EGLContext context =
       eglCreateContext(attempt.display, config, EGL_NO_CONTEXT, context_attributes);
   if (context == EGL_NO_CONTEXT)
     return fail("eglCreateContext(GL 4.5 core) failed (" + egl_error_name(eglGetError()) + ")");
   try {
-    return std::make_unique<EglHeadlessContext>(attempt.display, context, attempt.platform, debug);
+    return std::make_unique<EglHeadlessContext>(attempt.display, context, attempt.platform,
+                                                options);
   } catch (const GlContextError& e) {
     failures.push_back(attempt.label + ": " + e.what());
     return nullptr;
@@ -224,7 +225,7 @@ std::unique_ptr<GlContext> create_headless_context(const HeadlessOptions& option
         }
         const Attempt attempt{"egl-device", label,
                               eglGetPlatformDisplayEXT(EGL_PLATFORM_DEVICE_EXT, device, nullptr)};
-        if (auto context = try_display(attempt, options.debug, failures)) return context;
+        if (auto context = try_display(attempt, options, failures)) return context;
       }
       if (count == 0) failures.push_back("EGL_EXT_platform_device: no devices");
     } else {
@@ -237,7 +238,7 @@ std::unique_ptr<GlContext> create_headless_context(const HeadlessOptions& option
       const Attempt attempt{
           "egl-surfaceless", "EGL_MESA_platform_surfaceless",
           eglGetPlatformDisplayEXT(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, nullptr)};
-      if (auto context = try_display(attempt, options.debug, failures)) return context;
+      if (auto context = try_display(attempt, options, failures)) return context;
     } else {
       failures.push_back("EGL_MESA_platform_surfaceless: not supported");
     }

@@ -9,7 +9,6 @@
 
 #include "facet/driver/gl_context.hpp"
 #include "facet/driver/monitors.hpp"
-#include "gl_context_internal.hpp"
 
 namespace facet::driver {
 
@@ -81,7 +80,7 @@ GlfwWindowContext::GlfwWindowContext(const WindowOptions& options) {
     glfwMakeContextCurrent(window);
     glfwSwapInterval(options.vsync ? 1 : 0);
     read_info_and_check("glfw");
-    if (options.debug) detail::install_debug_output();
+    if (options.debug) install_debug_output(options.debug_log);
   } catch (...) {
     if (window_) glfwDestroyWindow(as_window(window_));
     window_ = nullptr;

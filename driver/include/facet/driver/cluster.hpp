@@ -36,6 +36,7 @@
 #include <string>
 #include <vector>
 
+#include "facet/driver/log.hpp"
 #include "facet/driver/session.hpp"
 #include "facet/projection_io/display_config.hpp"
 
@@ -92,7 +93,7 @@ struct ClusterNodeOptions {
   // Master: at most this many frames a second (a headless run paced like a show); nullopt: as
   // fast as the slowest node renders.
   std::optional<double> rate_hz;
-  std::function<void(const std::string&)> report;  // one line per event; default: stderr
+  std::function<void(const std::string&)> report;  // one line per event; empty: none
 };
 
 // The cluster's deadline in ms: its deadline_ms, or kDefaultClusterDeadlineFrames frame periods.
@@ -205,9 +206,10 @@ NodeDisplay load_node_display(const std::string& display, std::optional<glm::ive
 
 // Joins `share`'s cluster as its master or a secondary (make_cluster_master,
 // make_cluster_secondary) at kFramePeriod_s, with the request's timeout and pace and the
-// content_digest of what this node shows.
+// content_digest of what this node shows. The node's lines (who joined, missed a barrier, was
+// dropped or rejoined) go to `log` as warnings.
 std::unique_ptr<FrameSync> join_cluster(const ClusterNodeShare& share, const std::string& display,
-                                        const ClusterRequest& request,
-                                        std::uint64_t content_digest);
+                                        const ClusterRequest& request, std::uint64_t content_digest,
+                                        const LogSink& log);
 
 }  // namespace facet::driver

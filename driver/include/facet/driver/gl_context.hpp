@@ -8,6 +8,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "facet/driver/log.hpp"
+
 namespace facet::driver {
 
 // No OpenGL 4.5 core context could be made (no EGL/GLFW platform, no suitable device or driver,
@@ -52,9 +54,14 @@ class GlContext {
   // Reads GlInfo from the current context and throws GlContextError when it is not GL >= 4.5
   // core. Call once from the derived constructor after making the context current.
   void read_info_and_check(std::string platform);
+  // Routes the KHR_debug messages of medium and high severity of this context, which must be
+  // current, to `log` as warnings ("GL debug: MESSAGE"), synchronously; nothing when `log` is
+  // empty.
+  void install_debug_output(LogSink log);
 
  private:
   GlInfo info_;
+  LogSink debug_log_;  // the debug callback's user pointer: lives as long as the context
 };
 
 enum class EglPlatform {
@@ -67,8 +74,11 @@ struct HeadlessOptions {
   EglPlatform platform = EglPlatform::automatic;
   // Index into eglQueryDevicesEXT's list, or -1 to take the first device that gives GL 4.5 core.
   int device_index = -1;
-  // Requests a debug context and routes KHR_debug messages of high severity to stderr.
+  // Requests a debug context (GL_CONTEXT_FLAG_DEBUG_BIT).
   bool debug = false;
+  // A debug context's KHR_debug messages of medium and high severity, as warnings
+  // ("GL debug: MESSAGE"); empty: none are reported.
+  LogSink debug_log;
 };
 
 // Makes an EGL context with no surface (EGL_KHR_surfaceless_context) and makes it current on the
@@ -91,6 +101,7 @@ struct WindowOptions {
   bool vsync = true;      // swap interval 1 (else 0)
   bool visible = true;
   bool debug = false;  // as in HeadlessOptions
+  LogSink debug_log;   // as in HeadlessOptions
   // Shares textures and buffers (not framebuffers or vertex arrays) with this window's context.
   const GlfwWindowContext* share = nullptr;
 };
