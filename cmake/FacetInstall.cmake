@@ -21,8 +21,10 @@ install(TARGETS facet_api facet_driver facet_interop facet_projection facet_proj
         ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
         LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}
         INCLUDES DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
+# facet/driver/capture.hpp belongs to facet::capture, which is not installed.
 foreach(dir api/include driver/include interop/include projection/include projection/io/include)
-  install(DIRECTORY ${PROJECT_SOURCE_DIR}/${dir}/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
+  install(DIRECTORY ${PROJECT_SOURCE_DIR}/${dir}/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}
+          PATTERN capture.hpp EXCLUDE)
 endforeach()
 
 # The GLSL interface a material shader is written against (Display::set_material_shader).

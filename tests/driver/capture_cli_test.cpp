@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "../calibration/capture_rig.hpp"
+#include "capture_rig_files.hpp"
 #include "facet/calibration/calibrate.hpp"
 #include "facet/calibration/capture.hpp"
 #include "facet/calibration/live_capture.hpp"
@@ -32,38 +33,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// The rig as a file and a display.json naming its two projectors (no warps yet).
-struct RigFiles {
-  test::TempFolder temp;
-  fs::path rig = temp.path() / "rig.json";
-  fs::path display = temp.path() / "display.json";
-
-  explicit RigFiles(const Rig& value = test::capture_test_rig()) {
-    write_rig(rig, value);
-    nlohmann::json projectors = nlohmann::json::array();
-    int x = 0;
-    for (const ProjectorModel& p : value.projectors) {
-      projectors.push_back({{"name", p.name},
-                            {"size", {p.size.x, p.size.y}},
-                            {"gamma", 2.2},
-                            {"output", {{"window", {x, 0, p.size.x, p.size.y}}}}});
-      x += p.size.x;
-    }
-    std::ofstream(display) << nlohmann::json{
-        {"format", "facet-display/1"},
-        {"name", "capture-test"},
-        {"eye", {0, 0, 0}},
-        {"render", {{"method", "naive"}, {"tolerance_px", 0.5}}},
-        {"missing_monitor", "window"},
-        {"projectors",
-         projectors}}.dump(1);
-  }
-
-  std::string command(const fs::path& out, const std::string& extra = "") const {
-    return "capture --display " + display.string() + " --camera fake:" + rig.string() + " --out " +
-           out.string() + " --settle-ms 0 --quiet " + extra;
-  }
-};
+using test::RigFiles;
 
 // Every frame file of the finished capture `a` exists in `b` with the same bytes, and both
 // capture.json files list the same frames.
