@@ -215,9 +215,10 @@ TEST(DepthImage, BadInputIsRefusedNamingTheField) {
 using facet::test::background_sphere;
 
 std::vector<std::uint32_t> render_ids(const Scene& scene, const std::vector<OutputSpec>& outputs,
-                                      const glm::dmat4& T_eye_world) {
+                                      const glm::dmat4& T_eye_world,
+                                      std::string_view method_name = "facets") {
   const GpuScene gpu = upload_scene(scene);
-  auto method = make_render_method("facets");
+  auto method = make_render_method(method_name);
   method->prepare(scene, gpu, outputs, RenderSettings{});
   std::vector<OutputTarget> targets;
   targets.push_back(OutputTarget::create(outputs[0].warp.output_size));
@@ -230,10 +231,7 @@ std::vector<std::uint32_t> render_ids(const Scene& scene, const std::vector<Outp
 struct DomeHoles {
   std::size_t holes = 0, inside = 0;
 };
-DomeHoles dome_holes(const Scene& scene, const glm::dmat4& T_eye_world) {
-  const glm::ivec2 size{128, 128};
-  const std::vector<OutputSpec> outputs = load_display_outputs("builtin:dome180", size);
-  const std::vector<std::uint32_t> ids = render_ids(scene, outputs, T_eye_world);
+DomeHoles dome_holes(const std::vector<std::uint32_t>& ids, glm::ivec2 size) {
   DomeHoles count;
   for (int j = 0; j < size.y; ++j)
     for (int i = 0; i < size.x; ++i) {
@@ -243,6 +241,11 @@ DomeHoles dome_holes(const Scene& scene, const glm::dmat4& T_eye_world) {
       count.holes += ids[std::size_t(j * size.x + i)] == 0;
     }
   return count;
+}
+DomeHoles dome_holes(const Scene& scene, const glm::dmat4& T_eye_world) {
+  const glm::ivec2 size{128, 128};
+  const std::vector<OutputSpec> outputs = load_display_outputs("builtin:dome180", size);
+  return dome_holes(render_ids(scene, outputs, T_eye_world), size);
 }
 
 TEST(DepthImage, DpciOfABackgroundSphereLeavesNoHoleOnTheDome) {
@@ -310,6 +313,44 @@ GridCover grid_cover(const Scene& scene, std::size_t object, glm::ivec2 size, in
   return cover;
 }
 
+// A 150×90 planar image (100° wide, sizes not a multiple of the block) of a plane 5 m ahead.
+DepthImage plane_image() {
+  DepthImage plane = make_planar({150, 90}, 100.0);
+  for (int j = 0; j < 90; ++j)
+    for (int i = 0; i < 150; ++i) {
+      const std::size_t k = plane.parts[0].pixel_index(i, j);
+      plane.parts[0].distance_m[k] = float(5.0 / -plane.parts[0].v_image(i, j).z);
+      plane.parts[0].normal[k] = {0, 0, 1};
+    }
+  return plane;
+}
+
+// A 200×100 DPCI (and its cap) of a sphere of 20 m around its eye.
+DepthImage sphere_dpci() {
+  DepthImage sphere = make_dpci({200, 100});
+  for (DepthImagePart& part : sphere.parts)
+    for (int j = 0; j < part.size.y; ++j)
+      for (int i = 0; i < part.size.x; ++i) {
+        const std::size_t k = part.pixel_index(i, j);
+        part.distance_m[k] = 20.0f;
+        part.normal[k] = -glm::vec3(part.v_image(i, j));
+      }
+  return sphere;
+}
+
+// Whether every part of `mesh` is watertight in its image grid (grid_cover).
+void expect_watertight(const DepthImage& image, const Scene& mesh, const std::string& where) {
+  for (std::size_t p = 0; p < image.parts.size(); ++p) {
+    const DepthImagePart& part = image.parts[p];
+    const int last_x = part.base.wraps_horizontally() ? part.size.x : part.size.x - 1;
+    const GridCover cover = grid_cover(mesh, p, part.size, last_x);
+    EXPECT_EQ(cover.inner_edges_not_twice, 0u) << where << " " << part.name;
+    EXPECT_EQ(cover.border_edges_not_once, 0u) << where << " " << part.name;
+    EXPECT_EQ(cover.turned, 0u) << where << " " << part.name;
+    EXPECT_EQ(cover.area, double(last_x) * (part.size.y - 1)) << where << " " << part.name;
+  }
+}
+
 TEST(DepthImage, LodMeshHasNoCrackWhereBlocksChangeStep) {
   // The checker itself: two cells of step 1 beside one of step 2 without the middle node on the
   // shared side (a T-junction) are found, and with it (a fan) are not.
@@ -353,21 +394,7 @@ TEST(DepthImage, LodMeshHasNoCrackWhereBlocksChangeStep) {
   // A plane 5 m ahead of a planar image (sizes not a multiple of the block), and a sphere of
   // 20 m around a DPCI's eye, every pixel seen; level of detail from an eye near the plane's
   // corner and 12 m off the sphere's centre, so that the blocks take several steps.
-  DepthImage plane = make_planar({150, 90}, 100.0);
-  for (int j = 0; j < 90; ++j)
-    for (int i = 0; i < 150; ++i) {
-      const std::size_t k = plane.parts[0].pixel_index(i, j);
-      plane.parts[0].distance_m[k] = float(5.0 / -plane.parts[0].v_image(i, j).z);
-      plane.parts[0].normal[k] = {0, 0, 1};
-    }
-  DepthImage sphere = make_dpci({200, 100});
-  for (DepthImagePart& part : sphere.parts)
-    for (int j = 0; j < part.size.y; ++j)
-      for (int i = 0; i < part.size.x; ++i) {
-        const std::size_t k = part.pixel_index(i, j);
-        part.distance_m[k] = 20.0f;
-        part.normal[k] = -glm::vec3(part.v_image(i, j));
-      }
+  const DepthImage plane = plane_image(), sphere = sphere_dpci();
   for (const auto& [image, eye, angle] : {std::tuple{&plane, glm::dvec3(-4.0, 2.5, -4.0), 0.05},
                                           std::tuple{&sphere, glm::dvec3(12.0, 3.0, 0.0), 0.08}}) {
     const DepthMesh mesh = depth_image_mesh(*image, {.lod_angle_rad = angle, .lod_eye_world = eye});
@@ -385,16 +412,7 @@ TEST(DepthImage, LodMeshHasNoCrackWhereBlocksChangeStep) {
                 full.scene.triangle_count());
     EXPECT_GE(levels, 3u) << histogram;
     EXPECT_LT(mesh.scene.triangle_count(), full.scene.triangle_count() / 2);
-    for (std::size_t p = 0; p < image->parts.size(); ++p) {
-      const DepthImagePart& part = image->parts[p];
-      const bool wraps = part.base.wraps_horizontally();
-      const int last_x = wraps ? part.size.x : part.size.x - 1;
-      const GridCover cover = grid_cover(mesh.scene, p, part.size, last_x);
-      EXPECT_EQ(cover.inner_edges_not_twice, 0u) << part.name;
-      EXPECT_EQ(cover.border_edges_not_once, 0u) << part.name;
-      EXPECT_EQ(cover.turned, 0u) << part.name;
-      EXPECT_EQ(cover.area, double(last_x) * (part.size.y - 1)) << part.name;
-    }
+    expect_watertight(*image, mesh.scene, "lod");
   }
   // The level of detail's own bad values.
   EXPECT_NE(
@@ -402,6 +420,54 @@ TEST(DepthImage, LodMeshHasNoCrackWhereBlocksChangeStep) {
       std::string::npos);
   EXPECT_NE(error_of([&] { depth_image_mesh(plane, {.lod_angle_rad = -1.0}); }).find("lod"),
             std::string::npos);
+  EXPECT_NE(error_of([&] {
+              depth_image_mesh(plane, {.lod_angle_rad = 0.05, .lod_levels = DepthLodLevels{{1}}});
+            }).find("lod"),
+            std::string::npos);
+  EXPECT_NE(error_of([&] { DepthLodChooser(plane, {}); }).find("lod"), std::string::npos);
+}
+
+// The level choice for a moving eye: DepthLodChooser gives what depth_image_mesh chooses for
+// each eye, a block refines as the eye approaches it and coarsens as it leaves, and every mesh
+// built from the chosen levels is watertight.
+TEST(DepthImage, LodLevelsFollowTheEye) {
+  const DepthImage plane = plane_image();
+  const DepthMeshOptions options{.lod_angle_rad = 0.05};
+  const DepthLodChooser chooser(plane, options);
+  // The block holding the image's centre pixel (75, 45): blocks of 16, 10 across.
+  const std::size_t centre = 2 * 10 + 4;
+  std::vector<int> centre_levels;
+  std::size_t distinct = 0;
+  DepthLodLevels last;
+  // From the image's eye straight towards the plane (5 m ahead, image -z) to 1 m before it,
+  // then back and 6 m further away.
+  for (const double z : {0.0, -1.0, -2.0, -3.0, -4.0, -2.0, 0.0, 3.0, 6.0}) {
+    const glm::dvec3 eye(0.0, 0.0, z);
+    const DepthLodLevels levels = chooser.levels(eye);
+    ASSERT_EQ(levels.size(), 1u);
+    ASSERT_EQ(levels[0].size(), 60u);
+    centre_levels.push_back(levels[0][centre]);
+    distinct += levels != last;
+    last = levels;
+    const DepthMesh chosen = depth_image_mesh(plane, {.lod_angle_rad = 0.05, .lod_eye_world = eye});
+    const DepthMesh given = depth_image_mesh(plane, {.lod_angle_rad = 0.05, .lod_levels = levels});
+    EXPECT_EQ(chosen.scene.indices, given.scene.indices) << "eye z " << z;
+    EXPECT_EQ(chosen.scene.positions, given.scene.positions) << "eye z " << z;
+    expect_watertight(plane, given.scene, "eye z " + std::to_string(z));
+  }
+  std::string text;
+  for (int l : centre_levels) text += std::to_string(l) + " ";
+  std::printf("centre block's level, eye z 0 -1 -2 -3 -4 -2 0 3 6 m: %s\n", text.c_str());
+  // Nearer never coarser, farther never finer; 1 m from the plane step 1, from 11 m coarser than
+  // from the image's own eye.
+  for (std::size_t k = 1; k < 5; ++k) EXPECT_LE(centre_levels[k], centre_levels[k - 1]) << k;
+  for (std::size_t k = 5; k < centre_levels.size(); ++k)
+    EXPECT_GE(centre_levels[k], centre_levels[k - 1]) << k;
+  EXPECT_EQ(centre_levels[4], 0);
+  EXPECT_GT(centre_levels[0], 0);
+  EXPECT_EQ(centre_levels[6], centre_levels[0]);
+  EXPECT_GT(centre_levels[8], centre_levels[0]);
+  EXPECT_GE(distinct, 5u);
 }
 
 TEST(DepthImage, LodDpciOfABackgroundSphereLeavesNoHoleOnTheDome) {
@@ -427,6 +493,87 @@ TEST(DepthImage, LodDpciOfABackgroundSphereLeavesNoHoleOnTheDome) {
   }
 }
 
+// One method drawing a ViewDependentScene along a path of eyes: the scene rebuilt where the
+// levels change, its buffers replaced (replace_geometry) and the method's scene state with them
+// (RenderMethod::replace_scene). Per frame the ID image, and whether the scene was rebuilt
+// before it.
+struct MovingFrame {
+  std::vector<std::uint32_t> ids;
+  bool rebuilt = false;
+};
+std::vector<MovingFrame> render_moving(ViewDependentScene& lod,
+                                       const std::vector<OutputSpec>& outputs,
+                                       const std::vector<glm::dmat4>& T_world_eyes,
+                                       std::string_view method_name,
+                                       const std::function<void(std::size_t)>& after_frame = {}) {
+  GpuScene gpu = upload_scene(lod.scene());
+  auto method = make_render_method(method_name);
+  method->prepare(lod.scene(), gpu, outputs, RenderSettings{});
+  std::vector<OutputTarget> targets;
+  targets.push_back(OutputTarget::create(outputs[0].warp.output_size));
+  std::vector<MovingFrame> frames;
+  for (std::size_t k = 0; k < T_world_eyes.size(); ++k) {
+    MovingFrame& frame = frames.emplace_back();
+    frame.rebuilt = lod.update(glm::dvec3(T_world_eyes[k][3]));
+    if (frame.rebuilt) {
+      replace_geometry(gpu, lod.scene());
+      method->replace_scene(lod.scene(), gpu, outputs, RenderSettings{});
+    }
+    method->render(glm::inverse(T_world_eyes[k]), targets);
+    frame.ids = targets[0].read_ids();
+    if (after_frame) after_frame(k);
+  }
+  return frames;
+}
+
+// The sphere's LOD DPCI seen from an eye that moves 8 m out from the centre, turning and tilting:
+// the scene is rebuilt as the levels change, every frame leaves no hole on the dome, and every
+// frame's IDs are those of a method prepared afresh for that frame's scene (the facets pipeline,
+// which keeps its facets across the rebuilds, and the cube map, which prepares anew).
+TEST(DepthImage, LodSceneRebuiltAsTheEyeMovesLeavesNoHoleOnTheDome) {
+  test::shared_context();
+  const Scene sphere = background_sphere(64, 32, 20.0f);
+  DepthImageRequest request;
+  request.size = {128, 64};
+  const facet::test::TempFolder scratch("facet_depth_image_moving_eye");
+  const fs::path file = scratch.path() / "sphere.exr";
+  write_depth_image(file, render_depth_image(sphere, request));
+  const SceneName name = parse_scene_name("depth:" + file.string() + "@lod=0.1");
+  const glm::ivec2 size{128, 128};
+  const std::vector<OutputSpec> outputs = load_display_outputs("builtin:dome180", size);
+  std::vector<glm::dmat4> T_world_eyes;
+  for (int k = 0; k < 6; ++k) {
+    const double turn = 0.3 * k;
+    const glm::dvec3 eye = 1.6 * k * glm::dvec3(std::cos(turn), 0.0, std::sin(turn));
+    T_world_eyes.push_back(glm::translate(glm::dmat4(1.0), eye) * glm::rotate(glm::dmat4(1.0),
+                                                                              glm::radians(8.0 * k),
+                                                                              glm::dvec3(1, 0, 0)));
+  }
+  for (const std::string_view method : {"facets", "cubemap"}) {
+    ViewDependentScene lod(name, glm::dvec3(T_world_eyes[0][3]));
+    std::vector<std::size_t> triangles;
+    std::vector<std::vector<std::uint32_t>> fresh;
+    const std::vector<MovingFrame> frames =
+        render_moving(lod, outputs, T_world_eyes, method, [&](std::size_t k) {
+          triangles.push_back(lod.scene().triangle_count());
+          fresh.push_back(render_ids(lod.scene(), outputs, glm::inverse(T_world_eyes[k]), method));
+        });
+    std::size_t rebuilds = 0;
+    std::string text;
+    for (std::size_t k = 0; k < frames.size(); ++k) {
+      rebuilds += frames[k].rebuilt;
+      const DomeHoles count = dome_holes(frames[k].ids, size);
+      EXPECT_EQ(count.holes, 0u) << method << " frame " << k << ", of " << count.inside;
+      EXPECT_EQ(frames[k].ids, fresh[k]) << method << " frame " << k;
+      text += std::to_string(triangles[k]) + (frames[k].rebuilt ? "* " : " ");
+    }
+    std::printf("%.*s: triangles per frame (* rebuilt): %s\n", int(method.size()), method.data(),
+                text.c_str());
+    EXPECT_FALSE(frames[0].rebuilt);
+    EXPECT_GE(rebuilds, 1u) << method;
+  }
+}
+
 // The DPCI of the city, drawn forward onto the dome, against the polygon city's reference IDs
 // (Embree): mesh triangle IDs map back to the city triangle each came from (the id channel).
 struct CityComparison {
@@ -435,13 +582,10 @@ struct CityComparison {
   double holes = 0;  // share of pixels the polygons cover and the depth image does not
 };
 
-CityComparison compare_with_city(const Scene& city, const DepthMesh& mesh,
+// `tested`: the IDs drawn on the dome of `size`, mapped to the city's triangles.
+CityComparison compare_with_city(const Scene& city, const std::vector<std::uint32_t>& tested,
                                  const glm::dmat4& T_eye_world, glm::ivec2 size) {
   std::vector<OutputSpec> outputs = load_display_outputs("builtin:dome180", size);
-  const std::vector<std::uint32_t> mesh_ids = render_ids(mesh.scene, outputs, T_eye_world);
-  std::vector<std::uint32_t> tested(mesh_ids.size());
-  for (std::size_t k = 0; k < tested.size(); ++k)
-    tested[k] = mesh_ids[k] == 0 ? 0 : mesh.source_id[mesh_ids[k] - 1];
   const ReferenceRaycaster raycaster(city);
   const WarpInverse inverse(outputs[0].warp);
   const std::vector<std::uint32_t> reference = raycaster.ids(inverse, T_eye_world);
@@ -455,6 +599,16 @@ CityComparison compare_with_city(const Scene& city, const DepthMesh& mesh,
   }
   result.holes = double(holes) / double(std::max<std::size_t>(covered, 1));
   return result;
+}
+
+CityComparison compare_with_city(const Scene& city, const DepthMesh& mesh,
+                                 const glm::dmat4& T_eye_world, glm::ivec2 size) {
+  std::vector<OutputSpec> outputs = load_display_outputs("builtin:dome180", size);
+  const std::vector<std::uint32_t> mesh_ids = render_ids(mesh.scene, outputs, T_eye_world);
+  std::vector<std::uint32_t> tested(mesh_ids.size());
+  for (std::size_t k = 0; k < tested.size(); ++k)
+    tested[k] = mesh_ids[k] == 0 ? 0 : mesh.source_id[mesh_ids[k] - 1];
+  return compare_with_city(city, tested, T_eye_world, size);
 }
 
 // The city's DPCI of 512×256 (and its cap) from the first eye of its camera path.
@@ -540,6 +694,63 @@ TEST(DepthImage, CityDpciWithLodKeepsAccuracyWithFewerTriangles) {
     EXPECT_LE(b.edges.p99_px, a.edges.p99_px + 0.5);
     EXPECT_LE(b.holes, a.holes + 0.005);
   }
+}
+
+// The city's DPCI with level of detail drawn by one `facets` method as the eye moves from the
+// image's own eye to 3 m up and 4 m back, the scene rebuilt where the levels change: every frame
+// draws the IDs of the static LOD mesh built for its eye, and the last frame keeps the static
+// test's margins against the full grid.
+TEST(DepthImage, CityDpciLodFollowsAMovingEyeAsAStaticOneDoes) {
+  test::shared_context();
+  const Scene city = build_city();
+  const DepthImageRequest request = city_dpci_request();
+  const DepthImage image = render_depth_image(city, request);
+  const facet::test::TempFolder scratch("facet_depth_image_city_moving");
+  const fs::path file = scratch.path() / "city.exr";
+  write_depth_image(file, image);
+  const glm::ivec2 size{192, 192};
+  const std::vector<OutputSpec> outputs = load_display_outputs("builtin:dome180", size);
+  std::vector<glm::dmat4> T_world_eyes;
+  for (int k = 0; k <= 4; ++k)
+    T_world_eyes.push_back(
+        glm::translate(request.T_world_image, glm::dvec3(0.0, 3.0, 4.0) * (k / 4.0)));
+  ViewDependentScene lod(parse_scene_name("depth:" + file.string() + "@lod=0.02"),
+                         glm::dvec3(T_world_eyes[0][3]));
+  std::vector<std::uint32_t> last_tested;
+  std::string text;
+  const std::vector<MovingFrame> frames =
+      render_moving(lod, outputs, T_world_eyes, "facets", [&](std::size_t k) {
+        const DepthMesh fixed = depth_image_mesh(
+            image, {.lod_angle_rad = 0.02, .lod_eye_world = glm::dvec3(T_world_eyes[k][3])});
+        EXPECT_EQ(lod.scene().indices, fixed.scene.indices) << "frame " << k;
+        EXPECT_EQ(lod.scene().triangle_count(), fixed.scene.triangle_count()) << "frame " << k;
+        text += std::to_string(fixed.scene.triangle_count()) + " ";
+        if (k + 1 == T_world_eyes.size()) {
+          const std::vector<std::uint32_t> ids =
+              render_ids(fixed.scene, outputs, glm::inverse(T_world_eyes[k]));
+          last_tested = ids;
+        }
+      });
+  std::size_t rebuilds = 0;
+  for (const MovingFrame& frame : frames) rebuilds += frame.rebuilt;
+  std::printf("moving eye: %zu rebuilds, triangles per frame %s\n", rebuilds, text.c_str());
+  EXPECT_GE(rebuilds, 1u);
+  // The last frame: the moving method's IDs are the static mesh's, and against the polygon city
+  // within the static test's margins of the full grid.
+  EXPECT_EQ(frames.back().ids, last_tested);
+  std::vector<std::uint32_t> tested = frames.back().ids;
+  for (std::uint32_t& id : tested) id = lod.source_ids()[id];
+  const glm::dmat4 T_eye_world = glm::inverse(T_world_eyes.back());
+  const CityComparison moving = compare_with_city(city, tested, T_eye_world, size);
+  const CityComparison full = compare_with_city(city, depth_image_mesh(image), T_eye_world, size);
+  std::printf(
+      "last eye: moving lod id_mismatch %.5f p99 %.2f px holes %.5f; full grid id_mismatch "
+      "%.5f p99 %.2f px holes %.5f\n",
+      moving.ids.id_mismatch, moving.edges.p99_px, moving.holes, full.ids.id_mismatch,
+      full.edges.p99_px, full.holes);
+  EXPECT_LE(moving.ids.id_mismatch, full.ids.id_mismatch + 0.002);
+  EXPECT_LE(moving.edges.p99_px, full.edges.p99_px + 0.5);
+  EXPECT_LE(moving.holes, full.holes + 0.005);
 }
 
 TEST(DepthImage, SceneNamesTakeDepthImagesAloneAndHybrid) {
@@ -635,6 +846,22 @@ TEST(DepthImage, CliRendersTheCityDpciAgainstThePolygonCity) {
             report["triangles_scene"].get<std::uint64_t>());
   EXPECT_LE(lod["reference"]["id_mismatch"].get<double>(), 0.005);
   EXPECT_LE(lod["reference"]["p99_edge_px"].get<double>(), 2.0);
+  // A moving eye (circling a point 10 m ahead, 3° a frame): the levels chosen for every frame's
+  // eye, the scene rebuilt where they change; the last frame against the polygon city within the
+  // moved eye's bounds of the static comparison.
+  const nlohmann::json moving = render_report(
+      "@lod=0.05 --frames 3 --eye 0,1.7,-6 --look-at "
+      "0,1.7,-16");
+  ASSERT_FALSE(moving.is_null());
+  ASSERT_TRUE(moving.contains("depth_lod")) << moving.dump();
+  const nlohmann::json& moving_lod = moving["depth_lod"];
+  std::printf("moving eye, @lod=0.05, 3 frames: %s; id_mismatch %.5f, p99 %.2f px\n",
+              moving_lod.dump().c_str(), moving["reference"]["id_mismatch"].get<double>(),
+              moving["reference"]["p99_edge_px"].get<double>());
+  EXPECT_GE(moving_lod["rebuilds"].get<int>(), 1);
+  EXPECT_LT(moving_lod["triangles_max"].get<double>(), report["triangles_scene"].get<double>());
+  EXPECT_LE(moving["reference"]["id_mismatch"].get<double>(), 0.005);
+  EXPECT_LE(moving["reference"]["p99_edge_px"].get<double>(), 3.0);
   // A bad angle: exit 2 naming --scene and the angle.
   EXPECT_EQ(facet::test::run_facet("render --display builtin:dome180 --size 16x16 --scene depth:" +
                                        image.string() + "@lod=3",

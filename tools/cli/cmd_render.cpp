@@ -304,31 +304,40 @@ void run(const RenderOptions& options) {
     reference_scene = as_reference_scene([&] { return load_scene(*reference_scene_name); });
   }
   const SceneView view = choose_view(scene, view_request, scene_name.builtin_city(), "render");
+  // The view moves every frame (unless --static-view): along the city's camera path, or turning
+  // on the spot or about the point looked at (choose_scene_view).
+  const FrameViews views(view, kFrameStepS, options.static_view);
+  // Depth images with @lod take their levels as seen from each frame's eye (the view comes from
+  // the scene, so the first frame's scene is built twice); the scene is rebuilt, its buffers
+  // replaced and the method's scene state with them, on the frames where the levels change.
+  std::optional<ViewDependentScene> lod_scene;
   if (uses_depth_lod(scene_name)) {
-    // Depth images with @lod take their steps as seen from the first frame's eye (the view comes
-    // from the scene, so the scene is built twice). The scene is uploaded once: later frames
-    // keep these steps; a turning view keeps the eye's position and so the right ones.
-    const glm::dvec3 eye(FrameViews(view, kFrameStepS, options.static_view).T_world_eye(0)[3]);
-    source_ids.clear();
-    scene = load_scene(scene_name, &source_ids, eye);
+    lod_scene.emplace(scene_name, glm::dvec3(views.T_world_eye(0)[3]));
+    scene = Scene{};
   }
+  const Scene& drawn = lod_scene ? lod_scene->scene() : scene;
+  const std::vector<std::uint32_t>& drawn_source_ids =
+      lod_scene ? lod_scene->source_ids() : source_ids;
 
   auto context = create_headless_context();
   check_material_shader(settings.material);  // its own compile errors name its file (exit 2)
   auto method = make_render_method(options.method);
-  const GpuScene gpu_scene = upload_scene(scene, options.anisotropy);
-  method->prepare(scene, gpu_scene, outputs, settings);
+  GpuScene gpu_scene = upload_scene(drawn, options.anisotropy);
+  method->prepare(drawn, gpu_scene, outputs, settings);
   std::vector<OutputTarget> targets;
   for (const OutputSpec& output : outputs) {
     targets.push_back(OutputTarget::create(output.warp.output_size, settings.msaa_samples));
   }
 
-  // The view moves every frame (unless --static-view): along the city's camera path, or turning
-  // on the spot or about the point looked at (choose_scene_view).
-  const FrameViews views(view, kFrameStepS, options.static_view);
   GpuTimer timer;
   std::vector<double> frame_ms;
   std::vector<RenderStats> stats;
+  // With @lod: per frame the level choice and, where the levels changed, the rebuild and
+  // replacement (update_ms: all of it, wall clock), and the drawn scene's triangles.
+  struct {
+    std::size_t rebuilds = 0;
+    std::vector<double> update_ms, choose_ms, build_ms, triangles;
+  } lod;
   glm::dmat4 T_eye_world(1.0);
   // From here on SIGINT and SIGTERM stop the command cleanly (Interrupted, exit 128 + signal).
   watch_interrupts();
@@ -338,6 +347,21 @@ void run(const RenderOptions& options) {
     throw_if_interrupted("stopped after " + std::to_string(k) + " of " +
                          std::to_string(frame_count) + " frames; " + nothing_written);
     T_eye_world = views.T_eye_world(int(k));
+    if (lod_scene) {
+      const auto update_start = std::chrono::steady_clock::now();
+      if (lod_scene->update(glm::dvec3(views.T_world_eye(int(k))[3]))) {
+        replace_geometry(gpu_scene, drawn);
+        method->replace_scene(drawn, gpu_scene, outputs, settings);
+        ++lod.rebuilds;
+        lod.build_ms.push_back(lod_scene->build_ms());
+      }
+      glFinish();
+      lod.update_ms.push_back(
+          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - update_start)
+              .count());
+      lod.choose_ms.push_back(lod_scene->choose_ms());
+      lod.triangles.push_back(double(drawn.triangle_count()));
+    }
     const auto start = std::chrono::steady_clock::now();
     stats.push_back(method->render(T_eye_world, targets, &timer));
     glFinish();
@@ -360,9 +384,9 @@ void run(const RenderOptions& options) {
   auto compare = [&](const std::filesystem::path& ids_folder) {
     if (options.reference)
       reference =
-          compare_with_reference(reference_scene ? *reference_scene : scene, outputs, targets,
+          compare_with_reference(reference_scene ? *reference_scene : drawn, outputs, targets,
                                  hidden, T_eye_world, options.ids ? ids_folder : "", stopped,
-                                 reference_scene ? &source_ids : nullptr, settings.z_near);
+                                 reference_scene ? &drawn_source_ids : nullptr, settings.z_near);
   };
   if (options.out.empty()) {
     compare("");
@@ -409,7 +433,7 @@ void run(const RenderOptions& options) {
                            {"renderer", context->info().renderer},
                            {"frames", frame_count},
                            {"facets", last.facets},
-                           {"triangles_scene", scene.triangle_count()},
+                           {"triangles_scene", drawn.triangle_count()},
                            {"triangles_in", last.triangles_in},
                            {"triangles_visible", last.triangles_visible},
                            {"triangles_sole_piece", last.triangles_sole_piece},
@@ -430,6 +454,16 @@ void run(const RenderOptions& options) {
     std::size_t pieces = 0;
     for (const OutputSpec& output : outputs) pieces += output.glc->pieces.size();
     report["glc_pieces"] = pieces;  // GLCs of the camera (strips, reflector triangles)
+  }
+  if (lod_scene) {
+    const auto [fewest, most] = std::minmax_element(lod.triangles.begin(), lod.triangles.end());
+    report["depth_lod"] = {{"rebuilds", lod.rebuilds},
+                           {"update_ms", median(lod.update_ms)},
+                           {"choose_ms", median(lod.choose_ms)},
+                           {"rebuild_ms", lod.build_ms.empty() ? 0.0 : median(lod.build_ms)},
+                           {"triangles_median", median(lod.triangles)},
+                           {"triangles_min", *fewest},
+                           {"triangles_max", *most}};
   }
   if (reference) report["reference"] = *reference;
   if (options.json) {

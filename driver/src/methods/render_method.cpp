@@ -38,6 +38,12 @@ std::string joined_names() {
 
 }  // namespace
 
+void RenderMethod::replace_scene(const Scene& scene, const GpuScene& gpu_scene,
+                                 std::span<const OutputSpec> outputs,
+                                 const RenderSettings& settings) {
+  prepare(scene, gpu_scene, outputs, settings);
+}
+
 std::span<const std::string_view> render_method_names() { return kNames; }
 
 void check_render_method(std::string_view name) {

@@ -166,10 +166,14 @@ void FacetMethodBase::prepare(const Scene& scene, const GpuScene& gpu_scene,
   const std::size_t table_values = scene_list_triangles_ / kListBlockTriangles + 2;
   const std::size_t list_texels = list_entries() + 1 + (table_values + 3) / 4;
   const std::size_t args_words = kListArgsPatchDraws + 4 * std::size_t(material_count());
+  std::vector<FacetSet> kept = std::move(kept_facets_);
+  kept_facets_.clear();
   outputs_.clear();
-  for (const OutputSpec& output : outputs) {
-    OutputState state(FacetSet::build(output.warp, settings.facets, settings.z_near,
-                                      settings.merge_coplanar_facets));
+  for (std::size_t i = 0; i < outputs.size(); ++i) {
+    OutputState state(kept.size() == outputs.size()
+                          ? std::move(kept[i])
+                          : FacetSet::build(outputs[i].warp, settings.facets, settings.z_near,
+                                            settings.merge_coplanar_facets));
     const std::uint32_t no_stats[6] = {0, 0, 0, 0, 0, 0};
     state.stats = Buffer::create(sizeof no_stats, no_stats);
     state.list_on_gpu = gpu_lists && list_entries() > 0 && !state.facets.mesh.facets.empty();
@@ -187,6 +191,15 @@ void FacetMethodBase::prepare(const Scene& scene, const GpuScene& gpu_scene,
     outputs_.push_back(std::move(state));
   }
   have_view_ = false;
+}
+
+void FacetMethodBase::replace_scene(const Scene& scene, const GpuScene& gpu_scene,
+                                    std::span<const OutputSpec> outputs,
+                                    const RenderSettings& settings) {
+  kept_facets_.clear();
+  if (outputs.size() == outputs_.size())
+    for (OutputState& out : outputs_) kept_facets_.push_back(std::move(out.facets));
+  prepare(scene, gpu_scene, outputs, settings);
 }
 
 std::uint32_t FacetMethodBase::list_capacity(std::size_t i) const {

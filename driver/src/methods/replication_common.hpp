@@ -113,6 +113,9 @@ class FacetMethodBase : public RenderMethod {
  public:
   void prepare(const Scene& scene, const GpuScene& gpu_scene, std::span<const OutputSpec> outputs,
                const RenderSettings& settings) override;
+  // Prepares anew (the method's own prepare) with the facets of the outputs kept.
+  void replace_scene(const Scene& scene, const GpuScene& gpu_scene,
+                     std::span<const OutputSpec> outputs, const RenderSettings& settings) override;
 
  protected:
   struct OutputState {
@@ -225,6 +228,8 @@ class FacetMethodBase : public RenderMethod {
   bool have_view_ = false;
   std::vector<glm::mat4> last_T_world_object_;  // the transforms of the last update_view
   std::vector<BoundingSphere> eye_spheres_;     // the objects' spheres at the last update_view
+  // The outputs' facets while replace_scene prepares anew, taken by prepare in output order.
+  std::vector<FacetSet> kept_facets_;
 };
 
 // The pipelines that replicate into a pair buffer (facets, facets-gs). A frame queues every

@@ -413,9 +413,7 @@ std::vector<int> nodes_between(const std::vector<int>& nodes, int a, int b) {
   return inside;
 }
 
-}  // namespace
-
-DepthMesh depth_image_mesh(const DepthImage& image, const DepthMeshOptions& options) {
+void check_mesh_options(const DepthMeshOptions& options) {
   if (options.step < 1 || options.step > 64)
     throw InputError(
         "command line", OptionName{"step"},
@@ -425,36 +423,173 @@ DepthMesh depth_image_mesh(const DepthImage& image, const DepthMeshOptions& opti
     throw InputError("command line", OptionName{"lod"},
                      "expected a level-of-detail angle in [0, 1] rad; got " +
                          std::to_string(options.lod_angle_rad));
-  const bool lod = options.lod_angle_rad > 0;
-  if (lod && options.step != 1)
+  if (options.lod_angle_rad > 0 && options.step != 1)
     throw InputError("command line", OptionName{"lod"},
                      "expected grid step 1 with level of detail (it chooses the steps); got " +
                          std::to_string(options.step));
+}
+
+// The grid of one part: nodes x in [0, last_x] (x = W, the cylinder's seam, is pixel column 0
+// again), y in [0, last_y]; blocks of `block` nodes a side (one for the whole part without level
+// of detail).
+struct PartGrid {
+  int W = 0, H = 0, last_x = 0, last_y = 0, block = 1, blocks_x = 0, blocks_y = 0;
+  bool wraps = false;
+  PartGrid(const DepthImagePart& part, bool lod)
+      : W(part.size.x), H(part.size.y), wraps(part.base.wraps_horizontally()) {
+    last_x = wraps ? W : W - 1;
+    last_y = H - 1;
+    block = lod ? kDepthLodBlock : std::max(last_x, last_y) + 1;
+    blocks_x = last_x > 0 ? (last_x + block - 1) / block : 0;
+    blocks_y = last_y > 0 ? (last_y + block - 1) / block : 0;
+  }
+};
+
+constexpr int kLodLevels = std::countr_zero(unsigned(kDepthLodBlock)) + 1;
+
+}  // namespace
+
+DepthLodChooser::DepthLodChooser(const DepthImage& image, const DepthMeshOptions& options) {
+  check_mesh_options(options);
+  if (!(options.lod_angle_rad > 0))
+    throw InputError("command line", OptionName{"lod"},
+                     "expected a level-of-detail angle in (0, 1] rad; got " +
+                         std::to_string(options.lod_angle_rad));
+  image.validate();
+  T_image_world_ = glm::inverse(image.T_world_image);
+  angle_rad_ = options.lod_angle_rad;
+  const double tangent_sin = std::sin(glm::radians(options.edge_tangent_deg));
+  for (const DepthImagePart& part : image.parts) {
+    const PartGrid grid(part, true);
+    Part& out = parts_.emplace_back();
+    out.blocks_x = grid.blocks_x;
+    out.blocks_y = grid.blocks_y;
+    out.wraps = grid.wraps;
+    out.p_image.assign(part.distance_m.size(), glm::dvec3(0.0));
+    const auto seen = [&](int i, int j) {
+      return !std::isinf(part.distance_m[part.pixel_index(i, j)]);
+    };
+    for (int j = 0; j < grid.H; ++j)
+      for (int i = 0; i < grid.W; ++i)
+        if (seen(i, j))
+          out.p_image[part.pixel_index(i, j)] =
+              double(part.distance_m[part.pixel_index(i, j)]) * part.v_image(i, j);
+    if (grid.blocks_x <= 0 || grid.blocks_y <= 0) continue;
+    for (int j = 0; j < grid.H; ++j) {
+      for (int i = 0; i < grid.W; ++i) {
+        if (!seen(i, j)) continue;
+        const std::size_t k = part.pixel_index(i, j);
+        const glm::dvec3 n(part.normal[k]);
+        const int bx = std::min(i / grid.block, grid.blocks_x - 1),
+                  by = std::min(j / grid.block, grid.blocks_y - 1);
+        for (const glm::ivec2 next : {glm::ivec2(i + 1, j), glm::ivec2(i, j + 1)}) {
+          int ni = next.x;
+          if (ni == grid.W) {
+            if (!grid.wraps) continue;
+            ni = 0;
+          }
+          if (next.y >= grid.H || !seen(ni, next.y)) continue;
+          const std::size_t m = part.pixel_index(ni, next.y);
+          if (!joins_one_surface(out.p_image[k], n, out.p_image[m], glm::dvec3(part.normal[m]),
+                                 options.edge_footprints, tangent_sin))
+            continue;
+          out.pairs.push_back(
+              {std::uint32_t(k), std::uint32_t(m), std::uint32_t(by * grid.blocks_x + bx)});
+        }
+      }
+    }
+  }
+}
+
+DepthLodLevels DepthLodChooser::levels(const glm::dvec3& eye_world) const {
+  const glm::dvec3 eye(T_image_world_ * glm::dvec4(eye_world, 1.0));
+  DepthLodLevels levels;
+  for (const Part& part : parts_) {
+    const int blocks_x = part.blocks_x, blocks_y = part.blocks_y;
+    std::vector<std::uint8_t>& level = levels.emplace_back(
+        std::size_t(std::max(blocks_x, 0)) * std::size_t(std::max(blocks_y, 0)), std::uint8_t(0));
+    // The largest angle, seen from the eye, between neighbouring pixels that join one surface.
+    std::vector<double> angle(level.size(), 0.0);
+    for (const Part::Pair& pair : part.pairs) {
+      const glm::dvec3 a = part.p_image[pair.a] - eye, b = part.p_image[pair.b] - eye;
+      double& worst = angle[pair.block];
+      worst = std::max(worst, std::atan2(glm::length(glm::cross(a, b)), glm::dot(a, b)));
+    }
+    for (std::size_t b = 0; b < level.size(); ++b) {
+      int l = 0;
+      while (l + 1 < kLodLevels && angle[b] * double(1 << (l + 1)) <= angle_rad_) ++l;
+      level[b] = std::uint8_t(l);
+    }
+    // Neighbours differ by one level at most: lower the coarser until none is two above.
+    const auto level_at = [&](int bx, int by) -> std::uint8_t& {
+      return level[std::size_t(by) * std::size_t(blocks_x) + std::size_t(bx)];
+    };
+    for (bool changed = true; changed;) {
+      changed = false;
+      for (int by = 0; by < blocks_y; ++by)
+        for (int bx = 0; bx < blocks_x; ++bx) {
+          std::uint8_t& l = level_at(bx, by);
+          const auto limit = [&](int nx, int ny) {
+            if (nx < 0 || nx >= blocks_x) {
+              if (!part.wraps) return;
+              nx = (nx + blocks_x) % blocks_x;
+            }
+            if (ny < 0 || ny >= blocks_y) return;
+            if (l > level_at(nx, ny) + 1) {
+              l = std::uint8_t(level_at(nx, ny) + 1);
+              changed = true;
+            }
+          };
+          limit(bx - 1, by);
+          limit(bx + 1, by);
+          limit(bx, by - 1);
+          limit(bx, by + 1);
+        }
+    }
+  }
+  return levels;
+}
+
+DepthMesh depth_image_mesh(const DepthImage& image, const DepthMeshOptions& options) {
+  check_mesh_options(options);
+  const bool lod = options.lod_angle_rad > 0;
   image.validate();
   DepthMesh mesh;
   Scene& scene = mesh.scene;
   scene.name = "depth image";
   const double tangent_sin = std::sin(glm::radians(options.edge_tangent_deg));
-  constexpr int kLevels = std::countr_zero(unsigned(kDepthLodBlock)) + 1;
-  if (lod) mesh.lod_blocks_by_level.assign(kLevels, 0);
-  const glm::dvec3 lod_eye =
-      lod && options.lod_eye_world
-          ? glm::dvec3(glm::inverse(image.T_world_image) * glm::dvec4(*options.lod_eye_world, 1.0))
-          : glm::dvec3(0.0);
+  DepthLodLevels levels;
+  if (lod) {
+    mesh.lod_blocks_by_level.assign(kLodLevels, 0);
+    if (options.lod_levels) {
+      levels = *options.lod_levels;
+      bool fits = levels.size() == image.parts.size();
+      for (std::size_t p = 0; fits && p < levels.size(); ++p) {
+        const PartGrid grid(image.parts[p], true);
+        fits = levels[p].size() ==
+               std::size_t(std::max(grid.blocks_x, 0)) * std::size_t(std::max(grid.blocks_y, 0));
+        for (std::uint8_t l : levels[p]) fits = fits && l < kLodLevels;
+      }
+      if (!fits)
+        throw InputError("command line", OptionName{"lod"},
+                         "expected levels below " + std::to_string(kLodLevels) +
+                             " for every block of every part of the depth image");
+    } else {
+      levels = DepthLodChooser(image, options)
+                   .levels(options.lod_eye_world ? *options.lod_eye_world
+                                                 : glm::dvec3(image.T_world_image[3]));
+    }
+  }
   // Per vertex of the scene (all parts): its point and normal in the image frame, its source ID.
   std::vector<glm::dvec3> p_vertex, n_vertex;
   std::vector<std::uint32_t> id_vertex;
-  for (const DepthImagePart& part : image.parts) {
-    const bool wraps = part.base.wraps_horizontally();
-    const int W = part.size.x, H = part.size.y;
-    // Grid nodes: x in [0, last_x] (x = W, the cylinder's seam, is pixel column 0 again),
-    // y in [0, H - 1].
-    const int last_x = wraps ? W : W - 1, last_y = H - 1;
+  for (std::size_t part_index = 0; part_index < image.parts.size(); ++part_index) {
+    const DepthImagePart& part = image.parts[part_index];
+    const PartGrid grid(part, lod);
+    const bool wraps = grid.wraps;
+    const int W = grid.W, H = grid.H, last_x = grid.last_x, last_y = grid.last_y;
+    const int block = grid.block, blocks_x = grid.blocks_x, blocks_y = grid.blocks_y;
     const auto pixel_x = [&](int x) { return x == W ? 0 : x; };
-    // Blocks: one for the whole part without level of detail.
-    const int block = lod ? kDepthLodBlock : std::max(last_x, last_y) + 1;
-    const int blocks_x = last_x > 0 ? (last_x + block - 1) / block : 0;
-    const int blocks_y = last_y > 0 ? (last_y + block - 1) / block : 0;
     const auto block_from_x = [&](int bx) { return bx * block; };
     const auto block_to_x = [&](int bx) { return std::min((bx + 1) * block, last_x); };
     const auto block_from_y = [&](int by) { return by * block; };
@@ -484,67 +619,11 @@ DepthMesh depth_image_mesh(const DepthImage& image, const DepthMeshOptions& opti
     };
 
     // Each block's level (step 2^level).
-    std::vector<int> level(std::size_t(blocks_x) * std::size_t(blocks_y), 0);
-    const auto level_at = [&](int bx, int by) -> int& {
-      return level[std::size_t(by) * std::size_t(blocks_x) + std::size_t(bx)];
+    const auto level_at = [&](int bx, int by) -> int {
+      return levels[part_index][std::size_t(by) * std::size_t(blocks_x) + std::size_t(bx)];
     };
-    if (lod) {
-      // The largest angle, seen from the eye, between neighbouring pixels that join one surface.
-      std::vector<double> angle(level.size(), 0.0);
-      const auto seen = [&](int i, int j) {
-        return !std::isinf(part.distance_m[part.pixel_index(i, j)]);
-      };
-      for (int j = 0; j < H; ++j) {
-        for (int i = 0; i < W; ++i) {
-          if (!seen(i, j)) continue;
-          const glm::dvec3 p = point(i, j), n(part.normal[part.pixel_index(i, j)]);
-          const int bx = std::min(i / block, blocks_x - 1), by = std::min(j / block, blocks_y - 1);
-          if (bx < 0 || by < 0) continue;
-          for (const glm::ivec2 next : {glm::ivec2(i + 1, j), glm::ivec2(i, j + 1)}) {
-            int ni = next.x;
-            if (ni == W) {
-              if (!wraps) continue;
-              ni = 0;
-            }
-            if (next.y >= H || !seen(ni, next.y)) continue;
-            const glm::dvec3 q = point(ni, next.y), m(part.normal[part.pixel_index(ni, next.y)]);
-            if (!joins_one_surface(p, n, q, m, options.edge_footprints, tangent_sin)) continue;
-            const glm::dvec3 a = p - lod_eye, b = q - lod_eye;
-            double& worst = angle[std::size_t(by) * std::size_t(blocks_x) + std::size_t(bx)];
-            worst = std::max(worst, std::atan2(glm::length(glm::cross(a, b)), glm::dot(a, b)));
-          }
-        }
-      }
-      for (std::size_t b = 0; b < level.size(); ++b) {
-        int l = 0;
-        while (l + 1 < kLevels && angle[b] * double(1 << (l + 1)) <= options.lod_angle_rad) ++l;
-        level[b] = l;
-      }
-      // Neighbours differ by one level at most: lower the coarser until none is two above.
-      for (bool changed = true; changed;) {
-        changed = false;
-        for (int by = 0; by < blocks_y; ++by)
-          for (int bx = 0; bx < blocks_x; ++bx) {
-            int& l = level_at(bx, by);
-            const auto limit = [&](int nx, int ny) {
-              if (nx < 0 || nx >= blocks_x) {
-                if (!wraps) return;
-                nx = (nx + blocks_x) % blocks_x;
-              }
-              if (ny < 0 || ny >= blocks_y) return;
-              if (l > level_at(nx, ny) + 1) {
-                l = level_at(nx, ny) + 1;
-                changed = true;
-              }
-            };
-            limit(bx - 1, by);
-            limit(bx + 1, by);
-            limit(bx, by - 1);
-            limit(bx, by + 1);
-          }
-      }
-      for (int l : level) ++mesh.lod_blocks_by_level[std::size_t(l)];
-    }
+    if (lod)
+      for (std::uint8_t l : levels[part_index]) ++mesh.lod_blocks_by_level[std::size_t(l)];
     // A block's nodes along x and y at its step. Without level of detail the cylinder keeps its
     // last column before the seam (every step-th pixel and the last, then the seam).
     const auto xs_of = [&](int bx, int by) {

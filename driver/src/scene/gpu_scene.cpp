@@ -49,10 +49,12 @@ float resolve_anisotropy(float requested) {
   return std::clamp(requested, 1.0f, std::max(1.0f, max_anisotropy));
 }
 
-GpuScene upload_scene(const Scene& scene, float max_anisotropy) {
+namespace {
+
+// The vertex and index buffers, their buffer textures and vertex array, and the object table.
+void upload_geometry(GpuScene& gpu, const Scene& scene) {
   FACET_ASSERT(scene.normals.size() == scene.positions.size());
   FACET_ASSERT(scene.uvs.size() == scene.positions.size());
-  GpuScene gpu;
   gpu.positions = Buffer::create_from(scene.positions);
   gpu.normals = Buffer::create_from(scene.normals);
   gpu.uvs = Buffer::create_from(scene.uvs);
@@ -60,6 +62,43 @@ GpuScene upload_scene(const Scene& scene, float max_anisotropy) {
   gpu.normal_texels = Texture::create_buffer_view(gpu.normals, GL_RGB32F, 3 * sizeof(float));
   gpu.uv_texels = Texture::create_buffer_view(gpu.uvs, GL_RG32F, 2 * sizeof(float));
   gpu.indices = Buffer::create_from(scene.indices);
+  std::vector<GpuObject> objects;
+  for (const auto& o : scene.objects) {
+    GpuObject g{};
+    std::memcpy(g.T_world_object, glm::value_ptr(o.T_world_object), sizeof g.T_world_object);
+    std::memcpy(g.bounds_min, glm::value_ptr(o.bounds_world.p_min), 3 * sizeof(float));
+    std::memcpy(g.bounds_max, glm::value_ptr(o.bounds_world.p_max), 3 * sizeof(float));
+    g.first_primitive = o.first_primitive;
+    g.primitive_count = o.primitive_count;
+    objects.push_back(g);
+  }
+  gpu.objects = Buffer::create_from(objects);
+
+  gpu.vertex_array = VertexArray::create();
+  const GLuint vao = gpu.vertex_array.id();
+  glVertexArrayVertexBuffer(vao, 0, gpu.positions.id(), 0, 3 * sizeof(float));
+  glVertexArrayVertexBuffer(vao, 1, gpu.normals.id(), 0, 3 * sizeof(float));
+  glVertexArrayVertexBuffer(vao, 2, gpu.uvs.id(), 0, 2 * sizeof(float));
+  const GLint sizes[3] = {3, 3, 2};
+  for (GLuint a = 0; a < 3; ++a) {
+    glEnableVertexArrayAttrib(vao, a);
+    glVertexArrayAttribFormat(vao, a, sizes[a], GL_FLOAT, GL_FALSE, 0);
+    glVertexArrayAttribBinding(vao, a, a);
+  }
+  glVertexArrayElementBuffer(vao, gpu.indices.id());
+}
+
+}  // namespace
+
+void replace_geometry(GpuScene& gpu, const Scene& scene) {
+  FACET_ASSERT(scene.materials.size() == gpu.material_texture.size());
+  FACET_ASSERT(scene.images.size() == gpu.textures.size());
+  upload_geometry(gpu, scene);
+}
+
+GpuScene upload_scene(const Scene& scene, float max_anisotropy) {
+  GpuScene gpu;
+  upload_geometry(gpu, scene);
 
   std::vector<GpuMaterial> materials;
   for (const auto& m : scene.materials) {
@@ -87,31 +126,6 @@ GpuScene upload_scene(const Scene& scene, float max_anisotropy) {
   glBindBufferRange(GL_UNIFORM_BUFFER, material_shading_binding, gpu.material_shading.id(),
                     static_cast<GLintptr>(scene.materials.size() * gpu.material_shading_stride),
                     kBlockBytes);
-
-  std::vector<GpuObject> objects;
-  for (const auto& o : scene.objects) {
-    GpuObject g{};
-    std::memcpy(g.T_world_object, glm::value_ptr(o.T_world_object), sizeof g.T_world_object);
-    std::memcpy(g.bounds_min, glm::value_ptr(o.bounds_world.p_min), 3 * sizeof(float));
-    std::memcpy(g.bounds_max, glm::value_ptr(o.bounds_world.p_max), 3 * sizeof(float));
-    g.first_primitive = o.first_primitive;
-    g.primitive_count = o.primitive_count;
-    objects.push_back(g);
-  }
-  gpu.objects = Buffer::create_from(objects);
-
-  gpu.vertex_array = VertexArray::create();
-  const GLuint vao = gpu.vertex_array.id();
-  glVertexArrayVertexBuffer(vao, 0, gpu.positions.id(), 0, 3 * sizeof(float));
-  glVertexArrayVertexBuffer(vao, 1, gpu.normals.id(), 0, 3 * sizeof(float));
-  glVertexArrayVertexBuffer(vao, 2, gpu.uvs.id(), 0, 2 * sizeof(float));
-  const GLint sizes[3] = {3, 3, 2};
-  for (GLuint a = 0; a < 3; ++a) {
-    glEnableVertexArrayAttrib(vao, a);
-    glVertexArrayAttribFormat(vao, a, sizes[a], GL_FLOAT, GL_FALSE, 0);
-    glVertexArrayAttribBinding(vao, a, a);
-  }
-  glVertexArrayElementBuffer(vao, gpu.indices.id());
 
   gpu.max_anisotropy = resolve_anisotropy(max_anisotropy);
   for (const auto& image : scene.images) {

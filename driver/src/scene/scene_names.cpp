@@ -1,6 +1,7 @@
 #include "facet/driver/scene_names.hpp"
 
 #include <charconv>
+#include <chrono>
 #include <cmath>
 #include <glm/gtc/matrix_transform.hpp>
 
@@ -178,6 +179,75 @@ Scene load_scene(const SceneName& name, std::vector<std::uint32_t>* source_ids,
                 : merge_scenes(std::move(scene), mesh.scene);
   }
   return scene;
+}
+
+namespace {
+
+double ms_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+      .count();
+}
+
+}  // namespace
+
+ViewDependentScene::ViewDependentScene(const SceneName& name, const glm::dvec3& eye_world)
+    : name_(name), polygons_(load_polygons(name)) {
+  for (const DepthImageName& file : name.depth_images) {
+    Image& image = images_.emplace_back();
+    image.image = read_depth_image(file.file);
+    if (file.lod_angle_rad > 0) {
+      image.chooser.emplace(image.image, DepthMeshOptions{.lod_angle_rad = file.lod_angle_rad});
+      image.levels = image.chooser->levels(eye_world);
+      image.mesh = depth_image_mesh(
+          image.image, {.lod_angle_rad = file.lod_angle_rad, .lod_levels = image.levels});
+    } else {
+      image.mesh = depth_image_mesh(image.image, {.step = file.step});
+    }
+    image.mesh.scene.name = file.file.filename().string();
+  }
+  build();
+}
+
+void ViewDependentScene::build() {
+  source_ids_.resize(polygons_.triangle_count() + 1);
+  for (std::size_t id = 0; id < source_ids_.size(); ++id) source_ids_[id] = std::uint32_t(id);
+  scene_ = name_.kind == SceneName::Kind::depth_images ? Scene{} : polygons_;
+  for (std::size_t k = 0; k < images_.size(); ++k) {
+    const DepthMesh& mesh = images_[k].mesh;
+    source_ids_.insert(source_ids_.end(), mesh.source_id.begin(), mesh.source_id.end());
+    scene_ = (k == 0 && name_.kind == SceneName::Kind::depth_images)
+                 ? mesh.scene
+                 : merge_scenes(std::move(scene_), mesh.scene);
+  }
+}
+
+bool ViewDependentScene::update(const glm::dvec3& eye_world) {
+  const auto start = std::chrono::steady_clock::now();
+  std::vector<std::optional<DepthLodLevels>> changed(images_.size());
+  bool any = false;
+  for (std::size_t k = 0; k < images_.size(); ++k) {
+    if (!images_[k].chooser) continue;
+    DepthLodLevels levels = images_[k].chooser->levels(eye_world);
+    if (levels == images_[k].levels) continue;
+    changed[k] = std::move(levels);
+    any = true;
+  }
+  choose_ms_ = ms_since(start);
+  build_ms_ = 0;
+  if (!any) return false;
+  const auto build_start = std::chrono::steady_clock::now();
+  for (std::size_t k = 0; k < images_.size(); ++k) {
+    if (!changed[k]) continue;
+    Image& image = images_[k];
+    image.levels = std::move(*changed[k]);
+    image.mesh = depth_image_mesh(
+        image.image,
+        {.lod_angle_rad = name_.depth_images[k].lod_angle_rad, .lod_levels = image.levels});
+    image.mesh.scene.name = name_.depth_images[k].file.filename().string();
+  }
+  build();
+  build_ms_ = ms_since(build_start);
+  return true;
 }
 
 FrameViews::FrameViews(const SceneView& view, double city_step_s, bool static_view)

@@ -121,12 +121,48 @@ struct DepthMeshOptions {
   // 1 at the least: the image holds no more), moving away shrinks it.
   double lod_angle_rad = 0;
   std::optional<glm::dvec3> lod_eye_world = std::nullopt;
+  // With level of detail: the levels (DepthLodChooser::levels) to build, instead of choosing them
+  // from lod_eye_world; InputError naming "lod" when their counts do not fit the image's blocks.
+  std::optional<std::vector<std::vector<std::uint8_t>>> lod_levels = std::nullopt;
 };
 // The block side of DepthMeshOptions::lod_angle_rad, in pixels, and the coarsest step.
 inline constexpr int kDepthLodBlock = 16;
 // The angle `depth:FILE.exr@lod` takes (scene_names.hpp): 0.01 rad, about 1.6 pixels of the
 // 512² 180° dome.
 inline constexpr double kDepthLodDefaultRad = 0.01;
+
+// The level of every level-of-detail block (its step is 2^level) of every part: levels[p][by ·
+// blocks_x + bx], blocks_x = ceil(last_x / kDepthLodBlock) and blocks_y = ceil((H - 1) /
+// kDepthLodBlock) with last_x = W at a cylinder (its seam) and W - 1 otherwise.
+using DepthLodLevels = std::vector<std::vector<std::uint8_t>>;
+
+// The level choice of DepthMeshOptions::lod_angle_rad for any eye, keeping what does not depend
+// on the eye: every seen pixel's point in the image frame and which neighbouring pixels join one
+// surface. levels() for an eye equals what depth_image_mesh chooses with lod_eye_world = that eye,
+// so a view that moves can rebuild the mesh (DepthMeshOptions::lod_levels) only when they change.
+class DepthLodChooser {
+ public:
+  // InputError as depth_image_mesh's, and naming "lod" for an angle that is not in (0, 1] rad.
+  DepthLodChooser(const DepthImage& image, const DepthMeshOptions& options);
+  // The levels seen from eye_world (world frame, metres).
+  DepthLodLevels levels(const glm::dvec3& eye_world) const;
+
+ private:
+  struct Part {
+    int blocks_x = 0, blocks_y = 0;
+    bool wraps = false;
+    std::vector<glm::dvec3> p_image;  // per pixel, row-major; unused where nothing is seen
+    // Neighbouring pixels (right, below; across the seam) that join one surface, and the block
+    // their first pixel lies in.
+    struct Pair {
+      std::uint32_t a, b, block;
+    };
+    std::vector<Pair> pairs;
+  };
+  glm::dmat4 T_image_world_{1.0};
+  double angle_rad_ = 0;
+  std::vector<Part> parts_;
+};
 
 // The source of every triangle of a depth image's mesh.
 struct DepthMesh {

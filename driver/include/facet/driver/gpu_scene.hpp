@@ -98,5 +98,9 @@ bool is_software_renderer();
 // Uploads the scene. Needs a current GL context; the GpuScene must be destroyed while a context
 // of the same share group is current.
 GpuScene upload_scene(const Scene& scene, float max_anisotropy = kAutomaticAnisotropy);
+// Replaces the vertex and index buffers (new buffer objects: bind them anew) and the object
+// table of `gpu` with `scene`'s, which must have the materials and images of the scene uploaded
+// (a view-dependent mesh rebuilt with other triangles); keeps the textures and material tables.
+void replace_geometry(GpuScene& gpu, const Scene& scene);
 
 }  // namespace facet::driver

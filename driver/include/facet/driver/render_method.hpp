@@ -183,6 +183,16 @@ class RenderMethod {
   // by changing both between frames (Session does, from FrameState::object_poses).
   virtual RenderStats render(const glm::dmat4& T_eye_world, std::span<OutputTarget> targets,
                              class GpuTimer* timer = nullptr) = 0;
+
+  // The scene's triangles changed between frames (a view-dependent mesh rebuilt: the same
+  // objects, materials and images, other vertices and indices): `scene` and `gpu_scene` (its
+  // buffers replaced by replace_geometry) take the place of those given to prepare, with the
+  // outputs and settings given there. What depends on the scene is rebuilt and the next frame runs
+  // every pass (the facet methods' culling, lists and coverage, as for a moving scene); the facet
+  // methods keep their facets, which depend only on the outputs. The default prepares anew.
+  // Needs a current context.
+  virtual void replace_scene(const Scene& scene, const GpuScene& gpu_scene,
+                             std::span<const OutputSpec> outputs, const RenderSettings& settings);
 };
 
 // Every method name make_render_method accepts, in the order `facet bench` lists them.

@@ -28,6 +28,7 @@
 #include <vector>
 
 #include "facet/driver/city.hpp"
+#include "facet/driver/depth_image.hpp"
 #include "facet/driver/scene.hpp"
 #include "facet/driver/scene_view.hpp"
 
@@ -82,6 +83,41 @@ Scene load_scene(const SceneName& name, std::vector<std::uint32_t>* source_ids =
 // Whether any depth image of the name takes level of detail (@lod).
 bool uses_depth_lod(const SceneName& name);
 inline Scene load_scene(std::string_view text) { return load_scene(parse_scene_name(text)); }
+
+// A scene name whose depth images take level of detail (@lod), rebuilt as the eye moves. The
+// files are read, the polygon scene and the meshes of images without @lod built once; each @lod
+// image keeps a DepthLodChooser, and the scene is rebuilt only when some image's levels change:
+// then it is load_scene's result for the eye, with the same objects, materials and images and
+// other vertices and indices (for replace_geometry and RenderMethod::replace_scene).
+class ViewDependentScene {
+ public:
+  // The scene as seen from eye_world (world frame, metres). load_scene's errors.
+  ViewDependentScene(const SceneName& name, const glm::dvec3& eye_world);
+  // Chooses every @lod image's levels as seen from eye_world; rebuilds the scene and returns true
+  // when any differ from the scene's.
+  bool update(const glm::dvec3& eye_world);
+  const Scene& scene() const { return scene_; }
+  // load_scene's source_ids table of the current scene.
+  const std::vector<std::uint32_t>& source_ids() const { return source_ids_; }
+  // The last update's wall-clock milliseconds: choosing the levels, and rebuilding (0 without).
+  double choose_ms() const { return choose_ms_; }
+  double build_ms() const { return build_ms_; }
+
+ private:
+  void build();
+  SceneName name_;
+  Scene polygons_;
+  struct Image {
+    DepthImage image;
+    std::optional<DepthLodChooser> chooser;  // @lod only
+    DepthLodLevels levels;                   // @lod only: the scene's
+    DepthMesh mesh;                          // the mesh of the scene
+  };
+  std::vector<Image> images_;
+  Scene scene_;
+  std::vector<std::uint32_t> source_ids_;
+  double choose_ms_ = 0, build_ms_ = 0;
+};
 
 // The eye pose of frame k of `facet render` and `facet bench`, turning about world up (y) by 360°
 // every kTurnFrames frames where no camera path drives it. A static view keeps frame 0's pose on
