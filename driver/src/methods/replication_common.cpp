@@ -167,7 +167,9 @@ void FacetMethodBase::prepare(const Scene& scene, const GpuScene& gpu_scene,
   const std::size_t list_texels = list_entries() + 1 + (table_values + 3) / 4;
   const std::size_t args_words = kListArgsPatchDraws + 4 * std::size_t(material_count());
   std::vector<FacetSet> kept = std::move(kept_facets_);
+  const std::vector<std::uint32_t> kept_pairs = std::move(kept_pair_capacities_);
   kept_facets_.clear();
+  kept_pair_capacities_.clear();
   outputs_.clear();
   for (std::size_t i = 0; i < outputs.size(); ++i) {
     OutputState state(kept.size() == outputs.size()
@@ -188,6 +190,7 @@ void FacetMethodBase::prepare(const Scene& scene, const GpuScene& gpu_scene,
       state.list_offsets =
           Buffer::create((std::size_t(list_entries()) + 1) * sizeof(std::uint32_t));
     }
+    if (kept_pairs.size() == outputs.size()) state.pair_capacity = kept_pairs[i];
     outputs_.push_back(std::move(state));
   }
   have_view_ = false;
@@ -197,8 +200,12 @@ void FacetMethodBase::replace_scene(const Scene& scene, const GpuScene& gpu_scen
                                     std::span<const OutputSpec> outputs,
                                     const RenderSettings& settings) {
   kept_facets_.clear();
+  kept_pair_capacities_.clear();
   if (outputs.size() == outputs_.size())
-    for (OutputState& out : outputs_) kept_facets_.push_back(std::move(out.facets));
+    for (OutputState& out : outputs_) {
+      kept_facets_.push_back(std::move(out.facets));
+      kept_pair_capacities_.push_back(out.pair_capacity);
+    }
   prepare(scene, gpu_scene, outputs, settings);
 }
 

@@ -228,8 +228,11 @@ class FacetMethodBase : public RenderMethod {
   bool have_view_ = false;
   std::vector<glm::mat4> last_T_world_object_;  // the transforms of the last update_view
   std::vector<BoundingSphere> eye_spheres_;     // the objects' spheres at the last update_view
-  // The outputs' facets while replace_scene prepares anew, taken by prepare in output order.
+  // The outputs' facets and pair capacities while replace_scene prepares anew, taken by prepare
+  // in output order (a rebuilt scene replicates about as much as the one it replaces, so its
+  // first frame starts from the last frame's room rather than overflowing and replicating twice).
   std::vector<FacetSet> kept_facets_;
+  std::vector<std::uint32_t> kept_pair_capacities_;
 };
 
 // The pipelines that replicate into a pair buffer (facets, facets-gs). A frame queues every
