@@ -645,6 +645,22 @@ DepthMesh depth_image_mesh(const DepthImage& image, const DepthMeshOptions& opti
     // A triangle of grid nodes when all corners are seen and every edge joins one surface; wound
     // counter-clockwise seen from the eye.
     using Node = glm::ivec2;
+    // joins_one_surface (symmetric) of the cell's edges, each judged once: the four triangles a
+    // plain cell tries share its four sides and two diagonals. Cleared for every cell.
+    struct JudgedEdge {
+      std::size_t u, w;
+      bool joins;
+    };
+    std::vector<JudgedEdge> judged;
+    const auto edge_joins = [&](std::size_t u, std::size_t w) {
+      if (u > w) std::swap(u, w);
+      for (const JudgedEdge& edge : judged)
+        if (edge.u == u && edge.w == w) return edge.joins;
+      const bool joins = joins_one_surface(p_vertex[u], n_vertex[u], p_vertex[w], n_vertex[w],
+                                           options.edge_footprints, tangent_sin);
+      judged.push_back({u, w, joins});
+      return joins;
+    };
     const auto triangle = [&](Node na, Node nb, Node nc, std::array<std::uint32_t, 3>& out,
                               std::uint32_t& id) {
       const std::int64_t a = vertex_at(na.x, na.y), b = vertex_at(nb.x, nb.y),
@@ -653,9 +669,7 @@ DepthMesh depth_image_mesh(const DepthImage& image, const DepthMeshOptions& opti
       const std::array<std::size_t, 3> v{std::size_t(a), std::size_t(b), std::size_t(c)};
       for (int e = 0; e < 3; ++e) {
         const std::size_t u = v[std::size_t(e)], w = v[std::size_t((e + 1) % 3)];
-        if (!joins_one_surface(p_vertex[u], n_vertex[u], p_vertex[w], n_vertex[w],
-                               options.edge_footprints, tangent_sin))
-          return false;
+        if (!edge_joins(u, w)) return false;
       }
       const glm::dvec3 normal =
           glm::cross(p_vertex[v[1]] - p_vertex[v[0]], p_vertex[v[2]] - p_vertex[v[0]]);
@@ -705,6 +719,7 @@ DepthMesh depth_image_mesh(const DepthImage& image, const DepthMeshOptions& opti
                 left && gi == 0 ? nodes_between(left_ys, y0, y1) : std::vector<int>{};
             const std::vector<int> on_right =
                 right && gi + 2 == xs.size() ? nodes_between(right_ys, y0, y1) : std::vector<int>{};
+            judged.clear();
             std::array<std::uint32_t, 3> tri{};
             std::uint32_t id = 0;
             if (on_top.empty() && on_bottom.empty() && on_left.empty() && on_right.empty()) {

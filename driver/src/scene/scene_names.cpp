@@ -213,11 +213,14 @@ void ViewDependentScene::build() {
   for (std::size_t id = 0; id < source_ids_.size(); ++id) source_ids_[id] = std::uint32_t(id);
   scene_ = name_.kind == SceneName::Kind::depth_images ? Scene{} : polygons_;
   for (std::size_t k = 0; k < images_.size(); ++k) {
-    const DepthMesh& mesh = images_[k].mesh;
+    DepthMesh& mesh = images_[k].mesh;
     source_ids_.insert(source_ids_.end(), mesh.source_id.begin(), mesh.source_id.end());
-    scene_ = (k == 0 && name_.kind == SceneName::Kind::depth_images)
-                 ? mesh.scene
-                 : merge_scenes(std::move(scene_), mesh.scene);
+    if (k > 0 || name_.kind != SceneName::Kind::depth_images)
+      scene_ = merge_scenes(std::move(scene_), mesh.scene);
+    else if (images_.size() == 1)
+      scene_ = std::move(mesh.scene);  // a lone image's mesh is built anew before every build()
+    else
+      scene_ = mesh.scene;
   }
 }
 
