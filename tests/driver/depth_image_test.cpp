@@ -25,6 +25,7 @@
 #include "facet/driver/render_method.hpp"
 #include "facet/driver/scene_names.hpp"
 #include "facet/driver/scene_view.hpp"
+#include "facet/driver/session.hpp"
 #include "facet/projection/errors.hpp"
 #include "facet/projection/warp_inverse.hpp"
 #include "gl_test_context.hpp"
@@ -572,6 +573,38 @@ TEST(DepthImage, LodSceneRebuiltAsTheEyeMovesLeavesNoHoleOnTheDome) {
     EXPECT_FALSE(frames[0].rebuilt);
     EXPECT_GE(rebuilds, 1u) << method;
   }
+}
+
+// `facet run`'s Session with a view-dependent scene: each frame's eye chooses the levels, the
+// session's scene is the LOD mesh for that eye, and the dome shows no hole.
+TEST(DepthImage, SessionRebuildsTheLodSceneForEachFramesEye) {
+  test::shared_context();
+  const Scene sphere = background_sphere(64, 32, 20.0f);
+  DepthImageRequest request;
+  request.size = {128, 64};
+  const DepthImage image = render_depth_image(sphere, request);
+  const facet::test::TempFolder scratch("facet_depth_image_session");
+  const fs::path file = scratch.path() / "sphere.exr";
+  write_depth_image(file, image);
+  const SceneName name = parse_scene_name("depth:" + file.string() + "@lod=0.1");
+  const glm::ivec2 size{128, 128};
+  Session session(load_session_display("builtin:dome180", size), load_scene(name));
+  session.set_view_dependent_scene(std::make_unique<ViewDependentScene>(name, glm::dvec3(0.0)));
+  std::size_t rebuilds = 0;
+  for (int k = 0; k < 4; ++k) {
+    FrameState state;
+    state.frame = std::uint64_t(k);
+    const glm::dvec3 eye(2.5 * k, 0.0, 0.0);
+    state.T_world_eye = glm::translate(glm::dmat4(1.0), eye);
+    const FrameStats stats = session.render(state, true);
+    rebuilds += stats.scene_rebuilt;
+    EXPECT_EQ(session.scene().indices,
+              depth_image_mesh(image, {.lod_angle_rad = 0.1, .lod_eye_world = eye}).scene.indices)
+        << "frame " << k;
+    const DomeHoles count = dome_holes(session.targets()[0].read_ids(), size);
+    EXPECT_EQ(count.holes, 0u) << "frame " << k << ", of " << count.inside;
+  }
+  EXPECT_GE(rebuilds, 1u);
 }
 
 // The DPCI of the city, drawn forward onto the dome, against the polygon city's reference IDs

@@ -192,6 +192,10 @@ void run(const RunOptions& options) {
     std::cerr << "facet run: no display server (DISPLAY is not set): running headless\n";
   auto context = driver::create_headless_context();
   driver::Session session(display, std::move(scene));
+  // Depth images with @lod take their levels as seen from every frame's eye (headless runs).
+  if (driver::uses_depth_lod(scene_name))
+    session.set_view_dependent_scene(
+        std::make_unique<driver::ViewDependentScene>(scene_name, glm::dvec3(path(0.0)[3])));
   session.set_pattern(pattern);
   driver::HeadlessRunOptions headless_options;
   headless_options.frames = frames.value_or(10);

@@ -501,12 +501,37 @@ void Session::set_pattern(std::optional<TestPattern> pattern) {
   }
 }
 
+void Session::set_view_dependent_scene(std::unique_ptr<ViewDependentScene> scene) {
+  view_dependent_ = std::move(scene);
+  if (view_dependent_) replace_scene(view_dependent_->scene());
+}
+
+void Session::replace_scene(const Scene& scene) {
+  scene_ = scene;
+  rest_poses_.clear();
+  for (const Object& object : scene_.objects)
+    rest_poses_.push_back({object.T_world_object, object.bounds_world, std::nullopt});
+  replace_geometry(gpu_scene_, scene_);
+  for (std::size_t i = 0; i < methods_.size(); ++i) {
+    const SessionOutput& output = display_.outputs[i];
+    RenderSettings settings = display_.settings;  // as the constructor prepared it
+    settings.facets.origin.output = output.spec.name;
+    methods_[i]->replace_scene(scene_, gpu_scene_, std::span(&output.spec, 1), settings);
+  }
+}
+
 FrameStats Session::render(const FrameState& state, bool finish) {
   const auto start = std::chrono::steady_clock::now();
+  bool rebuilt = false;
+  if (view_dependent_ && view_dependent_->update(glm::dvec3(state.T_world_eye[3]))) {
+    replace_scene(view_dependent_->scene());
+    rebuilt = true;
+  }
   place_objects(state.object_poses, animated_object_poses(scene_.animation, state.time_s));
   FrameStats stats;
   stats.frame = state.frame;
   stats.time_s = state.time_s;
+  stats.scene_rebuilt = rebuilt;
   const glm::dmat4 T_eye_world = glm::inverse(state.T_world_eye);
   for (std::size_t i = 0; i < methods_.size(); ++i) {
     OutputFrameStats output;

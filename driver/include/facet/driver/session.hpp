@@ -21,6 +21,7 @@
 #include "facet/driver/gpu_timer.hpp"
 #include "facet/driver/render_method.hpp"
 #include "facet/driver/scene.hpp"
+#include "facet/driver/scene_names.hpp"
 #include "facet/projection/test_pattern.hpp"
 #include "facet/projection_io/display_config.hpp"
 
@@ -96,6 +97,8 @@ struct FrameStats {
   std::uint64_t frame = 0;
   double time_s = 0;
   double cpu_ms = 0;  // wall time of Session::render on the CPU, including glFinish when asked
+  // With a view-dependent scene: whether this frame's eye rebuilt it (set_view_dependent_scene).
+  bool scene_rebuilt = false;
   std::vector<OutputFrameStats> outputs;
   std::vector<PassTime> pass_ms;  // GPU time per pass summed over outputs, from an earlier frame
 
@@ -121,6 +124,11 @@ class Session {
   // so that cpu_ms is the frame's full time. InputError("frame state", ...) for a pose of an
   // object the scene does not have, or of one object twice; nothing is rendered then.
   FrameStats render(const FrameState& state, bool finish = false);
+
+  // From the next render on, the scene is `scene`'s (which replaces the one given): each frame
+  // first updates it for the frame's eye (ViewDependentScene::update), and where it is rebuilt
+  // replaces the GPU buffers and every output's method state (RenderMethod::replace_scene).
+  void set_view_dependent_scene(std::unique_ptr<ViewDependentScene> scene);
 
   // Shows `pattern` on every output instead of the scene from the next render on (nullopt: the
   // scene again). The images are drawn once here (latlong inverts every output's warp); blended
@@ -155,8 +163,12 @@ class Session {
     std::optional<Aabb> bounds_object;
   };
 
+  // Replaces the scene (the same objects, materials and images: a view-dependent one rebuilt).
+  void replace_scene(const Scene& scene);
+
   SessionDisplay display_;
   Scene scene_;
+  std::unique_ptr<ViewDependentScene> view_dependent_;
   std::vector<RestPose> rest_poses_;
   GpuScene gpu_scene_;
   std::vector<std::unique_ptr<RenderMethod>> methods_;
