@@ -31,6 +31,16 @@ flat in uint v_triangle_id;
 layout(location = 1) out uint out_triangle_id;
 #endif
 
+// Renderers that write more per sample define EXTRA_OUTPUTS 1 and link a fragment shader object
+// defining write_extra_outputs(), called after the colour and the ID are written (the GLC
+// two-pass method's samples: glc/glc_sample.frag).
+#ifndef EXTRA_OUTPUTS
+#define EXTRA_OUTPUTS 0
+#endif
+#if EXTRA_OUTPUTS
+void write_extra_outputs();
+#endif
+
 void main() {
   MaterialInput m;
   m.p_world = v_p_world;
@@ -57,5 +67,8 @@ void main() {
   out_colour = shade(m);
 #if WRITE_TRIANGLE_ID
   out_triangle_id = v_triangle_id;
+#endif
+#if EXTRA_OUTPUTS
+  write_extra_outputs();
 #endif
 }

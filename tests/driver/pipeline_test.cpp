@@ -80,7 +80,7 @@ std::size_t count_value(const std::vector<std::uint32_t>& ids, std::uint32_t val
 
 TEST(Pipeline, MethodNamesAndUnknownMethod) {
   const auto names = render_method_names();
-  ASSERT_EQ(names.size(), 8u);
+  ASSERT_EQ(names.size(), 9u);
   EXPECT_EQ(names[0], "facets");
   EXPECT_THROW(make_render_method("bogus"), InputError);
   for (std::string_view name : names) EXPECT_EQ(make_render_method(name)->name(), name);

@@ -222,15 +222,15 @@ void run(const RenderOptions& options) {
   // A GLC camera has no single centre of projection, which every other method's warp needs.
   check_render_method(options.method);
   const bool glc_display = !outputs.empty() && outputs.front().glc;
-  if (glc_display && options.method != "glc") {
+  if (glc_display && !is_glc_method(options.method)) {
     throw InputError("command line", "--method",
-                     "expected glc for the GLC camera " + options.display +
+                     "expected glc or glc-2pass for the GLC camera " + options.display +
                          " (its rays share no centre, which method " + options.method + " needs)");
   }
-  if (!glc_display && options.method == "glc") {
-    throw InputError(
-        "command line", "--display",
-        "expected a GLC camera (FILE.glc.json) for --method glc; got " + options.display);
+  if (!glc_display && is_glc_method(options.method)) {
+    throw InputError("command line", "--display",
+                     "expected a GLC camera (FILE.glc.json) for --method " + options.method +
+                         "; got " + options.display);
   }
   // Read with the display, before any GL work: a bad blend map is refused at once.
   const std::vector<std::vector<bool>> hidden =

@@ -369,7 +369,7 @@ void add_cylinder_scenario(const ScenarioSizes& sizes, std::vector<BenchScenario
 
 // "glc" (or one of its parts): the GLC cameras of Yu, Yu & McMillan's paper cases (configs/glc
 // holds the same as files): the cross-slit city, the 360° circular cross-slit panorama and the
-// mirror sphere, each drawn by the glc method alone.
+// mirror sphere, each drawn by the two GLC methods alone.
 void add_glc_scenarios(const std::string& name, const ScenarioSizes& sizes,
                        std::vector<BenchScenario>& scenarios) {
   auto glc_scenario = [&](const std::string& part, const std::string& description,
@@ -381,10 +381,13 @@ void add_glc_scenarios(const std::string& name, const ScenarioSizes& sizes,
     const glm::ivec2 size = camera.size;
     s.outputs.push_back({part, Warp::analytic(BaseProjection::perspective(-1, 1, 1, -1), size),
                          std::make_shared<const PiecewiseGlc>(std::move(camera))});
-    BenchSetting setting;
-    setting.method = "glc";
-    setting.label = "camera";
-    s.settings.push_back(setting);
+    // The ray cast and the paper's two-pass rasterization, side by side.
+    for (const char* method : {"glc", "glc-2pass"}) {
+      BenchSetting setting;
+      setting.method = method;
+      setting.label = "camera";
+      s.settings.push_back(setting);
+    }
     scenarios.push_back(std::move(s));
   };
   const bool all_parts = name == "glc";

@@ -10,13 +10,14 @@
 namespace facet::driver {
 namespace {
 
-constexpr std::array<std::string_view, 8> kNames = {
-    "facets", "facets-gs", "tessellated", "cubemap", "perspective", "naive", "vertex", "glc"};
+constexpr std::array<std::string_view, 9> kNames = {"facets",  "facets-gs",   "tessellated",
+                                                    "cubemap", "perspective", "naive",
+                                                    "vertex",  "glc",         "glc-2pass"};
 
 using Factory = std::unique_ptr<RenderMethod> (*)();
 
 // The methods built so far; a listed name with no factory here is not available yet.
-const std::array<std::pair<std::string_view, Factory>, 8> kFactories = {{
+const std::array<std::pair<std::string_view, Factory>, 9> kFactories = {{
     {"facets", &detail::make_facet_pipeline},
     {"facets-gs", &detail::make_facet_gs_pipeline},
     {"tessellated", &detail::make_tessellated_pipeline},
@@ -25,6 +26,7 @@ const std::array<std::pair<std::string_view, Factory>, 8> kFactories = {{
     {"naive", &detail::make_naive_method},
     {"vertex", &detail::make_vertex_method},
     {"glc", &detail::make_glc_method},
+    {"glc-2pass", &detail::make_glc_2pass_method},
 }};
 
 std::string joined_names() {
@@ -45,6 +47,8 @@ void RenderMethod::replace_scene(const Scene& scene, const GpuScene& gpu_scene,
 }
 
 std::span<const std::string_view> render_method_names() { return kNames; }
+
+bool is_glc_method(std::string_view name) { return name == "glc" || name == "glc-2pass"; }
 
 void check_render_method(std::string_view name) {
   for (const auto& [known, factory] : kFactories) {
@@ -75,8 +79,8 @@ void refuse_glc_outputs(std::span<const OutputSpec> outputs, std::string_view me
   for (const OutputSpec& output : outputs) {
     if (output.glc) {
       throw InputError("command line", OptionName{"method"},
-                       "expected glc for output '" + output.name + "', a GLC camera's; got " +
-                           std::string(method));
+                       "expected glc or glc-2pass for output '" + output.name +
+                           "', a GLC camera's; got " + std::string(method));
     }
   }
 }

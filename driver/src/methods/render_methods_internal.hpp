@@ -17,9 +17,10 @@ std::unique_ptr<RenderMethod> make_cubemap_method();        // "cubemap" (cubema
 std::unique_ptr<RenderMethod> make_perspective_method();    // "perspective"
 std::unique_ptr<RenderMethod> make_vertex_method();         // "vertex" (vertex_method.cpp)
 std::unique_ptr<RenderMethod> make_glc_method();            // "glc" (glc_method.cpp)
+std::unique_ptr<RenderMethod> make_glc_2pass_method();      // "glc-2pass" (glc_2pass_method.cpp)
 
-// For every method but glc, in its prepare: throws InputError(OptionName "method") when an output
-// is a GLC camera's, whose warp only carries the output size.
+// For every method but glc and glc-2pass, in its prepare: throws InputError(OptionName "method")
+// when an output is a GLC camera's, whose warp only carries the output size.
 void refuse_glc_outputs(std::span<const OutputSpec> outputs, std::string_view method);
 
 }  // namespace facet::driver::detail

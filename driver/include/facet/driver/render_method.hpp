@@ -29,7 +29,8 @@ namespace facet::driver {
 
 // One projector output as a renderer sees it: its exact warp (the map from eye directions to
 // its output pixels) and its name. An output of a GLC camera (a *.glc.json display) has no
-// single centre of projection: `glc` is its camera, drawn by the "glc" method alone, and `warp`
+// single centre of projection: `glc` is its camera, drawn by the GLC methods alone ("glc",
+// "glc-2pass": is_glc_method), and `warp`
 // only carries its output size.
 struct OutputSpec {
   std::string name;
@@ -167,7 +168,8 @@ struct RenderStats {
 class RenderMethod {
  public:
   virtual ~RenderMethod() = default;
-  // "facets", "facets-gs", "tessellated", "cubemap", "perspective", "naive", "vertex", "glc".
+  // "facets", "facets-gs", "tessellated", "cubemap", "perspective", "naive", "vertex", "glc",
+  // "glc-2pass".
   virtual std::string_view name() const = 0;
 
   // Builds everything that depends only on the outputs and the scene: facets, matrices, cube
@@ -197,6 +199,9 @@ class RenderMethod {
 
 // Every method name make_render_method accepts, in the order `facet bench` lists them.
 std::span<const std::string_view> render_method_names();
+// Whether the method draws GLC cameras (*.glc.json outputs), and only those: "glc" (the ray
+// cast) and "glc-2pass" (the paper's two-pass rasterization).
+bool is_glc_method(std::string_view name);
 // Throws InputError(OptionName "method", ...) for an unknown name. Methods may make GL objects from
 // the start: call with a current context (check_render_method checks a name without one).
 std::unique_ptr<RenderMethod> make_render_method(std::string_view name);
