@@ -1,11 +1,12 @@
 // GLC two-pass rasterization ("glc-2pass", Yu, Yu & McMillan), pass 2: one GLC piece's pass-1
 // samples moved to their GLC image points, neighbouring samples joined into triangles so that no
-// holes open between them. The piece's samples fill a rectangle of the sample atlas; every cell
-// of four neighbouring samples is two triangles, six vertices from gl_VertexID (no attributes).
-// A sample that saw nothing lies at infinity along its proxy ray: its image point is the pixel
-// whose GLC ray has that direction (the ray directions are affine in (α, β):
-// M1·(α, β) = d.xy / d.z − duv0), at the farthest depth. A triangle with a sample without an image
-// point (a singular projection, a direction the GLC never takes) is not drawn.
+// holes open between them. The piece's samples fill a rectangle of the sample atlas; vertex v is
+// its sample v (row by row), and an index buffer makes every cell of four neighbouring samples
+// two triangles, so that each sample is moved once. A sample that saw nothing lies at infinity
+// along its proxy ray: its image point is the pixel whose GLC ray has that direction (the ray
+// directions are affine in (α, β): M1·(α, β) = d.xy / d.z − duv0), at the farthest depth. A
+// sample without an image point (a singular projection, a direction the GLC never takes) gets
+// clip distance −1e20, which clips its triangles away.
 layout(binding = 0) uniform sampler2D glc_samples;  // pass 1's RGBA32F: pixel.xy, depth, kind
 layout(location = 0) uniform vec2 output_size;
 layout(location = 1) uniform float z_near;
@@ -47,24 +48,15 @@ bool place(ivec2 texel, out vec3 placed) {
 }
 
 void main() {
-  const int cell = gl_VertexID / 6, corner = gl_VertexID % 6;
-  const ivec2 base = rect.xy + ivec2(cell % (rect.z - 1), cell / (rect.z - 1));
-  // Triangles (0, 0) (1, 0) (0, 1) and (0, 1) (1, 0) (1, 1) of the cell.
-  const ivec2 offsets[6] = ivec2[6](ivec2(0, 0), ivec2(1, 0), ivec2(0, 1), ivec2(0, 1),
-                                    ivec2(1, 0), ivec2(1, 1));
-  const int first = corner < 3 ? 0 : 3;
-  bool all_placed = true;
-  vec3 own = vec3(0.0);
-  for (int i = 0; i < 3; ++i) {
-    vec3 placed;
-    all_placed = place(base + offsets[first + i], placed) && all_placed;
-    if (first + i == corner) own = placed;
-  }
-  v_texel = vec2(base + offsets[corner]);
-  if (!all_placed) {
-    gl_Position = vec4(2.0, 2.0, 2.0, 1.0);  // outside the clip volume: the triangle is dropped
+  const ivec2 texel = rect.xy + ivec2(gl_VertexID % rect.z, gl_VertexID / rect.z);
+  v_texel = vec2(texel);
+  vec3 placed;
+  if (!place(texel, placed)) {
+    gl_ClipDistance[0] = -1e20;
+    gl_Position = vec4(0.0, 0.0, 0.0, 1.0);
     return;
   }
-  gl_Position = vec4(2.0 * own.x / output_size.x - 1.0, 1.0 - 2.0 * own.y / output_size.y, own.z,
-                     1.0);
+  gl_ClipDistance[0] = 1.0;
+  gl_Position = vec4(2.0 * placed.x / output_size.x - 1.0, 1.0 - 2.0 * placed.y / output_size.y,
+                     placed.z, 1.0);
 }

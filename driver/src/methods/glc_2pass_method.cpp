@@ -52,7 +52,7 @@ constexpr double kMaxProxyHalfAngleDeg = 75.0;
 constexpr int kMaxAtlasSide = 16384;
 // Pass-2 cells per draw: llvmpipe's draw module costs time quadratic in a draw's batch
 // (replication_common.hpp).
-constexpr int kCellsPerDraw = 4096;
+constexpr std::size_t kCellsPerDraw = 4096;
 
 // A piece's proxy pinhole: centre (eye frame), frustum about it and the samples' rectangle in the
 // atlas.
@@ -60,8 +60,9 @@ struct Proxy {
   glm::dvec3 centre{0.0};
   Frustum frustum;
   double near = 0;
-  glm::ivec2 size{2, 2};    // samples
-  glm::ivec2 origin{0, 0};  // in the atlas, GL rows from the bottom
+  glm::ivec2 size{2, 2};        // samples
+  glm::ivec2 origin{0, 0};      // in the atlas, GL rows from the bottom
+  std::size_t first_index = 0;  // its cells' triangles in the output's grid indices
 };
 
 // The pixel points whose rays a piece's proxy must hold: the centres of the pixels at the ends of
@@ -283,6 +284,22 @@ class Glc2PassMethod final : public ObjectBaseline {
         height = pack_atlas(out.proxies, width);
       }
       out.atlas_size = {width, height};
+      // Every piece's cells: two triangles of its local sample numbers (row by row).
+      std::vector<std::uint32_t> indices;
+      for (Proxy& p : out.proxies) {
+        p.first_index = indices.size();
+        const std::uint32_t w = std::uint32_t(p.size.x);
+        for (std::uint32_t j = 0; j + 1 < std::uint32_t(p.size.y); ++j) {
+          for (std::uint32_t i = 0; i + 1 < w; ++i) {
+            const std::uint32_t a = j * w + i, b = a + 1, c = a + w, d = c + 1;
+            for (std::uint32_t v : {a, b, c, c, b, d}) indices.push_back(v);
+          }
+        }
+      }
+      out.grid_indices = Buffer::create_from(indices);
+      out.grid_vao = VertexArray::create();
+      glVertexArrayElementBuffer(out.grid_vao.id(), out.grid_indices.id());
+      buffer_bytes_ += 4ull * indices.size();
       out.colour = Texture::create_2d(GL_SRGB8_ALPHA8, width, height);
       out.ids = Texture::create_2d(GL_R32UI, width, height);
       out.samples = Texture::create_2d(GL_RGBA32F, width, height);
@@ -360,7 +377,8 @@ class Glc2PassMethod final : public ObjectBaseline {
       begin_reversed_z_scene(false);
       glDepthMask(GL_TRUE);
       splat_program_.use();
-      glBindVertexArray(empty_vao_.id());
+      glEnable(GL_CLIP_DISTANCE0);
+      glBindVertexArray(out.grid_vao.id());
       glBindTextureUnit(0, out.samples.id());
       glBindTextureUnit(1, out.colour.id());
       glBindTextureUnit(2, out.ids.id());
@@ -384,11 +402,14 @@ class Glc2PassMethod final : public ObjectBaseline {
         glUniformMatrix2fv(6, 1, GL_FALSE, glm::value_ptr(c.m1));
         glUniform2fv(7, 1, glm::value_ptr(c.duv0));
         glUniformMatrix3fv(8, 1, GL_FALSE, glm::value_ptr(c.pixel_from_ab));
-        const int cells = (proxy.size.x - 1) * (proxy.size.y - 1);
-        for (int first = 0; first < cells; first += kCellsPerDraw) {
-          glDrawArrays(GL_TRIANGLES, 6 * first, 6 * std::min(kCellsPerDraw, cells - first));
+        const std::size_t cells = std::size_t(proxy.size.x - 1) * std::size_t(proxy.size.y - 1);
+        for (std::size_t first = 0; first < cells; first += kCellsPerDraw) {
+          const std::size_t offset = 4 * (proxy.first_index + 6 * first);
+          glDrawElements(GL_TRIANGLES, GLsizei(6 * std::min(kCellsPerDraw, cells - first)),
+                         GL_UNSIGNED_INT, reinterpret_cast<const void*>(offset));
         }
       }
+      glDisable(GL_CLIP_DISTANCE0);
       glBindVertexArray(0);
       targets[i].resolve();
       end_reversed_z_scene();
@@ -414,6 +435,8 @@ class Glc2PassMethod final : public ObjectBaseline {
     glm::ivec2 atlas_size{0, 0};
     Texture colour, ids, samples, depth, piece_map;
     Framebuffer framebuffer;
+    Buffer grid_indices;  // pass 2's triangles, per piece from Proxy::first_index
+    VertexArray grid_vao;
   };
 
   // A GLC's projection coefficients in its frame (glc/glc_sample.vert): M(z) = m0 + z·m1,
