@@ -270,7 +270,7 @@ TEST(RenderCli, GlcCameraRendersWithItsMethodAndRefusesBadInput) {
       {"render --display " + good + " --method glc --size 64x64", "expected the size of"},
       {"render --display " + good + " --method glc --material chalk",
        "field '--material': expected lit, solid-wireframe, pen-and-ink, procedural or a GLSL file"},
-      {"run " + good + " --frames 1", "only the glc render method draws"},
+      {"run " + good + " --frames 1", "only the glc and glc-2pass render methods draw"},
   };
   for (const auto& [arguments, expected] : refused) {
     const Result result = run_cli(arguments);

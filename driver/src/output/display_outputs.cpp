@@ -75,9 +75,10 @@ LoadedDisplay load_display(std::string_view display, std::optional<glm::ivec2> s
     outputs.push_back({name.empty() ? "output" : name, std::move(warp)});
   } else if (display.ends_with(".glc.json")) {
     if (!allow_glc) {
-      throw InputError("command line", OptionName{"display"},
-                       "expected a display; " + std::string(display) +
-                           " is a GLC camera, which only the glc render method draws");
+      throw InputError(
+          "command line", OptionName{"display"},
+          "expected a display; " + std::string(display) +
+              " is a GLC camera, which only the glc and glc-2pass render methods draw");
     }
     auto camera = std::make_shared<const PiecewiseGlc>(read_glc_camera(std::string(display)));
     if (size && *size != camera->size) {
