@@ -472,52 +472,51 @@ TEST(ClusterProtocol, ASecondaryWithoutAMasterGivesUp) {
       << b.error;
 }
 
-TEST(ClusterProtocol, ANodeOfAnotherDisplayIsRefused) {
-  const facet::test::TempFolder scratch("facet-cluster-test");
-  const pio::DisplayCluster cluster = test_cluster(scratch.path(), 300);
+// Master a runs 5 frames with b and with c, whose content digest (43) is another display's; c is
+// critical when asked. The master's join timeout is 60 s: c's refusal must settle the wait.
+struct RefusedNodeRuns {
+  NodeRun a, b, c;
   Log log;
-  NodeRun b, c, a;
-  std::thread tb([&] { b = run_secondary(node_options(cluster, "b", log)); });
-  std::thread tc([&] { c = run_secondary(node_options(cluster, "c", log, 43)); });
-  // c's refusal settles the wait: the master starts once b has joined, long before this.
-  ClusterNodeOptions master = node_options(cluster, "a", log);
+};
+void run_with_a_refused_c(bool c_critical, RefusedNodeRuns& runs) {
+  const facet::test::TempFolder scratch("facet-cluster-test");
+  const pio::DisplayCluster cluster = test_cluster(scratch.path(), 300, c_critical);
+  std::thread tb([&] { runs.b = run_secondary(node_options(cluster, "b", runs.log)); });
+  std::thread tc([&] { runs.c = run_secondary(node_options(cluster, "c", runs.log, 43)); });
+  ClusterNodeOptions master = node_options(cluster, "a", runs.log);
   master.join_timeout = std::chrono::milliseconds(60'000);
-  a = run_master(master, 5);
+  runs.a = run_master(master, 5);
   tb.join();
   tc.join();
-  EXPECT_FALSE(log.contains("not joined within")) << log.all();
-  EXPECT_NE(c.error.find("InputError: display.json: field 'cluster': the display and scene "
-                         "master a runs (content digest 000000000000002a), but this node's "
-                         "differ (000000000000002b)"),
+}
+
+TEST(ClusterProtocol, ANodeOfAnotherDisplayIsRefused) {
+  RefusedNodeRuns runs;
+  run_with_a_refused_c(false, runs);
+  EXPECT_FALSE(runs.log.contains("not joined within")) << runs.log.all();
+  EXPECT_NE(runs.c.error.find("InputError: display.json: field 'cluster': the display and scene "
+                              "master a runs (content digest 000000000000002a), but this node's "
+                              "differ (000000000000002b)"),
             std::string::npos)
-      << c.error;
-  EXPECT_TRUE(log.contains("a: starting without c (refused: another display or scene"))
-      << log.all();
+      << runs.c.error;
+  EXPECT_TRUE(runs.log.contains("a: starting without c (refused: another display or scene"))
+      << runs.log.all();
   // c is not critical: the others run without it.
-  EXPECT_EQ(a.error, "");
-  EXPECT_EQ(b.swapped, frames_upto(5));
+  EXPECT_EQ(runs.a.error, "");
+  EXPECT_EQ(runs.b.swapped, frames_upto(5));
 }
 
 TEST(ClusterProtocol, ARefusedCriticalNodeStopsEveryone) {
-  const facet::test::TempFolder scratch("facet-cluster-test");
-  const pio::DisplayCluster cluster = test_cluster(scratch.path(), 300, true);
-  Log log;
-  NodeRun b, c, a;
-  std::thread tb([&] { b = run_secondary(node_options(cluster, "b", log)); });
-  std::thread tc([&] { c = run_secondary(node_options(cluster, "c", log, 43)); });
-  ClusterNodeOptions master = node_options(cluster, "a", log);
-  master.join_timeout = std::chrono::milliseconds(60'000);
-  a = run_master(master, 5);
-  tb.join();
-  tc.join();
-  EXPECT_NE(a.error.find("PeerLost: critical node c runs another display or scene"),
+  RefusedNodeRuns runs;
+  run_with_a_refused_c(true, runs);
+  EXPECT_NE(runs.a.error.find("PeerLost: critical node c runs another display or scene"),
             std::string::npos)
-      << a.error << "\n"
-      << log.all();
-  EXPECT_NE(b.error.find("PeerLost: master a stopped: critical node c runs another display"),
+      << runs.a.error << "\n"
+      << runs.log.all();
+  EXPECT_NE(runs.b.error.find("PeerLost: master a stopped: critical node c runs another display"),
             std::string::npos)
-      << b.error;
-  EXPECT_TRUE(a.swapped.empty());
+      << runs.b.error;
+  EXPECT_TRUE(runs.a.swapped.empty());
 }
 
 TEST(ClusterProtocol, AnAddressInUseIsAnInputError) {

@@ -249,12 +249,17 @@ DomeHoles dome_holes(const Scene& scene, const glm::dmat4& T_eye_world) {
   return dome_holes(render_ids(scene, outputs, T_eye_world), size);
 }
 
-TEST(DepthImage, DpciOfABackgroundSphereLeavesNoHoleOnTheDome) {
-  test::shared_context();
-  const Scene sphere = background_sphere(64, 32, 20.0f);
+// The 128×64 DPCI (and its cap) that render_depth_image makes of a background sphere of 20 m
+// about the image's eye. Needs a current context.
+DepthImage rendered_sphere_dpci() {
   DepthImageRequest request;
   request.size = {128, 64};
-  const DepthImage image = render_depth_image(sphere, request);
+  return render_depth_image(background_sphere(64, 32, 20.0f), request);
+}
+
+TEST(DepthImage, DpciOfABackgroundSphereLeavesNoHoleOnTheDome) {
+  test::shared_context();
+  const DepthImage image = rendered_sphere_dpci();
   // Every pixel sees the sphere, at most its chord sag nearer than the radius.
   const double sag = 20.0 * (1 - std::cos(M_PI / 32));
   for (const DepthImagePart& part : image.parts)
@@ -473,10 +478,7 @@ TEST(DepthImage, LodLevelsFollowTheEye) {
 
 TEST(DepthImage, LodDpciOfABackgroundSphereLeavesNoHoleOnTheDome) {
   test::shared_context();
-  const Scene sphere = background_sphere(64, 32, 20.0f);
-  DepthImageRequest request;
-  request.size = {128, 64};
-  const DepthImage image = render_depth_image(sphere, request);
+  const DepthImage image = rendered_sphere_dpci();
   // An eye 8 m off the centre: the near side at 12 m keeps step 1, the far side at 28 m does not.
   const glm::dvec3 eye(8.0, 0.0, 0.0);
   const DepthMesh mesh = depth_image_mesh(image, {.lod_angle_rad = 0.1, .lod_eye_world = eye});
@@ -533,12 +535,9 @@ std::vector<MovingFrame> render_moving(ViewDependentScene& lod,
 // which keeps its facets across the rebuilds, and the cube map, which prepares anew).
 TEST(DepthImage, LodSceneRebuiltAsTheEyeMovesLeavesNoHoleOnTheDome) {
   test::shared_context();
-  const Scene sphere = background_sphere(64, 32, 20.0f);
-  DepthImageRequest request;
-  request.size = {128, 64};
   const facet::test::TempFolder scratch("facet_depth_image_moving_eye");
   const fs::path file = scratch.path() / "sphere.exr";
-  write_depth_image(file, render_depth_image(sphere, request));
+  write_depth_image(file, rendered_sphere_dpci());
   const SceneName name = parse_scene_name("depth:" + file.string() + "@lod=0.1");
   const glm::ivec2 size{128, 128};
   const std::vector<OutputSpec> outputs = load_display_outputs("builtin:dome180", size);
@@ -579,10 +578,7 @@ TEST(DepthImage, LodSceneRebuiltAsTheEyeMovesLeavesNoHoleOnTheDome) {
 // session's scene is the LOD mesh for that eye, and the dome shows no hole.
 TEST(DepthImage, SessionRebuildsTheLodSceneForEachFramesEye) {
   test::shared_context();
-  const Scene sphere = background_sphere(64, 32, 20.0f);
-  DepthImageRequest request;
-  request.size = {128, 64};
-  const DepthImage image = render_depth_image(sphere, request);
+  const DepthImage image = rendered_sphere_dpci();
   const facet::test::TempFolder scratch("facet_depth_image_session");
   const fs::path file = scratch.path() / "sphere.exr";
   write_depth_image(file, image);

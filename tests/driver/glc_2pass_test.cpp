@@ -15,25 +15,13 @@
 #include "facet/projection/errors.hpp"
 #include "facet/projection/glc.hpp"
 #include "gl_test_context.hpp"
+#include "glc_test_city.hpp"
 #include "test_scenes.hpp"
 
 namespace facet::driver {
 namespace {
 
-struct Fixture {
-  Scene scene = build_city({.blocks_per_side = 2, .texture_size = 16});
-  glm::dmat4 T_eye_world = glm::inverse(CityCameraPath({.blocks_per_side = 2}).T_world_eye(3.0));
-};
-
-const Fixture& fixture() {
-  static const Fixture f;
-  return f;
-}
-
-OutputSpec glc_output(const PiecewiseGlc& camera) {
-  return {"glc", Warp::analytic(BaseProjection::perspective(-1, 1, 1, -1), camera.size),
-          std::make_shared<const PiecewiseGlc>(camera)};
-}
+using facet::test::glc_output;
 
 std::vector<std::uint32_t> render_ids(const Scene& scene, const PiecewiseGlc& camera,
                                       const glm::dmat4& T_eye_world) {
@@ -55,7 +43,7 @@ struct Accuracy {
 };
 
 Accuracy compare_with_oracle(const PiecewiseGlc& camera, const std::string& what) {
-  const Fixture& f = fixture();
+  const facet::test::GlcTestCity& f = facet::test::glc_test_city();
   const std::vector<std::uint32_t> ids = render_ids(f.scene, camera, f.T_eye_world);
   const RenderSettings settings;
   const ReferenceRaycaster oracle(f.scene);
@@ -148,7 +136,7 @@ TEST(Glc2PassRender, NoHolesInsideASurroundingSphere) {
 
 TEST(Glc2PassRender, WarpOutputIsRefused) {
   test::shared_context();
-  const Fixture& f = fixture();
+  const facet::test::GlcTestCity& f = facet::test::glc_test_city();
   const GpuScene gpu_scene = upload_scene(f.scene);
   auto method = make_render_method("glc-2pass");
   const OutputSpec outputs[1] = {

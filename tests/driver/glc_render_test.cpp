@@ -19,20 +19,13 @@
 #include "facet/projection/errors.hpp"
 #include "facet/projection/glc.hpp"
 #include "gl_test_context.hpp"
+#include "glc_test_city.hpp"
 #include "support/files.hpp"
 
 namespace facet::driver {
 namespace {
 
-struct Fixture {
-  Scene scene = build_city({.blocks_per_side = 2, .texture_size = 16});
-  glm::dmat4 T_eye_world = glm::inverse(CityCameraPath({.blocks_per_side = 2}).T_world_eye(3.0));
-};
-
-const Fixture& fixture() {
-  static const Fixture f;
-  return f;
-}
+using facet::test::glc_output;
 
 struct Result {
   std::vector<std::uint32_t> ids, reference;
@@ -42,11 +35,10 @@ struct Result {
 
 Result render_and_compare(const PiecewiseGlc& camera, const std::string& what) {
   test::shared_context();
-  const Fixture& f = fixture();
+  const facet::test::GlcTestCity& f = facet::test::glc_test_city();
   const GpuScene gpu_scene = upload_scene(f.scene);
   auto method = make_render_method("glc");
-  OutputSpec output{"glc", Warp::analytic(BaseProjection::perspective(-1, 1, 1, -1), camera.size),
-                    std::make_shared<const PiecewiseGlc>(camera)};
+  OutputSpec output = glc_output(camera);
   const RenderSettings settings;
   method->prepare(f.scene, gpu_scene, {&output, 1}, settings);
   std::vector<OutputTarget> targets;
@@ -124,11 +116,6 @@ Image render_image(std::string_view method, const Scene& scene, const OutputSpec
   return {targets[0].read_ids(), targets[0].read_colour_rgba8()};
 }
 
-OutputSpec glc_output(const PiecewiseGlc& camera) {
-  return {"glc", Warp::analytic(BaseProjection::perspective(-1, 1, 1, -1), camera.size),
-          std::make_shared<const PiecewiseGlc>(camera)};
-}
-
 // Whether pixel `at` and its 8 neighbours show one triangle (interior of a triangle's image).
 bool one_triangle_about(const std::vector<std::uint32_t>& ids, glm::ivec2 size, int x, int y) {
   const std::uint32_t id = ids[std::size_t(y) * std::size_t(size.x) + std::size_t(x)];
@@ -156,7 +143,7 @@ TEST(GlcRender, MaterialsChangeColoursNotIds) {
   const std::filesystem::path user = scratch.path() / "bary.frag";
   std::ofstream(user) << "vec4 shade(MaterialInput m) {\n  return vec4(m.barycentric * "
                          "(m.edge_px.x > 1.0 ? 1.0 : 0.5), 1.0);\n}\n";
-  const Fixture& f = fixture();
+  const facet::test::GlcTestCity& f = facet::test::glc_test_city();
   const PiecewiseGlc camera = circular_panorama(360, 0.25, 120, 16, {200, 150}, "test", "camera");
   const OutputSpec output = glc_output(camera);
   const Image lit = render_image("glc", f.scene, output, RenderSettings{}, f.T_eye_world);
@@ -186,7 +173,7 @@ TEST(GlcRender, EachSceneMaterialShadesWithItsOwnShader) {
   const facet::test::TempFolder scratch("facet_glc_material");
   const std::filesystem::path magenta = scratch.path() / "magenta.frag";
   std::ofstream(magenta) << "vec4 shade(MaterialInput m) { return vec4(1, 0, 1, 1); }\n";
-  const Fixture& f = fixture();
+  const facet::test::GlcTestCity& f = facet::test::glc_test_city();
   Scene shaded = f.scene;
   for (std::size_t m = 0; m < shaded.materials.size(); m += 2)
     shaded.materials[m].shader = load_material_shader(magenta.string());
@@ -235,7 +222,7 @@ TEST(GlcRender, EachSceneMaterialShadesWithItsOwnShader) {
 // percentile to 192 (asserted over 8), so the comparison fails if glc did not sample them.
 TEST(GlcRender, PinholeShowsTheTexturesFacetsShow) {
   test::shared_context();
-  const Fixture& f = fixture();
+  const facet::test::GlcTestCity& f = facet::test::glc_test_city();
   GlcFrame frame;
   frame.origin = glm::dvec3(0, 0, -0.1);
   frame.axes = glm::dmat3(glm::dvec3(1, 0, 0), glm::dvec3(0, -1, 0), glm::dvec3(0, 0, -1));
@@ -288,7 +275,7 @@ TEST(GlcRender, PinholeShowsTheTexturesFacetsShow) {
 
 TEST(GlcRender, WarpOutputIsRefused) {
   test::shared_context();
-  const Fixture& f = fixture();
+  const facet::test::GlcTestCity& f = facet::test::glc_test_city();
   const GpuScene gpu_scene = upload_scene(f.scene);
   auto method = make_render_method("glc");
   const OutputSpec outputs[1] = {
@@ -298,7 +285,7 @@ TEST(GlcRender, WarpOutputIsRefused) {
 
 TEST(GlcRender, EveryOtherMethodRefusesAGlcOutput) {
   test::shared_context();
-  const Fixture& f = fixture();
+  const facet::test::GlcTestCity& f = facet::test::glc_test_city();
   const GpuScene gpu_scene = upload_scene(f.scene);
   const PiecewiseGlc camera = circular_panorama(360, 0.25, 120, 16, {64, 48}, "test", "camera");
   const OutputSpec outputs[1] = {

@@ -27,6 +27,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <glm/gtc/matrix_access.hpp>
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/type_ptr.hpp>
 #include <limits>
@@ -316,18 +317,7 @@ class Glc2PassMethod final : public ObjectBaseline {
       const GLenum buffers[3] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2};
       glNamedFramebufferDrawBuffers(out.framebuffer.id(), 3, buffers);
       out.framebuffer.check_complete();
-      // The piece map in GL rows (row 0 at the bottom).
-      std::vector<std::int32_t> rows(camera.piece_of_pixel.size());
-      for (int y = 0; y < camera.size.y; ++y) {
-        std::copy_n(camera.piece_of_pixel.begin() + std::ptrdiff_t(y) * camera.size.x,
-                    camera.size.x,
-                    rows.begin() + std::ptrdiff_t(camera.size.y - 1 - y) * camera.size.x);
-      }
-      out.piece_map = Texture::create_2d(GL_R32I, camera.size.x, camera.size.y);
-      glTextureParameteri(out.piece_map.id(), GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-      glTextureParameteri(out.piece_map.id(), GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-      glTextureSubImage2D(out.piece_map.id(), 0, 0, 0, camera.size.x, camera.size.y, GL_RED_INTEGER,
-                          GL_INT, rows.data());
+      out.piece_map = upload_piece_map(camera);
       // The atlas' colour (4), IDs (4), samples (16) and depth (4) bytes a texel; the piece map.
       buffer_bytes_ += 28ull * std::uint64_t(width) * std::uint64_t(height) +
                        4ull * std::uint64_t(camera.size.x) * std::uint64_t(camera.size.y);
@@ -473,12 +463,9 @@ class Glc2PassMethod final : public ObjectBaseline {
     const glm::dmat4 T_clip_eye = perspective_image_clip_from_eye(proxy.frustum, proxy.near) *
                                   glm::translate(glm::dmat4(1.0), -proxy.centre);
     glm::dvec4 planes[6];
-    const glm::dmat4 M = glm::transpose(T_clip_eye);
-    planes[0] = M[3] + M[0];
-    planes[1] = M[3] - M[0];
-    planes[2] = M[3] + M[1];
-    planes[3] = M[3] - M[1];
-    planes[4] = M[3] - M[2];  // reversed-Z: depth <= w in front of the near plane
+    std::ranges::copy(frustum_side_planes(T_clip_eye), planes);
+    // Reversed-Z: depth <= w in front of the near plane.
+    planes[4] = glm::row(T_clip_eye, 3) - glm::row(T_clip_eye, 2);
     const glm::dvec3 n = glc.frame().axes[2];
     planes[5] = glm::dvec4(n, -glm::dot(n, glc.frame().origin) - settings_.z_near);
     const Coefficients c = coefficients(glc);
@@ -488,13 +475,7 @@ class Glc2PassMethod final : public ObjectBaseline {
       const Object& object = scene_->objects[o];
       const BoundingSphere& sphere = spheres[o];
       if (sphere.radius < 0) continue;
-      bool outside = false;
-      for (const glm::dvec4& plane : planes) {
-        const double length = glm::length(glm::dvec3(plane));
-        outside = outside ||
-                  glm::dot(glm::dvec3(plane), sphere.centre) + plane.w < -sphere.radius * length;
-      }
-      if (outside) continue;
+      if (sphere_outside_a_plane(sphere, planes)) continue;
       object_drawn[o] = 1;
       const glm::dmat4 T_eye_object = T_eye_world * glm::dmat4(object.T_world_object);
       const glm::mat4 T_clip_object(T_clip_eye * T_eye_object), T_eye_object_f(T_eye_object);

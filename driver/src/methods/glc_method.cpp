@@ -226,19 +226,7 @@ class GlcMethod final : public RenderMethod {
         }
       }
       out.pieces = Buffer::create_from(pieces);
-      // The piece map in GL rows (row 0 at the bottom).
-      std::vector<std::int32_t> rows(camera.piece_of_pixel.size());
-      for (int y = 0; y < camera.size.y; ++y) {
-        std::copy_n(camera.piece_of_pixel.begin() + std::ptrdiff_t(y) * camera.size.x,
-                    camera.size.x,
-                    rows.begin() + std::ptrdiff_t(camera.size.y - 1 - y) * camera.size.x);
-      }
-      out.piece_map = Texture::create_2d(GL_R32I, camera.size.x, camera.size.y);
-      // Integer textures are complete only with nearest filtering.
-      glTextureParameteri(out.piece_map.id(), GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-      glTextureParameteri(out.piece_map.id(), GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-      glTextureSubImage2D(out.piece_map.id(), 0, 0, 0, camera.size.x, camera.size.y, GL_RED_INTEGER,
-                          GL_INT, rows.data());
+      out.piece_map = upload_piece_map(camera);
       outputs_.push_back(std::move(out));
     }
     vao_ = VertexArray::create();
@@ -487,5 +475,20 @@ class GlcMethod final : public RenderMethod {
 }  // namespace
 
 std::unique_ptr<RenderMethod> make_glc_method() { return std::make_unique<GlcMethod>(); }
+
+Texture upload_piece_map(const PiecewiseGlc& camera) {
+  std::vector<std::int32_t> rows(camera.piece_of_pixel.size());
+  for (int y = 0; y < camera.size.y; ++y) {
+    std::copy_n(camera.piece_of_pixel.begin() + std::ptrdiff_t(y) * camera.size.x, camera.size.x,
+                rows.begin() + std::ptrdiff_t(camera.size.y - 1 - y) * camera.size.x);
+  }
+  Texture map = Texture::create_2d(GL_R32I, camera.size.x, camera.size.y);
+  // Integer textures are complete only with nearest filtering.
+  glTextureParameteri(map.id(), GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+  glTextureParameteri(map.id(), GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+  glTextureSubImage2D(map.id(), 0, 0, 0, camera.size.x, camera.size.y, GL_RED_INTEGER, GL_INT,
+                      rows.data());
+  return map;
+}
 
 }  // namespace facet::driver::detail

@@ -8,6 +8,7 @@
 // (a 180° dome, a 360° cylinder) cannot be held by one image: an InputError.
 #include <algorithm>
 #include <cmath>
+#include <glm/gtc/matrix_access.hpp>
 #include <glm/gtc/type_ptr.hpp>
 
 #include "../gl/scene_framebuffer.hpp"
@@ -155,12 +156,9 @@ class PerspectiveMethod final : public ObjectBaseline {
     const Scene& scene = *scene_;
     // The frustum's side and near planes in the eye frame: (n, d) with n·p + d >= 0 inside.
     glm::dvec4 planes[5];
-    const glm::dmat4 M = glm::transpose(T_clip_eye);
-    planes[0] = M[3] + M[0];
-    planes[1] = M[3] - M[0];
-    planes[2] = M[3] + M[1];
-    planes[3] = M[3] - M[1];
-    planes[4] = M[3] - glm::dvec4(0, 0, 0, settings_.z_near);  // w = distance along the axis
+    std::ranges::copy(frustum_side_planes(T_clip_eye), planes);
+    // w = distance along the axis
+    planes[4] = glm::row(T_clip_eye, 3) - glm::dvec4(0, 0, 0, settings_.z_near);
     std::uint64_t drawn = 0;
     const Program* in_use = nullptr;
     const std::vector<BoundingSphere> eye_spheres = object_spheres(scene, T_eye_world);
@@ -168,13 +166,7 @@ class PerspectiveMethod final : public ObjectBaseline {
       const Object& object = scene.objects[o];
       const BoundingSphere& sphere = eye_spheres[o];
       if (sphere.radius < 0) continue;
-      bool outside = false;
-      for (const glm::dvec4& plane : planes) {
-        const double length = glm::length(glm::dvec3(plane));
-        outside = outside ||
-                  glm::dot(glm::dvec3(plane), sphere.centre) + plane.w < -sphere.radius * length;
-      }
-      if (outside) continue;
+      if (sphere_outside_a_plane(sphere, planes)) continue;
       const glm::dmat4 T_eye_object = T_eye_world * glm::dmat4(object.T_world_object);
       const glm::mat4 T_clip_object(T_clip_eye * T_eye_object), T_eye_object_f(T_eye_object);
       drawn += draw_object_primitives(

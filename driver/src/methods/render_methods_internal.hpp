@@ -5,7 +5,9 @@
 #include <span>
 #include <string_view>
 
+#include "facet/driver/gl_objects.hpp"
 #include "facet/driver/render_method.hpp"
+#include "facet/projection/glc.hpp"
 
 namespace facet::driver::detail {
 
@@ -22,5 +24,9 @@ std::unique_ptr<RenderMethod> make_glc_2pass_method();      // "glc-2pass" (glc_
 // For every method but glc and glc-2pass, in its prepare: throws InputError(OptionName "method")
 // when an output is a GLC camera's, whose warp only carries the output size.
 void refuse_glc_outputs(std::span<const OutputSpec> outputs, std::string_view method);
+
+// The GLC camera's piece of every pixel (PiecewiseGlc::piece_of_pixel) as an R32I texture in GL
+// rows (row 0 at the bottom), nearest filtering; glc_method.cpp.
+Texture upload_piece_map(const PiecewiseGlc& camera);
 
 }  // namespace facet::driver::detail

@@ -39,6 +39,20 @@ Aabb Scene::bounds_world() const {
   return box;
 }
 
+std::array<glm::dvec4, 4> frustum_side_planes(const glm::dmat4& T_clip_frame) {
+  const glm::dmat4 M = glm::transpose(T_clip_frame);  // M[k]: row k of T_clip_frame
+  return {M[3] + M[0], M[3] - M[0], M[3] + M[1], M[3] - M[1]};
+}
+
+bool sphere_outside_a_plane(const BoundingSphere& sphere, std::span<const glm::dvec4> planes) {
+  for (const glm::dvec4& plane : planes) {
+    const glm::dvec3 normal(plane);
+    if (glm::dot(normal, sphere.centre) + plane.w < -sphere.radius * glm::length(normal))
+      return true;
+  }
+  return false;
+}
+
 std::vector<BoundingSphere> object_spheres(const Scene& scene, const glm::dmat4& T_frame_world) {
   std::vector<BoundingSphere> spheres(scene.objects.size());
   for (std::size_t o = 0; o < scene.objects.size(); ++o) {

@@ -4,6 +4,7 @@
 // Frames and units: vertex positions are in the object's own frame, in metres; an object's
 // T_world_object maps them into the world frame (metres, y up, ground at y = 0 for the built-in
 // city, as in glTF). Triangles are counter-clockwise when seen from their front side.
+#include <array>
 #include <cstdint>
 #include <glm/mat4x4.hpp>
 #include <glm/vec2.hpp>
@@ -11,6 +12,7 @@
 #include <glm/vec4.hpp>
 #include <limits>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -115,6 +117,12 @@ struct BoundingSphere {
 };
 // Every object's BoundingSphere in the frame T_frame_world (rigid) leads to, in the objects' order.
 std::vector<BoundingSphere> object_spheres(const Scene& scene, const glm::dmat4& T_frame_world);
+// True when `sphere` lies wholly outside one of `planes` (in the sphere's frame; a point X is
+// inside plane p when dot(p.xyz, X) + p.w >= 0, p.xyz of any length), as frustum culling asks.
+bool sphere_outside_a_plane(const BoundingSphere& sphere, std::span<const glm::dvec4> planes);
+// The side planes (x >= -w, x <= w, y >= -w, y <= w) of the clip transform T_clip_frame, in the
+// frame it takes points from, as sphere_outside_a_plane reads them.
+std::array<glm::dvec4, 4> frustum_side_planes(const glm::dmat4& T_clip_frame);
 
 // The scene with every triangle cut into n² (regular subdivision: each edge in n equal parts,
 // the pieces of one triangle sharing their vertices), positions, texture coordinates and normals
