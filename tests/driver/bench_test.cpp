@@ -358,6 +358,42 @@ TEST(BenchCli, GlcScenarioHasARowPerPaperCase) {
   EXPECT_EQ(methods, (std::map<std::string, int>{{"glc", 3}, {"glc-2pass", 3}}));
 }
 
+// A depth image at @lod seen from an eye that circles the point it looks at (--eye, --look-at;
+// 3° a frame, about 0.5 m here): the levels are chosen for each timed frame's eye, the scene
+// rebuilt where they change, every method takes it, and each row reports the rebuilds and what
+// they cost, outside its frame time.
+TEST(BenchCli, DepthImageLevelOfDetailFollowsTheEyeOverTheTimedFrames) {
+  const fs::path folder = test::fresh_folder("facet_bench_cli_depth_lod");
+  const fs::path image = folder / "city.exr";
+  ASSERT_EQ(
+      test::run_facet("depth-image --scene builtin:city --size 128x64 --out " + image.string(),
+                      folder / "image_log.txt"),
+      0)
+      << slurp(folder / "image_log.txt");
+  const fs::path out = folder / "bench";
+  ASSERT_EQ(test::run_facet("bench --quick --scenario cylinder --frames 3 --eye 0,4.7,-2 "
+                            "--look-at 0,1.7,-12 --scene depth:" +
+                                image.string() + "@lod=0.3 --out " + out.string(),
+                            folder / "log.txt"),
+            0)
+      << slurp(folder / "log.txt");
+  const nlohmann::json json = nlohmann::json::parse(slurp(out / "bench.json"));
+  ASSERT_FALSE(json["rows"].empty());
+  std::set<std::uint64_t> rebuilds;
+  for (const auto& row : json["rows"]) {
+    ASSERT_FALSE(row.contains("error")) << row.dump();
+    ASSERT_TRUE(row.contains("scene_rebuilds")) << row.dump();
+    rebuilds.insert(row["scene_rebuilds"].get<std::uint64_t>());
+    EXPECT_GT(row["scene_rebuild_ms"].get<double>(), 0.0) << row.dump();
+    EXPECT_GT(row["scene_replace_ms"].get<double>(), 0.0) << row.dump();
+  }
+  // One count for the scenario, shared by its rows, and at least one rebuild in 3 frames.
+  ASSERT_EQ(rebuilds.size(), 1u);
+  EXPECT_GE(*rebuilds.begin(), 1u);
+  EXPECT_LE(*rebuilds.begin(), 3u);
+  EXPECT_NE(slurp(folder / "log.txt").find("depth image level of detail"), std::string::npos);
+}
+
 // At equal error: the cylinder at quarter size runs 512² faces, so it gains a facets tolerance
 // build at the cube map's error, rounded down; the quick sweep does not.
 TEST(BenchScenarios, MatchedToleranceFollowsTheCubeMapsError) {

@@ -141,6 +141,27 @@ TEST_F(XorgDummy, WindowsLandOnTheirMonitorsAndShowTheirOutputs) {
   EXPECT_GT(report["last_frame"]["replicas"].get<double>(), 0.0);
 }
 
+// A depth image at @lod in a windowed run: the camera path moves the eye (a turn a minute about
+// the point looked at, 6° in 60 frames, about 1.1 m here), and the session rebuilds the image's
+// mesh where the levels change, as headless runs do. The report counts those frames.
+TEST_F(XorgDummy, ADepthImageAtLodIsRebuiltAsThePathMovesTheEye) {
+  const fs::path display = write_display("depth_lod");
+  const fs::path image = folder_ / "depth_lod" / "city.exr";
+  ASSERT_EQ(run_shell(std::string(FACET_CLI) + " depth-image --scene builtin:city --size 128x64 " +
+                      "--out " + image.string() + " > /dev/null"),
+            0);
+  const fs::path report_path = folder_ / "depth_lod_report.json";
+  const std::string command = "ASAN_OPTIONS=detect_leaks=0 DISPLAY=" + display_ + " " + FACET_CLI +
+                              " run " + display.string() + " --scene depth:" + image.string() +
+                              "@lod=0.3 --eye 0,4.7,-2 --look-at 0,1.7,-12 --frames 60 --report " +
+                              report_path.string();
+  ASSERT_EQ(run_shell(command), 0);
+  const nlohmann::json report = nlohmann::json::parse(std::ifstream(report_path));
+  EXPECT_GE(report["scene_rebuilds"].get<int>(), 1) << report.dump();
+  EXPECT_LT(report["scene_rebuilds"].get<int>(), 60) << report.dump();
+  EXPECT_GT(report["last_frame"]["replicas"].get<double>(), 0.0);
+}
+
 // --span: one borderless window over all three monitors, each output read back from its own
 // viewport byte for byte.
 TEST_F(XorgDummy, OneSpanningWindowShowsEveryOutputInItsPlace) {

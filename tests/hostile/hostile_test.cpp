@@ -2645,6 +2645,9 @@ void add_flags_error_bench(std::vector<Variant>& out) {
   add_flag_values(out, "bench", bench_dome4, "--rig",
                   inputs(".json") + std::vector<std::string>{"builtin:", "builtin:bogus"});
   add_flag_values(out, "bench", bench, "--scene", scenes());
+  add_flag_values(out, "bench", bench, "--eye", points());
+  add_flag_values(out, "bench", bench, "--look-at", points(), {"--eye=0,1.6,0"});
+  add_flag_values(out, "bench", bench, "--camera", names() + std::vector<std::string>{"nobody"});
 }
 
 // Every input kind with its generator: one test each, its variants run in turn (one process per

@@ -34,6 +34,7 @@ struct BenchCommandOptions {
   std::string out = "out/bench";
   std::string rig = "builtin:dome4";
   std::string scene = "builtin:city";
+  ViewFlags view;
   bool quick = false, static_view = false;
 };
 
@@ -131,7 +132,8 @@ void run(const BenchCommandOptions& command) {
   options.dome_rig = command.rig;
   options.scene = command.scene;
   options.static_view = command.static_view;
-  parse_scene_name(command.scene);  // exit 2 before any GL work
+  options.view = command.view.request();  // malformed flags and scene names before any GL work
+  parse_scene_name(command.scene);
   if (command.quick && command.frames == BenchCommandOptions{}.frames) options.frames = 3;
   if (command.out.empty()) throw InputError("command line", "--out", "expected a folder");
   // Before any GL work: an --out that may not be written is refused at once.
@@ -207,6 +209,7 @@ const Registration registration{
           ->add_option("--scene", options->scene,
                        std::string("Scene of every scenario but scale: ") + kSceneNameSyntax)
           ->capture_default_str();
+      options->view.add_to(*command);
       command->add_flag("--static-view", options->static_view,
                         "Keep the accuracy frame's view on every timed frame (default: it moves)");
       command->add_flag("--quick", options->quick,

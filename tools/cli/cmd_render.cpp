@@ -332,12 +332,9 @@ void run(const RenderOptions& options) {
   GpuTimer timer;
   std::vector<double> frame_ms;
   std::vector<RenderStats> stats;
-  // With @lod: per frame the level choice and, where the levels changed, the rebuild and
-  // replacement (update_ms: all of it, wall clock), and the drawn scene's triangles.
-  struct {
-    std::size_t rebuilds = 0;
-    std::vector<double> update_ms, choose_ms, build_ms, triangles;
-  } lod;
+  // With @lod: per frame the level choice, the rebuild and the replacement of the GPU scene and
+  // the method's scene state, wall clock (the choice and the rebuild alone: lod_scene->stats()).
+  std::vector<double> lod_update_ms;
   glm::dmat4 T_eye_world(1.0);
   // From here on SIGINT and SIGTERM stop the command cleanly (Interrupted, exit 128 + signal).
   watch_interrupts();
@@ -352,15 +349,11 @@ void run(const RenderOptions& options) {
       if (lod_scene->update(glm::dvec3(views.T_world_eye(int(k))[3]))) {
         replace_geometry(gpu_scene, drawn);
         method->replace_scene(drawn, gpu_scene, outputs, settings);
-        ++lod.rebuilds;
-        lod.build_ms.push_back(lod_scene->build_ms());
       }
       glFinish();
-      lod.update_ms.push_back(
+      lod_update_ms.push_back(
           std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - update_start)
               .count());
-      lod.choose_ms.push_back(lod_scene->choose_ms());
-      lod.triangles.push_back(double(drawn.triangle_count()));
     }
     const auto start = std::chrono::steady_clock::now();
     stats.push_back(method->render(T_eye_world, targets, &timer));
@@ -456,14 +449,14 @@ void run(const RenderOptions& options) {
     report["glc_pieces"] = pieces;  // GLCs of the camera (strips, reflector triangles)
   }
   if (lod_scene) {
-    const auto [fewest, most] = std::minmax_element(lod.triangles.begin(), lod.triangles.end());
+    const ViewDependentScene::Summary lod = lod_scene->summary();
     report["depth_lod"] = {{"rebuilds", lod.rebuilds},
-                           {"update_ms", median(lod.update_ms)},
-                           {"choose_ms", median(lod.choose_ms)},
-                           {"rebuild_ms", lod.build_ms.empty() ? 0.0 : median(lod.build_ms)},
-                           {"triangles_median", median(lod.triangles)},
-                           {"triangles_min", *fewest},
-                           {"triangles_max", *most}};
+                           {"update_ms", median(lod_update_ms)},
+                           {"choose_ms", lod.choose_ms},
+                           {"rebuild_ms", lod.build_ms},
+                           {"triangles_median", lod.triangles_median},
+                           {"triangles_min", lod.triangles_min},
+                           {"triangles_max", lod.triangles_max}};
   }
   if (reference) report["reference"] = *reference;
   if (options.json) {

@@ -185,6 +185,7 @@ void run(const RunOptions& options) {
     if (!options.report.empty()) window_options.report = options.report;
     window_options.sync = sync.get();
     window_options.log = console_log("facet run: ");
+    if (driver::uses_depth_lod(scene_name)) window_options.view_dependent_scene = scene_name;
     driver::run_windowed_session(display, scene, path, window_options);
     return;
   }
@@ -192,7 +193,7 @@ void run(const RunOptions& options) {
     std::cerr << "facet run: no display server (DISPLAY is not set): running headless\n";
   auto context = driver::create_headless_context();
   driver::Session session(display, std::move(scene));
-  // Depth images with @lod take their levels as seen from every frame's eye (headless runs).
+  // Depth images with @lod take their levels as seen from every frame's eye.
   if (driver::uses_depth_lod(scene_name))
     session.set_view_dependent_scene(
         std::make_unique<driver::ViewDependentScene>(scene_name, glm::dvec3(path(0.0)[3])));

@@ -26,7 +26,8 @@ struct ViewFlags {
   // OptionFlags table of every command that renders a scene (render, run, bench, depth-image):
   // the three above, and --scene and --material, which each command declares with its own help.
   // "step" is the scene name's step (builtin:city:STEP), set by --scene. A command keeps the rows
-  // of the flags it declares (keep_declared_flags): bench has --scene alone, depth-image --eye.
+  // of the flags it declares (keep_declared_flags): bench has no --material, depth-image only
+  // --scene and --eye.
   static const OptionFlagList& option_flags() {
     static const OptionFlagList flags{{"material", "--material"}, {"scene", "--scene"},
                                       {"step", "--scene"},        {"camera", "--camera"},

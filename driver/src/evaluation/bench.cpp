@@ -233,7 +233,8 @@ struct Runner {
   std::unique_ptr<RenderMethod> method;
   GpuTimer timer;
   std::vector<double> frame_ms;
-  std::vector<double> reused_ms;  // facet pipelines: frames that skip passes 1 and 2
+  std::vector<double> reused_ms;   // facet pipelines: frames that skip passes 1 and 2
+  std::vector<double> replace_ms;  // @lod scenes: taking each rebuilt scene (BenchRow)
   std::vector<RenderStats> stats;
   BenchRow row;
 };
@@ -590,10 +591,22 @@ using Say = std::function<void(const std::string&)>;
 // scale scenarios) or share BenchOptions::scene, so each scene is built once.
 struct LoadedScene {
   std::string name;
-  Scene scene;
+  Scene fixed;  // the scene, unless `lod` holds it
+  // A scene with @lod depth images: rebuilt as the eye moves (follow), the reference built from
+  // the first view's.
+  std::unique_ptr<ViewDependentScene> lod;
   GpuScene gpu;
   std::unique_ptr<ReferenceRaycaster> raycaster;
   std::unique_ptr<FrameViews> views;
+
+  const Scene& scene() const { return lod ? lod->scene() : fixed; }
+  // With `lod`: chooses the levels for frame k's eye; where the scene was rebuilt, replaces the
+  // GPU scene's geometry and returns true.
+  bool follow(int k) {
+    if (!lod || !lod->update(glm::dvec3(views->T_world_eye(k)[3]))) return false;
+    replace_geometry(gpu, lod->scene());
+    return true;
+  }
 };
 
 // Makes `loaded` hold the scene named `scene_text`, building it unless it holds it already (the
@@ -606,15 +619,23 @@ void load_scene_once(std::unique_ptr<LoadedScene>& loaded, const std::string& sc
   const SceneName scene_name = parse_scene_name(scene_text);
   auto next = std::make_unique<LoadedScene>();
   next->name = scene_text;
-  next->scene = load_scene(scene_name);
-  next->gpu = upload_scene(next->scene);
-  next->raycaster = std::make_unique<ReferenceRaycaster>(next->scene);
+  next->fixed = load_scene(scene_name);
   // The view facet render takes by default: outside a closed model, else at its centre.
-  const SceneView view = choose_scene_view(next->scene, {}, scene_name.builtin_city());
+  const SceneView view =
+      choose_scene_view(next->fixed, scene_text == options.scene ? options.view : ViewRequest{},
+                        scene_name.builtin_city());
   next->views = std::make_unique<FrameViews>(view, kBenchFrameStepS, options.static_view);
+  if (uses_depth_lod(scene_name)) {
+    next->lod = std::make_unique<ViewDependentScene>(scene_name,
+                                                     glm::dvec3(next->views->T_world_eye(0)[3]));
+    next->fixed = Scene{};
+  }
+  next->gpu = upload_scene(next->scene());
+  next->raycaster = std::make_unique<ReferenceRaycaster>(next->scene());
   loaded = std::move(next);
   say(format("scene %s: %zu triangles, %zu objects, ready in %.0f ms", scene_text.c_str(),
-             loaded->scene.triangle_count(), loaded->scene.objects.size(), wall_ms_since(start)));
+             loaded->scene().triangle_count(), loaded->scene().objects.size(),
+             wall_ms_since(start)));
   if (!view.message.empty()) say("scene " + scene_text + ": " + view.message);
 }
 
@@ -624,7 +645,7 @@ void load_scene_once(std::unique_ptr<LoadedScene>& loaded, const std::string& sc
 // report row per runner.
 class ScenarioBench {
  public:
-  ScenarioBench(const BenchScenario& scenario, std::string scene_text, const LoadedScene& loaded,
+  ScenarioBench(const BenchScenario& scenario, std::string scene_text, LoadedScene& loaded,
                 const BenchOptions& options, const Say& say)
       : scenario_(scenario),
         scene_text_(std::move(scene_text)),
@@ -668,7 +689,7 @@ class ScenarioBench {
     const auto start = std::chrono::steady_clock::now();
     try {
       runner.method = make_render_method(setting.method);
-      runner.method->prepare(loaded_.scene, loaded_.gpu, scenario_.outputs, setting.settings);
+      runner.method->prepare(loaded_.scene(), loaded_.gpu, scenario_.outputs, setting.settings);
     } catch (const InputError& error) {
       row.error = error.what();
       say_("  " + setting.method + " " + setting.label + ": not run: " + row.error);
@@ -693,8 +714,10 @@ class ScenarioBench {
 
   // Timed frames, interleaved: every setting once per frame, the starting setting rotating.
   void time_frames() {
+    const std::size_t rebuilds_before = loaded_.lod ? loaded_.lod->stats().rebuilds : 0;
     for (int k = 1; k <= options_.frames; ++k) {
       const glm::dmat4 T = loaded_.views->T_eye_world(k);
+      if (loaded_.follow(k)) take_rebuilt_scene();
       for (std::size_t j = 0; j < runners_.size(); ++j) {
         Runner& runner = runners_[(j + std::size_t(k)) % runners_.size()];
         if (!runner.method) continue;
@@ -711,6 +734,32 @@ class ScenarioBench {
         }
       }
       say_(format("  timed frame %d of %d done", k, options_.frames));
+    }
+    if (loaded_.lod) {
+      const ViewDependentScene::Stats& stats = loaded_.lod->stats();
+      const std::vector<double> build_ms(stats.build_ms.begin() + std::ptrdiff_t(rebuilds_before),
+                                         stats.build_ms.end());
+      for (Runner& runner : runners_) {
+        runner.row.scene_rebuilds = stats.rebuilds - rebuilds_before;
+        if (!build_ms.empty()) runner.row.scene_rebuild_ms = median(build_ms);
+        if (!runner.replace_ms.empty()) runner.row.scene_replace_ms = median(runner.replace_ms);
+      }
+      say_(format("  depth image level of detail: %zu rebuilds in %d frames, %.1f ms each",
+                  stats.rebuilds - rebuilds_before, options_.frames, median(build_ms)));
+      // The next scenario starts from the first view's scene, which its reference shows.
+      if (loaded_.follow(0)) say_("  scene back at the first view's levels");
+    }
+  }
+
+  // Every prepared runner's method takes the scene rebuilt for a new view (timed in replace_ms).
+  void take_rebuilt_scene() {
+    for (Runner& runner : runners_) {
+      if (!runner.method) continue;
+      const auto start = std::chrono::steady_clock::now();
+      runner.method->replace_scene(loaded_.scene(), loaded_.gpu, scenario_.outputs,
+                                   runner.setting.settings);
+      glFinish();
+      runner.replace_ms.push_back(wall_ms_since(start));
     }
   }
 
@@ -729,7 +778,7 @@ class ScenarioBench {
     row.scenario = scenario_.name;
     row.scene = scene_text_;
     row.scale_group = scenario_.scale_group;
-    row.triangles_scene = loaded_.scene.triangle_count();
+    row.triangles_scene = loaded_.scene().triangle_count();
     row.method = setting.method;
     row.setting = setting.label;
     row.fit_label = setting.fit_label.empty() ? setting.label : setting.fit_label;
@@ -892,7 +941,7 @@ class ScenarioBench {
 
   const BenchScenario& scenario_;
   const std::string scene_text_;
-  const LoadedScene& loaded_;
+  LoadedScene& loaded_;
   const BenchOptions& options_;
   const Say& say_;
   const glm::dmat4 T0_;  // the first view: the accuracy frame's

@@ -116,6 +116,11 @@ nlohmann::json row_json(const BenchRow& row) {
   if (row.id_pixels_differing_from_facets) {
     j["id_pixels_differing_from_facets"] = *row.id_pixels_differing_from_facets;
   }
+  if (row.scene_rebuilds) {
+    j["scene_rebuilds"] = *row.scene_rebuilds;
+    j["scene_rebuild_ms"] = optional_json(row.scene_rebuild_ms);
+    j["scene_replace_ms"] = optional_json(row.scene_replace_ms);
+  }
   return j;
 }
 
@@ -187,6 +192,9 @@ std::string csv_text(const BenchReport& report) {
         row.geometric_source,
         row.id_pixels_differing_from_facets ? std::to_string(*row.id_pixels_differing_from_facets)
                                             : "",
+        row.scene_rebuilds ? std::to_string(*row.scene_rebuilds) : "",
+        row.scene_rebuild_ms ? format("%.6g", *row.scene_rebuild_ms) : "",
+        row.scene_replace_ms ? format("%.6g", *row.scene_replace_ms) : "",
         row.error};
     for (std::size_t k = 0; k < fields.size(); ++k) text += (k ? "," : "") + csv_field(fields[k]);
     text += "\n";
@@ -427,6 +435,9 @@ std::vector<std::string> bench_csv_columns() {
           "geometric_rms_px",
           "geometric_source",
           "id_pixels_differing_from_facets",
+          "scene_rebuilds",
+          "scene_rebuild_ms",
+          "scene_replace_ms",
           "error"};
 }
 

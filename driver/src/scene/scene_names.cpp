@@ -1,10 +1,12 @@
 #include "facet/driver/scene_names.hpp"
 
+#include <algorithm>
 #include <charconv>
 #include <chrono>
 #include <cmath>
 #include <glm/gtc/matrix_transform.hpp>
 
+#include "facet/driver/bench.hpp"  // median
 #include "facet/driver/depth_image.hpp"
 #include "facet/driver/gltf_loader.hpp"
 #include "facet/projection/errors.hpp"
@@ -235,22 +237,40 @@ bool ViewDependentScene::update(const glm::dvec3& eye_world) {
     changed[k] = std::move(levels);
     any = true;
   }
-  choose_ms_ = ms_since(start);
-  build_ms_ = 0;
-  if (!any) return false;
-  const auto build_start = std::chrono::steady_clock::now();
-  for (std::size_t k = 0; k < images_.size(); ++k) {
-    if (!changed[k]) continue;
-    Image& image = images_[k];
-    image.levels = std::move(*changed[k]);
-    image.mesh = depth_image_mesh(
-        image.image,
-        {.lod_angle_rad = name_.depth_images[k].lod_angle_rad, .lod_levels = image.levels});
-    image.mesh.scene.name = name_.depth_images[k].file.filename().string();
+  ++stats_.updates;
+  stats_.choose_ms.push_back(ms_since(start));
+  if (any) {
+    const auto build_start = std::chrono::steady_clock::now();
+    for (std::size_t k = 0; k < images_.size(); ++k) {
+      if (!changed[k]) continue;
+      Image& image = images_[k];
+      image.levels = std::move(*changed[k]);
+      image.mesh = depth_image_mesh(
+          image.image,
+          {.lod_angle_rad = name_.depth_images[k].lod_angle_rad, .lod_levels = image.levels});
+      image.mesh.scene.name = name_.depth_images[k].file.filename().string();
+    }
+    build();
+    ++stats_.rebuilds;
+    stats_.build_ms.push_back(ms_since(build_start));
   }
-  build();
-  build_ms_ = ms_since(build_start);
-  return true;
+  stats_.triangles.push_back(double(scene_.triangle_count()));
+  return any;
+}
+
+ViewDependentScene::Summary ViewDependentScene::summary() const {
+  Summary summary{.updates = stats_.updates,
+                  .rebuilds = stats_.rebuilds,
+                  .choose_ms = median(stats_.choose_ms),
+                  .build_ms = median(stats_.build_ms),
+                  .triangles_median = median(stats_.triangles)};
+  if (!stats_.triangles.empty()) {
+    const auto [fewest, most] =
+        std::minmax_element(stats_.triangles.begin(), stats_.triangles.end());
+    summary.triangles_min = *fewest;
+    summary.triangles_max = *most;
+  }
+  return summary;
 }
 
 FrameViews::FrameViews(const SceneView& view, double city_step_s, bool static_view)

@@ -419,7 +419,7 @@ nlohmann::json windowed_report(const SessionDisplay& display, std::span<const Mo
                                std::span<const detail::OutputsWindow> windows,
                                std::span<const WindowReport> reports,
                                const std::vector<std::string>& monitor_events,
-                               const FrameStats& last_frame) {
+                               const FrameStats& last_frame, std::uint64_t scene_rebuilds) {
   nlohmann::json windows_json = nlohmann::json::array();
   for (std::size_t w = 0; w < windows.size(); ++w) {
     nlohmann::json outputs_json = nlohmann::json::array();
@@ -441,6 +441,7 @@ nlohmann::json windowed_report(const SessionDisplay& display, std::span<const Mo
   }
   return {{"windows", windows_json},
           {"monitor_events", monitor_events},
+          {"scene_rebuilds", scene_rebuilds},
           {"last_frame", frame_stats_to_json(last_frame)}};
 }
 
@@ -478,6 +479,9 @@ void run_windowed_session(const SessionDisplay& display, const Scene& scene, con
 
   windows.front().context->make_current();
   Session session(display, scene);
+  if (options.view_dependent_scene)
+    session.set_view_dependent_scene(std::make_unique<ViewDependentScene>(
+        *options.view_dependent_scene, glm::dvec3(path(0.0)[3])));
   session.set_pattern(options.pattern);
   const detail::WindowPresenter presenter(session.targets());
   const Program overlay_program =
@@ -495,7 +499,7 @@ void run_windowed_session(const SessionDisplay& display, const Scene& scene, con
   FrameStats stats;
   // SIGINT or SIGTERM (after watch_interrupts) closes the windows like Escape, but writes no
   // report: the run ends with Interrupted below.
-  std::uint64_t frames_shown = 0;
+  std::uint64_t frames_shown = 0, scene_rebuilds = 0;
   int interrupted_by = 0;
   for (std::uint64_t frame = 0; !options.frames || frame < *options.frames; ++frame) {
     if (detail::poll_run_ends(windows, nav.quit, interrupted_by)) break;
@@ -519,6 +523,7 @@ void run_windowed_session(const SessionDisplay& display, const Scene& scene, con
     }
     // In a cluster the barrier is for rendered outputs: wait for the GPU first.
     stats = session.render(state, options.sync != nullptr);
+    scene_rebuilds += stats.scene_rebuilt;
     if (options.sync) {
       nlohmann::json line;
       show = options.sync->ready_to_swap(state, line);
@@ -550,8 +555,8 @@ void run_windowed_session(const SessionDisplay& display, const Scene& scene, con
   }
 
   if (options.report && !interrupted_by) {
-    const nlohmann::json report =
-        windowed_report(display, monitors, placements, windows, reports, nav.messages, stats);
+    const nlohmann::json report = windowed_report(display, monitors, placements, windows, reports,
+                                                  nav.messages, stats, scene_rebuilds);
     write_atomically(*options.report, [&](const fs::path& temporary) {
       std::ofstream(temporary) << report.dump(2) << '\n';
     });

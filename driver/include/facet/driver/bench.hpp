@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "facet/driver/render_method.hpp"
+#include "facet/driver/scene_view.hpp"
 #include "facet/projection/atomic_folder.hpp"
 
 namespace facet::driver {
@@ -33,6 +34,9 @@ struct BenchOptions {
   std::vector<std::string> scenarios;
   // The scene of every scenario but "scale"'s (which sets its own): a parse_scene_name name.
   std::string scene = "builtin:city";
+  // The view of the scenarios that draw `scene` (choose_scene_view; the others take their own
+  // scene's default view).
+  ViewRequest view;
   // Keep frame 0's view on every timed frame (FrameViews); by default the view moves.
   bool static_view = false;
   int frames = 5;           // timed frames per setting (>= 1)
@@ -119,6 +123,14 @@ struct BenchRow {
   std::string geometric_source;
   // facets-gs: pixels whose ID differs from same_ids_as' image on the accuracy frame.
   std::optional<std::uint64_t> id_pixels_differing_from_facets;
+  // Scenes with @lod depth images (scene_names.hpp), else nullopt. Before each timed frame the
+  // levels are chosen for its eye, and where they change the scene is rebuilt, once for every row
+  // of the scenario, outside frame_ms: the rebuilds over the timed frames, the median CPU ms of
+  // one (ViewDependentScene::Stats::build_ms), and the median ms of this row's method taking the
+  // rebuilt scene (the shared GpuScene's replace_geometry, then RenderMethod::replace_scene, then
+  // glFinish).
+  std::optional<std::uint64_t> scene_rebuilds;
+  std::optional<double> scene_rebuild_ms, scene_replace_ms;
 };
 
 // Least-squares slope of log(y) against log(x): the exponent b of y = a · x^b. nullopt when fewer

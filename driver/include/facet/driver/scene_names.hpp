@@ -99,9 +99,21 @@ class ViewDependentScene {
   const Scene& scene() const { return scene_; }
   // load_scene's source_ids table of the current scene.
   const std::vector<std::uint32_t>& source_ids() const { return source_ids_; }
-  // The last update's wall-clock milliseconds: choosing the levels, and rebuilding (0 without).
-  double choose_ms() const { return choose_ms_; }
-  double build_ms() const { return build_ms_; }
+  // What the updates so far did (wall-clock milliseconds on the CPU).
+  struct Stats {
+    std::size_t updates = 0, rebuilds = 0;
+    std::vector<double> choose_ms;  // per update: choosing every @lod image's levels
+    std::vector<double> build_ms;   // per rebuild: the meshes and the merged scene
+    std::vector<double> triangles;  // per update: the scene's triangles after it
+  };
+  const Stats& stats() const { return stats_; }
+  // Medians of stats() (0 where there is none) and the fewest and most triangles.
+  struct Summary {
+    std::size_t updates = 0, rebuilds = 0;
+    double choose_ms = 0, build_ms = 0;
+    double triangles_median = 0, triangles_min = 0, triangles_max = 0;
+  };
+  Summary summary() const;
 
  private:
   void build();
@@ -116,7 +128,7 @@ class ViewDependentScene {
   std::vector<Image> images_;
   Scene scene_;
   std::vector<std::uint32_t> source_ids_;
-  double choose_ms_ = 0, build_ms_ = 0;
+  Stats stats_;
 };
 
 // The eye pose of frame k of `facet render` and `facet bench`, turning about world up (y) by 360°

@@ -13,6 +13,7 @@
 #include "facet/driver/log.hpp"
 #include "facet/driver/monitors.hpp"
 #include "facet/driver/scene.hpp"
+#include "facet/driver/scene_names.hpp"
 #include "facet/driver/scene_view.hpp"
 #include "facet/driver/session.hpp"
 #include "facet/projection/atomic_folder.hpp"
@@ -116,6 +117,10 @@ struct WindowRunOptions {
   std::optional<TestPattern> pattern;
   // The windows opened (info), the pattern shown (info), monitors that come or go (warning).
   LogSink log;
+  // A scene name with @lod depth images (uses_depth_lod): the session draws it instead of
+  // `scene`, built for the camera path's first eye and rebuilt where the eye's levels change
+  // (Session::set_view_dependent_scene). The report counts the frames that rebuilt it.
+  std::optional<SceneName> view_dependent_scene;
 };
 
 // Opens the windows (one per output on its monitor, or one spanning window), renders until the
