@@ -328,6 +328,41 @@ TEST(BenchScenarios, EveryScenarioHasValidOutputsAndEveryMethod) {
   EXPECT_THROW(driver::make_bench_scenarios(options), InputError);
 }
 
+// Liu, Liu & Wu's comparison: the polygons and DPCIs of them at two sizes, every method, all from
+// the DPCI's eye. A DPCI's mesh has two triangles per seen pixel at most, whatever the polygons;
+// each row is checked against the oracle of the scene it draws.
+TEST(BenchCli, DepthScenarioComparesPolygonsWithTheirDpcis) {
+  const fs::path folder = test::fresh_folder("facet_bench_cli_depth");
+  const fs::path out = folder / "bench";
+  ASSERT_EQ(test::run_facet(
+                "bench --quick --scenario depth --frames 1 --size-scale 0.5 --out " + out.string(),
+                folder / "log.txt"),
+            0)
+      << slurp(folder / "log.txt");
+  const nlohmann::json json = nlohmann::json::parse(slurp(out / "bench.json"));
+  std::map<std::string, std::uint64_t> triangles;
+  std::map<std::string, std::string> scenes;
+  for (const auto& row : json["rows"]) {
+    ASSERT_FALSE(row.contains("error")) << row.dump();
+    const std::string scenario = row["scenario"].get<std::string>();
+    triangles[scenario] = row["triangles_scene"].get<std::uint64_t>();
+    scenes[scenario] = row["scene"].get<std::string>();
+    if (row["method"] == "facets") {
+      EXPECT_LE(row["id_mismatch"].get<double>(), 0.01) << row.dump();
+    }
+  }
+  ASSERT_EQ(triangles.size(), 3u);
+  EXPECT_EQ(scenes["depth:city"], "builtin:city from its DPCI's eye");
+  EXPECT_EQ(scenes["depth:city@dpci64"], "DPCI 64x64 of builtin:city");
+  EXPECT_EQ(scenes["depth:city@dpci32"], "DPCI 32x32 of builtin:city");
+  // Cylinder W x H plus cap H x H pixels, two triangles each at most.
+  EXPECT_GT(triangles["depth:city@dpci64"], 2000u);
+  EXPECT_LE(triangles["depth:city@dpci64"], 2u * (64 * 64 + 64 * 64));
+  EXPECT_LE(triangles["depth:city@dpci32"], 2u * (32 * 32 + 32 * 32));
+  EXPECT_GT(triangles["depth:city@dpci64"], 3 * triangles["depth:city@dpci32"]);
+  EXPECT_GT(triangles["depth:city"], triangles["depth:city@dpci64"]);
+}
+
 // The GLC paper cases: three scenarios of a glc and a glc-2pass row each; glc matches the
 // oracle's GLC rays, glc-2pass (the paper's two-pass rasterization) comes close.
 TEST(BenchCli, GlcScenarioHasARowPerPaperCase) {

@@ -180,14 +180,17 @@ const Registration registration{
       command
           ->add_option("--scenario", options->scenario,
                        "cylinder | deformation[-80x60|-128x128] | dome | dome-master | dome4 | "
-                       "scale[-scenes|-facets|-width] | glc[-city|-panorama|-mirror] | "
+                       "scale[-scenes|-facets|-width] | glc[-city|-panorama|-mirror] | depth | "
                        "cluster | all (all: cylinder, "
                        "deformation, dome; scale: its three parts, every method over "
                        "builtin:city, :4, :8 on the cylinder and the dome, the facet methods over "
                        "40 to 320 strips, and every method at three output widths, each with the "
                        "exponent of frame time fitted; glc: the GLC paper cases (cross-slit "
                        "city 1024x320, 360-degree panorama 800x600, mirror sphere 800x800) by "
-                       "the glc method; cluster: the cluster protocol's cost per "
+                       "the glc method; depth: builtin:city and city-fine:8 against DPCIs of "
+                       "the city at 512 and 256 on the dome master, from the DPCI's eye; "
+                       "cluster: the "
+                       "cluster protocol's cost per "
                        "frame and loss detection at 2, 4, 8 nodes, no rendering)")
           ->capture_default_str();
       command

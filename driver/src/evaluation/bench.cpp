@@ -11,6 +11,7 @@
 #include <set>
 
 #include "facet/driver/city.hpp"
+#include "facet/driver/depth_image.hpp"
 #include "facet/driver/display_outputs.hpp"
 #include "facet/driver/gpu_scene.hpp"
 #include "facet/driver/gpu_timer.hpp"
@@ -317,7 +318,8 @@ std::vector<std::string> checked_scenario_names(const BenchOptions& options) {
                                               "glc",
                                               "glc-city",
                                               "glc-panorama",
-                                              "glc-mirror"};
+                                              "glc-mirror",
+                                              "depth"};
   std::vector<std::string> names = options.scenarios;
   if (names.empty()) names = {"cylinder", "deformation", "dome"};
   for (const std::string& name : names) {
@@ -325,7 +327,7 @@ std::vector<std::string> checked_scenario_names(const BenchOptions& options) {
       throw InputError("command line", OptionName{"scenarios"},
                        "expected cylinder, deformation, deformation-80x60, deformation-128x128, "
                        "dome, dome-master, dome4, scale (scale-scenes, scale-facets, scale-width), "
-                       "glc (glc-city, glc-panorama, glc-mirror) or all; got '" +
+                       "glc (glc-city, glc-panorama, glc-mirror), depth or all; got '" +
                            name + "'");
     }
   }
@@ -495,6 +497,43 @@ void add_scale_scenarios(const std::string& name, const ScenarioSizes& sizes,
   if (all_parts || name == "scale-width") add_scale_width_scenarios(sizes, scenarios);
 }
 
+// "depth": Liu, Liu & Wu's comparison of polygons against depth images (their Table 1) on the
+// 180-degree dome master: the city's polygons, the same surfaces cut into 64 times the triangles
+// (city-fine:8), and DPCIs of the city at 512 and 256, every method (quick: the city and its DPCIs
+// at 64 and 32, facets at 1 px and the cube map), all from the DPCI's eye.
+void add_depth_scenarios(const ScenarioSizes& sizes, std::vector<BenchScenario>& scenarios) {
+  const std::string source = "builtin:city";
+  const std::vector<std::string> polygons =
+      sizes.quick ? std::vector<std::string>{source}
+                  : std::vector<std::string>{source, "builtin:city-fine:8"};
+  const std::vector<int> image_sizes =
+      sizes.quick ? std::vector<int>{64, 32} : std::vector<int>{512, 256};
+  auto add = [&](const std::string& scene, int image_size) {
+    BenchScenario s;
+    s.scene = scene;
+    s.depth_image_eye = true;
+    s.depth_image_size = glm::ivec2(image_size);
+    s.outputs = load_display_outputs("builtin:dome180", scaled({2048, 2048}, sizes.scale));
+    const std::string drawn = image_size > 0
+                                  ? "a " + size_text(s.depth_image_size) + " DPCI of " + scene
+                                  : scene + "'s polygons";
+    s.name = "depth:" + scene.substr(std::string("builtin:").size()) +
+             (image_size > 0 ? "@dpci" + std::to_string(image_size) : "");
+    s.description = "the 180-degree dome at " + size_text(s.outputs[0].warp.output_size) + ", " +
+                    drawn + ", from the DPCI's eye";
+    const FacetTolerance tolerance{sizes.quick ? 1.0 : 0.25};
+    s.settings = sweep({tolerance}, tolerance, {tolerance}, sizes.faces({512}), {1});
+    if (sizes.quick)
+      std::erase_if(s.settings, [](const BenchSetting& setting) {
+        return setting.method != "facets" && setting.method != "cubemap";
+      });
+    s.matched_cube_face = sizes.quick ? 0 : sizes.faces({512})[0];
+    scenarios.push_back(std::move(s));
+  };
+  for (const std::string& scene : polygons) add(scene, 0);
+  for (const int image_size : image_sizes) add(source, image_size);
+}
+
 // "deformation" (or one of its parts): the view deformation on an 80x60 and (full sweep only) a
 // 128x128 camera texture.
 void add_deformation_scenarios(const std::string& name, const ScenarioSizes& sizes,
@@ -572,6 +611,8 @@ std::vector<BenchScenario> make_bench_scenarios(const BenchOptions& options) {
       add_glc_scenarios(name, sizes, scenarios);
     } else if (name.starts_with("scale")) {
       add_scale_scenarios(name, sizes, scenarios);
+    } else if (name == "depth") {
+      add_depth_scenarios(sizes, scenarios);
     } else if (name.starts_with("deformation")) {
       add_deformation_scenarios(name, sizes, scenarios);
     } else {
@@ -609,21 +650,49 @@ struct LoadedScene {
   }
 };
 
-// Makes `loaded` hold the scene named `scene_text`, building it unless it holds it already (the
-// last scene's GPU and CPU memory freed first).
+// A depth-image scenario's scene (BenchScenario::depth_image_eye): the polygons with the eye of
+// their DPCI as a camera, or that DPCI's grid mesh.
+Scene depth_scenario_scene(Scene polygons, const SceneName& name, glm::ivec2 image_size) {
+  const glm::dmat4 T_world_image =
+      depth_image_pose(polygons, name.builtin_city(), DepthImageKind::dpci, std::nullopt);
+  if (image_size.x > 0) {
+    return depth_image_mesh(render_depth_image(polygons, {.kind = DepthImageKind::dpci,
+                                                          .size = image_size,
+                                                          .T_world_image = T_world_image}))
+        .scene;
+  }
+  SceneCamera eye;
+  eye.name = kDepthImageEyeCamera;
+  eye.T_world_camera = T_world_image;
+  polygons.cameras.push_back(eye);
+  return polygons;
+}
+
+// Makes `loaded` hold the scenario's scene, `scene_text` unless the scenario draws a depth
+// image, building it unless it holds it already (the last scene's GPU and CPU memory freed
+// first).
 void load_scene_once(std::unique_ptr<LoadedScene>& loaded, const std::string& scene_text,
-                     const BenchOptions& options, const Say& say) {
-  if (loaded && loaded->name == scene_text) return;
+                     const BenchScenario& scenario, const BenchOptions& options, const Say& say) {
+  const std::string name =
+      !scenario.depth_image_eye ? scene_text
+      : scenario.depth_image_size.x > 0
+          ? "DPCI " + size_text(scenario.depth_image_size) + " of " + scene_text
+          : scene_text + " from its DPCI's eye";
+  if (loaded && loaded->name == name) return;
   loaded.reset();
   const auto start = std::chrono::steady_clock::now();
   const SceneName scene_name = parse_scene_name(scene_text);
   auto next = std::make_unique<LoadedScene>();
-  next->name = scene_text;
+  next->name = name;
   next->fixed = load_scene(scene_name);
+  if (scenario.depth_image_eye)
+    next->fixed =
+        depth_scenario_scene(std::move(next->fixed), scene_name, scenario.depth_image_size);
   // The view facet render takes by default: outside a closed model, else at its centre.
-  const SceneView view =
-      choose_scene_view(next->fixed, scene_text == options.scene ? options.view : ViewRequest{},
-                        scene_name.builtin_city());
+  const SceneView view = choose_scene_view(
+      next->fixed,
+      !scenario.depth_image_eye && scene_text == options.scene ? options.view : ViewRequest{},
+      scene_name.builtin_city());
   next->views = std::make_unique<FrameViews>(view, kBenchFrameStepS, options.static_view);
   if (uses_depth_lod(scene_name)) {
     next->lod = std::make_unique<ViewDependentScene>(scene_name,
@@ -633,10 +702,10 @@ void load_scene_once(std::unique_ptr<LoadedScene>& loaded, const std::string& sc
   next->gpu = upload_scene(next->scene());
   next->raycaster = std::make_unique<ReferenceRaycaster>(next->scene());
   loaded = std::move(next);
-  say(format("scene %s: %zu triangles, %zu objects, ready in %.0f ms", scene_text.c_str(),
+  say(format("scene %s: %zu triangles, %zu objects, ready in %.0f ms", name.c_str(),
              loaded->scene().triangle_count(), loaded->scene().objects.size(),
              wall_ms_since(start)));
-  if (!view.message.empty()) say("scene " + scene_text + ": " + view.message);
+  if (!view.message.empty()) say("scene " + name + ": " + view.message);
 }
 
 // One scenario's bench, in the order run_bench calls it: the setup (each output's warp inverse,
@@ -972,9 +1041,9 @@ BenchReport run_bench(const BenchOptions& options, const std::string& renderer,
   std::unique_ptr<LoadedScene> loaded;
   for (const BenchScenario& scenario : scenarios) {
     const std::string scene_text = scenario.scene.empty() ? options.scene : scenario.scene;
-    load_scene_once(loaded, scene_text, options, say);
+    load_scene_once(loaded, scene_text, scenario, options, say);
     say("scenario " + scenario.name + ": " + scenario.description);
-    ScenarioBench bench(scenario, scene_text, *loaded, options, say);
+    ScenarioBench bench(scenario, loaded->name, *loaded, options, say);
     for (const BenchSetting& setting :
          with_matched_tolerance(scenario, bench.matched_cube_max_px()))
       bench.prepare(setting);

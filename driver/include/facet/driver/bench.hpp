@@ -67,6 +67,12 @@ struct BenchScenario {
   // sizes, "scale-facets-cylinder" over facet counts, "scale-width-cylinder" over output widths);
   // the exponent fits (bench_scale_fits) run over the rows of one group, method and fit label.
   std::string scale_group;
+  // Depth-image scenarios ("depth"): all of them look from the eye of a DPCI of `scene`
+  // (depth_image_pose at the scene's default view), turning on the spot there. With a
+  // depth_image_size the scene drawn is that DPCI (render_depth_image at this cylinder size, the
+  // cap H x H, meshed at step 1); without, `scene`'s polygons.
+  bool depth_image_eye = false;
+  glm::ivec2 depth_image_size{0, 0};
   std::vector<OutputSpec> outputs;
   std::vector<BenchSetting> settings;
   // The cube face edge at whose geometric max error run_bench adds a facets tolerance build
