@@ -189,9 +189,8 @@ const Registration registration{
                        "city 1024x320, 360-degree panorama 800x600, mirror sphere 800x800) by "
                        "the glc method; depth: builtin:city and city-fine:8 against DPCIs of "
                        "the city at 512 and 256 on the dome master, from the DPCI's eye; "
-                       "cluster: the "
-                       "cluster protocol's cost per "
-                       "frame and loss detection at 2, 4, 8 nodes, no rendering)")
+                       "cluster: the cluster protocol's cost per frame and loss detection at 2, "
+                       "4, 8 nodes, no rendering)")
           ->capture_default_str();
       command
           ->add_option("--frames", options->frames,

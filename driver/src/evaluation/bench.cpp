@@ -783,7 +783,7 @@ class ScenarioBench {
 
   // Timed frames, interleaved: every setting once per frame, the starting setting rotating.
   void time_frames() {
-    const std::size_t rebuilds_before = loaded_.lod ? loaded_.lod->stats().rebuilds : 0;
+    const std::size_t rebuilds_before = loaded_.lod ? loaded_.lod->stats().build_ms.size() : 0;
     for (int k = 1; k <= options_.frames; ++k) {
       const glm::dmat4 T = loaded_.views->T_eye_world(k);
       if (loaded_.follow(k)) take_rebuilt_scene();
@@ -809,12 +809,12 @@ class ScenarioBench {
       const std::vector<double> build_ms(stats.build_ms.begin() + std::ptrdiff_t(rebuilds_before),
                                          stats.build_ms.end());
       for (Runner& runner : runners_) {
-        runner.row.scene_rebuilds = stats.rebuilds - rebuilds_before;
+        runner.row.scene_rebuilds = build_ms.size();
         if (!build_ms.empty()) runner.row.scene_rebuild_ms = median(build_ms);
         if (!runner.replace_ms.empty()) runner.row.scene_replace_ms = median(runner.replace_ms);
       }
       say_(format("  depth image level of detail: %zu rebuilds in %d frames, %.1f ms each",
-                  stats.rebuilds - rebuilds_before, options_.frames, median(build_ms)));
+                  build_ms.size(), options_.frames, median(build_ms)));
       // The next scenario starts from the first view's scene, which its reference shows.
       if (loaded_.follow(0)) say_("  scene back at the first view's levels");
     }

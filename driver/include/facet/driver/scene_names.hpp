@@ -101,15 +101,14 @@ class ViewDependentScene {
   const std::vector<std::uint32_t>& source_ids() const { return source_ids_; }
   // What the updates so far did (wall-clock milliseconds on the CPU).
   struct Stats {
-    std::size_t updates = 0, rebuilds = 0;
     std::vector<double> choose_ms;  // per update: choosing every @lod image's levels
     std::vector<double> build_ms;   // per rebuild: the meshes and the merged scene
     std::vector<double> triangles;  // per update: the scene's triangles after it
   };
   const Stats& stats() const { return stats_; }
-  // Medians of stats() (0 where there is none) and the fewest and most triangles.
+  // The rebuilds, medians of stats() (0 where there is none) and the fewest and most triangles.
   struct Summary {
-    std::size_t updates = 0, rebuilds = 0;
+    std::size_t rebuilds = 0;
     double choose_ms = 0, build_ms = 0;
     double triangles_median = 0, triangles_min = 0, triangles_max = 0;
   };
