@@ -1,7 +1,7 @@
 // Naive multi-pass baseline: one glDrawArrays per (facet, record), pulling the record's
 // triangles; the same arithmetic as replication/draw.vert, without any coverage work.
-layout(location = 44) uniform uint facet;
-layout(location = 45) uniform uint record;
+layout(location = 53) uniform uint drawn_facet;
+layout(location = 54) uniform uint drawn_record;
 
 out vec3 v_n_world;
 out vec2 v_uv;
@@ -22,16 +22,16 @@ vec4 facet_clip(uint f, vec3 p_eye);
 float facet_clip_distance(uint f, int k, vec3 p_eye);
 
 void main() {
-  uint object = record_object(record);
-  uint v = record_vertex(record, uint(gl_VertexID));
+  uint object = record_object(drawn_record);
+  uint v = record_vertex(drawn_record, uint(gl_VertexID));
   vec3 p_eye = eye_position(object, v);
-  gl_Position = facet_clip(facet, p_eye);
-  for (int k = 0; k < 4; ++k) gl_ClipDistance[k] = facet_clip_distance(facet, k, p_eye);
+  gl_Position = facet_clip(drawn_facet, p_eye);
+  for (int k = 0; k < 4; ++k) gl_ClipDistance[k] = facet_clip_distance(drawn_facet, k, p_eye);
   v_n_world = world_normal(object, v);
   v_uv = vertex_uv(v);
   v_p_world = world_position(object, v);
   v_p_eye = p_eye;
   uint corner = uint(gl_VertexID) % 3u;
   v_barycentric = vec3(corner == 0u, corner == 1u, corner == 2u);
-  v_triangle_id = record_first_id(record) + uint(gl_VertexID) / 3u;
+  v_triangle_id = record_first_id(drawn_record) + uint(gl_VertexID) / 3u;
 }

@@ -17,6 +17,7 @@
 #include "facet/driver/city.hpp"
 #include "facet/driver/display_outputs.hpp"
 #include "facet/driver/material_shader.hpp"
+#include "facet/driver/program.hpp"
 #include "facet/driver/render_method.hpp"
 #include "facet/projection/errors.hpp"
 #include "gl_test_context.hpp"
@@ -137,6 +138,42 @@ TEST(Materials, UserFilesCompileAndBrokenOnesNameTheirFileAndLine) {
                    scratch.write("depth.frag", "void f() { gl_FragDepth = 0.5; }").string()),
                InputError);
   EXPECT_THROW(load_material_shader(scratch.path().string() + "/good.glsl"), InputError);
+}
+
+// A link error the material does not cause (a vertex stage calling a function nobody defines)
+// stays facet's own ShaderError with the driver's whole log, not an error about the material.
+TEST(Materials, LinkErrorsElsewhereStayShaderErrors) {
+  test::shared_context();
+  const MaterialShader material = load_material_shader("lit");
+  ProgramBuilder builder;
+  builder.define("WRITE_TRIANGLE_ID", "1");
+  builder.source(ShaderStage::vertex, "broken vertex", R"(
+out vec3 v_n_world;
+out vec2 v_uv;
+out vec3 v_p_world;
+out vec3 v_p_eye;
+out vec3 v_barycentric;
+flat out uint v_triangle_id;
+vec4 undefined_helper();
+void main() {
+  v_n_world = vec3(0.0, 1.0, 0.0);
+  v_uv = vec2(0.0);
+  v_p_world = vec3(0.0);
+  v_p_eye = vec3(0.0, 0.0, -1.0);
+  v_barycentric = vec3(1.0, 0.0, 0.0);
+  v_triangle_id = 1u;
+  gl_Position = undefined_helper();
+}
+)");
+  add_material_stages(builder, material);
+  try {
+    link_with_material(builder, material);
+    ADD_FAILURE() << "a program calling an undefined function linked";
+  } catch (const InputError& e) {
+    ADD_FAILURE() << "blamed on the material: " << e.what();
+  } catch (const ShaderError& e) {
+    EXPECT_NE(std::string(e.what()).find("undefined_helper"), std::string::npos) << e.what();
+  }
 }
 
 // The material shades; the replication and the IDs never see it.

@@ -4,6 +4,7 @@
 
 #include <map>
 #include <regex>
+#include <set>
 #include <string>
 
 #include "facet/driver/facet_gpu.hpp"
@@ -143,6 +144,58 @@ TEST(Shaders, MaterialShadingBindingMatchesTheCpp) {
         << name;
     EXPECT_EQ(std::stoul(match[1]), material_shading_binding) << name;
   }
+}
+
+// Explicit uniform locations are program-wide, and every replication stage links with
+// replication_lib.comp: a location the library uses may not name another uniform there, and a
+// stage's uniform may not take the name of one of the library's functions. llvmpipe links such
+// programs when one of the two is unused; NVIDIA's linker refuses both.
+TEST(Shaders, ReplicationUniformsAgreeWithTheLibrary) {
+  const std::regex declaration(R"(layout\(location = (\d+)\) uniform \w+ (\w+)(\[)?)");
+  const auto locations = [&](std::string_view name) {
+    std::map<int, std::string> names;
+    const std::string text(embedded_shader(name).text);
+    for (std::sregex_iterator it(text.begin(), text.end(), declaration), end; it != end; ++it) {
+      EXPECT_FALSE((*it)[3].matched) << name << ": array uniform " << (*it)[2]
+                                     << " takes several locations; this test reads one";
+      names[std::stoi((*it)[1])] = (*it)[2];
+    }
+    return names;
+  };
+  const auto library = locations("replication/replication_lib.comp");
+  ASSERT_GE(library.size(), 3u);
+  std::set<std::string> library_functions;
+  const std::string library_text(embedded_shader("replication/replication_lib.comp").text);
+  const std::regex function(R"((?:^|\n)\w+ (\w+)\()");
+  for (std::sregex_iterator it(library_text.begin(), library_text.end(), function), end; it != end;
+       ++it)
+    library_functions.insert((*it)[1]);
+  ASSERT_TRUE(library_functions.contains("record")) << "the library's functions were not read";
+  const std::regex any_uniform(R"(uniform \w+ (\w+)\s*;)");
+  int stages = 0;
+  for (const EmbeddedShader& shader : embedded_shaders()) {
+    if (!shader.name.starts_with("replication/") ||
+        shader.name == "replication/replication_lib.comp")
+      continue;
+    ++stages;
+    const std::string text(shader.text);
+    for (std::sregex_iterator it(text.begin(), text.end(), any_uniform), end; it != end; ++it) {
+      EXPECT_FALSE(library_functions.contains((*it)[1]))
+          << shader.name << ": uniform " << (*it)[1] << " has a library function's name";
+    }
+    for (const auto& [location, name] : locations(shader.name)) {
+      const auto in_library = library.find(location);
+      if (in_library != library.end()) {
+        EXPECT_EQ(in_library->second, name) << shader.name << ": location " << location;
+      }
+      for (const auto& [library_location, library_name] : library) {
+        if (library_name == name) {
+          EXPECT_EQ(library_location, location) << shader.name << ": uniform " << name;
+        }
+      }
+    }
+  }
+  EXPECT_GE(stages, 10);
 }
 
 TEST(Shaders, EveryEmbeddedShaderCompiles) {

@@ -16,6 +16,7 @@
 #include "facet/driver/gpu_scene.hpp"
 #include "facet/driver/gpu_timer.hpp"
 #include "facet/driver/perspective_image.hpp"
+#include "facet/driver/program.hpp"
 #include "facet/driver/reference.hpp"
 #include "facet/driver/scene_names.hpp"
 #include "facet/driver/scene_view.hpp"
@@ -749,22 +750,28 @@ class ScenarioBench {
   }
 
   // Prepares `setting`'s method and measures its accuracy on the warm-up frame; a setting whose
-  // prepare throws InputError keeps a row with the error and is not timed.
+  // prepare throws InputError or ShaderError keeps a row with the error and is not timed.
   void prepare(const BenchSetting& setting) {
     Runner runner;
     runner.setting = setting;
     runner.row = first_columns(setting);
     BenchRow& row = runner.row;
+    // InputError: the setting does not apply here; ShaderError: this GL driver refuses the
+    // method's shaders (the driver's log is in the row). The other settings still run.
+    const auto not_run = [&](const std::exception& error) {
+      row.error = error.what();
+      say_("  " + setting.method + " " + setting.label + ": not run: " + row.error);
+      runner.method.reset();
+      runners_.push_back(std::move(runner));
+    };
     const auto start = std::chrono::steady_clock::now();
     try {
       runner.method = make_render_method(setting.method);
       runner.method->prepare(loaded_.scene(), loaded_.gpu, scenario_.outputs, setting.settings);
     } catch (const InputError& error) {
-      row.error = error.what();
-      say_("  " + setting.method + " " + setting.label + ": not run: " + row.error);
-      runner.method.reset();
-      runners_.push_back(std::move(runner));
-      return;
+      return not_run(error);
+    } catch (const ShaderError& error) {
+      return not_run(error);
     }
     const double prepare_ms = wall_ms_since(start);
     measure_ids(runner);

@@ -12,6 +12,10 @@
 namespace facet::driver::detail {
 namespace {
 
+// naive.vert's uniforms, past replication_lib.comp's locations (the two link into one stage).
+constexpr GLint kFacetLocation = 53;
+constexpr GLint kRecordLocation = 54;
+
 class NaiveMethod final : public FacetMethodBase {
  public:
   std::string_view name() const override { return "naive"; }
@@ -53,7 +57,7 @@ class NaiveMethod final : public FacetMethodBase {
       for (std::uint32_t f = 0; f < pieces.size(); ++f) {
         if (!pieces.drawn(f)) continue;
         for (std::size_t slot = 0; slot < draw_.size(); ++slot)
-          glProgramUniform1ui(draw_.program(slot).id(), 44, f);
+          glProgramUniform1ui(draw_.program(slot).id(), kFacetLocation, f);
         for (std::uint32_t m = 0; m < material_count(); ++m) {
           for (std::uint32_t r : records_by_material_[m]) {
             const GpuRecord& record = records_[r];
@@ -72,7 +76,7 @@ class NaiveMethod final : public FacetMethodBase {
               set_material(program, m);
               bound_material = m;
             }
-            glUniform1ui(45, r);
+            glUniform1ui(kRecordLocation, r);
             glDrawArrays(GL_TRIANGLES, 0, GLsizei(3 * record.triangle_count));
             stats.replicas += record.triangle_count;
           }

@@ -174,15 +174,41 @@ void add_material_stages(ProgramBuilder& builder, const MaterialShader& material
   }
 }
 
+namespace {
+
+// The material stages with a minimal vertex stage: what check_material_shader links.
+ProgramBuilder material_check_program(const MaterialShader& material) {
+  ProgramBuilder builder;
+  builder.define("WRITE_TRIANGLE_ID", "1");
+  builder.source(ShaderStage::vertex, "material check", std::string(kCheckVertex));
+  add_material_stages(builder, material);
+  return builder;
+}
+
+bool material_links_alone(const MaterialShader& material) {
+  try {
+    material_check_program(material).link();
+    return true;
+  } catch (const ShaderError&) {
+    return false;
+  }
+}
+
+}  // namespace
+
 Program link_with_material(const ProgramBuilder& builder, const MaterialShader& material) {
   const std::string file = material_file(material);
   try {
     return builder.link();
   } catch (const ShaderError& e) {
     if (e.file().find(file) == std::string::npos) throw;
+    const bool compile = e.file() == file;
+    // A program that fails to link although the material links alone is facet's own error: the
+    // whole driver log goes up.
+    if (!compile && material_links_alone(material)) throw;
     // The driver's first error line, the material's own where it names the file.
     std::string first;
-    std::istringstream lines(e.what());
+    std::istringstream lines(e.log());
     for (std::string line; std::getline(lines, line);) {
       if (line.find("error") == std::string::npos && line.find("ERROR") == std::string::npos)
         continue;
@@ -190,7 +216,6 @@ Program link_with_material(const ProgramBuilder& builder, const MaterialShader& 
       if (line.find(file + ":") != std::string::npos) break;
     }
     if (first.empty()) first = e.what();
-    const bool compile = e.file() == file;
     throw InputError(
         file, OptionName{"material"},
         std::string(compile ? "GLSL compile error" : "GLSL link error") +
@@ -202,11 +227,7 @@ Program link_with_material(const ProgramBuilder& builder, const MaterialShader& 
 }
 
 void check_material_shader(const MaterialShader& material) {
-  ProgramBuilder builder;
-  builder.define("WRITE_TRIANGLE_ID", "1");
-  builder.source(ShaderStage::vertex, "material check", std::string(kCheckVertex));
-  add_material_stages(builder, material);
-  link_with_material(builder, material);
+  link_with_material(material_check_program(material), material);
 }
 
 }  // namespace facet::driver

@@ -36,10 +36,10 @@ std::string material_stage_text(std::string_view material_text);
 void add_material_stages(ProgramBuilder& builder, const MaterialShader& material,
                          std::string_view gather = "scene/material.frag");
 
-// Links a program whose fragment stage add_material_stages made. A compile or link error that
-// names the material's file (a user's material that does not compile against the interface, or
-// defines no shade()) becomes an InputError (field `--material`) naming that file, the line and
-// the compiler's first error line; other errors stay ShaderErrors. Needs a current context.
+// Links a program whose fragment stage add_material_stages made. The material's compile error,
+// or a link error when the material does not link alone either (it defines no shade(), say),
+// becomes an InputError (field `--material`) naming that file, the line and the driver's first
+// error line; other errors stay ShaderErrors with the whole log. Needs a current context.
 Program link_with_material(const ProgramBuilder& builder, const MaterialShader& material);
 
 // Compiles and links the material with scene/material.frag and a minimal vertex stage:
