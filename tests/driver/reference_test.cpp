@@ -292,6 +292,19 @@ TEST(EdgeDisplacement, ShiftedRectangleIsMeasuredAgainstTheExactEdges) {
   EXPECT_EQ(e.beyond_window, 0u);
   EXPECT_NEAR(e.max_px, 29.5, 1e-6);
 
+  // Past max_searched_pixels a strided sample is searched: every pixel of the shifted edge is
+  // 1.5 px from it, so the sample's figures are the whole image's; the far pixel may fall out.
+  const EdgeDisplacement all =
+      raycaster.edge_displacement(inverse, glm::dmat4(1), reference, tested, {});
+  EXPECT_EQ(all.searched_pixels, all.differing_pixels);
+  e = raycaster.edge_displacement(inverse, glm::dmat4(1), reference, tested,
+                                  {.max_searched_pixels = 50});
+  EXPECT_EQ(e.differing_pixels, all.differing_pixels);
+  EXPECT_EQ(e.searched_pixels, 50u);
+  EXPECT_EQ(e.measured_pixels + e.beyond_window + e.depth_ties + e.outside_display, 50u);
+  EXPECT_GE(e.max_px, 1.5 - 1e-9);
+  EXPECT_LE(e.max_px, 1.5 + 1e-6);
+
   EXPECT_THROW(raycaster.edge_displacement(inverse, glm::dmat4(1), reference,
                                            std::vector<std::uint32_t>(10), {}),
                InputError);

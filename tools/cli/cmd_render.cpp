@@ -151,6 +151,8 @@ nlohmann::json compare_with_reference(const Scene& scene, const std::vector<Outp
                           {"max_edge_px", e.max_px},
                           {"p99_edge_px", e.p99_px},
                           {"edge_beyond_window_pixels", e.beyond_window},
+                          {"differing_pixels", e.differing_pixels},
+                          {"edge_searched_pixels", e.searched_pixels},
                           {"depth_tie_pixels", e.depth_ties},
                           {"outside_display_pixels", e.outside_display},
                           {"outside_display_max_px", e.outside_display_max_px},
@@ -159,6 +161,7 @@ nlohmann::json compare_with_reference(const Scene& scene, const std::vector<Outp
     pooled.mismatched_pixels += c.mismatched_pixels;
     blend_hidden_pixels += hidden_pixels;
     edges.differing_pixels += e.differing_pixels;
+    edges.searched_pixels += e.searched_pixels;
     edges.measured_pixels += e.measured_pixels;
     edges.beyond_window += e.beyond_window;
     edges.depth_ties += e.depth_ties;
@@ -177,6 +180,7 @@ nlohmann::json compare_with_reference(const Scene& scene, const std::vector<Outp
           {"max_edge_px", edges.max_px},
           {"p99_edge_px", edges.p99_px},
           {"differing_pixels", edges.differing_pixels},
+          {"edge_searched_pixels", edges.searched_pixels},
           {"edge_beyond_window_pixels", edges.beyond_window},
           {"depth_tie_pixels", edges.depth_ties},
           {"outside_display_pixels", edges.outside_display},

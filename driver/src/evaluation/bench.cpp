@@ -774,17 +774,25 @@ class ScenarioBench {
       return not_run(error);
     }
     const double prepare_ms = wall_ms_since(start);
+    const auto measure_start = std::chrono::steady_clock::now();
     measure_ids(runner);
     measure_geometric_error(setting, row);
+    const std::string sampled =
+        row.edge_searched_pixels < row.edge_differing_pixels
+            ? format(" (edges over %llu of %llu differing pixels)",
+                     static_cast<unsigned long long>(row.edge_searched_pixels),
+                     static_cast<unsigned long long>(row.edge_differing_pixels))
+            : std::string();
     say_(format(
-        "  %-11s %-12s prepared in %7.0f ms: id_mismatch %.5f, edges max %.2f px (output "
-        "%zu pixel %d,%d) p99 %.2f px, %llu depth ties, %llu drawn outside the display "
-        "(up to %.2f px), geometric max %.3f px",
-        setting.method.c_str(), setting.label.c_str(), prepare_ms, row.id_mismatch, row.max_edge_px,
-        row.worst_edge_output, row.worst_edge_pixel.x, row.worst_edge_pixel.y, row.p99_edge_px,
+        "  %-11s %-12s prepared in %7.0f ms, measured in %6.0f ms: id_mismatch %.5f, edges max "
+        "%.2f px (output %zu pixel %d,%d) p99 %.2f px, %llu depth ties, %llu drawn outside the "
+        "display (up to %.2f px), geometric max %.3f px%s",
+        setting.method.c_str(), setting.label.c_str(), prepare_ms, wall_ms_since(measure_start),
+        row.id_mismatch, row.max_edge_px, row.worst_edge_output, row.worst_edge_pixel.x,
+        row.worst_edge_pixel.y, row.p99_edge_px,
         static_cast<unsigned long long>(row.depth_tie_pixels),
         static_cast<unsigned long long>(row.outside_display_pixels), row.outside_display_max_px,
-        row.geometric_max_px));
+        row.geometric_max_px, sampled.c_str()));
     runners_.push_back(std::move(runner));
   }
 
@@ -893,6 +901,8 @@ class ScenarioBench {
       }
       pooled.p99_edge_px = std::max(pooled.p99_edge_px, e.p99_px);
       row.edge_beyond_window_pixels += e.beyond_window;
+      row.edge_differing_pixels += e.differing_pixels;
+      row.edge_searched_pixels += e.searched_pixels;
       row.depth_tie_pixels += e.depth_ties;
       row.outside_display_pixels += e.outside_display;
       row.outside_display_max_px = std::max(row.outside_display_max_px, e.outside_display_max_px);

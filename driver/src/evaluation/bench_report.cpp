@@ -105,6 +105,8 @@ nlohmann::json row_json(const BenchRow& row) {
             {"max_edge_px", row.max_edge_px},
             {"p99_edge_px", row.p99_edge_px},
             {"edge_beyond_window_pixels", row.edge_beyond_window_pixels},
+            {"edge_differing_pixels", row.edge_differing_pixels},
+            {"edge_searched_pixels", row.edge_searched_pixels},
             {"depth_tie_pixels", row.depth_tie_pixels},
             {"outside_display_pixels", row.outside_display_pixels},
             {"outside_display_max_px", row.outside_display_max_px},

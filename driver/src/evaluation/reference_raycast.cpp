@@ -70,6 +70,15 @@ std::vector<glm::ivec2> differing_pixels(glm::ivec2 size,
   return differing;
 }
 
+// At most `limit` of `differing` (0: all), evenly strided over the row-major order.
+std::vector<glm::ivec2> searched_sample(const std::vector<glm::ivec2>& differing,
+                                        std::size_t limit) {
+  if (limit == 0 || differing.size() <= limit) return differing;
+  std::vector<glm::ivec2> sample(limit);
+  for (std::size_t k = 0; k < limit; ++k) sample[k] = differing[k * differing.size() / limit];
+  return sample;
+}
+
 // The distance from `centre` to the nearest point of a lattice of 1/subsamples px where
 // `marks_the_edge` holds, searched ring by ring out to radius_px; nullopt when none is that near.
 // Every lattice point on Chebyshev ring r is at least r steps away, so a search ends once r²
@@ -111,12 +120,14 @@ double searched_distance(glm::dvec2 centre, double limit_px, const EdgeDisplacem
 
 // The summary of the differing pixels' distances (negative: none within the window; NaN: a depth
 // tie), those drawn outside the display (`outside`) kept apart.
-EdgeDisplacement summarize_edges(const std::vector<glm::ivec2>& differing,
+EdgeDisplacement summarize_edges(std::size_t differing_pixels,
+                                 const std::vector<glm::ivec2>& differing,
                                  const std::vector<double>& distance,
                                  const std::vector<char>& outside,
                                  const EdgeDisplacementOptions& options) {
   EdgeDisplacement result;
-  result.differing_pixels = differing.size();
+  result.differing_pixels = differing_pixels;
+  result.searched_pixels = differing.size();
   std::vector<double> measured;
   for (std::size_t k = 0; k < distance.size(); ++k) {
     const double d = distance[k];
@@ -338,7 +349,9 @@ EdgeDisplacement ReferenceRaycaster::edge_displacement(
     const std::vector<std::uint32_t>& reference, const std::vector<std::uint32_t>& tested,
     const EdgeDisplacementOptions& options) const {
   const glm::ivec2 size = inverse.warp().output_size;
-  const std::vector<glm::ivec2> differing = differing_pixels(size, reference, tested, options);
+  const std::vector<glm::ivec2> all_differing = differing_pixels(size, reference, tested, options);
+  const std::vector<glm::ivec2> differing =
+      searched_sample(all_differing, options.max_searched_pixels);
   const glm::dmat4 T_world_eye = glm::inverse(T_eye_world);
   const glm::dvec3 p_eye_world(T_world_eye[3]);
   const glm::dmat3 R_world_eye(T_world_eye);
@@ -505,7 +518,7 @@ EdgeDisplacement ReferenceRaycaster::edge_displacement(
     distance[std::size_t(k)] = searched_distance(centre, limit, options, marks_the_edge);
   });
 
-  return summarize_edges(differing, distance, outside, options);
+  return summarize_edges(all_differing.size(), differing, distance, outside, options);
 }
 
 IdComparison compare_ids(const std::vector<std::uint32_t>& reference,
@@ -613,7 +626,9 @@ EdgeDisplacement ReferenceRaycaster::edge_displacement(
     const std::vector<std::uint32_t>& reference, const std::vector<std::uint32_t>& tested,
     const EdgeDisplacementOptions& options) const {
   const glm::ivec2 size = camera.size;
-  const std::vector<glm::ivec2> differing = differing_pixels(size, reference, tested, options);
+  const std::vector<glm::ivec2> all_differing = differing_pixels(size, reference, tested, options);
+  const std::vector<glm::ivec2> differing =
+      searched_sample(all_differing, options.max_searched_pixels);
   const glm::dmat4 T_world_eye = glm::inverse(T_eye_world);
   const glm::dmat3 R_world_eye(T_world_eye);
   // The camera's ray through q in the world frame; its direction's frame-z component is 1, so
@@ -651,7 +666,7 @@ EdgeDisplacement ReferenceRaycaster::edge_displacement(
           return id != 0 ? seen == id : seen != expected;
         });
   });
-  return summarize_edges(differing, distance, outside, options);
+  return summarize_edges(all_differing.size(), differing, distance, outside, options);
 }
 
 }  // namespace facet::driver

@@ -110,9 +110,11 @@ struct BenchRow {
   // Σ mismatched / Σ compared (compare_ids); max_edge_px the largest and p99_edge_px the largest
   // output's p99 of the edge displacement against the exact geometry
   // (ReferenceRaycaster::edge_displacement), which leaves out the differing pixels counted in
-  // edge_beyond_window_pixels (more than 4 px).
+  // edge_beyond_window_pixels (more than 4 px). Where many pixels differ the edge figures are
+  // over a strided sample: edge_searched_pixels of edge_differing_pixels (EdgeDisplacementOptions).
   double id_mismatch = 0, max_edge_px = 0, p99_edge_px = 0;
   std::uint64_t edge_beyond_window_pixels = 0;
+  std::uint64_t edge_differing_pixels = 0, edge_searched_pixels = 0;
   std::uint64_t depth_tie_pixels = 0;  // coinciding surfaces, left out of the edge figures
   // Drawn where the display covers nothing, and the farthest of those from what it covers.
   std::uint64_t outside_display_pixels = 0;
