@@ -28,17 +28,12 @@
 
 #include "facet/driver/content_player.hpp"
 #include "facet/driver/gl_context.hpp"
+#include "facet/projection/statistics.hpp"
 
 namespace fs = std::filesystem;
 using namespace facet;
 
 namespace {
-
-double median(std::vector<double> values) {
-  if (values.empty()) return 0;
-  std::sort(values.begin(), values.end());
-  return values[values.size() / 2];
-}
 
 // Frame k: rings and spokes that move, over a texture of fine lines, so the encoder has work.
 cv::Mat pattern_frame(cv::Size size, int k) {

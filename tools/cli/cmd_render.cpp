@@ -27,6 +27,7 @@
 #include "facet/projection/atomic_folder.hpp"
 #include "facet/projection/errors.hpp"
 #include "facet/projection/interrupt.hpp"
+#include "facet/projection/statistics.hpp"
 #include "facet/projection_io/blend_file.hpp"
 #include "frames_flag.hpp"
 #include "option_flags.hpp"
@@ -55,13 +56,6 @@ struct RenderOptions {
   DomeOrientationFlags orientation;
   bool ids = false, depth = false, reference = false, json = false, static_view = false;
 };
-
-double median(std::vector<double> values) {
-  if (values.empty()) return 0;
-  std::sort(values.begin(), values.end());
-  const std::size_t n = values.size();
-  return n % 2 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
-}
 
 // Per output, which pixels its display.json's blend map hides: α = 0 in every channel, where
 // the projector shows black whatever it draws. Empty for an output without a blend map (and for

@@ -25,6 +25,7 @@
 #include "facet/projection/facet_error.hpp"
 #include "facet/projection/glc.hpp"
 #include "facet/projection/rig.hpp"
+#include "facet/projection/statistics.hpp"
 #include "facet/projection/warp_inverse.hpp"
 #include "facet/projection_io/rig_file.hpp"
 
@@ -266,13 +267,6 @@ std::vector<BenchSetting> with_matched_tolerance(const BenchScenario& scenario,
   matched.settings.facets.layout = FacetTolerance{px};
   settings.insert(last_facets.base(), matched);
   return settings;
-}
-
-double median(std::vector<double> values) {
-  if (values.empty()) return 0;
-  std::sort(values.begin(), values.end());
-  const std::size_t n = values.size();
-  return n % 2 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
 }
 
 namespace {

@@ -6,10 +6,10 @@
 #include <cmath>
 #include <glm/gtc/matrix_transform.hpp>
 
-#include "facet/driver/bench.hpp"  // median
 #include "facet/driver/depth_image.hpp"
 #include "facet/driver/gltf_loader.hpp"
 #include "facet/projection/errors.hpp"
+#include "facet/projection/statistics.hpp"
 
 namespace facet::driver {
 namespace {

@@ -206,6 +206,4 @@ void write_bench_files(const BenchReport& report, const std::filesystem::path& f
 // The CSV columns, in order (bench.csv's header).
 std::vector<std::string> bench_csv_columns();
 
-double median(std::vector<double> values);
-
 }  // namespace facet::driver
