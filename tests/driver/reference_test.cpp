@@ -4,7 +4,12 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <glm/gtc/matrix_transform.hpp>
+#include <limits>
+#include <map>
+#include <random>
 
 #include "facet/driver/render_method.hpp"
 #include "facet/projection/errors.hpp"
@@ -241,6 +246,53 @@ TEST(CompareIds, WrapXJoinsTheLeftAndRightColumns) {
   // neighbours 0 and 2 are both ID 2).
   EXPECT_EQ(across.mismatched_pixels, 40u);
   EXPECT_EQ(round.mismatched_pixels, 40u);
+}
+
+// Random blobs of IDs, and a tested image with pixels moved far (beyond the 8 px rings, so the
+// search in the ID's rows runs): the edge figures equal a brute-force nearest pixel of the same
+// ID, with and without wrap_x.
+TEST(CompareIds, FarPixelsMatchABruteForceSearch) {
+  const glm::ivec2 size(90, 50);
+  std::mt19937 random(7);
+  std::vector<std::uint32_t> reference(std::size_t(size.x) * size.y, 0);
+  for (std::uint32_t id = 1; id <= 12; ++id) {
+    const int x0 = int(random() % 80), y0 = int(random() % 40), w = 3 + int(random() % 10),
+              h = 3 + int(random() % 10);
+    for (int y = y0; y < std::min(size.y, y0 + h); ++y)
+      for (int x = x0; x < std::min(size.x, x0 + w); ++x)
+        reference[std::size_t(y) * size.x + x] = id;
+  }
+  std::vector<std::uint32_t> tested = reference;
+  for (int k = 0; k < 300; ++k) tested[random() % tested.size()] = std::uint32_t(random() % 13);
+  for (const bool wrap_x : {false, true}) {
+    SCOPED_TRACE(wrap_x ? "wrap_x" : "no wrap");
+    const IdComparison c = compare_ids(reference, tested, size, {.wrap_x = wrap_x});
+    std::map<std::uint32_t, std::size_t> counts;
+    for (std::uint32_t id : reference) ++counts[id];
+    std::vector<double> edge_px;
+    for (int y = 0; y < size.y; ++y) {
+      for (int x = 0; x < size.x; ++x) {
+        const std::uint32_t id = tested[std::size_t(y) * size.x + x];
+        if (id == reference[std::size_t(y) * size.x + x] || counts[id] < 16) continue;
+        long best = std::numeric_limits<long>::max();
+        for (int v = 0; v < size.y; ++v) {
+          for (int u = 0; u < size.x; ++u) {
+            if (reference[std::size_t(v) * size.x + u] != id) continue;
+            long dx = std::abs(u - x);
+            if (wrap_x) dx = std::min(dx, long(size.x) - dx);
+            best = std::min(best, dx * dx + long(v - y) * (v - y));
+          }
+        }
+        edge_px.push_back(std::sqrt(double(best)));
+      }
+    }
+    ASSERT_GT(edge_px.size(), 100u);
+    ASSERT_GT(*std::max_element(edge_px.begin(), edge_px.end()), 8.0) << "no far pixel tried";
+    EXPECT_DOUBLE_EQ(c.max_edge_px, *std::max_element(edge_px.begin(), edge_px.end()));
+    const std::size_t k = std::min(edge_px.size() - 1, std::size_t(0.99 * double(edge_px.size())));
+    std::nth_element(edge_px.begin(), edge_px.begin() + std::ptrdiff_t(k), edge_px.end());
+    EXPECT_DOUBLE_EQ(c.p99_edge_px, edge_px[k]);
+  }
 }
 
 TEST(CompareIds, WrongSizesAreInputErrors) {

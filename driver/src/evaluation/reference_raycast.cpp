@@ -556,6 +556,37 @@ IdComparison compare_ids(const std::vector<std::uint32_t>& reference,
   }
   // Rings up to this Chebyshev radius are searched pixel by pixel; beyond, the ID's pixel list.
   constexpr int kLocalRadius = 8;
+  // The squared distance from (x, y) to the nearest of `id_pixels` (row-major order, so each row's
+  // pixels are a run sorted by x), row by row outwards from y until the rows are farther than
+  // the best found: a few binary searches where a scan of the whole list cost O(its pixels) for
+  // every far pixel (the vertex method at 1600×1200: 97% of a 138 s `render --reference`).
+  auto nearest_in_rows = [&](const std::vector<glm::ivec2>& id_pixels, int x, int y) {
+    const auto by_y = [](const glm::ivec2& a, const glm::ivec2& b) { return a.y < b.y; };
+    const auto by_x = [](const glm::ivec2& a, int value) { return a.x < value; };
+    long best = std::numeric_limits<long>::max();
+    auto try_row = [&](int row) {
+      const auto [first, last] =
+          std::equal_range(id_pixels.begin(), id_pixels.end(), glm::ivec2(0, row), by_y);
+      if (first == last) return;
+      const auto at_x = std::lower_bound(first, last, x, by_x);
+      const long dy = row - y;
+      auto try_pixel = [&](const glm::ivec2& p) {
+        const long dx = x_distance(p.x - x);
+        best = std::min(best, dx * dx + dy * dy);
+      };
+      // The nearest in x is beside x's place in the run; with wrap_x it may be either end.
+      if (at_x != last) try_pixel(*at_x);
+      if (at_x != first) try_pixel(*(at_x - 1));
+      try_pixel(*first);
+      try_pixel(*(last - 1));
+    };
+    const int first_row = id_pixels.front().y, last_row = id_pixels.back().y;
+    for (long dy = 0; dy * dy < best && (y - dy >= first_row || y + dy <= last_row); ++dy) {
+      try_row(int(y - dy));
+      if (dy > 0) try_row(int(y + dy));
+    }
+    return best;
+  };
 
   IdComparison result;
   std::vector<double> edge_px;
@@ -600,12 +631,7 @@ IdComparison compare_ids(const std::vector<std::uint32_t>& reference,
           }
         }
       }
-      if (best > long(kLocalRadius) * kLocalRadius) {
-        for (const glm::ivec2& p : list->second) {
-          const long dx = x_distance(p.x - x), dy = p.y - y;
-          best = std::min(best, dx * dx + dy * dy);
-        }
-      }
+      if (best > long(kLocalRadius) * kLocalRadius) best = nearest_in_rows(list->second, x, y);
       edge_px.push_back(std::sqrt(double(best)));
     }
   }
