@@ -164,10 +164,9 @@ struct IdComparison {
 //
 // A pixel with nothing within the window costs the whole coarse lattice, (2·window_px·
 // coarse_subsamples)² ray casts: about 1.3 ms on one core here. Where more than
-// max_searched_pixels pixels differ (a method that is off by pixels over much of the image:
-// 43% of an 800×600 cylinder for the vertex method took 200 s on 2 cores), an evenly strided
-// sample of max_searched_pixels of them is searched, and every count and figure but
-// differing_pixels is over that sample.
+// max_searched_pixels pixels differ (a method off by pixels over much of the image, as the
+// vertex method is over 43% of the cylinder), an evenly strided sample of max_searched_pixels of
+// them is searched, and every count and figure but differing_pixels is over that sample.
 struct EdgeDisplacementOptions {
   bool wrap_x = false;
   int subsamples = 32;
