@@ -549,17 +549,15 @@ IdComparison compare_ids(const std::vector<std::uint32_t>& reference,
     return options.wrap_x ? std::min(dx, long(size.x) - dx) : dx;
   };
 
-  // Where each ID lies in the reference, for edge distances beyond the local search.
+  // Where each ID lies in the reference, for the edge distances.
   std::unordered_map<std::uint32_t, std::vector<glm::ivec2>> pixels_of_id;
   for (int y = 0; y < size.y; ++y) {
     for (int x = 0; x < size.x; ++x) pixels_of_id[at(reference, x, y)].push_back({x, y});
   }
-  // Rings up to this Chebyshev radius are searched pixel by pixel; beyond, the ID's pixel list.
-  constexpr int kLocalRadius = 8;
   // The squared distance from (x, y) to the nearest of `id_pixels` (row-major order, so each row's
   // pixels are a run sorted by x), row by row outwards from y until the rows are farther than
-  // the best found: a few binary searches where a scan of the whole list cost O(its pixels) for
-  // every far pixel (the vertex method at 1600×1200: 97% of a 138 s `render --reference`).
+  // the best found: a few binary searches however far the pixel is (a scan of the whole list for
+  // every far pixel took 97% of a 138 s `render --reference` of the vertex method at 1600×1200).
   auto nearest_in_rows = [&](const std::vector<glm::ivec2>& id_pixels, int x, int y) {
     const auto by_y = [](const glm::ivec2& a, const glm::ivec2& b) { return a.y < b.y; };
     const auto by_x = [](const glm::ivec2& a, int value) { return a.x < value; };
@@ -616,23 +614,7 @@ IdComparison compare_ids(const std::vector<std::uint32_t>& reference,
         ++result.sparse_id_pixels;
         continue;
       }
-      // Every pixel on Chebyshev ring r is at least r away, so the search ends once r² passes
-      // the best squared distance.
-      long best = std::numeric_limits<long>::max();
-      for (int r = 1; r <= kLocalRadius && long(r) * r <= best; ++r) {
-        for (int dy = -r; dy <= r; ++dy) {
-          const int ny = y + dy;
-          if (ny < 0 || ny >= size.y) continue;
-          const int step = (dy == -r || dy == r) ? 1 : 2 * r;
-          for (int dx = -r; dx <= r; dx += step) {
-            const int nx = column(x + dx);
-            if (nx < 0 || at(reference, nx, ny) != id) continue;
-            best = std::min(best, long(dx) * dx + long(dy) * dy);
-          }
-        }
-      }
-      if (best > long(kLocalRadius) * kLocalRadius) best = nearest_in_rows(list->second, x, y);
-      edge_px.push_back(std::sqrt(double(best)));
+      edge_px.push_back(std::sqrt(double(nearest_in_rows(list->second, x, y))));
     }
   }
   result.id_mismatch = result.compared_pixels == 0
