@@ -500,6 +500,20 @@ FacetMesh build_fewest_facets(const Warp& warp, double target, int max_cells) {
   return std::move(*adaptive);
 }
 
+// The layout `builder` makes for a per-cell target of `target` px.
+FacetMesh build_layout(const Warp& warp, FacetTolerance::Builder builder, double target,
+                       int max_cells) {
+  switch (builder) {
+    case FacetTolerance::Builder::tensor:
+      return build_tolerance_layout(warp, target, max_cells);
+    case FacetTolerance::Builder::bisection:
+      return detail::build_adaptive_layout(warp, target, max_cells);
+    case FacetTolerance::Builder::fewest:
+      break;
+  }
+  return build_fewest_facets(warp, target, max_cells);
+}
+
 // A figure rounded up to two significant digits, for "set it to at least ...".
 double round_up_2(double x) {
   const double unit = std::pow(10.0, std::floor(std::log10(x)) - 1);
@@ -518,16 +532,17 @@ FacetMesh build_to_tolerance(const Warp& warp, const FacetBuildOptions& options)
     throw InputError({}, "near_miss", "expected a fraction >= 0");
   }
   // Below kProbePx / 10 a tolerance is first checked against an estimate of the cells it needs,
-  // from a tensor build at kProbePx: a cell's error grows as the square of its size where the
-  // warp curves both ways, so its cells grow at most about as 1/tolerance. One that would need
-  // more than twice max_cells is refused before building (1e-9 px on the dome took 13 s and
-  // 2.7 GB to give up).
+  // from a build at kProbePx by the same builder: a cell's error grows as the square of its size
+  // where the warp curves both ways, so its cells grow at most about as 1/tolerance. One that
+  // would need more than twice max_cells is refused before building (1e-9 px took 13 s and
+  // 2.7 GB to give up on the dome, and 20 s on the calibrated board, whose tensor grid cannot
+  // meet 1 px where bisection can).
   constexpr double kProbePx = 1.0;
   std::optional<double> probe_cells;
   if (tolerance < 0.1 * kProbePx) {
     try {
       probe_cells =
-          double(build_tolerance_layout(warp, kProbePx, options.max_cells).facets.size()) / 2;
+          double(build_layout(warp, layout.builder, kProbePx, options.max_cells).facets.size()) / 2;
     } catch (const InputError&) {
       // No estimate: the build below reports what it cannot meet.
     }
@@ -557,11 +572,7 @@ FacetMesh build_to_tolerance(const Warp& warp, const FacetBuildOptions& options)
   for (int attempt = 0; attempt < 3; ++attempt) {
     FacetMesh mesh;
     try {
-      mesh = layout.builder == FacetTolerance::Builder::tensor
-                 ? build_tolerance_layout(warp, target, options.max_cells)
-             : layout.builder == FacetTolerance::Builder::bisection
-                 ? detail::build_adaptive_layout(warp, target, options.max_cells)
-                 : build_fewest_facets(warp, target, options.max_cells);
+      mesh = build_layout(warp, layout.builder, target, options.max_cells);
     } catch (const InputError&) {
       if (!best) throw;
       break;  // a retry's finer target cannot be built: judge the tries so far
