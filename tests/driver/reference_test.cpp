@@ -248,9 +248,9 @@ TEST(CompareIds, WrapXJoinsTheLeftAndRightColumns) {
   EXPECT_EQ(round.mismatched_pixels, 40u);
 }
 
-// Random blobs of IDs, and a tested image with pixels moved far (beyond the 8 px rings, so the
-// search in the ID's rows runs): the edge figures equal a brute-force nearest pixel of the same
-// ID, with and without wrap_x.
+// Random blobs of IDs, and a tested image with pixels moved near and far from their ID (some
+// more than 8 px, across rows and the wrapped seam): the edge figures equal a brute-force
+// nearest pixel of the same ID, with and without wrap_x.
 TEST(CompareIds, FarPixelsMatchABruteForceSearch) {
   const glm::ivec2 size(90, 50);
   std::mt19937 random(7);

@@ -575,8 +575,10 @@ IdComparison compare_ids(const std::vector<std::uint32_t>& reference,
       // The nearest in x is beside x's place in the run; with wrap_x it may be either end.
       if (at_x != last) try_pixel(*at_x);
       if (at_x != first) try_pixel(*(at_x - 1));
-      try_pixel(*first);
-      try_pixel(*(last - 1));
+      if (options.wrap_x) {
+        try_pixel(*first);
+        try_pixel(*(last - 1));
+      }
     };
     const int first_row = id_pixels.front().y, last_row = id_pixels.back().y;
     for (long dy = 0; dy * dy < best && (y - dy >= first_row || y + dy <= last_row); ++dy) {
