@@ -61,7 +61,13 @@ std::uint64_t draw_object_primitives(const Scene& scene, const GpuScene& gpu, st
     gpu.bind_material_texture(primitive.material, 0);
     glUniform1ui(2, primitive.first_index);
     glUniform1ui(3, id);
-    glDrawArrays(mode, 0, GLsizei(primitive.index_count));
+    // Patches of three vertices in draws of kSoftwarePatchesPerDraw on a software rasterizer.
+    const std::uint32_t per_draw = mode == GL_PATCHES && is_software_renderer()
+                                       ? 3 * kSoftwarePatchesPerDraw
+                                       : std::max<std::uint32_t>(primitive.index_count, 1);
+    for (std::uint32_t first = 0; first < primitive.index_count; first += per_draw) {
+      glDrawArrays(mode, GLint(first), GLsizei(std::min(per_draw, primitive.index_count - first)));
+    }
     id += primitive.index_count / 3;
   }
   return id - first_id;

@@ -40,13 +40,25 @@ class MaterialPrograms {
   std::vector<std::uint32_t> material_slot_;
 };
 
+// Patches per draw on a software rasterizer (the tessellated form with the CPU's triangle list,
+// the vertex method). llvmpipe's tessellation-evaluation stage (Mesa 22.3, draw_tess.c) grows its
+// output vertex, index and length arrays by realloc once per patch of a batch of up to 1024
+// vertices. Under ASan every realloc copies into fresh pages, so a batch costs time quadratic in
+// its patches: in the ASan build, the bench of BenchCli.DepthImageLevelOfDetail... took 1,992 ms
+// a frame for the tessellated form and 2,551 ms for the vertex method at tess=16, against 116
+// and 102 ms in draws of 64. In the normal build draws of 64 cost the same or less (`facet bench
+// --quick --scenario cylinder`, three runs each: tessellated 302-347 against 349-357 ms, vertex
+// at tess=16 102-124 against 133-140 ms).
+inline constexpr std::uint32_t kSoftwarePatchesPerDraw = 64;
+
 // Draws scene object o's primitives, each with its material's program of `programs`, for the
 // programs that pull the scene's vertices one primitive at a time (baselines/pull_scene.vert):
 // uniform 2 is the primitive's first index, 3 its first triangle ID (IDs run from `first_id`), 8
 // and 9 the material's base colour and whether it has a texture (bound to unit 0).
 // `send_object` sets the object's own uniforms on the program in use, and is called again
 // whenever the program changes; `in_use` carries the program in use from call to call (nullptr
-// at first). `mode`: GL_TRIANGLES, or GL_PATCHES for tessellation. Returns the triangles drawn.
+// at first). `mode`: GL_TRIANGLES, or GL_PATCHES of three vertices for tessellation (in draws of
+// kSoftwarePatchesPerDraw on a software rasterizer). Returns the triangles drawn.
 std::uint64_t draw_object_primitives(const Scene& scene, const GpuScene& gpu, std::size_t o,
                                      std::uint32_t first_id, const MaterialPrograms& programs,
                                      const Program*& in_use, GLenum mode,

@@ -108,6 +108,18 @@ class TessellatedPipeline final : public FacetMethodBase {
         in_use = &program;
       }
       set_material(program, m);
+      if (!out.list_on_gpu && is_software_renderer()) {
+        // The list is the CPU's, so its material ranges are known here (see
+        // kSoftwarePatchesPerDraw).
+        const std::uint32_t begin = out.material_ranges[2 * m];
+        const std::uint32_t end = out.material_ranges[2 * m + 1];
+        for (std::uint32_t first = begin; first < end; first += kSoftwarePatchesPerDraw) {
+          glDrawArraysInstanced(GL_PATCHES, GLint(first),
+                                GLsizei(std::min(kSoftwarePatchesPerDraw, end - first)),
+                                GLsizei(patch_instances(out)));
+        }
+        continue;
+      }
       // list_args holds each material's patches as (count, instances, first, 0).
       const std::uintptr_t command = (kListArgsPatchDraws + 4 * std::uintptr_t(m)) * 4;
       glDrawArraysIndirect(GL_PATCHES, reinterpret_cast<const void*>(command));
