@@ -41,7 +41,8 @@ void MaterialPrograms::clear() {
 std::uint64_t draw_object_primitives(const Scene& scene, const GpuScene& gpu, std::size_t o,
                                      std::uint32_t first_id, const MaterialPrograms& programs,
                                      const Program*& in_use, GLenum mode,
-                                     const std::function<void()>& send_object) {
+                                     const std::function<void()>& send_object,
+                                     std::uint32_t vertices_per_draw) {
   const Object& object = scene.objects[o];
   bool object_sent = false;
   std::uint32_t id = first_id;
@@ -61,9 +62,8 @@ std::uint64_t draw_object_primitives(const Scene& scene, const GpuScene& gpu, st
     gpu.bind_material_texture(primitive.material, 0);
     glUniform1ui(2, primitive.first_index);
     glUniform1ui(3, id);
-    // Patches of three vertices in draws of kSoftwarePatchesPerDraw on a software rasterizer.
-    const std::uint32_t per_draw = mode == GL_PATCHES && is_software_renderer()
-                                       ? 3 * kSoftwarePatchesPerDraw
+    const std::uint32_t per_draw = vertices_per_draw > 0
+                                       ? vertices_per_draw
                                        : std::max<std::uint32_t>(primitive.index_count, 1);
     for (std::uint32_t first = 0; first < primitive.index_count; first += per_draw) {
       glDrawArrays(mode, GLint(first), GLsizei(std::min(per_draw, primitive.index_count - first)));

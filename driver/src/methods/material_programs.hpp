@@ -57,12 +57,15 @@ inline constexpr std::uint32_t kSoftwarePatchesPerDraw = 64;
 // and 9 the material's base colour and whether it has a texture (bound to unit 0).
 // `send_object` sets the object's own uniforms on the program in use, and is called again
 // whenever the program changes; `in_use` carries the program in use from call to call (nullptr
-// at first). `mode`: GL_TRIANGLES, or GL_PATCHES of three vertices for tessellation (in draws of
-// kSoftwarePatchesPerDraw on a software rasterizer). Returns the triangles drawn.
+// at first). `mode`: GL_TRIANGLES, or GL_PATCHES of three vertices for tessellation.
+// `vertices_per_draw` > 0 splits each primitive into draws of at most that many vertices (a
+// multiple of 3; kSoftwarePatchesPerDraw patches on a software rasterizer); 0 draws it whole.
+// Returns the triangles drawn.
 std::uint64_t draw_object_primitives(const Scene& scene, const GpuScene& gpu, std::size_t o,
                                      std::uint32_t first_id, const MaterialPrograms& programs,
                                      const Program*& in_use, GLenum mode,
-                                     const std::function<void()>& send_object);
+                                     const std::function<void()>& send_object,
+                                     std::uint32_t vertices_per_draw = 0);
 
 // The depth convention of every scene pass: clip z in [0, 1] with the origin at the lower left,
 // reversed Z (GL_GREATER against depth cleared to 0), and GL's back-face culling on exactly when

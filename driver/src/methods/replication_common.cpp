@@ -149,8 +149,9 @@ void FacetMethodBase::prepare(const Scene& scene, const GpuScene& gpu_scene,
       Texture::create_buffer_view(records_buffer_, GL_RGBA32UI, 4 * sizeof(std::uint32_t));
   object_frame_texels_ = Texture::create_buffer_view(object_frames_, GL_RGBA32F, 4 * sizeof(float));
   if (!empty_vao_) empty_vao_ = VertexArray::create();
-  chunked_draws_ = is_software_renderer() && (epoxy_gl_version() >= 46 ||
-                                              epoxy_has_gl_extension("GL_ARB_indirect_parameters"));
+  software_renderer_ = is_software_renderer();
+  chunked_draws_ = software_renderer_ && (epoxy_gl_version() >= 46 ||
+                                          epoxy_has_gl_extension("GL_ARB_indirect_parameters"));
   const bool gpu_lists =
       lists_on_gpu_allowed() &&
       (settings.triangle_list == TriangleListBuild::gpu ||

@@ -219,7 +219,8 @@ class FacetMethodBase : public RenderMethod {
   Program list_objects_, list_counts_, list_write_;
   PrefixScan list_scan_;
   Texture record_texels_,
-      object_frame_texels_;  // records_buffer_, object_frames_ as buffer textures
+      object_frame_texels_;         // records_buffer_, object_frames_ as buffer textures
+  bool software_renderer_ = false;  // is_software_renderer(), at prepare
   // Pass 3 splits each material's replicas into draws of kSoftwareReplicasPerDraw (see there).
   bool chunked_draws_ = false;
   VertexArray empty_vao_;  // core profile draws need a vertex array; attributes are pulled

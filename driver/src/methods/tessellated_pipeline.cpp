@@ -108,7 +108,7 @@ class TessellatedPipeline final : public FacetMethodBase {
         in_use = &program;
       }
       set_material(program, m);
-      if (!out.list_on_gpu && is_software_renderer()) {
+      if (!out.list_on_gpu && software_renderer_) {
         // The list is the CPU's, so its material ranges are known here (see
         // kSoftwarePatchesPerDraw).
         const std::uint32_t begin = out.material_ranges[2 * m];

@@ -191,6 +191,7 @@ class VertexMethod final : public ObjectBaseline {
 
     if (!counters_) counters_ = Buffer::create(kCounters * sizeof(std::uint32_t));
     const bool tessellated = settings.max_tessellation > 1;
+    vertices_per_draw_ = tessellated && is_software_renderer() ? 3 * kSoftwarePatchesPerDraw : 0;
     MaterialPrograms& draw = tessellated ? tess_programs_ : plain_programs_;
     draw.prepare(scene, settings.material, [tessellated](const MaterialShader& shader) {
       return tessellated
@@ -259,12 +260,14 @@ class VertexMethod final : public ObjectBaseline {
         if (!may_be_seen(out, eye_spheres[o].centre, eye_spheres[o].radius * 1.0001)) continue;
         const Object& object = scene.objects[o];
         const glm::mat4 T_eye_object(T_eye_world * glm::dmat4(object.T_world_object));
-        draw_object_primitives(scene, *gpu_scene_, o, triangle_base_[o] + 1, draw, in_use,
-                               tessellated ? GL_PATCHES : GL_TRIANGLES, [&] {
-                                 glUniformMatrix4fv(0, 1, GL_FALSE, glm::value_ptr(T_eye_object));
-                                 glUniformMatrix4fv(1, 1, GL_FALSE,
-                                                    glm::value_ptr(object.T_world_object));
-                               });
+        draw_object_primitives(
+            scene, *gpu_scene_, o, triangle_base_[o] + 1, draw, in_use,
+            tessellated ? GL_PATCHES : GL_TRIANGLES,
+            [&] {
+              glUniformMatrix4fv(0, 1, GL_FALSE, glm::value_ptr(T_eye_object));
+              glUniformMatrix4fv(1, 1, GL_FALSE, glm::value_ptr(object.T_world_object));
+            },
+            vertices_per_draw_);
         stats.triangles_in += triangle_base_[o + 1] - triangle_base_[o];
       }
       if (out.coverage_mask) draw_mask(out, 0.0f);
@@ -313,6 +316,8 @@ class VertexMethod final : public ObjectBaseline {
   std::vector<OutputState> outputs_;
   Buffer counters_;
   MaterialPrograms plain_programs_, tess_programs_;
+  // draw_object_primitives' split of the patches (0: whole primitives).
+  std::uint32_t vertices_per_draw_ = 0;
   Program mask_program_;
 };
 
