@@ -6,11 +6,13 @@
 // the next chunk's offset), each placed by an atomic of its own. Either way stage_offset[t] says
 // where (chains with kChained set). A frame whose pairs exceed pair_capacity, or whose staged
 // words exceed staged_capacity, sets `overflow` and is run again with more room.
-// Three programs, each writing the same counts and staging for the triangles it answers:
+// Four passes, each writing the same counts and staging for the triangles it answers:
 // - the cull pass (one invocation per list triangle) culls, gives a triangle of an object inside
 //   one piece that piece, and queues the others for the grid pass;
 // - the grid pass (GRID_PASS: one invocation per queued triangle) takes what the coverage grid
-//   answers, and queues the rest for the walk pass;
+//   answers within one invocation's bounds, and queues the rest for the wide pass
+//   (replication/count_wide.comp: a work group per triangle shares its candidates) or, where the
+//   grid cannot bound the triangle, for the walk pass;
 // - the walk pass (WALK_PASS: one work group per queued triangle) walks the hierarchy for them.
 // Each queue carries its pass's indirect dispatch. llvmpipe runs both sides of every branch for
 // all lanes of a SIMD row, so the queues are what keep a pass's cost to the triangles that need
@@ -53,6 +55,13 @@ layout(std430, binding = 20) buffer WalkQueue {
   uint walk_queue[];
 };
 const uint kWalkRow = 1024u;
+// The wide pass's (replication/count_wide.comp) indirect dispatch, as the walk pass's, then the
+// queue.
+layout(std430, binding = 16) buffer WideQueue {
+  uint wide_groups_x, wide_groups_y, wide_groups_z;
+  uint wide_count;
+  uint wide_queue[];
+};
 // The grid pass's indirect dispatch, one work group per LOCAL_SIZE queued triangles in rows of
 // kWalkRow groups, then the queue.
 layout(std430, binding = 21) buffer GridQueue {
@@ -67,7 +76,8 @@ bool triangle_may_cover(vec3 p[3]);
 uvec4 list_entry(uint e);
 uint list_triangle_count();
 bool grid_coverage(vec3 p[3], uint t, uint pair_base, uint wanted, out uint wanted_facet,
-                   out uint found);
+                   out uint found, out uint status);
+const uint kGridWide = 2u;  // replication_lib.comp
 uint walk_coverage(vec3 p[3], uint t, uint pair_base, uint wanted, out uint wanted_facet);
 
 const uint kKept = 8u;               // kStagedChunkFacets
@@ -132,12 +142,20 @@ void main() {
     count = walk_coverage(p, t, 0u, 0xffffffffu, unused);
 #else
 #if defined(GRID_PASS)
-    if (!grid_coverage(p, t, 0u, 0xffffffffu, unused, count)) {
+    uint status;
+    if (!grid_coverage(p, t, 0u, 0xffffffffu, unused, count, status)) {
       count = 0u;
-      uint at = atomicAdd(walk_count, 1u);
-      walk_queue[at] = t;
-      if (at < kWalkRow) atomicAdd(walk_groups_x, 1u);
-      if (at % kWalkRow == 0u) atomicAdd(walk_groups_y, 1u);
+      if (status == kGridWide) {
+        uint at = atomicAdd(wide_count, 1u);
+        wide_queue[at] = t;
+        if (at < kWalkRow) atomicAdd(wide_groups_x, 1u);
+        if (at % kWalkRow == 0u) atomicAdd(wide_groups_y, 1u);
+      } else {
+        uint at = atomicAdd(walk_count, 1u);
+        walk_queue[at] = t;
+        if (at < kWalkRow) atomicAdd(walk_groups_x, 1u);
+        if (at % kWalkRow == 0u) atomicAdd(walk_groups_y, 1u);
+      }
     }
 #else
     uint sole = list_entry(e).z;

@@ -673,19 +673,39 @@ bool may_meet(vec3 u[3], vec4 edge[3], uint f) {
   return true;
 }
 
-// walk_coverage's contract, answered from the grid into `found` when the triangle is small
-// enough for it (else false): conservative like the walk, with the few extra facets
-// test_candidate keeps.
-bool grid_coverage(vec3 p[3], uint t, uint pair_base, uint wanted, out uint wanted_facet,
-                   out uint found) {
-  wanted_facet = kNone;
-  found = 0u;
-  if (!triangle_may_cover(p)) return true;
-  vec3 u[3] = vec3[3](normalize(p[0]), normalize(p[1]), normalize(p[2]));
+// What the grid makes of a triangle (grid_query).
+const uint kGridEmpty = 0u;  // it covers nothing
+const uint kGridLane = 1u;   // one invocation tests its candidates (grid_coverage)
+const uint kGridWide = 2u;   // beyond one invocation's bounds, within the wide pass's
+const uint kGridWalk = 3u;   // the walk takes it
+// The wide pass (replication/count_wide.comp): the 64 invocations of a work group share one
+// triangle's candidates, of at most kWideMaxRows bucket rows and kWideMaxCandidates listed pieces.
+// llvmpipe counts a work group's loop iterations against one budget of 65535: each invocation
+// visits at most the range's rows and 128 listed pieces, twice, with a binary search over a row's
+// buckets (at most 4096, 12 steps) for each piece where buckets are not cells, so each of the
+// group's 8 SIMD rows of 8 lanes takes at most 2·(256 + 128·13) iterations, all 8 about 31,000.
+const uint kWideMaxRows = 256u;
+const uint kWideMaxCandidates = 8192u;
+
+// A triangle against the grid: its unit corners, the inward unit normals of its edge planes (with
+// their rounding slack in w), the buckets its chart box touches (first column, first row,
+// columns, rows) and how many pieces those buckets list.
+struct GridQuery {
+  vec3 u[3];
+  vec4 edge[3];
+  uvec4 range;
+  uint listed;
+};
+
+uint grid_query(vec3 p[3], out GridQuery q) {
+  q.range = uvec4(0u);
+  q.listed = 0u;
+  if (!triangle_may_cover(p)) return kGridEmpty;
+  q.u = vec3[3](normalize(p[0]), normalize(p[1]), normalize(p[2]));
   mat3 R_base_eye = mat3(grid_float(12u), grid_float(13u), grid_float(14u), grid_float(15u),
                          grid_float(16u), grid_float(17u), grid_float(18u), grid_float(19u),
                          grid_float(20u));
-  vec3 b[3] = vec3[3](R_base_eye * u[0], R_base_eye * u[1], R_base_eye * u[2]);
+  vec3 b[3] = vec3[3](R_base_eye * q.u[0], R_base_eye * q.u[1], R_base_eye * q.u[2]);
   uint chart = grid_chart();
   // A perspective chart is gnomonic: a triangle in front has its chart box at its corners
   // (CoverageGrid::gnomonic_box).
@@ -699,55 +719,77 @@ bool grid_coverage(vec3 p[3], uint t, uint pair_base, uint wanted, out uint want
     box = vec4(lo.x - pad, hi.x + pad, lo.y - pad, hi.y + pad);
   } else {
     vec4 angles;
-    if (!direction_box(b, chart, angles, full_phi)) return false;
-    if (!chart_box(chart, angles, full_phi, box)) return true;
+    if (!direction_box(b, chart, angles, full_phi)) return kGridWalk;
+    if (!chart_box(chart, angles, full_phi, box)) return kGridEmpty;
   }
-  uvec4 range;
-  if (!bucket_range(box, full_phi && chart <= kChartEquirectangular, range)) return true;
-  if (range.z * range.w > kGridMaxBuckets) return false;
+  if (!bucket_range(box, full_phi && chart <= kChartEquirectangular, q.range)) return kGridEmpty;
+  uint buckets = q.range.z * q.range.w;
+  if (buckets > kGridMaxBuckets && q.range.w > kWideMaxRows) return kGridWalk;
   uint columns = grid_word(2);
-  bool periodic = grid_periodic();
-  uint first_offset = grid_word(9), facets_offset = grid_word(10), boxes_offset = grid_word(11);
-  // Listed facets, row by row from at most two runs of buckets.
-  uint listed = 0u;
-  uint end = range.x + range.z;
-  for (uint j = range.y; j < range.y + range.w; ++j) {
+  uint first_offset = grid_word(9);
+  // Listed pieces, row by row from at most two runs of buckets.
+  uint end = q.range.x + q.range.z;
+  for (uint j = q.range.y; j < q.range.y + q.range.w; ++j) {
     uint row = first_offset + j * columns;
-    listed += grid_word(row + min(end, columns)) - grid_word(row + range.x);
-    if (end > columns) listed += grid_word(row + end - columns) - grid_word(row);
+    q.listed += grid_word(row + min(end, columns)) - grid_word(row + q.range.x);
+    if (end > columns) q.listed += grid_word(row + end - columns) - grid_word(row);
   }
-  if (listed > kGridMaxCandidates) return false;
   // Inward unit normals of the triangle's edge planes; the slack covers the rounding of a
   // normal made from nearly parallel corners (a short edge: the test then never rejects).
-  float orientation = dot(cross(u[0], u[1]), u[2]) >= 0.0 ? 1.0 : -1.0;
-  vec4 edge[3];
+  float orientation = dot(cross(q.u[0], q.u[1]), q.u[2]) >= 0.0 ? 1.0 : -1.0;
   for (int k = 0; k < 3; ++k) {
-    vec3 normal = orientation * cross(u[k], u[k < 2 ? k + 1 : 0]);
+    vec3 normal = orientation * cross(q.u[k], q.u[k < 2 ? k + 1 : 0]);
     float len = length(normal);
-    edge[k] = len > 1e-6 ? vec4(normal / len, kCoverageSlack + 4e-7 / len) : vec4(0, 0, 0, 1);
+    q.edge[k] = len > 1e-6 ? vec4(normal / len, kCoverageSlack + 4e-7 / len) : vec4(0, 0, 0, 1);
   }
+  if (buckets <= kGridMaxBuckets && q.listed <= kGridMaxCandidates) return kGridLane;
+  return q.range.w <= kWideMaxRows && q.listed <= kWideMaxCandidates ? kGridWide : kGridWalk;
+}
+
+// A piece is listed at most once in a bucket, so a one-bucket range needs no de-duplication, and
+// cell buckets list each piece once, so they need none at all.
+bool grid_single_listing(GridQuery q) {
+  return q.range.z * q.range.w == 1u || grid_cell_buckets();
+}
+
+// Whether piece f, listed in bucket column i of row j of the query's range, is a candidate there:
+// where pieces may be listed in several buckets, only in the first bucket, in visiting order, that
+// its range and the query's share.
+bool grid_first_listing(GridQuery q, uint i, uint j, uint f) {
+  uint columns = grid_word(2), boxes_offset = grid_word(11);
+  uvec4 fb = uvec4(grid_word(boxes_offset + 4u * f), grid_word(boxes_offset + 4u * f + 1u),
+                   grid_word(boxes_offset + 4u * f + 2u), grid_word(boxes_offset + 4u * f + 3u));
+  uint first_row = max(q.range.y, fb.y);
+  uint first_column = max(q.range.x, fb.x);
+  if (grid_periodic())
+    first_column = (q.range.x + columns - fb.x) % columns < fb.z ? q.range.x : fb.x;
+  return i == first_column && j == first_row;
+}
+
+// walk_coverage's contract, answered from the grid into `found` when one invocation takes the
+// triangle (else false): conservative like the walk, with the few extra facets may_meet keeps.
+bool grid_coverage(vec3 p[3], uint t, uint pair_base, uint wanted, out uint wanted_facet,
+                   out uint found, out uint status) {
+  wanted_facet = kNone;
+  found = 0u;
+  GridQuery q;
+  status = grid_query(p, q);
+  if (status == kGridEmpty) return true;
+  if (status != kGridLane) return false;
+  uint columns = grid_word(2);
+  bool periodic = grid_periodic();
+  uint first_offset = grid_word(9), facets_offset = grid_word(10);
+  bool single = grid_single_listing(q);
   // The loop always runs to its end (no early return at the wanted facet), so that a triangle
   // takes the same path in every pass that covers it.
-  // A facet is listed at most once in a bucket, so a one-bucket box needs no de-duplication, and
-  // cell buckets list each facet once, so they need none at all.
-  bool one_bucket = range.z * range.w == 1u || grid_cell_buckets();
-  for (uint j = range.y; j < range.y + range.w; ++j) {
-    for (uint k = 0u; k < range.z; ++k) {
-      uint i = periodic ? (range.x + k) % columns : range.x + k;
+  for (uint j = q.range.y; j < q.range.y + q.range.w; ++j) {
+    for (uint k = 0u; k < q.range.z; ++k) {
+      uint i = periodic ? (q.range.x + k) % columns : q.range.x + k;
       uint bucket = first_offset + j * columns + i;
       for (uint m = grid_word(bucket); m < grid_word(bucket + 1u); ++m) {
         uint f = grid_word(facets_offset + m);
-        if (!one_bucket) {
-          uvec4 fb = uvec4(grid_word(boxes_offset + 4u * f), grid_word(boxes_offset + 4u * f + 1u),
-                           grid_word(boxes_offset + 4u * f + 2u), grid_word(boxes_offset + 4u * f + 3u));
-          // Taken once: in the first bucket, in visiting order, that both ranges share.
-          uint first_row = max(range.y, fb.y);
-          uint first_column = max(range.x, fb.x);
-          if (periodic)
-            first_column = (range.x + columns - fb.x) % columns < fb.z ? range.x : fb.x;
-          if (i != first_column || j != first_row) continue;
-        }
-        if (!may_meet(u, edge, f)) continue;
+        if (!single && !grid_first_listing(q, i, j, f)) continue;
+        if (!may_meet(q.u, q.edge, f)) continue;
         if (found == wanted) wanted_facet = f;
         if (pair_base != kNone) write_pair(pair_base + found, t, f);
         ++found;
@@ -775,8 +817,8 @@ uint cover_without_walk(vec3 p[3], uint t, uint e, uint pair_base, uint wanted,
     if (pair_base != kNone) write_pair(pair_base, t, sole);
     return 1u;
   }
-  uint found = 0u;
-  if (grid_coverage(p, t, pair_base, wanted, wanted_facet, found)) return found;
+  uint found = 0u, status;
+  if (grid_coverage(p, t, pair_base, wanted, wanted_facet, found, status)) return found;
   return kNeedsWalk;
 }
 

@@ -336,7 +336,25 @@ TEST(Pipeline, GpuCoverageMatchesCpuReference) {
       RenderSettings s = settings;
       s.cull_back_faces = cull;
       s.coverage = coverage;
-      const auto gpu_lists = gpu_triangle_coverage(outputs[0].warp, s, triangles);
+      GpuCoverageRoutes routes;
+      const auto gpu_lists = gpu_triangle_coverage(outputs[0].warp, s, triangles, &routes);
+      std::printf(
+          "%s, %s coverage%s: %u triangles to the grid pass, %u to the wide pass, %u "
+          "walked\n",
+          name, coverage == FacetCoverage::grid ? "grid" : "walk", cull ? ", culled" : "",
+          routes.grid, routes.wide, routes.walk);
+      // Every route is checked below: on the domes the large triangles go to the wide pass, and
+      // those over thousands of the dense dome's facets on to the walk.
+      const std::string_view display = name;
+      if (display.starts_with("dome") && coverage == FacetCoverage::grid) {
+        EXPECT_GT(routes.wide, 0u) << name;
+        if (display.ends_with("28,800 facets")) {
+          EXPECT_GT(routes.walk, 0u) << name;
+        }
+      }
+      if (coverage == FacetCoverage::walk) {
+        EXPECT_EQ(routes.grid + routes.wide + routes.walk, 0u) << name;
+      }
       const FacetMesh mesh = build_facets(outputs[0].warp, s.facets);
       const CoverageIndex tight(mesh);
       const CoverageIndex loose(mesh, 0.25);  // bound on the GPU's rounding slack

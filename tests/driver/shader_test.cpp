@@ -53,9 +53,11 @@ TEST(Shaders, CoverageGridConstantsMatchTheCpp) {
   EXPECT_EQ(real("kGnomonicPad"), CoverageGrid::kGnomonicPad);
 }
 
-// Pass 1's staging layout exists three times: facet_gpu.hpp, count.comp and scatter.comp.
+// Pass 1's staging layout exists four times: facet_gpu.hpp, count.comp, count_wide.comp and
+// scatter.comp.
 TEST(Shaders, StagingConstantsMatchTheCpp) {
-  for (const char* name : {"replication/count.comp", "replication/scatter.comp"}) {
+  for (const char* name :
+       {"replication/count.comp", "replication/count_wide.comp", "replication/scatter.comp"}) {
     SCOPED_TRACE(name);
     const std::string text(embedded_shader(name).text);
     std::smatch match;
@@ -107,6 +109,7 @@ TEST(Shaders, StorageBufferBindingsMatchTheCpp) {
       {"DrawCounts", binding::draw_counts},
       {"WalkQueue", binding::walk_queue},
       {"GridQueue", binding::grid_queue},
+      {"WideQueue", binding::wide_queue},
       {"ListOut", binding::list_out},
       {"ObjectSpheres", binding::object_spheres},
       {"ObjectVisible", binding::object_visible},

@@ -16,7 +16,7 @@
 namespace facet::driver {
 std::vector<std::vector<std::uint32_t>> gpu_triangle_coverage(
     const Warp& warp, const RenderSettings& settings,
-    const std::vector<std::array<glm::vec3, 3>>& triangles_eye);
+    const std::vector<std::array<glm::vec3, 3>>& triangles_eye, GpuCoverageRoutes* routes);
 }
 
 namespace facet::driver::detail {
@@ -48,17 +48,22 @@ class FacetPipeline final : public PairPipelineBase {
       return link_replication_program({"replication/draw.vert"}, {{"WRITE_TRIANGLE_ID", "1"}},
                                       &shader);
     });
-    // The grid pass is built for each output's kind of grid (replication_lib.comp, grid_chart).
+    // The grid and wide passes are built for each output's kind of grid (replication_lib.comp,
+    // grid_chart).
     for (const OutputState& out : outputs_) {
       const CoverageGrid& grid = out.facets.grid;
       const std::uint32_t kind = grid_kind(grid);
       if (grid_programs_.contains(kind)) continue;
-      grid_programs_.emplace(kind, link_replication_program(
-                                       {"replication/count.comp"},
-                                       {{"GRID_PASS", "1"},
-                                        {"GRID_CHART", std::to_string(std::uint32_t(grid.chart()))},
-                                        {"GRID_PERIODIC", grid.periodic() ? "1" : "0"},
-                                        {"GRID_CELL_BUCKETS", grid.cell_buckets() ? "1" : "0"}}));
+      const std::vector<ShaderDefine> grid_defines = {
+          {"GRID_CHART", std::to_string(std::uint32_t(grid.chart()))},
+          {"GRID_PERIODIC", grid.periodic() ? "1" : "0"},
+          {"GRID_CELL_BUCKETS", grid.cell_buckets() ? "1" : "0"}};
+      std::vector<ShaderDefine> lane_defines = grid_defines;
+      lane_defines.push_back({"GRID_PASS", "1"});
+      grid_programs_.emplace(
+          kind,
+          GridPrograms{link_replication_program({"replication/count.comp"}, lane_defines),
+                       link_replication_program({"replication/count_wide.comp"}, grid_defines)});
     }
   }
 
@@ -75,7 +80,7 @@ class FacetPipeline final : public PairPipelineBase {
     const std::uint32_t n = list_capacity(i);  // the list's triangles, or at most
     ensure_capacity(out.scan, (std::size_t(n) + 1) * sizeof(std::uint32_t));
     ensure_capacity(out.stage_offsets, std::max<std::size_t>(n, 1) * sizeof(std::uint32_t));
-    for (Buffer* queue : {&out.grid_queue, &out.walk_queue})
+    for (Buffer* queue : {&out.grid_queue, &out.wide_queue, &out.walk_queue})
       ensure_capacity(*queue, (kQueueHeaderWords + std::size_t(n)) * sizeof(std::uint32_t));
     const std::uint32_t capacity = pair_capacity(i);
     ensure_capacity(out.staged, staged_words(capacity) * sizeof(std::uint32_t));
@@ -87,14 +92,16 @@ class FacetPipeline final : public PairPipelineBase {
       out.stats.sub_data(0, sizeof zero, zero);
       const std::uint32_t empty_queue[kQueueHeaderWords] = {0, 0, 1, 0};
       out.grid_queue.sub_data(0, sizeof empty_queue, empty_queue);
+      out.wide_queue.sub_data(0, sizeof empty_queue, empty_queue);
       out.walk_queue.sub_data(0, sizeof empty_queue, empty_queue);
       bind_output(i);
       const Program& first = settings_.coverage == FacetCoverage::walk ? count_walk_ : count_;
       dispatch_for_output(first, i, out.list_args, kListArgsCullDispatch);
       glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_COMMAND_BARRIER_BIT);
-      const Program& grid = grid_programs_.at(grid_kind(out.facets.grid));
+      const GridPrograms& grid = grid_programs_.at(grid_kind(out.facets.grid));
       for (const auto& [program, queue] :
-           {std::pair<const Program*, const Buffer*>{&grid, &out.grid_queue},
+           {std::pair<const Program*, const Buffer*>{&grid.lane, &out.grid_queue},
+            std::pair<const Program*, const Buffer*>{&grid.wide, &out.wide_queue},
             std::pair<const Program*, const Buffer*>{&walk_, &out.walk_queue}}) {
         dispatch_for_output(*program, i, *queue, 0);
         glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_COMMAND_BARRIER_BIT);
@@ -128,7 +135,8 @@ class FacetPipeline final : public PairPipelineBase {
   }
 
   friend std::vector<std::vector<std::uint32_t>> facet::driver::gpu_triangle_coverage(
-      const Warp&, const RenderSettings&, const std::vector<std::array<glm::vec3, 3>>&);
+      const Warp&, const RenderSettings&, const std::vector<std::array<glm::vec3, 3>>&,
+      GpuCoverageRoutes*);
 
   static std::uint32_t grid_kind(const CoverageGrid& grid) {
     return std::uint32_t(grid.chart()) | (grid.periodic() ? 16u : 0u) |
@@ -137,7 +145,10 @@ class FacetPipeline final : public PairPipelineBase {
 
   Program count_, walk_, count_walk_, scatter_, args_;
   MaterialPrograms draw_;
-  std::map<std::uint32_t, Program> grid_programs_;  // the grid pass per grid_kind
+  struct GridPrograms {
+    Program lane, wide;  // the grid pass (count.comp's GRID_PASS) and the wide pass
+  };
+  std::map<std::uint32_t, GridPrograms> grid_programs_;  // per grid_kind
   PrefixScan scan_;
 };
 
@@ -151,7 +162,7 @@ namespace facet::driver {
 
 std::vector<std::vector<std::uint32_t>> gpu_triangle_coverage(
     const Warp& warp, const RenderSettings& settings,
-    const std::vector<std::array<glm::vec3, 3>>& triangles_eye) {
+    const std::vector<std::array<glm::vec3, 3>>& triangles_eye, GpuCoverageRoutes* routes) {
   std::vector<std::vector<std::uint32_t>> result(triangles_eye.size());
   if (triangles_eye.empty()) return result;
   Scene scene;
@@ -182,6 +193,14 @@ std::vector<std::vector<std::uint32_t>> gpu_triangle_coverage(
     pipeline.replicate(0, unused_target, nullptr);
     const bool fits = pipeline.read_replication(0);
     FACET_ASSERT(fits);
+  }
+  if (routes) {
+    const auto queued = [](const Buffer& queue) {
+      std::uint32_t header[detail::kQueueHeaderWords] = {};
+      queue.get_sub_data(0, sizeof header, header);
+      return header[detail::kQueueHeaderWords - 1];
+    };
+    *routes = {queued(out.grid_queue), queued(out.wide_queue), queued(out.walk_queue)};
   }
   std::vector<GpuReplica> replicas(out.replicas);
   if (!replicas.empty())

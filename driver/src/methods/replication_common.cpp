@@ -418,6 +418,7 @@ void FacetMethodBase::bind_output(std::size_t i) const {
     out.stage_offsets.bind_base(GL_SHADER_STORAGE_BUFFER, binding::stage_offsets);
   if (out.walk_queue) out.walk_queue.bind_base(GL_SHADER_STORAGE_BUFFER, binding::walk_queue);
   if (out.grid_queue) out.grid_queue.bind_base(GL_SHADER_STORAGE_BUFFER, binding::grid_queue);
+  if (out.wide_queue) out.wide_queue.bind_base(GL_SHADER_STORAGE_BUFFER, binding::wide_queue);
   if (out.draw_args) out.draw_args.bind_base(GL_SHADER_STORAGE_BUFFER, binding::draw_args);
 }
 
@@ -453,7 +454,7 @@ std::uint64_t FacetMethodBase::buffer_bytes(const OutputState& out) const {
   for (const Buffer* b :
        {&out.list_buffer, &out.ranges_buffer, &out.list_args, &out.object_visible_flags,
         &out.list_offsets, &out.scan, &out.pairs, &out.stats, &out.draw_args, &out.draw_counts,
-        &out.staged, &out.stage_offsets, &out.grid_queue, &out.walk_queue})
+        &out.staged, &out.stage_offsets, &out.grid_queue, &out.wide_queue, &out.walk_queue})
     bytes += b->size();
   return bytes;
 }

@@ -8,9 +8,10 @@
 //   3 indices (GpuScene)   7 coverage nodes   8 coverage order      (FacetSet, per output)
 //   10 counts / exclusive scan   11 pairs (modern: GpuReplica; seed: triangle, replica)
 //   12 stats   13 material ranges of the triangle list   14 indirect draw arguments
-//   15 scan block sums   17 staged facets of pass 1   18 their offsets
+//   15 scan block sums   16 pass 1's wide queue   17 staged facets of pass 1   18 their offsets
 //   19 draw commands used per material (pass 3's glMultiDrawArraysIndirectCountARB)
-//   20 pass 1's walk queue: the walk pass's indirect dispatch, then the triangles it takes
+//   20, 21 pass 1's walk and grid queues (16 the wide pass's): each pass's indirect dispatch,
+//   then the triangles it takes
 // Read-only tables are buffer textures (samplerBuffer, texelFetch): the scene
 // (GpuScene::bind_for_pulling, units 8-10), and at texture_unit:: the object frames (RGBA32F, 8
 // texels per GpuObjectFrame, per frame), the pieces (RGBA32F, 8 texels per GpuFacet, per output),
@@ -44,7 +45,7 @@ namespace binding {
 inline constexpr GLuint indices = pulling::indices_binding, nodes = 7, order = 8, scan = 10,
                         pairs = 11, stats = 12, material_ranges = 13, draw_args = 14,
                         block_sums = 15, staged = 17, stage_offsets = 18, draw_counts = 19,
-                        walk_queue = 20, grid_queue = 21;
+                        walk_queue = 20, grid_queue = 21, wide_queue = 16;
 // The triangle list built on the GPU (replication/list_build.comp): the list buffer written as
 // storage, the objects' eye-frame spheres and which may meet a facet, the list's indirect
 // arguments, and the static record of every entry and first entry of every material.
@@ -192,11 +193,18 @@ bool sphere_may_meet_cone(const glm::dvec3& centre, double radius, const glm::dv
 // True when a sphere may meet any facet's guarded pyramid (walks the coverage hierarchy).
 bool sphere_may_meet_facets(const FacetSet& set, const glm::dvec3& centre, double radius);
 
+// Pass 1's queues (replication/count.comp): the triangles the cull pass left to the grid pass, and
+// those the grid pass left to the wide pass and to the walk.
+struct GpuCoverageRoutes {
+  std::uint32_t grid = 0, wide = 0, walk = 0;
+};
 // Passes 1 and 2 of the "facets" pipeline on eye-frame triangles (metres, T_eye_world = identity),
-// read back: for each triangle, the pieces (sorted; FacetPieces) it is replicated into. For tests
-// against CoverageIndex::query. Needs a current context.
+// read back: for each triangle, the pieces (sorted; FacetPieces) it is replicated into, and, given
+// `routes`, the passes that took them. For tests against CoverageIndex::query. Needs a current
+// context.
 std::vector<std::vector<std::uint32_t>> gpu_triangle_coverage(
     const Warp& warp, const RenderSettings& settings,
-    const std::vector<std::array<glm::vec3, 3>>& triangles_eye);
+    const std::vector<std::array<glm::vec3, 3>>& triangles_eye,
+    GpuCoverageRoutes* routes = nullptr);
 
 }  // namespace facet::driver
