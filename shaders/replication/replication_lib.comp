@@ -234,6 +234,10 @@ bool triangle_may_cover(vec3 p[3]) {
 // The coverage grid (pack_coverage_grid): one R32UI buffer texture.
 layout(binding = 15) uniform usamplerBuffer grid_texels;
 uint grid_word(uint i) { return texelFetch(grid_texels, int(i)).x; }
+// The same words four to a texel, for the per-piece records that start on one (bucket ranges,
+// pyramid corners): one fetch instead of four.
+layout(binding = 19) uniform usamplerBuffer grid_vec4_texels;
+uvec4 grid_vec4(uint i) { return texelFetch(grid_vec4_texels, int(i / 4u)); }
 // The piece that draws facet f (FacetPieces::piece_of_facet, from the grid's header word 22).
 uint piece_of_facet(uint f) { return grid_word(grid_word(22) + f); }
 
@@ -661,10 +665,9 @@ bool may_meet(vec3 u[3], vec4 edge[3], uint f) {
       return false;
   }
   uint at = grid_word(21) + 12u * f;
-  vec3 c[4];
-  for (int m = 0; m < 4; ++m)
-    c[m] = vec3(grid_float(at + 3u * uint(m)), grid_float(at + 3u * uint(m) + 1u),
-                grid_float(at + 3u * uint(m) + 2u));
+  vec4 w0 = uintBitsToFloat(grid_vec4(at)), w1 = uintBitsToFloat(grid_vec4(at + 4u)),
+       w2 = uintBitsToFloat(grid_vec4(at + 8u));
+  vec3 c[4] = vec3[4](w0.xyz, vec3(w0.w, w1.xy), vec3(w1.zw, w2.x), w2.yzw);
   for (int k = 0; k < 3; ++k) {
     if (dot(edge[k].xyz, c[0]) + edge[k].w < 0.0 && dot(edge[k].xyz, c[1]) + edge[k].w < 0.0 &&
         dot(edge[k].xyz, c[2]) + edge[k].w < 0.0 && dot(edge[k].xyz, c[3]) + edge[k].w < 0.0)
@@ -756,9 +759,8 @@ bool grid_single_listing(GridQuery q) {
 // where pieces may be listed in several buckets, only in the first bucket, in visiting order, that
 // its range and the query's share.
 bool grid_first_listing(GridQuery q, uint i, uint j, uint f) {
-  uint columns = grid_word(2), boxes_offset = grid_word(11);
-  uvec4 fb = uvec4(grid_word(boxes_offset + 4u * f), grid_word(boxes_offset + 4u * f + 1u),
-                   grid_word(boxes_offset + 4u * f + 2u), grid_word(boxes_offset + 4u * f + 3u));
+  uint columns = grid_word(2);
+  uvec4 fb = grid_vec4(grid_word(11) + 4u * f);
   uint first_row = max(q.range.y, fb.y);
   uint first_column = max(q.range.x, fb.x);
   if (grid_periodic())

@@ -68,7 +68,8 @@ TEST(Shaders, StagingConstantsMatchTheCpp) {
   }
 }
 
-// The list's block size and the scatter's texture units exist twice: facet_gpu.hpp and the GLSL.
+// The list's block size and the texture units of the scatter and of the coverage grid exist
+// twice: facet_gpu.hpp and the GLSL.
 TEST(Shaders, ListAndScatterConstantsMatchTheCpp) {
   std::smatch match;
   const std::string library(embedded_shader("replication/replication_lib.comp").text);
@@ -78,12 +79,15 @@ TEST(Shaders, ListAndScatterConstantsMatchTheCpp) {
   ASSERT_TRUE(std::regex_search(list_build, match, std::regex(R"(kTableBlockTriangles = (\d+)u)")));
   EXPECT_EQ(std::stoul(match[1]), kListBlockTriangles);
   const std::string scatter(embedded_shader("replication/scatter.comp").text);
-  for (const auto& [name, unit] :
-       {std::pair<const char*, GLuint>{"scan_texels", texture_unit::scan},
-        {"staged_texels", texture_unit::staged},
-        {"stage_offset_texels", texture_unit::stage_offsets}}) {
+  for (const auto& [text, name, unit] :
+       {std::tuple<const std::string*, const char*, GLuint>{&scatter, "scan_texels",
+                                                            texture_unit::scan},
+        {&scatter, "staged_texels", texture_unit::staged},
+        {&scatter, "stage_offset_texels", texture_unit::stage_offsets},
+        {&library, "grid_texels", texture_unit::grid},
+        {&library, "grid_vec4_texels", texture_unit::grid_vec4}}) {
     ASSERT_TRUE(std::regex_search(
-        scatter, match,
+        *text, match,
         std::regex(R"(binding = (\d+)\) uniform usamplerBuffer )" + std::string(name))))
         << name;
     EXPECT_EQ(std::stoul(match[1]), unit) << name;

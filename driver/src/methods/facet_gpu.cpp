@@ -245,10 +245,15 @@ std::vector<std::uint32_t> pack_coverage_grid(const CoverageGrid& grid, const Fa
   words.insert(words.end(), first.begin(), first.end());
   words[10] = std::uint32_t(words.size());
   words.insert(words.end(), listed.begin(), listed.end());
+  // The bucket ranges and the pyramid corners start on a texel of the grid's RGBA32UI view
+  // (texture_unit::grid_vec4): one fetch a range, three a piece's corners.
+  const auto align_to_texel = [&] { words.resize((words.size() + 3) / 4 * 4, 0u); };
+  align_to_texel();
   words[11] = std::uint32_t(words.size());
   for (const BucketRange& r : ranges) {
     words.insert(words.end(), {r.first_column, r.first_row, r.columns, r.rows});
   }
+  align_to_texel();
   words[21] = std::uint32_t(words.size());
   for (const auto& corners : pieces.corners)
     for (const glm::dvec3& c : corners)
@@ -304,6 +309,7 @@ FacetSet FacetSet::build(const Warp& warp, const FacetBuildOptions& options, dou
                {},
                {},
                {},
+               {},
                {}};
   const std::vector<GpuFacet> gpu_facets = pack_facets(set.mesh, set.pieces, z_near);
   const auto nodes = pack_coverage_nodes(set.index);
@@ -317,6 +323,8 @@ FacetSet FacetSet::build(const Warp& warp, const FacetBuildOptions& options, dou
   set.nodes = nodes.empty() ? Buffer::create(sizeof no_node, &no_node) : Buffer::create_from(nodes);
   set.grid_words = Buffer::create_from(pack_coverage_grid(set.grid, set.pieces));
   set.grid_texels = Texture::create_buffer_view(set.grid_words, GL_R32UI, sizeof(std::uint32_t));
+  set.grid_vec4_texels =
+      Texture::create_buffer_view(set.grid_words, GL_RGBA32UI, 4 * sizeof(std::uint32_t));
   set.order = set.index.order().empty() ? Buffer::create(sizeof no_order, &no_order)
                                         : Buffer::create_from(set.index.order());
   return set;
@@ -327,6 +335,7 @@ void FacetSet::bind() const {
   nodes.bind_base(GL_SHADER_STORAGE_BUFFER, binding::nodes);
   order.bind_base(GL_SHADER_STORAGE_BUFFER, binding::order);
   grid_texels.bind_unit(texture_unit::grid);
+  grid_vec4_texels.bind_unit(texture_unit::grid_vec4);
 }
 
 bool sphere_may_meet_cone(const glm::dvec3& centre, double radius, const glm::dvec3* planes,

@@ -37,6 +37,9 @@ namespace facet::driver {
 // Read-only tables are buffer textures (texelFetch), as the scene is (gpu_scene.hpp, pulling::).
 namespace texture_unit {
 inline constexpr GLuint object_frames = 11, facets = 12, records = 13, list = 14, grid = 15;
+// The coverage grid again, as RGBA32UI: its per-piece bucket ranges and pyramid corners, which
+// pack_coverage_grid starts on a texel.
+inline constexpr GLuint grid_vec4 = 19;
 // The scatter's reads of pass 1's results (R32UI views of binding::scan, staged, stage_offsets).
 inline constexpr GLuint scan = 16, staged = 17, stage_offsets = 18;
 }  // namespace texture_unit
@@ -141,10 +144,11 @@ std::vector<GpuCoverageNode> pack_coverage_nodes(const CoverageIndex& index);
 // radius_cap, then the offsets of bucket_first, bucket_pieces and the per-piece bucket ranges,
 // then R_base_eye column-major, then the offsets of the pyramid corners, of piece_of_facet and of
 // the cell breaks, 0 for uniform buckets), then those arrays, the pieces' guarded pyramid corners
-// (4 × 3 floats per piece), FacetPieces::piece_of_facet and, for cell buckets, pad_p and pad_q
-// (grown by the float rounding), then p_breaks and q_breaks as floats. Buckets list pieces: a quad
-// in every bucket of the smallest range holding both its facets' ranges (its guarded pyramid lies
-// in the union of theirs), a facet no quad holds where the grid lists it.
+// (4 × 3 floats per piece; the ranges and the corners each start on a multiple of four words, a
+// texel of texture_unit::grid_vec4), FacetPieces::piece_of_facet and, for cell buckets, pad_p and
+// pad_q (grown by the float rounding), then p_breaks and q_breaks as floats. Buckets list pieces: a
+// quad in every bucket of the smallest range holding both its facets' ranges (its guarded pyramid
+// lies in the union of theirs), a facet no quad holds where the grid lists it.
 inline constexpr std::uint32_t kGridHeaderWords = 24;
 std::vector<std::uint32_t> pack_coverage_grid(const CoverageGrid& grid, const FacetPieces& pieces);
 // Pass 1 of `facets` stages every facet it finds (binding::staged; replication/count.comp, kKept
@@ -171,7 +175,8 @@ struct FacetSet {
   CoverageGrid grid;
   FacetPieces pieces;
   Buffer facets, nodes, order, grid_words;  // one GpuFacet per piece; binding::nodes, order
-  Texture facet_texels, grid_texels;  // buffer textures: texture_unit::facets, texture_unit::grid
+  // Buffer textures: texture_unit::facets, texture_unit::grid and texture_unit::grid_vec4.
+  Texture facet_texels, grid_texels, grid_vec4_texels;
 
   // Builds the facets of `warp` (InputError when the layout cannot be met) and their pieces, and
   // uploads them. Needs a current context.
