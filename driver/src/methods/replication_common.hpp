@@ -144,8 +144,9 @@ class FacetMethodBase : public RenderMethod {
     Buffer draw_counts;
     std::uint32_t draws_per_material = 1, replicas_per_draw = 1;
     // Pass 1's facets per triangle (facets only), and where each triangle's run starts; the
-    // triangles the cull pass leaves to the grid pass, and those the grid pass leaves to the walk
-    // pass (each queue: its pass's indirect dispatch and count, then the list triangles).
+    // triangles the cull pass leaves to the grid pass, and those the grid pass leaves to the wide
+    // pass and to the walk pass (each queue: its pass's indirect dispatch and count, then the list
+    // triangles).
     Buffer staged, stage_offsets, grid_queue, wide_queue, walk_queue;
     // scan, staged and stage_offsets as R32UI buffer textures for the scatter (facets only).
     BufferView scan_texels, staged_texels, stage_offset_texels;
