@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstdio>
 #include <glm/gtc/matrix_transform.hpp>
@@ -162,6 +163,65 @@ TEST(FacetPieces, CoplanarCellsBecomeConvexQuads) {
   const FacetPieces dome_pieces = make_facet_pieces(dome_mesh, true);
   EXPECT_TRUE(dome_pieces.quads.empty());
   EXPECT_EQ(dome_pieces.size(), dome_mesh.facets.size());
+}
+
+// pack_coverage_grid starts the per-piece bucket ranges and pyramid corners on a texel of the
+// RGBA32UI view (replication_lib.comp's grid_vec4), and they hold what the grid and the pieces
+// say: each piece's corners as float bits, and a range for each piece the grid lists.
+TEST(FacetPieces, PackedGridRecordsStartOnATexel) {
+  FacetBuildOptions forty, coarse;
+  forty.layout = FacetStrips{40};
+  coarse.layout = FacetTolerance{2.0};
+  // The dome4 projector's bisection layout has uniform buckets.
+  const auto projector = load_display_outputs(
+      std::string(FACET_SOURCE_DIR) + "/configs/displays/dome4/display.json", std::nullopt);
+  for (const auto& [name, outputs, options] :
+       {std::tuple{"cylinder strips", cylinder(), forty}, std::tuple{"dome 2 px", dome(), coarse},
+        std::tuple{"dome4 projector 2 px", projector, coarse}}) {
+    const Warp& warp = outputs[0].warp;
+    const FacetMesh mesh = build_facets(warp, options);
+    const CoverageGrid grid(mesh, warp.base, warp.R_eye_base);
+    const FacetPieces pieces = make_facet_pieces(mesh, true);
+    if (std::string_view(name).starts_with("dome4")) {
+      EXPECT_FALSE(grid.cell_buckets()) << name;
+    }
+    const std::vector<std::uint32_t> words = pack_coverage_grid(grid, pieces);
+    ASSERT_GE(words.size(), kGridHeaderWords) << name;
+    const std::uint32_t ranges_at = words[11], corners_at = words[21];
+    EXPECT_EQ(ranges_at % 4, 0u) << name;
+    EXPECT_EQ(corners_at % 4, 0u) << name;
+    ASSERT_LE(std::size_t(corners_at) + 12 * pieces.size(), words.size()) << name;
+    for (std::uint32_t p = 0; p < pieces.size(); ++p) {
+      for (int c = 0; c < 4; ++c)
+        for (int k = 0; k < 3; ++k)
+          EXPECT_EQ(words[corners_at + 12 * p + 3 * c + k],
+                    std::bit_cast<std::uint32_t>(float(pieces.corners[p][c][k])))
+              << name << " piece " << p;
+    }
+    // Bucket b lists pieces words[listed_at + m] for m in [words[first_at + b], words[first_at +
+    // b + 1]); the range of each piece listed there holds the bucket, and every drawn piece is
+    // listed somewhere.
+    const std::uint32_t columns = words[2], rows = words[3];
+    const std::uint32_t first_at = words[9], listed_at = words[10];
+    std::size_t listings = 0;
+    for (std::uint32_t b = 0; b < columns * rows; ++b) {
+      for (std::uint32_t m = words[first_at + b]; m < words[first_at + b + 1]; ++m) {
+        const std::uint32_t p = words[listed_at + m];
+        const std::uint32_t i = b % columns, j = b / columns;
+        const std::uint32_t* range = &words[ranges_at + 4 * p];  // column, row, columns, rows
+        const std::uint32_t column_offset =
+            grid.periodic() ? (i + columns - range[0]) % columns : i - range[0];
+        EXPECT_TRUE(j >= range[1] && j - range[1] < range[3] && column_offset < range[2])
+            << name << " piece " << p << " listed in bucket " << b;
+        ++listings;
+      }
+    }
+    std::size_t drawn = 0;
+    for (std::uint32_t p = 0; p < pieces.size(); ++p) drawn += pieces.drawn(p) ? 1 : 0;
+    EXPECT_GE(listings, drawn) << name;
+    std::printf("%s: %s buckets %ux%u, %zu listings of %u pieces\n", name,
+                grid.cell_buckets() ? "cell" : "uniform", columns, rows, listings, pieces.size());
+  }
 }
 
 // A sphere inside one piece and clear of the others takes that piece alone: a small one in the
