@@ -53,6 +53,22 @@ TEST(Shaders, CoverageGridConstantsMatchTheCpp) {
   EXPECT_EQ(real("kGnomonicPad"), CoverageGrid::kGnomonicPad);
 }
 
+// grid_query's answers (replication_lib.comp) are read by the passes that queue on them,
+// count.comp and count_wide.comp, each with its own copy of the values it tests.
+TEST(Shaders, GridQueryAnswersMatchTheLibrary) {
+  const auto value = [](const char* shader, const std::string& name) {
+    const std::string text(embedded_shader(shader).text);
+    std::smatch match;
+    EXPECT_TRUE(std::regex_search(text, match, std::regex(name + R"( = (\d+)u)")))
+        << shader << ": " << name;
+    return match.empty() ? -1L : std::stol(match[1]);
+  };
+  const char* library = "replication/replication_lib.comp";
+  EXPECT_EQ(value("replication/count.comp", "kGridWide"), value(library, "kGridWide"));
+  for (const char* name : {"kGridEmpty", "kGridWalk"})
+    EXPECT_EQ(value("replication/count_wide.comp", name), value(library, name)) << name;
+}
+
 // Pass 1's staging layout exists four times: facet_gpu.hpp, count.comp, count_wide.comp and
 // scatter.comp.
 TEST(Shaders, StagingConstantsMatchTheCpp) {
