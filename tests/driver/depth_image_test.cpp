@@ -434,8 +434,9 @@ TEST(DepthImage, LodMeshHasNoCrackWhereBlocksChangeStep) {
 }
 
 // The level choice for a moving eye: DepthLodChooser gives what depth_image_mesh chooses for
-// each eye, a block refines as the eye approaches it and coarsens as it leaves, and every mesh
-// built from the chosen levels is watertight.
+// each eye, a block refines as the eye approaches it and coarsens as it leaves, every mesh built
+// from the chosen levels is watertight, and a DepthMeshBuilder kept along the path gives each
+// fresh mesh while remaking only some blocks.
 TEST(DepthImage, LodLevelsFollowTheEye) {
   const DepthImage plane = plane_image();
   const DepthMeshOptions options{.lod_angle_rad = 0.05};
@@ -445,6 +446,9 @@ TEST(DepthImage, LodLevelsFollowTheEye) {
   std::vector<int> centre_levels;
   std::size_t distinct = 0;
   DepthLodLevels last;
+  // One builder along the whole path, as a moving view keeps it.
+  DepthMeshBuilder builder(plane, options);
+  std::size_t partial_builds = 0;
   // From the image's eye straight towards the plane (5 m ahead, image -z) to 1 m before it,
   // then back and 6 m further away.
   for (const double z : {0.0, -1.0, -2.0, -3.0, -4.0, -2.0, 0.0, 3.0, 6.0}) {
@@ -460,7 +464,22 @@ TEST(DepthImage, LodLevelsFollowTheEye) {
     EXPECT_EQ(chosen.scene.indices, given.scene.indices) << "eye z " << z;
     EXPECT_EQ(chosen.scene.positions, given.scene.positions) << "eye z " << z;
     expect_watertight(plane, given.scene, "eye z " + std::to_string(z));
+    // The builder remakes only the blocks whose neighbourhood changed, and its mesh is the fresh
+    // build's, vertex for vertex.
+    const DepthMesh rebuilt = builder.build(levels);
+    EXPECT_EQ(rebuilt.scene.indices, given.scene.indices) << "eye z " << z;
+    EXPECT_EQ(rebuilt.scene.positions, given.scene.positions) << "eye z " << z;
+    EXPECT_EQ(rebuilt.scene.normals, given.scene.normals) << "eye z " << z;
+    EXPECT_EQ(rebuilt.scene.uvs, given.scene.uvs) << "eye z " << z;
+    EXPECT_EQ(rebuilt.source_id, given.source_id) << "eye z " << z;
+    EXPECT_EQ(rebuilt.dropped_triangles, given.dropped_triangles) << "eye z " << z;
+    EXPECT_EQ(rebuilt.lod_blocks_by_level, given.lod_blocks_by_level) << "eye z " << z;
+    ASSERT_EQ(builder.block_count(), 60u);
+    partial_builds += builder.blocks_made() > 0 && builder.blocks_made() < builder.block_count();
+    builder.build(levels);
+    EXPECT_EQ(builder.blocks_made(), 0u) << "eye z " << z;
   }
+  EXPECT_GE(partial_builds, 3u);
   std::string text;
   for (int l : centre_levels) text += std::to_string(l) + " ";
   std::printf("centre block's level, eye z 0 -1 -2 -3 -4 -2 0 3 6 m: %s\n", text.c_str());

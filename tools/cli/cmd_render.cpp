@@ -448,13 +448,11 @@ void run(const RenderOptions& options) {
   }
   if (lod_scene) {
     const ViewDependentScene::Summary lod = lod_scene->summary();
-    report["depth_lod"] = {{"rebuilds", lod.rebuilds},
-                           {"update_ms", median(lod_update_ms)},
-                           {"choose_ms", lod.choose_ms},
-                           {"rebuild_ms", lod.build_ms},
-                           {"triangles_median", lod.triangles_median},
-                           {"triangles_min", lod.triangles_min},
-                           {"triangles_max", lod.triangles_max}};
+    report["depth_lod"] = {
+        {"rebuilds", lod.rebuilds},           {"update_ms", median(lod_update_ms)},
+        {"choose_ms", lod.choose_ms},         {"rebuild_ms", lod.build_ms},
+        {"blocks_remade", lod.blocks_remade}, {"triangles_median", lod.triangles_median},
+        {"triangles_min", lod.triangles_min}, {"triangles_max", lod.triangles_max}};
   }
   if (reference) report["reference"] = *reference;
   if (options.json) {

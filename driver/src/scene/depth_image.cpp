@@ -550,10 +550,100 @@ DepthLodLevels DepthLodChooser::levels(const glm::dvec3& eye_world) const {
   return levels;
 }
 
-DepthMesh depth_image_mesh(const DepthImage& image, const DepthMeshOptions& options) {
+// One part of the image as DepthMeshBuilder keeps it.
+struct DepthMeshBuilder::Part {
+  std::string name;
+  int W = 0, H = 0, last_x = 0, last_y = 0, block = 1, blocks_x = 0, blocks_y = 0;
+  bool wraps = false;
+  // Per pixel, row-major: the point in the image frame (unused where nothing is seen), the stored
+  // normal and the source ID.
+  std::vector<glm::dvec3> p_image;
+  std::vector<bool> seen;
+  std::vector<glm::vec3> normal;
+  std::vector<std::uint32_t> id;
+  Image texture;
+  // A block's triangles as grid nodes (y · (W + 1) + x), counter-clockwise seen from the eye, in
+  // the order depth_image_mesh emits them; the seen nodes its triangles looked at, in the order
+  // they were first looked at (vertices are numbered in that order across blocks); and what they
+  // were made for: the block's level and each side's finer neighbour's (kNoNeighbour if none).
+  struct Block {
+    static constexpr std::uint8_t kNoNeighbour = 0xff;
+    bool made = false;
+    std::array<std::uint8_t, 5> key{};
+    std::vector<std::array<std::uint32_t, 3>> triangles;
+    std::vector<std::uint32_t> source_id;
+    std::vector<std::uint32_t> looked_at;
+    std::size_t dropped = 0;
+  };
+  std::vector<Block> blocks;
+
+  std::size_t node(int x, int y) const {
+    return std::size_t(y) * std::size_t(W + 1) + std::size_t(x);
+  }
+  std::size_t pixel_of_node(std::size_t n) const {
+    const int x = int(n % std::size_t(W + 1)), y = int(n / std::size_t(W + 1));
+    return std::size_t(y) * std::size_t(W) + std::size_t(x == W ? 0 : x);
+  }
+};
+
+DepthMeshBuilder::~DepthMeshBuilder() = default;
+DepthMeshBuilder::DepthMeshBuilder(DepthMeshBuilder&&) noexcept = default;
+DepthMeshBuilder& DepthMeshBuilder::operator=(DepthMeshBuilder&&) noexcept = default;
+
+std::size_t DepthMeshBuilder::block_count() const {
+  std::size_t count = 0;
+  for (const Part& part : parts_) count += part.blocks.size();
+  return count;
+}
+
+DepthMeshBuilder::DepthMeshBuilder(const DepthImage& image, const DepthMeshOptions& options)
+    : T_world_image_(image.T_world_image), options_(options), lod_(options.lod_angle_rad > 0) {
   check_mesh_options(options);
-  const bool lod = options.lod_angle_rad > 0;
   image.validate();
+  options_.lod_levels.reset();
+  options_.lod_eye_world.reset();
+  for (const DepthImagePart& source : image.parts) {
+    const PartGrid grid(source, lod_);
+    Part& part = parts_.emplace_back();
+    part.name = source.name;
+    part.W = grid.W;
+    part.H = grid.H;
+    part.last_x = grid.last_x;
+    part.last_y = grid.last_y;
+    part.block = grid.block;
+    part.blocks_x = grid.blocks_x;
+    part.blocks_y = grid.blocks_y;
+    part.wraps = grid.wraps;
+    const std::size_t pixels = source.distance_m.size();
+    part.p_image.assign(pixels, glm::dvec3(0.0));
+    part.seen.assign(pixels, false);
+    part.normal = source.normal;
+    part.id = source.source_id.empty() ? std::vector<std::uint32_t>(pixels, 0u) : source.source_id;
+    for (int j = 0; j < grid.H; ++j)
+      for (int i = 0; i < grid.W; ++i) {
+        const std::size_t k = source.pixel_index(i, j);
+        if (std::isinf(source.distance_m[k])) continue;
+        part.seen[k] = true;
+        part.p_image[k] = double(source.distance_m[k]) * source.v_image(i, j);
+      }
+    // The colour as an sRGB texture, texel centres at the vertices' uvs.
+    part.texture.name = source.name;
+    part.texture.width = source.size.x;
+    part.texture.height = source.size.y;
+    part.texture.rgba.resize(std::size_t(source.size.x) * source.size.y * 4);
+    for (std::size_t k = 0; k < source.colour.size(); ++k) {
+      for (int c = 0; c < 3; ++c)
+        part.texture.rgba[4 * k + std::size_t(c)] = srgb_encode(source.colour[k][c]);
+      part.texture.rgba[4 * k + 3] = 255;
+    }
+    part.blocks.resize(std::size_t(std::max(grid.blocks_x, 0)) *
+                       std::size_t(std::max(grid.blocks_y, 0)));
+  }
+}
+
+DepthMesh DepthMeshBuilder::build(const DepthLodLevels& given_levels) {
+  const DepthMeshOptions& options = options_;
+  const bool lod = lod_;
   DepthMesh mesh;
   Scene& scene = mesh.scene;
   scene.name = "depth image";
@@ -561,62 +651,27 @@ DepthMesh depth_image_mesh(const DepthImage& image, const DepthMeshOptions& opti
   DepthLodLevels levels;
   if (lod) {
     mesh.lod_blocks_by_level.assign(kLodLevels, 0);
-    if (options.lod_levels) {
-      levels = *options.lod_levels;
-      bool fits = levels.size() == image.parts.size();
-      for (std::size_t p = 0; fits && p < levels.size(); ++p) {
-        const PartGrid grid(image.parts[p], true);
-        fits = levels[p].size() ==
-               std::size_t(std::max(grid.blocks_x, 0)) * std::size_t(std::max(grid.blocks_y, 0));
-        for (std::uint8_t l : levels[p]) fits = fits && l < kLodLevels;
-      }
-      if (!fits)
-        throw InputError("command line", OptionName{"lod"},
-                         "expected levels below " + std::to_string(kLodLevels) +
-                             " for every block of every part of the depth image");
-    } else {
-      levels = DepthLodChooser(image, options)
-                   .levels(options.lod_eye_world ? *options.lod_eye_world
-                                                 : glm::dvec3(image.T_world_image[3]));
+    bool fits = given_levels.size() == parts_.size();
+    for (std::size_t p = 0; fits && p < given_levels.size(); ++p) {
+      fits = given_levels[p].size() == parts_[p].blocks.size();
+      for (std::uint8_t l : given_levels[p]) fits = fits && l < kLodLevels;
     }
+    if (!fits)
+      throw InputError("command line", OptionName{"lod"},
+                       "expected levels below " + std::to_string(kLodLevels) +
+                           " for every block of every part of the depth image");
+    levels = given_levels;
   }
-  // Per vertex of the scene (all parts): its point and normal in the image frame, its source ID.
-  std::vector<glm::dvec3> p_vertex, n_vertex;
-  std::vector<std::uint32_t> id_vertex;
-  for (std::size_t part_index = 0; part_index < image.parts.size(); ++part_index) {
-    const DepthImagePart& part = image.parts[part_index];
-    const PartGrid grid(part, lod);
-    const bool wraps = grid.wraps;
-    const int W = grid.W, H = grid.H, last_x = grid.last_x, last_y = grid.last_y;
-    const int block = grid.block, blocks_x = grid.blocks_x, blocks_y = grid.blocks_y;
-    const auto pixel_x = [&](int x) { return x == W ? 0 : x; };
+  blocks_made_ = 0;
+  for (std::size_t part_index = 0; part_index < parts_.size(); ++part_index) {
+    Part& part = parts_[part_index];
+    const bool wraps = part.wraps;
+    const int W = part.W, H = part.H, last_x = part.last_x, last_y = part.last_y;
+    const int block = part.block, blocks_x = part.blocks_x, blocks_y = part.blocks_y;
     const auto block_from_x = [&](int bx) { return bx * block; };
     const auto block_to_x = [&](int bx) { return std::min((bx + 1) * block, last_x); };
     const auto block_from_y = [&](int by) { return by * block; };
     const auto block_to_y = [&](int by) { return std::min((by + 1) * block, last_y); };
-
-    // Vertex index per node, -2 before it is looked at, -1 where the pixel sees nothing.
-    const std::size_t nodes_w = std::size_t(W) + 1;
-    std::vector<std::int64_t> vertex(nodes_w * std::size_t(std::max(H, 0)), -2);
-    const auto point = [&](int i, int j) {
-      return double(part.distance_m[part.pixel_index(i, j)]) * part.v_image(i, j);
-    };
-    const auto vertex_at = [&](int x, int y) -> std::int64_t {
-      std::int64_t& v = vertex[std::size_t(y) * nodes_w + std::size_t(x)];
-      if (v != -2) return v;
-      const int i = pixel_x(x);
-      const std::size_t k = part.pixel_index(i, y);
-      if (std::isinf(part.distance_m[k])) return v = -1;
-      v = std::int64_t(scene.positions.size());
-      const glm::dvec3 p = point(i, y);
-      p_vertex.push_back(p);
-      n_vertex.push_back(glm::dvec3(part.normal[k]));
-      id_vertex.push_back(part.source_id.empty() ? 0 : part.source_id[k]);
-      scene.positions.push_back(glm::vec3(p));
-      scene.normals.push_back(glm::normalize(part.normal[k]));
-      scene.uvs.push_back({float((x + 0.5) / W), float((y + 0.5) / H)});
-      return v;
-    };
 
     // Each block's level (step 2^level).
     const auto level_at = [&](int bx, int by) -> int {
@@ -638,190 +693,235 @@ DepthMesh depth_image_mesh(const DepthImage& image, const DepthMeshOptions& opti
       if (!lod) return block_nodes(0, last_y, options.step);
       return block_nodes(block_from_y(by), block_to_y(by), 1 << level_at(bx, by));
     };
-
-    Primitive primitive;
-    primitive.first_index = std::uint32_t(scene.indices.size());
-    primitive.material = std::uint32_t(scene.materials.size());
-    // A triangle of grid nodes when all corners are seen and every edge joins one surface; wound
-    // counter-clockwise seen from the eye.
-    using Node = glm::ivec2;
-    // joins_one_surface (symmetric) of the cell's edges, each judged once: the four triangles a
-    // plain cell tries share its four sides and two diagonals. Cleared for every cell.
-    struct JudgedEdge {
-      std::size_t u, w;
-      bool joins;
-    };
-    std::vector<JudgedEdge> judged;
-    const auto edge_joins = [&](std::size_t u, std::size_t w) {
-      if (u > w) std::swap(u, w);
-      for (const JudgedEdge& edge : judged)
-        if (edge.u == u && edge.w == w) return edge.joins;
-      const bool joins = joins_one_surface(p_vertex[u], n_vertex[u], p_vertex[w], n_vertex[w],
-                                           options.edge_footprints, tangent_sin);
-      judged.push_back({u, w, joins});
-      return joins;
-    };
-    const auto triangle = [&](Node na, Node nb, Node nc, std::array<std::uint32_t, 3>& out,
-                              std::uint32_t& id) {
-      const std::int64_t a = vertex_at(na.x, na.y), b = vertex_at(nb.x, nb.y),
-                         c = vertex_at(nc.x, nc.y);
-      if (a < 0 || b < 0 || c < 0) return false;
-      const std::array<std::size_t, 3> v{std::size_t(a), std::size_t(b), std::size_t(c)};
-      for (int e = 0; e < 3; ++e) {
-        const std::size_t u = v[std::size_t(e)], w = v[std::size_t((e + 1) % 3)];
-        if (!edge_joins(u, w)) return false;
+    // The finer neighbour of block (bx, by) at block (nx, ny), if that is one.
+    const auto finer_neighbour = [&](int bx, int by, int nx, int ny) -> std::optional<glm::ivec2> {
+      if (!lod) return std::nullopt;
+      if (nx < 0 || nx >= blocks_x) {
+        if (!wraps) return std::nullopt;
+        nx = (nx + blocks_x) % blocks_x;
       }
-      const glm::dvec3 normal =
-          glm::cross(p_vertex[v[1]] - p_vertex[v[0]], p_vertex[v[2]] - p_vertex[v[0]]);
-      if (glm::dot(normal, normal) == 0) return false;
-      const bool facing_eye = glm::dot(normal, p_vertex[v[0]]) < 0;
-      out = {std::uint32_t(a), std::uint32_t(facing_eye ? b : c),
-             std::uint32_t(facing_eye ? c : b)};
-      const std::uint32_t ia = id_vertex[v[0]], ib = id_vertex[v[1]], ic = id_vertex[v[2]];
-      id = ib == ic ? ib : ia;
-      return true;
+      if (ny < 0 || ny >= blocks_y) return std::nullopt;
+      if (level_at(nx, ny) >= level_at(bx, by)) return std::nullopt;
+      return glm::ivec2(nx, ny);
     };
-    const auto emit = [&](const std::array<std::uint32_t, 3>& tri, std::uint32_t id) {
-      scene.indices.insert(scene.indices.end(), tri.begin(), tri.end());
-      mesh.source_id.push_back(id);
-    };
-    for (int by = 0; by < blocks_y; ++by) {
-      for (int bx = 0; bx < blocks_x; ++bx) {
-        const std::vector<int> xs = xs_of(bx, by), ys = ys_of(bx, by);
-        // The finer neighbours' nodes along the shared edges (none without level of detail).
-        const auto neighbour = [&](int nx, int ny) -> std::optional<glm::ivec2> {
-          if (!lod) return std::nullopt;
-          if (nx < 0 || nx >= blocks_x) {
-            if (!wraps) return std::nullopt;
-            nx = (nx + blocks_x) % blocks_x;
+
+    // Nodes a block looked at, marked with the block's number + 1 while it is made.
+    std::vector<std::uint32_t> looked_by;
+    std::uint32_t block_number = 0;
+    const auto make_block = [&](int bx, int by, Part::Block& made) {
+      made.triangles.clear();
+      made.source_id.clear();
+      made.looked_at.clear();
+      made.dropped = 0;
+      if (looked_by.empty()) looked_by.assign(std::size_t(W + 1) * std::size_t(std::max(H, 0)), 0u);
+      ++block_number;
+      using Node = glm::ivec2;
+      // The seen node at (x, y), recorded as looked at; nullopt where the pixel sees nothing.
+      const auto look_at = [&](Node n) -> std::optional<std::size_t> {
+        const std::size_t k = part.pixel_of_node(part.node(n.x, n.y));
+        if (!part.seen[k]) return std::nullopt;
+        const std::size_t node = part.node(n.x, n.y);
+        if (looked_by[node] != block_number) {
+          looked_by[node] = block_number;
+          made.looked_at.push_back(std::uint32_t(node));
+        }
+        return node;
+      };
+      // joins_one_surface (symmetric) of the cell's edges, each judged once: the four triangles
+      // a plain cell tries share its four sides and two diagonals. Cleared for every cell.
+      struct JudgedEdge {
+        std::size_t u, w;
+        bool joins;
+      };
+      std::vector<JudgedEdge> judged;
+      const auto edge_joins = [&](std::size_t u, std::size_t w) {
+        if (u > w) std::swap(u, w);
+        for (const JudgedEdge& edge : judged)
+          if (edge.u == u && edge.w == w) return edge.joins;
+        const std::size_t ku = part.pixel_of_node(u), kw = part.pixel_of_node(w);
+        const bool joins =
+            joins_one_surface(part.p_image[ku], glm::dvec3(part.normal[ku]), part.p_image[kw],
+                              glm::dvec3(part.normal[kw]), options.edge_footprints, tangent_sin);
+        judged.push_back({u, w, joins});
+        return joins;
+      };
+      // A triangle of grid nodes when all corners are seen and every edge joins one surface;
+      // wound counter-clockwise seen from the eye.
+      const auto triangle = [&](Node na, Node nb, Node nc, std::array<std::uint32_t, 3>& out,
+                                std::uint32_t& id) {
+        const std::optional<std::size_t> a = look_at(na), b = look_at(nb), c = look_at(nc);
+        if (!a || !b || !c) return false;
+        const std::array<std::size_t, 3> v{*a, *b, *c};
+        for (int e = 0; e < 3; ++e) {
+          const std::size_t u = v[std::size_t(e)], w = v[std::size_t((e + 1) % 3)];
+          if (!edge_joins(u, w)) return false;
+        }
+        const std::array<std::size_t, 3> k{part.pixel_of_node(v[0]), part.pixel_of_node(v[1]),
+                                           part.pixel_of_node(v[2])};
+        const glm::dvec3 normal = glm::cross(part.p_image[k[1]] - part.p_image[k[0]],
+                                             part.p_image[k[2]] - part.p_image[k[0]]);
+        if (glm::dot(normal, normal) == 0) return false;
+        const bool facing_eye = glm::dot(normal, part.p_image[k[0]]) < 0;
+        out = {std::uint32_t(v[0]), std::uint32_t(facing_eye ? v[1] : v[2]),
+               std::uint32_t(facing_eye ? v[2] : v[1])};
+        const std::uint32_t ia = part.id[k[0]], ib = part.id[k[1]], ic = part.id[k[2]];
+        id = ib == ic ? ib : ia;
+        return true;
+      };
+      const auto emit = [&](const std::array<std::uint32_t, 3>& tri, std::uint32_t id) {
+        made.triangles.push_back(tri);
+        made.source_id.push_back(id);
+      };
+      const std::vector<int> xs = xs_of(bx, by), ys = ys_of(bx, by);
+      // The finer neighbours' nodes along the shared edges (none without level of detail).
+      const auto left = finer_neighbour(bx, by, bx - 1, by),
+                 right = finer_neighbour(bx, by, bx + 1, by),
+                 top = finer_neighbour(bx, by, bx, by - 1),
+                 bottom = finer_neighbour(bx, by, bx, by + 1);
+      const std::vector<int> left_ys = left ? ys_of(left->x, left->y) : std::vector<int>{},
+                             right_ys = right ? ys_of(right->x, right->y) : std::vector<int>{},
+                             top_xs = top ? xs_of(top->x, top->y) : std::vector<int>{},
+                             bottom_xs = bottom ? xs_of(bottom->x, bottom->y) : std::vector<int>{};
+      for (std::size_t gj = 0; gj + 1 < ys.size(); ++gj) {
+        for (std::size_t gi = 0; gi + 1 < xs.size(); ++gi) {
+          const int x0 = xs[gi], x1 = xs[gi + 1], y0 = ys[gj], y1 = ys[gj + 1];
+          // Extra nodes on the cell's sides from finer neighbours.
+          const std::vector<int> on_top =
+              top && gj == 0 ? nodes_between(top_xs, x0, x1) : std::vector<int>{};
+          const std::vector<int> on_bottom =
+              bottom && gj + 2 == ys.size() ? nodes_between(bottom_xs, x0, x1) : std::vector<int>{};
+          const std::vector<int> on_left =
+              left && gi == 0 ? nodes_between(left_ys, y0, y1) : std::vector<int>{};
+          const std::vector<int> on_right =
+              right && gi + 2 == xs.size() ? nodes_between(right_ys, y0, y1) : std::vector<int>{};
+          judged.clear();
+          std::array<std::uint32_t, 3> tri{};
+          std::uint32_t id = 0;
+          if (on_top.empty() && on_bottom.empty() && on_left.empty() && on_right.empty()) {
+            // The diagonal that keeps more triangles (across a discontinuity one may survive).
+            const Node n00(x0, y0), n10(x1, y0), n01(x0, y1), n11(x1, y1);
+            std::array<std::array<std::uint32_t, 3>, 4> tris{};
+            std::array<std::uint32_t, 4> ids{};
+            const std::array<std::array<Node, 3>, 4> corners{
+                {{n00, n01, n11}, {n00, n11, n10}, {n00, n01, n10}, {n10, n01, n11}}};
+            std::array<bool, 4> ok{};
+            for (std::size_t t = 0; t < 4; ++t)
+              ok[t] = triangle(corners[t][0], corners[t][1], corners[t][2], tris[t], ids[t]);
+            const int first = int(ok[0]) + int(ok[1]), second = int(ok[2]) + int(ok[3]);
+            const std::size_t from = second > first ? 2 : 0;
+            made.dropped += std::size_t(2 - std::max(first, second));
+            for (std::size_t t = from; t < from + 2; ++t)
+              if (ok[t]) emit(tris[t], ids[t]);
+            continue;
           }
-          if (ny < 0 || ny >= blocks_y) return std::nullopt;
-          if (level_at(nx, ny) >= level_at(bx, by)) return std::nullopt;
-          return glm::ivec2(nx, ny);
-        };
-        const auto left = neighbour(bx - 1, by), right = neighbour(bx + 1, by),
-                   top = neighbour(bx, by - 1), bottom = neighbour(bx, by + 1);
-        const std::vector<int> left_ys = left ? ys_of(left->x, left->y) : std::vector<int>{},
-                               right_ys = right ? ys_of(right->x, right->y) : std::vector<int>{},
-                               top_xs = top ? xs_of(top->x, top->y) : std::vector<int>{},
-                               bottom_xs =
-                                   bottom ? xs_of(bottom->x, bottom->y) : std::vector<int>{};
-        for (std::size_t gj = 0; gj + 1 < ys.size(); ++gj) {
-          for (std::size_t gi = 0; gi + 1 < xs.size(); ++gi) {
-            const int x0 = xs[gi], x1 = xs[gi + 1], y0 = ys[gj], y1 = ys[gj + 1];
-            // Extra nodes on the cell's sides from finer neighbours.
-            const std::vector<int> on_top =
-                top && gj == 0 ? nodes_between(top_xs, x0, x1) : std::vector<int>{};
-            const std::vector<int> on_bottom = bottom && gj + 2 == ys.size()
-                                                   ? nodes_between(bottom_xs, x0, x1)
-                                                   : std::vector<int>{};
-            const std::vector<int> on_left =
-                left && gi == 0 ? nodes_between(left_ys, y0, y1) : std::vector<int>{};
-            const std::vector<int> on_right =
-                right && gi + 2 == xs.size() ? nodes_between(right_ys, y0, y1) : std::vector<int>{};
-            judged.clear();
-            std::array<std::uint32_t, 3> tri{};
-            std::uint32_t id = 0;
-            if (on_top.empty() && on_bottom.empty() && on_left.empty() && on_right.empty()) {
-              // The diagonal that keeps more triangles (across a discontinuity one may survive).
-              const Node n00(x0, y0), n10(x1, y0), n01(x0, y1), n11(x1, y1);
-              std::array<std::array<std::uint32_t, 3>, 4> tris{};
-              std::array<std::uint32_t, 4> ids{};
-              const std::array<std::array<Node, 3>, 4> corners{
-                  {{n00, n01, n11}, {n00, n11, n10}, {n00, n01, n10}, {n10, n01, n11}}};
-              std::array<bool, 4> ok{};
-              for (std::size_t t = 0; t < 4; ++t)
-                ok[t] = triangle(corners[t][0], corners[t][1], corners[t][2], tris[t], ids[t]);
-              const int first = int(ok[0]) + int(ok[1]), second = int(ok[2]) + int(ok[3]);
-              const std::size_t from = second > first ? 2 : 0;
-              mesh.dropped_triangles += std::size_t(2 - std::max(first, second));
-              for (std::size_t t = from; t < from + 2; ++t)
-                if (ok[t]) emit(tris[t], ids[t]);
-              continue;
-            }
-            // The cell's outline, counter-clockwise in the grid (x right, y down): top left to
-            // bottom left, bottom right, top right, with the finer neighbours' nodes.
-            std::vector<Node> outline;
-            outline.emplace_back(x0, y0);
-            for (int y : on_left) outline.emplace_back(x0, y);
-            outline.emplace_back(x0, y1);
-            for (int x : on_bottom) outline.emplace_back(x, y1);
-            outline.emplace_back(x1, y1);
-            for (auto it = on_right.rbegin(); it != on_right.rend(); ++it)
-              outline.emplace_back(x1, *it);
-            outline.emplace_back(x1, y0);
-            for (auto it = on_top.rbegin(); it != on_top.rend(); ++it)
-              outline.emplace_back(*it, y0);
-            const auto add = [&](Node a, Node b, Node c) {
-              if (triangle(a, b, c, tri, id))
-                emit(tri, id);
-              else
-                ++mesh.dropped_triangles;
-            };
-            if (x1 - x0 >= 2 && y1 - y0 >= 2) {
-              // A fan about the cell's centre pixel.
-              const Node centre((x0 + x1) / 2, (y0 + y1) / 2);
-              for (std::size_t k = 0; k < outline.size(); ++k)
-                add(centre, outline[k], outline[(k + 1) % outline.size()]);
+          // The cell's outline, counter-clockwise in the grid (x right, y down): top left to
+          // bottom left, bottom right, top right, with the finer neighbours' nodes.
+          std::vector<Node> outline;
+          outline.emplace_back(x0, y0);
+          for (int y : on_left) outline.emplace_back(x0, y);
+          outline.emplace_back(x0, y1);
+          for (int x : on_bottom) outline.emplace_back(x, y1);
+          outline.emplace_back(x1, y1);
+          for (auto it = on_right.rbegin(); it != on_right.rend(); ++it)
+            outline.emplace_back(x1, *it);
+          outline.emplace_back(x1, y0);
+          for (auto it = on_top.rbegin(); it != on_top.rend(); ++it) outline.emplace_back(*it, y0);
+          const auto add = [&](Node a, Node b, Node c) {
+            if (triangle(a, b, c, tri, id))
+              emit(tri, id);
+            else
+              ++made.dropped;
+          };
+          if (x1 - x0 >= 2 && y1 - y0 >= 2) {
+            // A fan about the cell's centre pixel.
+            const Node centre((x0 + x1) / 2, (y0 + y1) / 2);
+            for (std::size_t k = 0; k < outline.size(); ++k)
+              add(centre, outline[k], outline[(k + 1) % outline.size()]);
+          } else {
+            // One pixel wide: the extra nodes lie on the two long sides; a strip between them.
+            const bool tall = x1 - x0 == 1;
+            std::vector<Node> a, b;  // the two long sides, in the same direction
+            if (tall) {
+              a.emplace_back(x0, y0);
+              for (int y : on_left) a.emplace_back(x0, y);
+              a.emplace_back(x0, y1);
+              b.emplace_back(x1, y0);
+              for (int y : on_right) b.emplace_back(x1, y);
+              b.emplace_back(x1, y1);
             } else {
-              // One pixel wide: the extra nodes lie on the two long sides; a strip between them.
-              const bool tall = x1 - x0 == 1;
-              std::vector<Node> a, b;  // the two long sides, in the same direction
-              if (tall) {
-                a.emplace_back(x0, y0);
-                for (int y : on_left) a.emplace_back(x0, y);
-                a.emplace_back(x0, y1);
-                b.emplace_back(x1, y0);
-                for (int y : on_right) b.emplace_back(x1, y);
-                b.emplace_back(x1, y1);
+              a.emplace_back(x0, y0);
+              for (int x : on_top) a.emplace_back(x, y0);
+              a.emplace_back(x1, y0);
+              b.emplace_back(x0, y1);
+              for (int x : on_bottom) b.emplace_back(x, y1);
+              b.emplace_back(x1, y1);
+            }
+            std::size_t ia = 0, ib = 0;
+            while (ia + 1 < a.size() || ib + 1 < b.size()) {
+              const int along_a = ia + 1 < a.size() ? (tall ? a[ia + 1].y : a[ia + 1].x) : 1 << 30;
+              const int along_b = ib + 1 < b.size() ? (tall ? b[ib + 1].y : b[ib + 1].x) : 1 << 30;
+              if (along_a <= along_b) {
+                add(a[ia], a[ia + 1], b[ib]);
+                ++ia;
               } else {
-                a.emplace_back(x0, y0);
-                for (int x : on_top) a.emplace_back(x, y0);
-                a.emplace_back(x1, y0);
-                b.emplace_back(x0, y1);
-                for (int x : on_bottom) b.emplace_back(x, y1);
-                b.emplace_back(x1, y1);
-              }
-              std::size_t ia = 0, ib = 0;
-              while (ia + 1 < a.size() || ib + 1 < b.size()) {
-                const int along_a =
-                    ia + 1 < a.size() ? (tall ? a[ia + 1].y : a[ia + 1].x) : 1 << 30;
-                const int along_b =
-                    ib + 1 < b.size() ? (tall ? b[ib + 1].y : b[ib + 1].x) : 1 << 30;
-                if (along_a <= along_b) {
-                  add(a[ia], a[ia + 1], b[ib]);
-                  ++ia;
-                } else {
-                  add(a[ia], b[ib + 1], b[ib]);
-                  ++ib;
-                }
+                add(a[ia], b[ib + 1], b[ib]);
+                ++ib;
               }
             }
           }
         }
       }
+    };
+
+    // Make the blocks whose level or finer neighbours changed; number the vertices in the order
+    // the blocks first looked at their nodes, as one pass over every block would.
+    Primitive primitive;
+    primitive.first_index = std::uint32_t(scene.indices.size());
+    primitive.material = std::uint32_t(scene.materials.size());
+    std::vector<std::uint32_t> vertex(std::size_t(W + 1) * std::size_t(std::max(H, 0)), ~0u);
+    for (int by = 0; by < blocks_y; ++by) {
+      for (int bx = 0; bx < blocks_x; ++bx) {
+        Part::Block& made = part.blocks[std::size_t(by) * std::size_t(blocks_x) + std::size_t(bx)];
+        std::array<std::uint8_t, 5> key{};
+        if (lod) {
+          const auto side = [&](int nx, int ny) {
+            const std::optional<glm::ivec2> n = finer_neighbour(bx, by, nx, ny);
+            return n ? std::uint8_t(level_at(n->x, n->y)) : Part::Block::kNoNeighbour;
+          };
+          key = {std::uint8_t(level_at(bx, by)), side(bx - 1, by), side(bx + 1, by),
+                 side(bx, by - 1), side(bx, by + 1)};
+        }
+        if (!made.made || made.key != key) {
+          make_block(bx, by, made);
+          made.made = true;
+          made.key = key;
+          ++blocks_made_;
+        }
+        for (const std::uint32_t node : made.looked_at) {
+          if (vertex[node] != ~0u) continue;
+          vertex[node] = std::uint32_t(scene.positions.size());
+          const std::size_t k = part.pixel_of_node(node);
+          const int x = int(node % std::uint32_t(W + 1)), y = int(node / std::uint32_t(W + 1));
+          scene.positions.push_back(glm::vec3(part.p_image[k]));
+          scene.normals.push_back(glm::normalize(part.normal[k]));
+          scene.uvs.push_back({float((x + 0.5) / W), float((y + 0.5) / H)});
+        }
+        for (const std::array<std::uint32_t, 3>& tri : made.triangles)
+          for (const std::uint32_t node : tri) scene.indices.push_back(vertex[node]);
+        mesh.source_id.insert(mesh.source_id.end(), made.source_id.begin(), made.source_id.end());
+        mesh.dropped_triangles += made.dropped;
+      }
     }
     primitive.index_count = std::uint32_t(scene.indices.size()) - primitive.first_index;
-    // The colour as an sRGB texture, texel centres at the vertices' uvs.
-    Image texture;
-    texture.name = part.name;
-    texture.width = part.size.x;
-    texture.height = part.size.y;
-    texture.rgba.resize(std::size_t(part.size.x) * part.size.y * 4);
-    for (std::size_t k = 0; k < part.colour.size(); ++k) {
-      for (int c = 0; c < 3; ++c)
-        texture.rgba[4 * k + std::size_t(c)] = srgb_encode(part.colour[k][c]);
-      texture.rgba[4 * k + 3] = 255;
-    }
     Material material;
     material.name = "depth image " + part.name;
     material.texture = int(scene.images.size());
     material.repeat = wraps;
-    scene.images.push_back(std::move(texture));
+    scene.images.push_back(part.texture);
     scene.materials.push_back(material);
     Object object;
     object.name = part.name;
-    object.T_world_object = glm::mat4(image.T_world_image);
+    object.T_world_object = glm::mat4(T_world_image_);
     object.first_primitive = std::uint32_t(scene.primitives.size());
     object.primitive_count = 1;
     scene.primitives.push_back(primitive);
@@ -829,10 +929,22 @@ DepthMesh depth_image_mesh(const DepthImage& image, const DepthMeshOptions& opti
   }
   SceneCamera eye;
   eye.name = kDepthImageEyeCamera;
-  eye.T_world_camera = image.T_world_image;
+  eye.T_world_camera = T_world_image_;
   scene.cameras.push_back(eye);
   scene.update_bounds();
   return mesh;
+}
+
+DepthMesh depth_image_mesh(const DepthImage& image, const DepthMeshOptions& options) {
+  DepthMeshBuilder builder(image, options);
+  DepthLodLevels levels;
+  if (options.lod_angle_rad > 0)
+    levels = options.lod_levels
+                 ? *options.lod_levels
+                 : DepthLodChooser(image, options)
+                       .levels(options.lod_eye_world ? *options.lod_eye_world
+                                                     : glm::dvec3(image.T_world_image[3]));
+  return builder.build(levels);
 }
 
 Scene merge_scenes(Scene a, const Scene& b) {

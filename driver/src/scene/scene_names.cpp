@@ -200,8 +200,8 @@ ViewDependentScene::ViewDependentScene(const SceneName& name, const glm::dvec3& 
     if (file.lod_angle_rad > 0) {
       image.chooser.emplace(image.image, DepthMeshOptions{.lod_angle_rad = file.lod_angle_rad});
       image.levels = image.chooser->levels(eye_world);
-      image.mesh = depth_image_mesh(
-          image.image, {.lod_angle_rad = file.lod_angle_rad, .lod_levels = image.levels});
+      image.builder.emplace(image.image, DepthMeshOptions{.lod_angle_rad = file.lod_angle_rad});
+      image.mesh = image.builder->build(image.levels);
     } else {
       image.mesh = depth_image_mesh(image.image, {.step = file.step});
     }
@@ -240,17 +240,20 @@ bool ViewDependentScene::update(const glm::dvec3& eye_world) {
   stats_.choose_ms.push_back(ms_since(start));
   if (any) {
     const auto build_start = std::chrono::steady_clock::now();
+    std::size_t blocks = 0, remade = 0;
     for (std::size_t k = 0; k < images_.size(); ++k) {
+      if (!images_[k].builder) continue;
+      blocks += images_[k].builder->block_count();
       if (!changed[k]) continue;
       Image& image = images_[k];
       image.levels = std::move(*changed[k]);
-      image.mesh = depth_image_mesh(
-          image.image,
-          {.lod_angle_rad = name_.depth_images[k].lod_angle_rad, .lod_levels = image.levels});
+      image.mesh = image.builder->build(image.levels);
+      remade += image.builder->blocks_made();
       image.mesh.scene.name = name_.depth_images[k].file.filename().string();
     }
     build();
     stats_.build_ms.push_back(ms_since(build_start));
+    stats_.blocks_remade.push_back(blocks > 0 ? double(remade) / double(blocks) : 0.0);
   }
   stats_.triangles.push_back(double(scene_.triangle_count()));
   return any;
@@ -260,6 +263,7 @@ ViewDependentScene::Summary ViewDependentScene::summary() const {
   Summary summary{.rebuilds = stats_.build_ms.size(),
                   .choose_ms = median(stats_.choose_ms),
                   .build_ms = median(stats_.build_ms),
+                  .blocks_remade = median(stats_.blocks_remade),
                   .triangles_median = median(stats_.triangles)};
   if (!stats_.triangles.empty()) {
     const auto [fewest, most] =

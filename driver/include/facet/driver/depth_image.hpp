@@ -184,6 +184,38 @@ struct DepthMesh {
 // not finite or outside [0, 1] rad, or an angle with a step other than 1.
 DepthMesh depth_image_mesh(const DepthImage& image, const DepthMeshOptions& options = {});
 
+// depth_image_mesh for one image and options at any levels of detail, keeping what does not
+// depend on the levels: every seen pixel's point, the colour textures, and each block's triangles
+// with the level they were made at and the levels of its finer neighbours (the nodes a block's
+// cells stitch to). A build re-assembles only the blocks whose own or finer neighbours' levels
+// differ from the last build's; the rest keep their triangles, so a view that moves pays for the
+// blocks whose level changed and for copying the others. build(levels) equals
+// depth_image_mesh(image, options with lod_levels = levels), vertex for vertex.
+class DepthMeshBuilder {
+ public:
+  // depth_image_mesh's InputError for the image and options (lod_levels and lod_eye_world are not
+  // used here: build() takes the levels).
+  DepthMeshBuilder(const DepthImage& image, const DepthMeshOptions& options);
+  ~DepthMeshBuilder();
+  DepthMeshBuilder(DepthMeshBuilder&&) noexcept;
+  DepthMeshBuilder& operator=(DepthMeshBuilder&&) noexcept;
+
+  // The mesh at `levels` (DepthLodChooser::levels; ignored without level of detail). InputError
+  // naming "lod" when they do not fit the image's blocks.
+  DepthMesh build(const DepthLodLevels& levels);
+  // Blocks (all parts) whose triangles the last build made anew, and blocks in all.
+  std::size_t blocks_made() const { return blocks_made_; }
+  std::size_t block_count() const;
+
+ private:
+  struct Part;
+  std::vector<Part> parts_;
+  glm::dmat4 T_world_image_{1.0};
+  DepthMeshOptions options_;
+  bool lod_ = false;
+  std::size_t blocks_made_ = 0;
+};
+
 // Several scenes in one: objects, primitives, materials, images and cameras appended in order
 // (triangle IDs of `b` follow those of `a`). `a`'s animation is kept, `b`'s is not taken.
 Scene merge_scenes(Scene a, const Scene& b);

@@ -103,13 +103,16 @@ class ViewDependentScene {
   struct Stats {
     std::vector<double> choose_ms;  // per update: choosing every @lod image's levels
     std::vector<double> build_ms;   // per rebuild: the meshes and the merged scene
+    // Per rebuild: the share of the @lod images' blocks whose triangles were made anew
+    // (DepthMeshBuilder::blocks_made over block_count); the others kept theirs.
+    std::vector<double> blocks_remade;
     std::vector<double> triangles;  // per update: the scene's triangles after it
   };
   const Stats& stats() const { return stats_; }
   // The rebuilds, medians of stats() (0 where there is none) and the fewest and most triangles.
   struct Summary {
     std::size_t rebuilds = 0;
-    double choose_ms = 0, build_ms = 0;
+    double choose_ms = 0, build_ms = 0, blocks_remade = 0;
     double triangles_median = 0, triangles_min = 0, triangles_max = 0;
   };
   Summary summary() const;
@@ -120,9 +123,10 @@ class ViewDependentScene {
   Scene polygons_;
   struct Image {
     DepthImage image;
-    std::optional<DepthLodChooser> chooser;  // @lod only
-    DepthLodLevels levels;                   // @lod only: the scene's
-    DepthMesh mesh;                          // the mesh of the scene
+    std::optional<DepthLodChooser> chooser;   // @lod only
+    std::optional<DepthMeshBuilder> builder;  // @lod only
+    DepthLodLevels levels;                    // @lod only: the scene's
+    DepthMesh mesh;                           // the mesh of the scene
   };
   std::vector<Image> images_;
   Scene scene_;
