@@ -508,13 +508,23 @@ DepthLodLevels DepthLodChooser::levels(const glm::dvec3& eye_world) const {
     const int blocks_x = part.blocks_x, blocks_y = part.blocks_y;
     std::vector<std::uint8_t>& level = levels.emplace_back(
         std::size_t(std::max(blocks_x, 0)) * std::size_t(std::max(blocks_y, 0)), std::uint8_t(0));
-    // The largest angle, seen from the eye, between neighbouring pixels that join one surface.
-    std::vector<double> angle(level.size(), 0.0);
+    // The largest angle, seen from the eye, between neighbouring pixels that join one surface,
+    // found as the largest chord |u_a - u_b| between their unit directions from the eye (2
+    // sin(angle / 2), which grows with the angle over [0, pi]): each pixel's direction is
+    // normalised once, not once per pair, and no pair takes an arctangent.
+    std::vector<glm::dvec3> u(part.p_image.size());
+    for (const Part::Pair& pair : part.pairs)
+      for (const std::uint32_t k : {pair.a, pair.b})
+        if (u[k] == glm::dvec3(0.0)) u[k] = glm::normalize(part.p_image[k] - eye);
+    std::vector<double> chord_squared(level.size(), 0.0);
     for (const Part::Pair& pair : part.pairs) {
-      const glm::dvec3 a = part.p_image[pair.a] - eye, b = part.p_image[pair.b] - eye;
-      double& worst = angle[pair.block];
-      worst = std::max(worst, std::atan2(glm::length(glm::cross(a, b)), glm::dot(a, b)));
+      const glm::dvec3 d = u[pair.a] - u[pair.b];
+      double& worst = chord_squared[pair.block];
+      worst = std::max(worst, glm::dot(d, d));
     }
+    std::vector<double> angle(level.size(), 0.0);
+    for (std::size_t b = 0; b < level.size(); ++b)
+      angle[b] = 2.0 * std::asin(std::min(1.0, 0.5 * std::sqrt(chord_squared[b])));
     for (std::size_t b = 0; b < level.size(); ++b) {
       int l = 0;
       while (l + 1 < kLodLevels && angle[b] * double(1 << (l + 1)) <= angle_rad_) ++l;
