@@ -66,13 +66,20 @@ std::vector<BoundingSphere> object_spheres(const Scene& scene, const glm::dmat4&
 }
 
 void Scene::update_bounds() {
-  for (auto& object : objects) {
+  // Each vertex an object's indices name is transformed once for that object (a mesh names a
+  // vertex about six times): the stamp is the object's number + 1 once it has been.
+  std::vector<std::uint32_t> stamp(positions.size(), 0u);
+  for (std::size_t o = 0; o < objects.size(); ++o) {
+    Object& object = objects[o];
+    const auto mark = std::uint32_t(o + 1);
     Aabb box;
     for (std::uint32_t i = 0; i < object.primitive_count; ++i) {
       const Primitive& primitive = primitives[object.first_primitive + i];
       for (std::uint32_t k = 0; k < primitive.index_count; ++k) {
-        const glm::vec3& p_object = positions[indices[primitive.first_index + k]];
-        box.extend(glm::vec3(object.T_world_object * glm::vec4(p_object, 1.0f)));
+        const std::uint32_t v = indices[primitive.first_index + k];
+        if (stamp[v] == mark) continue;
+        stamp[v] = mark;
+        box.extend(glm::vec3(object.T_world_object * glm::vec4(positions[v], 1.0f)));
       }
     }
     object.bounds_world = box;
