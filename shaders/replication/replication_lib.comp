@@ -25,20 +25,33 @@ layout(binding = 11) uniform samplerBuffer object_frame_texels;
 layout(binding = 12) uniform samplerBuffer facet_texels;
 vec4 clip_plane(uint f, int k) { return texelFetch(facet_texels, 8 * int(f) + 4 + k); }
 
-struct Node {  // GpuCoverageNode
+// A node of the hierarchy (GpuCoverageNode, 7 RGBA32UI texels) and the facet order (R32UI).
+layout(binding = 20) uniform usamplerBuffer node_texels;
+layout(binding = 21) uniform usamplerBuffer order_texels;
+struct Node {
   vec4 pyramid[4];
   vec4 cone;  // bounded nodes: unit axis, sine of the half-angle
   uint first;
   uint count;
   uint bounded;
-  uint padding;
-  uint range_first;  // every facet below: facet_order[range_first, range_first + range_count)
+  uint range_first;  // every facet below: facet_order over [range_first, range_first + range_count)
   uint range_count;
-  uint padding1;
-  uint padding2;
 };
-layout(std430, binding = 7) readonly buffer Nodes { Node nodes[]; };
-layout(std430, binding = 8) readonly buffer Order { uint facet_order[]; };
+Node node_at(uint i) {
+  int at = 7 * int(i);
+  Node node;
+  for (int k = 0; k < 4; ++k) node.pyramid[k] = uintBitsToFloat(texelFetch(node_texels, at + k));
+  node.cone = uintBitsToFloat(texelFetch(node_texels, at + 4));
+  uvec4 leaf = texelFetch(node_texels, at + 5);  // first, count, bounded
+  node.first = leaf.x;
+  node.count = leaf.y;
+  node.bounded = leaf.z;
+  uvec4 range = texelFetch(node_texels, at + 6);
+  node.range_first = range.x;
+  node.range_count = range.y;
+  return node;
+}
+uint facet_order(uint i) { return texelFetch(order_texels, int(i)).x; }
 
 // The frame's triangle list (ListEntry in replication_common.hpp), an RGBA32UI texel per record
 // in material order: (record, list position of its first triangle, the one piece all its
@@ -149,19 +162,11 @@ uint triangle_eye(uint t, out vec3 p[3]) {
   return e;
 }
 
-// True when the triangle with unit corner directions u meets the cone
-// {X : planes[k]·X >= -slack·|X|, k < plane_count}: Sutherland–Hodgman clipping, as
-// triangle_meets_cone in projection/src/coverage.cpp. The cone over a triangle from the eye is the
-// cone over its corner directions, so unit corners give the same answer, and every point met
-// below has |X| <= 1: a constant slack is at least slack·|X|, and never loses a facet.
-// The corner and plane loops have constant trip counts, so the compiler unrolls them: llvmpipe
-// ends a shader invocation's loops after 65535 iterations shared by all of them
-// (LP_MAX_TGSI_LOOP_ITERATIONS). The clipping loops stay loops: unrolled to their longest they
-// made the facet frame twice as slow, and walk_coverage takes whole subtrees, so only the facets
-// along a triangle's edges come here.
-bool meets_cone(vec3 u[3], vec4 planes[4], int plane_count) {
-  // Most tests end here. Every corner outside one plane: so is the whole triangle. A corner
-  // inside every plane: clipping would keep it as it is.
+// What the triangle's corners alone say of meets_cone: kCornersMiss when one plane has every
+// corner outside it (the triangle misses the cone), kCornersMeet when a corner is inside every
+// plane, else kCornersUndecided. Most tests end here.
+const int kCornersMiss = 0, kCornersMeet = 1, kCornersUndecided = 2;
+int cone_corner_test(vec3 u[3], vec4 planes[4], int plane_count) {
   bool corner_inside[3] = bool[3](true, true, true);
   for (int k = 0; k < 4; ++k) {
     if (k >= plane_count) break;
@@ -172,37 +177,61 @@ bool meets_cone(vec3 u[3], vec4 planes[4], int plane_count) {
       any_inside = any_inside || inside;
       corner_inside[c] = corner_inside[c] && inside;
     }
-    if (!any_inside) return false;
+    if (!any_inside) return kCornersMiss;
   }
-  if (corner_inside[0] || corner_inside[1] || corner_inside[2]) return true;
-  // Each plane adds at most one vertex: 3 + 4 at most.
-  vec3 poly[8];
-  vec3 next[8];
-  poly[0] = u[0];
-  poly[1] = u[1];
-  poly[2] = u[2];
-  int count = 3;
+  return corner_inside[0] || corner_inside[1] || corner_inside[2] ? kCornersMeet
+                                                                 : kCornersUndecided;
+}
+
+// True when the triangle with unit corner directions u meets the cone
+// {X : planes[k]·X >= -slack·|X|, k < plane_count}, as triangle_meets_cone in
+// projection/src/coverage.cpp. The cone over a triangle from the eye is the cone over its corner
+// directions, so the flat triangle through the unit corners gives the same answer, and every
+// point of it has |X| <= 1: a constant slack is at least slack·|X|, and never loses a facet.
+// Where the corners leave it undecided, the flat triangle's points inside every plane are a
+// convex polygon in the triangle's barycentric (alpha, beta), cut by three constraints of the
+// triangle and one per plane; it is empty unless one of its vertices, where two constraints'
+// lines cross, satisfies the others. The CPU clips the triangle instead (Sutherland–Hodgman),
+// which made the walk seven times slower on llvmpipe (driver/README.md): the polygon's arrays,
+// indexed by how many vertices each lane has kept, are loaded and stored one lane at a time. The
+// crossings' loops
+// have constant trip counts (18 pairs, 7 constraints), and llvmpipe ends an invocation's loops
+// after 65535 iterations shared by all of them (LP_MAX_TGSI_LOOP_ITERATIONS).
+// Two of the triangle's own constraints cross at a corner, which the corner test has decided.
+const ivec2 kConstraintPairs[18] = ivec2[18](
+    ivec2(0, 3), ivec2(0, 4), ivec2(0, 5), ivec2(0, 6), ivec2(1, 3), ivec2(1, 4), ivec2(1, 5),
+    ivec2(1, 6), ivec2(2, 3), ivec2(2, 4), ivec2(2, 5), ivec2(2, 6), ivec2(3, 4), ivec2(3, 5),
+    ivec2(3, 6), ivec2(4, 5), ivec2(4, 6), ivec2(5, 6));
+bool meets_cone(vec3 u[3], vec4 planes[4], int plane_count) {
+  int corners = cone_corner_test(u, planes, plane_count);
+  if (corners != kCornersUndecided) return corners == kCornersMeet;
+  // The point u0 + alpha (u1 - u0) + beta (u2 - u0) is inside constraint c where
+  // c.x alpha + c.y beta + c.z >= 0: alpha >= 0, beta >= 0, alpha + beta <= 1, then the planes
+  // (an unused plane's constraint always holds).
+  vec3 e1 = u[1] - u[0], e2 = u[2] - u[0];
+  vec3 c[7];
+  c[0] = vec3(1.0, 0.0, 0.0);
+  c[1] = vec3(0.0, 1.0, 0.0);
+  c[2] = vec3(-1.0, -1.0, 1.0);
   for (int k = 0; k < 4; ++k) {
-    if (k >= plane_count || count == 0) break;
     vec3 n = planes[k].xyz;
-    int written = 0;
-    for (int i = 0; i < count; ++i) {
-      vec3 a = poly[i];
-      vec3 b = poly[i + 1 < count ? i + 1 : 0];
-      float da = dot(n, a) + kCoverageSlack;
-      float db = dot(n, b) + kCoverageSlack;
-      if (da >= 0.0 && written < 8) next[written++] = a;
-      if ((da >= 0.0) != (db >= 0.0) && written < 8)
-        next[written++] = a + (b - a) * (da / (da - db));
-    }
-    count = written;
-    for (int i = 0; i < count; ++i) poly[i] = next[i];
+    c[3 + k] = k < plane_count ? vec3(dot(n, e1), dot(n, e2), dot(n, u[0]) + kCoverageSlack)
+                               : vec3(0.0, 0.0, 1.0);
   }
-  // What meets the cone only at the eye is seen edge-on and covers nothing.
-  for (int i = 0; i < count; ++i) {
-    if (length(poly[i]) > 1e-6) return true;
+  // A crossing is tested against the other five constraints (its own two hold there up to
+  // rounding), with room for rounding only: the slack above is what keeps it conservative.
+  bool meets = false;
+  for (int p = 0; p < 18; ++p) {
+    ivec2 pair = kConstraintPairs[p];
+    vec3 a = c[pair.x], b = c[pair.y];
+    float det = a.x * b.y - a.y * b.x;
+    vec3 vertex = vec3((b.z * a.y - a.z * b.y) / det, (a.z * b.x - b.z * a.x) / det, 1.0);
+    bool inside = abs(det) >= 1e-12;
+    for (int k = 0; k < 7; ++k)
+      inside = inside && (k == pair.x || k == pair.y || dot(c[k], vertex) >= -1e-7);
+    meets = meets || inside;
   }
-  return false;
+  return meets;
 }
 
 // Whether the cone (unit axis, sine of its half-angle) lies inside the triangle's cone, given the
@@ -266,11 +295,11 @@ uint walk_coverage(vec3 p[3], uint t, uint pair_base, uint wanted, out uint want
   int top = 0;
   stack[top++] = 0u;
   while (top > 0) {
-    Node node = nodes[stack[--top]];
+    Node node = node_at(stack[--top]);
     if (node.bounded != 0u && !meets_cone(u, node.pyramid, 4)) continue;
     if (node.bounded != 0u && cone_inside(e, node.cone)) {
       if (wanted != kNone && wanted < found + node.range_count) {
-        wanted_facet = piece_of_facet(facet_order[node.range_first + (wanted - found)]);
+        wanted_facet = piece_of_facet(facet_order(node.range_first + (wanted - found)));
         return wanted + 1u;
       }
       if (pair_base != kNone) {
@@ -279,7 +308,7 @@ uint walk_coverage(vec3 p[3], uint t, uint pair_base, uint wanted, out uint want
           for (uint m = 0u; m < 8u; ++m) {
             if (k + m < node.range_count)
               write_pair(pair_base + found + k + m, t,
-                         piece_of_facet(facet_order[node.range_first + k + m]));
+                         piece_of_facet(facet_order(node.range_first + k + m)));
           }
         }
       }
@@ -290,7 +319,7 @@ uint walk_coverage(vec3 p[3], uint t, uint pair_base, uint wanted, out uint want
       // A leaf holds at most kCoverageLeafSize facets (GpuCoverageNode).
       for (uint m = 0u; m < kCoverageLeafSize; ++m) {
         if (m >= node.count) break;
-        uint f = facet_order[node.first + m];
+        uint f = facet_order(node.first + m);
         vec4 planes[4] = vec4[4](clip_plane(f, 0), clip_plane(f, 1), clip_plane(f, 2), vec4(0.0));
         if (!meets_cone(u, planes, 3)) continue;
         if (found == wanted) {
@@ -320,7 +349,7 @@ bool sphere_may_meet_facets(vec3 centre, float radius) {
   int top = 0;
   stack[top++] = 0u;
   while (top > 0) {
-    Node node = nodes[stack[--top]];
+    Node node = node_at(stack[--top]);
     if (node.bounded != 0u) {
       bool outside = false;
       for (int k = 0; k < 4; ++k) outside = outside || dot(node.pyramid[k].xyz, centre) < -radius;
@@ -329,7 +358,7 @@ bool sphere_may_meet_facets(vec3 centre, float radius) {
     if (node.count > 0u) {
       for (uint m = 0u; m < kCoverageLeafSize; ++m) {
         if (m >= node.count) break;
-        uint f = facet_order[node.first + m];
+        uint f = facet_order(node.first + m);
         bool outside = false;
         for (int k = 0; k < 3; ++k) outside = outside || dot(clip_plane(f, k).xyz, centre) < -radius;
         if (!outside) return true;

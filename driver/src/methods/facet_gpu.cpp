@@ -310,6 +310,8 @@ FacetSet FacetSet::build(const Warp& warp, const FacetBuildOptions& options, dou
                {},
                {},
                {},
+               {},
+               {},
                {}};
   const std::vector<GpuFacet> gpu_facets = pack_facets(set.mesh, set.pieces, z_near);
   const auto nodes = pack_coverage_nodes(set.index);
@@ -321,19 +323,21 @@ FacetSet FacetSet::build(const Warp& warp, const FacetBuildOptions& options, dou
                                   : Buffer::create_from(gpu_facets);
   set.facet_texels = Texture::create_buffer_view(set.facets, GL_RGBA32F, 4 * sizeof(float));
   set.nodes = nodes.empty() ? Buffer::create(sizeof no_node, &no_node) : Buffer::create_from(nodes);
+  set.node_texels = Texture::create_buffer_view(set.nodes, GL_RGBA32UI, 4 * sizeof(std::uint32_t));
   set.grid_words = Buffer::create_from(pack_coverage_grid(set.grid, set.pieces));
   set.grid_texels = Texture::create_buffer_view(set.grid_words, GL_R32UI, sizeof(std::uint32_t));
   set.grid_vec4_texels =
       Texture::create_buffer_view(set.grid_words, GL_RGBA32UI, 4 * sizeof(std::uint32_t));
   set.order = set.index.order().empty() ? Buffer::create(sizeof no_order, &no_order)
                                         : Buffer::create_from(set.index.order());
+  set.order_texels = Texture::create_buffer_view(set.order, GL_R32UI, sizeof(std::uint32_t));
   return set;
 }
 
 void FacetSet::bind() const {
   facet_texels.bind_unit(texture_unit::facets);
-  nodes.bind_base(GL_SHADER_STORAGE_BUFFER, binding::nodes);
-  order.bind_base(GL_SHADER_STORAGE_BUFFER, binding::order);
+  node_texels.bind_unit(texture_unit::nodes);
+  order_texels.bind_unit(texture_unit::order);
   grid_texels.bind_unit(texture_unit::grid);
   grid_vec4_texels.bind_unit(texture_unit::grid_vec4);
 }

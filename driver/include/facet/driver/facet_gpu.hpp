@@ -5,18 +5,18 @@
 //
 // Shader storage bindings used by shaders/replication/** (one table so that every program sees
 // the same buffers at the same points):
-//   3 indices (GpuScene)   7 coverage nodes   8 coverage order      (FacetSet, per output)
-//   10 counts / exclusive scan   11 pairs (modern: GpuReplica; seed: triangle, replica)
-//   12 stats   13 material ranges of the triangle list   14 indirect draw arguments
-//   15 scan block sums   16 pass 1's wide queue   17 staged facets of pass 1   18 their offsets
-//   19 draw commands used per material (pass 3's glMultiDrawArraysIndirectCountARB)
-//   20, 21 pass 1's walk and grid queues (16 the wide pass's): each pass's indirect dispatch,
-//   then the triangles it takes
+//   3 indices (GpuScene)   10 counts / exclusive scan   11 pairs (modern: GpuReplica; seed:
+//   triangle, replica) 12 stats   13 material ranges of the triangle list   14 indirect draw
+//   arguments 15 scan block sums   16 pass 1's wide queue   17 staged facets of pass 1   18 their
+//   offsets 19 draw commands used per material (pass 3's glMultiDrawArraysIndirectCountARB) 20, 21
+//   pass 1's walk and grid queues (16 the wide pass's): each pass's indirect dispatch, then the
+//   triangles it takes
 // Read-only tables are buffer textures (samplerBuffer, texelFetch): the scene
 // (GpuScene::bind_for_pulling, units 8-10), and at texture_unit:: the object frames (RGBA32F, 8
 // texels per GpuObjectFrame, per frame), the pieces (RGBA32F, 8 texels per GpuFacet, per output),
-// the records (RGBA32UI, 2 texels per GpuRecord), the frame's triangle list (RGBA32UI, a texel per
-// ListEntry, per output) and the coverage grid (R32UI, pack_coverage_grid, per output).
+// the coverage hierarchy (RGBA32UI, 7 texels per GpuCoverageNode) and its order (R32UI), per
+// output, the records (RGBA32UI, 2 texels per GpuRecord), the frame's triangle list (RGBA32UI, a
+// texel per ListEntry, per output) and the coverage grid (R32UI, pack_coverage_grid, per output).
 #include <epoxy/gl.h>
 
 #include <array>
@@ -40,15 +40,17 @@ inline constexpr GLuint object_frames = 11, facets = 12, records = 13, list = 14
 // The coverage grid again, as RGBA32UI: its per-piece bucket ranges and pyramid corners, which
 // pack_coverage_grid starts on a texel.
 inline constexpr GLuint grid_vec4 = 19;
+// The coverage hierarchy (RGBA32UI, 7 texels per GpuCoverageNode) and its facet order (R32UI).
+inline constexpr GLuint nodes = 20, order = 21;
 // The scatter's reads of pass 1's results (R32UI views of binding::scan, staged, stage_offsets).
 inline constexpr GLuint scan = 16, staged = 17, stage_offsets = 18;
 }  // namespace texture_unit
 
 namespace binding {
-inline constexpr GLuint indices = pulling::indices_binding, nodes = 7, order = 8, scan = 10,
-                        pairs = 11, stats = 12, material_ranges = 13, draw_args = 14,
-                        block_sums = 15, staged = 17, stage_offsets = 18, draw_counts = 19,
-                        walk_queue = 20, grid_queue = 21, wide_queue = 16;
+inline constexpr GLuint indices = pulling::indices_binding, scan = 10, pairs = 11, stats = 12,
+                        material_ranges = 13, draw_args = 14, block_sums = 15, staged = 17,
+                        stage_offsets = 18, draw_counts = 19, walk_queue = 20, grid_queue = 21,
+                        wide_queue = 16;
 // The triangle list built on the GPU (replication/list_build.comp): the list buffer written as
 // storage, the objects' eye-frame spheres and which may meet a facet, the list's indirect
 // arguments, and the static record of every entry and first entry of every material.
@@ -174,9 +176,9 @@ struct FacetSet {
   CoverageIndex index;
   CoverageGrid grid;
   FacetPieces pieces;
-  Buffer facets, nodes, order, grid_words;  // one GpuFacet per piece; binding::nodes, order
-  // Buffer textures: texture_unit::facets, texture_unit::grid and texture_unit::grid_vec4.
-  Texture facet_texels, grid_texels, grid_vec4_texels;
+  Buffer facets, nodes, order, grid_words;  // one GpuFacet per piece
+  // Buffer textures: texture_unit::facets, grid, grid_vec4, nodes and order.
+  Texture facet_texels, grid_texels, grid_vec4_texels, node_texels, order_texels;
 
   // Builds the facets of `warp` (InputError when the layout cannot be met) and their pieces, and
   // uploads them. Needs a current context.
