@@ -5,12 +5,13 @@
 //
 // Shader storage bindings used by shaders/replication/** (one table so that every program sees
 // the same buffers at the same points):
-//   3 indices (GpuScene)   10 counts / exclusive scan   11 pairs (modern: GpuReplica; seed:
-//   triangle, replica) 12 stats   13 material ranges of the triangle list   14 indirect draw
-//   arguments 15 scan block sums   16 pass 1's wide queue   17 staged facets of pass 1   18 their
-//   offsets 19 draw commands used per material (pass 3's glMultiDrawArraysIndirectCountARB) 20, 21
-//   pass 1's walk and grid queues (16 the wide pass's): each pass's indirect dispatch, then the
-//   triangles it takes
+//   3 indices (GpuScene)   10 counts / exclusive scan
+//   11 pairs (modern: GpuReplica; seed: triangle, replica)   12 stats
+//   13 material ranges of the triangle list   14 indirect draw arguments   15 scan block sums
+//   16 pass 1's wide queue   17 staged facets of pass 1   18 their offsets
+//   19 draw commands used per material (pass 3's glMultiDrawArraysIndirectCountARB)
+//   20, 21 pass 1's walk and grid queues (16 the wide pass's): each pass's indirect dispatch,
+//   then the triangles it takes
 // Read-only tables are buffer textures (samplerBuffer, texelFetch): the scene
 // (GpuScene::bind_for_pulling, units 8-10), and at texture_unit:: the object frames (RGBA32F, 8
 // texels per GpuObjectFrame, per frame), the pieces (RGBA32F, 8 texels per GpuFacet, per output),
