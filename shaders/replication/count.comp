@@ -85,8 +85,12 @@ const uint kChained = 0x80000000u;   // kStagedChained
 const uint kNoChunk = 0xffffffffu;
 // The first kKept facets stay here; from the (kKept + 1)-th on, facets go straight to chunks of
 // the chain (chain_second onwards), each taken by one atomic when its first facet arrives. The
-// first chunk, holding kept[], is placed when the count is known.
-uint kept[kKept];
+// first chunk, holding kept(0) to kept(kKept - 1), is placed when the count is known. Two
+// vectors, not an array: each lane writes its own slot, and llvmpipe stores into an array at a
+// per-lane index one lane at a time (pass 1 of the dome master at 512x512 and 0.25 px: 10.3-10.4
+// ms with the array, 8.3-9.0 ms this way).
+uvec4 kept_low = uvec4(0u), kept_high = uvec4(0u);
+uint kept(uint k) { return k < 4u ? kept_low[k] : kept_high[k - 4u]; }
 uint chain_second = kNoChunk, chain_tail = kNoChunk;
 
 // A chunk of kKept facets and a link, or kNoChunk (and an overflowing frame) when none is left.
@@ -99,7 +103,9 @@ uint new_chunk() {
 
 void write_pair(uint at, uint t, uint facet) {
   if (at < kKept) {
-    kept[at] = facet;
+    // Slot `at` of the eight: a select per component.
+    kept_low = mix(kept_low, uvec4(facet), equal(uvec4(at), uvec4(0u, 1u, 2u, 3u)));
+    kept_high = mix(kept_high, uvec4(facet), equal(uvec4(at), uvec4(4u, 5u, 6u, 7u)));
     return;
   }
   uint slot = at % kKept;
@@ -198,7 +204,7 @@ void main() {
   if (!run) {
     uint head = new_chunk();
     if (head == kNoChunk) return;
-    for (uint k = 0u; k < kKept; ++k) staged[head + k] = kept[k];
+    for (uint k = 0u; k < kKept; ++k) staged[head + k] = kept(k);
     staged[head + kKept] = chain_second;
     stage_offset[t] = head | kChained;
     return;
@@ -211,5 +217,5 @@ void main() {
   }
   // To the run's length, not kKept: llvmpipe runs a loop until its last lane is done, and a
   // masked store still visits all eight lanes.
-  for (uint k = 0u; k < count; ++k) staged[base + k] = kept[k];
+  for (uint k = 0u; k < count; ++k) staged[base + k] = kept(k);
 }
