@@ -562,9 +562,9 @@ DepthLodLevels DepthLodChooser::levels(const glm::dvec3& eye_world) const {
 
 // One part of the image as DepthMeshBuilder keeps it.
 struct DepthMeshBuilder::Part {
+  Part(const DepthImagePart& source, bool lod) : name(source.name), grid(source, lod) {}
   std::string name;
-  int W = 0, H = 0, last_x = 0, last_y = 0, block = 1, blocks_x = 0, blocks_y = 0;
-  bool wraps = false;
+  PartGrid grid;
   // Per pixel, row-major: the point in the image frame (unused where nothing is seen), the stored
   // normal and the source ID.
   std::vector<glm::dvec3> p_image;
@@ -588,11 +588,11 @@ struct DepthMeshBuilder::Part {
   std::vector<Block> blocks;
 
   std::size_t node(int x, int y) const {
-    return std::size_t(y) * std::size_t(W + 1) + std::size_t(x);
+    return std::size_t(y) * std::size_t(grid.W + 1) + std::size_t(x);
   }
   std::size_t pixel_of_node(std::size_t n) const {
-    const int x = int(n % std::size_t(W + 1)), y = int(n / std::size_t(W + 1));
-    return std::size_t(y) * std::size_t(W) + std::size_t(x == W ? 0 : x);
+    const int x = int(n % std::size_t(grid.W + 1)), y = int(n / std::size_t(grid.W + 1));
+    return std::size_t(y) * std::size_t(grid.W) + std::size_t(x == grid.W ? 0 : x);
   }
 };
 
@@ -613,17 +613,8 @@ DepthMeshBuilder::DepthMeshBuilder(const DepthImage& image, const DepthMeshOptio
   options_.lod_levels.reset();
   options_.lod_eye_world.reset();
   for (const DepthImagePart& source : image.parts) {
-    const PartGrid grid(source, lod_);
-    Part& part = parts_.emplace_back();
-    part.name = source.name;
-    part.W = grid.W;
-    part.H = grid.H;
-    part.last_x = grid.last_x;
-    part.last_y = grid.last_y;
-    part.block = grid.block;
-    part.blocks_x = grid.blocks_x;
-    part.blocks_y = grid.blocks_y;
-    part.wraps = grid.wraps;
+    Part& part = parts_.emplace_back(source, lod_);
+    const PartGrid& grid = part.grid;
     const std::size_t pixels = source.distance_m.size();
     part.p_image.assign(pixels, glm::dvec3(0.0));
     part.seen.assign(pixels, false);
@@ -675,9 +666,10 @@ DepthMesh DepthMeshBuilder::build(const DepthLodLevels& given_levels) {
   blocks_made_ = 0;
   for (std::size_t part_index = 0; part_index < parts_.size(); ++part_index) {
     Part& part = parts_[part_index];
-    const bool wraps = part.wraps;
-    const int W = part.W, H = part.H, last_x = part.last_x, last_y = part.last_y;
-    const int block = part.block, blocks_x = part.blocks_x, blocks_y = part.blocks_y;
+    const PartGrid& grid = part.grid;
+    const bool wraps = grid.wraps;
+    const int W = grid.W, H = grid.H, last_x = grid.last_x, last_y = grid.last_y;
+    const int block = grid.block, blocks_x = grid.blocks_x, blocks_y = grid.blocks_y;
     const auto block_from_x = [&](int bx) { return bx * block; };
     const auto block_to_x = [&](int bx) { return std::min((bx + 1) * block, last_x); };
     const auto block_from_y = [&](int by) { return by * block; };
