@@ -5,7 +5,7 @@
 #include <mutex>
 
 #include "facets_internal.hpp"
-#include "parallel.hpp"
+#include "facet/projection/parallel.hpp"
 
 namespace facet {
 namespace detail {

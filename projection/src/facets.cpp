@@ -12,7 +12,7 @@
 #include "facet/projection/facet_error.hpp"
 #include "facet/projection/warp.hpp"
 #include "facets_internal.hpp"
-#include "parallel.hpp"
+#include "facet/projection/parallel.hpp"
 
 namespace facet {
 

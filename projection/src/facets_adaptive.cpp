@@ -11,7 +11,7 @@
 
 #include "facet/projection/errors.hpp"
 #include "facets_internal.hpp"
-#include "parallel.hpp"
+#include "facet/projection/parallel.hpp"
 
 namespace facet::detail {
 namespace {

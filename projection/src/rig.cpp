@@ -6,7 +6,7 @@
 #include <set>
 
 #include "facet/projection/errors.hpp"
-#include "parallel.hpp"
+#include "facet/projection/parallel.hpp"
 
 namespace facet {
 namespace {

@@ -5,7 +5,7 @@
 #include <limits>
 
 #include "facet/projection/errors.hpp"
-#include "parallel.hpp"
+#include "facet/projection/parallel.hpp"
 
 namespace facet {
 namespace {

@@ -5,9 +5,10 @@
 // - OBJECT_PASS, one invocation per object: kCulled unless its eye-frame bounding sphere may meet
 //   a facet's guarded pyramid (sphere_may_meet_facets in replication_lib.comp), else its sole
 //   piece (sole_piece_of_sphere) or kNoPiece;
-// - COUNT_PASS, one per entry: its record's triangles when its object may be seen, else 0, into
-//   the scan buffer (and 0 after the last entry, so that the exclusive scan ends with the total),
-//   and the triangles with a sole piece into the statistics;
+// - COUNT_PASS, one per entry: its state (its object's, unless its cluster faces away, or its
+//   cluster's own sphere meets no facet or lies in one piece alone), and its record's triangles
+//   when not culled, else 0, into the scan buffer (and 0 after the last entry, so that the
+//   exclusive scan ends with the total), and the triangles with a sole piece into the statistics;
 // - WRITE_PASS, one per entry, block and material: the entries, the block table, the material
 //   ranges, the header and the indirect arguments of the passes that follow (ListArgs), and the
 //   list's triangles into the statistics.
@@ -60,6 +61,16 @@ layout(std430, binding = 26) readonly buffer EntryRecords { uint entry_records[]
 #if defined(COUNT_PASS)
 layout(std430, binding = 10) writeonly buffer Scan { uint scan[]; };
 layout(std430, binding = 24) readonly buffer ObjectVisible { uint object_state[]; };
+layout(std430, binding = 29) writeonly buffer EntryStates { uint entry_state[]; };
+// Per record, where records are clusters (cluster_culling != 0): the eye-frame sphere as the
+// objects' (FacetMethodBase::cluster_spheres_buffer_), or in w kClusterCulledAlways (facing away,
+// or no triangle) or kClusterAsObject (culled as its object is).
+layout(std430, binding = 28) readonly buffer ClusterSpheres { vec4 cluster_spheres[]; };
+const float kClusterCulledAlways = -1.0, kClusterAsObject = -2.0;  // facet_gpu.hpp
+layout(location = 52) uniform uint sole_pieces;  // as the object pass's
+layout(location = 53) uniform uint cluster_culling;
+bool sphere_may_meet_facets(vec3 centre, float radius);
+uint sole_piece_of_sphere(vec3 centre, float radius);
 
 void main() {
   uint k = gl_GlobalInvocationID.x;
@@ -68,8 +79,19 @@ void main() {
     scan[k] = 0u;
     return;
   }
-  uvec4 entry_record = record(entry_records[k]);  // (first_index, triangles, object, material)
+  uint r = entry_records[k];
+  uvec4 entry_record = record(r);  // (first_index, triangles, object, material)
   uint state = object_state[entry_record.z];
+  if (state != kCulled && cluster_culling != 0u) {
+    vec4 sphere = cluster_spheres[r];
+    if (sphere.w == kClusterCulledAlways) {
+      state = kCulled;
+    } else if (sphere.w >= 0.0 && state == kNoPiece) {
+      if (!sphere_may_meet_facets(sphere.xyz, sphere.w)) state = kCulled;
+      else if (sole_pieces != 0u) state = sole_piece_of_sphere(sphere.xyz, sphere.w);
+    }
+  }
+  entry_state[k] = state;
   scan[k] = state != kCulled ? entry_record.y : 0u;
   if (state != kCulled && state != kNoPiece) atomicAdd(list_triangles_sole_piece, entry_record.y);
 }
@@ -84,7 +106,7 @@ layout(std430, binding = 27) readonly buffer MaterialFirstEntries { uint materia
 // each in rows of kRowGroups work groups,
 // facets-gs' pass-1 draw, then a patch draw per material for the tessellator form.
 layout(std430, binding = 25) writeonly buffer ListArgs { uint list_args[]; };
-layout(std430, binding = 24) readonly buffer ObjectVisible { uint object_state[]; };
+layout(std430, binding = 29) readonly buffer EntryStates { uint entry_state[]; };
 layout(location = 43) uniform uint material_count;
 layout(location = 51) uniform uint patch_instances;  // the tessellator form's instances per draw
 const uint kTableBlockTriangles = 64u;  // kListBlockTriangles
@@ -111,7 +133,7 @@ void main() {
   uint k = gl_GlobalInvocationID.x;
   uint total = scan[list_entries];
   if (k < list_entries) {
-    uint state = object_state[record(entry_records[k]).z];
+    uint state = entry_state[k];
     list_out[k] = uvec4(entry_records[k], scan[k], state == kCulled ? kNoPiece : state, 0u);
   }
   uint blocks = (total + kTableBlockTriangles - 1u) / kTableBlockTriangles;

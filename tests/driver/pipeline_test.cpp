@@ -348,6 +348,136 @@ TEST(Pipeline, ObjectCullingIsConservativeAgainstExactDistances) {
   }
 }
 
+// Clusters cover each primitive with consecutive runs of at most kClusterTriangles triangles
+// whose IDs continue the primitive's, and on the city most of them face one way.
+TEST(Pipeline, ClusterRecordsKeepTheTriangleIds) {
+  const Scene city = build_city();
+  const std::vector<GpuRecord> whole = make_records(city);
+  const std::vector<GpuRecord> clusters = make_cluster_records(city);
+  ASSERT_GT(clusters.size(), whole.size());
+  std::size_t c = 0, one_way = 0;
+  for (const GpuRecord& record : whole) {
+    std::uint32_t covered = 0;
+    while (covered < record.triangle_count) {
+      ASSERT_LT(c, clusters.size());
+      const GpuRecord& cluster = clusters[c++];
+      EXPECT_EQ(cluster.first_index, record.first_index + 3 * covered);
+      EXPECT_EQ(cluster.first_id, record.first_id + covered);
+      EXPECT_EQ(cluster.object, record.object);
+      EXPECT_EQ(cluster.material, record.material);
+      EXPECT_GE(cluster.triangle_count, 1u);
+      EXPECT_LE(cluster.triangle_count, kClusterTriangles);
+      const ClusterBounds bounds = cluster_bounds(city, cluster);
+      one_way += bounds.normal_spread_sin <= std::sin(glm::radians(60.0));
+      covered += cluster.triangle_count;
+    }
+    EXPECT_EQ(covered, record.triangle_count);
+  }
+  EXPECT_EQ(c, clusters.size());
+  std::printf("city: %zu records, %zu clusters, %zu with normals within 60 degrees of their axis\n",
+              whole.size(), clusters.size(), one_way);
+  EXPECT_GT(2 * one_way, clusters.size());
+}
+
+// cluster_bounds holds every corner in its sphere and every normal in its cone, and
+// cluster_faces_away claims a cluster only when each of its triangles has every corner p with
+// dot(normal, p - eye) > 0, which pass 1 culls as a back face: random clusters of random spread
+// seen from random eyes, and the city's clusters seen along its camera path, all checked in
+// double per triangle.
+TEST(Pipeline, ClusterCullingOnlyTakesBackFaces) {
+  std::mt19937 random(5);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  const auto random_unit = [&] {
+    glm::dvec3 v(unit(random), unit(random), unit(random));
+    return glm::length(v) < 1e-3 ? glm::dvec3(0, 0, 1) : glm::normalize(v);
+  };
+  // Every triangle of `record` faces away from `eye` at each of its corners.
+  const auto all_face_away = [](const Scene& scene, const GpuRecord& record,
+                                const glm::dvec3& eye) {
+    for (std::uint32_t t = 0; t < record.triangle_count; ++t) {
+      glm::dvec3 p[3];
+      for (int c = 0; c < 3; ++c)
+        p[c] = glm::dvec3(scene.positions[scene.indices[record.first_index + 3 * t + c]]);
+      const glm::dvec3 n = glm::cross(p[1] - p[0], p[2] - p[0]);
+      for (const glm::dvec3& q : p)
+        if (!(glm::dot(n, q - eye) > 0)) return false;
+    }
+    return true;
+  };
+  const auto check_bounds = [](const Scene& scene, const GpuRecord& record,
+                               const ClusterBounds& bounds) {
+    for (std::uint32_t t = 0; t < record.triangle_count; ++t) {
+      glm::dvec3 p[3];
+      for (int c = 0; c < 3; ++c) {
+        p[c] = glm::dvec3(scene.positions[scene.indices[record.first_index + 3 * t + c]]);
+        ASSERT_LE(glm::length(p[c] - bounds.centre), bounds.radius * (1 + 1e-12));
+      }
+      if (bounds.normal_spread_sin > 1) continue;
+      const glm::dvec3 n = glm::normalize(glm::cross(p[1] - p[0], p[2] - p[0]));
+      const double cos_spread = std::sqrt(1 - bounds.normal_spread_sin * bounds.normal_spread_sin);
+      ASSERT_GE(glm::dot(n, bounds.normal_axis), cos_spread - 1e-12);
+    }
+  };
+  std::size_t claimed = 0, random_eyes = 0;
+  for (int k = 0; k < 400; ++k) {
+    // A cluster of 16 triangles about a random point, their normals within a random spread of
+    // a random axis.
+    Scene scene;
+    const glm::dvec3 centre = 20.0 * random_unit(), axis = random_unit();
+    const double spread = std::abs(unit(random)) * 1.2, size = std::pow(10.0, unit(random));
+    for (int t = 0; t < 16; ++t) {
+      glm::dvec3 normal = axis;
+      for (int tries = 0; tries < 100; ++tries) {
+        normal = random_unit();
+        if (glm::dot(normal, axis) >= std::cos(spread)) break;
+        normal = axis;
+      }
+      const glm::dvec3 u = glm::normalize(glm::cross(normal, random_unit()));
+      const glm::dvec3 v = glm::cross(normal, u);
+      const glm::dvec3 at = centre + size * glm::dvec3(unit(random), unit(random), unit(random));
+      for (const glm::dvec3& q : {at, at + size * u, at + size * v}) {
+        scene.indices.push_back(std::uint32_t(scene.positions.size()));
+        scene.positions.push_back(glm::vec3(q));
+      }
+    }
+    const GpuRecord record{0, 16, 0, 0, 1, {}};
+    const ClusterBounds bounds = cluster_bounds(scene, record);
+    check_bounds(scene, record, bounds);
+    for (int e = 0; e < 20; ++e) {
+      const glm::dvec3 eye = centre + 60.0 * std::abs(unit(random)) * random_unit();
+      ++random_eyes;
+      if (!cluster_faces_away(bounds.centre - eye, bounds.radius, bounds.normal_axis,
+                              bounds.normal_spread_sin))
+        continue;
+      ++claimed;
+      ASSERT_TRUE(all_face_away(scene, record, eye)) << "cluster " << k << ", eye " << e;
+    }
+  }
+  std::printf("random clusters: %zu of %zu views claimed facing away\n", claimed, random_eyes);
+  EXPECT_GT(claimed, random_eyes / 10);
+
+  const Scene city = build_city();
+  const std::vector<GpuRecord> clusters = make_cluster_records(city);
+  std::size_t city_claimed = 0, city_triangles = 0, city_claimed_triangles = 0;
+  for (const GpuRecord& record : clusters) {
+    const ClusterBounds bounds = cluster_bounds(city, record);
+    check_bounds(city, record, bounds);
+    for (const double t : {0.0, 12.0, 31.0}) {
+      const glm::dvec3 eye(CityCameraPath(CityOptions{}).T_world_eye(t)[3]);
+      city_triangles += record.triangle_count;
+      if (!cluster_faces_away(bounds.centre - eye, bounds.radius, bounds.normal_axis,
+                              bounds.normal_spread_sin))
+        continue;
+      ++city_claimed;
+      city_claimed_triangles += record.triangle_count;
+      ASSERT_TRUE(all_face_away(city, record, eye)) << "city cluster " << record.first_id;
+    }
+  }
+  std::printf("city: %zu cluster views facing away, %zu of %zu triangle views\n", city_claimed,
+              city_claimed_triangles, city_triangles);
+  EXPECT_GT(5 * city_claimed_triangles, city_triangles);
+}
+
 TEST(Pipeline, GpuCoverageMatchesCpuReference) {
   test::shared_context();
   std::mt19937 random(7);
@@ -868,7 +998,8 @@ TEST(Pipeline, GpuTriangleListGivesTheCpuListsIdsTessellated) {
 
 // The city's 4 × 4 tiles (545,008 triangles) on the cylinder at 0.25 px: thousands of objects,
 // hundreds of them far behind the eye along the streets, within a degree of the cylinder's seam,
-// where the cells wrap. The GPU gives every object the CPU's sole piece, and the same image.
+// where the cells wrap. The GPU's sole pieces are the CPU's but for a few small clusters that
+// float's margin denies one, and it gives the same list and image.
 TEST(Pipeline, GpuSolePiecesAreTheCpusOnTheCityTiles) {
   test::shared_context();
   const Scene scene = load_scene("builtin:city:4");
@@ -889,7 +1020,14 @@ TEST(Pipeline, GpuSolePiecesAreTheCpusOnTheCityTiles) {
     ids.push_back(targets[0].read_ids());
   }
   EXPECT_GT(stats[0].triangles_sole_piece, stats[0].triangles_in / 3);
-  EXPECT_EQ(stats[1].triangles_sole_piece, stats[0].triangles_sole_piece);
+  // Float's margin (1e-6 of the distance) may deny a small cluster the piece double gives it,
+  // never the reverse.
+  EXPECT_LE(stats[1].triangles_sole_piece, stats[0].triangles_sole_piece);
+  EXPECT_GE(1000 * stats[1].triangles_sole_piece, 999 * stats[0].triangles_sole_piece);
+  std::printf("city:4 on the cylinder: sole piece GPU/CPU %llu/%llu of %llu list triangles\n",
+              static_cast<unsigned long long>(stats[1].triangles_sole_piece),
+              static_cast<unsigned long long>(stats[0].triangles_sole_piece),
+              static_cast<unsigned long long>(stats[0].triangles_in));
   EXPECT_EQ(stats[1].triangles_in, stats[0].triangles_in);
   EXPECT_EQ(stats[1].replicas, stats[0].replicas);
   EXPECT_EQ(ids[1], ids[0]);

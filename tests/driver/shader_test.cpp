@@ -84,8 +84,8 @@ TEST(Shaders, StagingConstantsMatchTheCpp) {
   }
 }
 
-// The list's block size and the texture units of the scatter and of the coverage grid exist
-// twice: facet_gpu.hpp and the GLSL.
+// The list's block size, the clusters' sphere markers and the texture units of the scatter and of
+// the coverage grid exist twice: facet_gpu.hpp and the GLSL.
 TEST(Shaders, ListAndScatterConstantsMatchTheCpp) {
   std::smatch match;
   const std::string library(embedded_shader("replication/replication_lib.comp").text);
@@ -94,6 +94,11 @@ TEST(Shaders, ListAndScatterConstantsMatchTheCpp) {
   const std::string list_build(embedded_shader("replication/list_build.comp").text);
   ASSERT_TRUE(std::regex_search(list_build, match, std::regex(R"(kTableBlockTriangles = (\d+)u)")));
   EXPECT_EQ(std::stoul(match[1]), kListBlockTriangles);
+  ASSERT_TRUE(std::regex_search(
+      list_build, match,
+      std::regex(R"(kClusterCulledAlways = (-?[0-9.]+), kClusterAsObject = (-?[0-9.]+);)")));
+  EXPECT_EQ(std::stof(match[1]), kClusterCulledAlways);
+  EXPECT_EQ(std::stof(match[2]), kClusterAsObject);
   const std::string scatter(embedded_shader("replication/scatter.comp").text);
   for (const auto& [text, name, unit] :
        {std::tuple<const std::string*, const char*, GLuint>{&scatter, "scan_texels",
@@ -135,7 +140,9 @@ TEST(Shaders, StorageBufferBindingsMatchTheCpp) {
       {"ObjectVisible", binding::object_visible},
       {"ListArgs", binding::list_args},
       {"EntryRecords", binding::entry_records},
-      {"MaterialFirstEntries", binding::material_first_entries}};
+      {"MaterialFirstEntries", binding::material_first_entries},
+      {"ClusterSpheres", binding::cluster_spheres},
+      {"EntryStates", binding::entry_states}};
   std::map<std::string, int> found;
   const std::regex block(R"(layout\(std430, binding = (\d+)\) (?:[a-z]+ )*buffer (\w+))");
   for (const EmbeddedShader& shader : embedded_shaders()) {

@@ -1,8 +1,11 @@
 #include "facet/driver/facet_gpu.hpp"
 
 #include <algorithm>
+#include <array>
 #include <bit>
 #include <cmath>
+#include <limits>
+#include <numbers>
 #include <optional>
 
 #include "facet/projection/errors.hpp"
@@ -274,24 +277,112 @@ std::vector<std::uint32_t> pack_coverage_grid(const CoverageGrid& grid, const Fa
   return words;
 }
 
-std::vector<GpuRecord> make_records(const Scene& scene) {
+namespace {
+
+// make_records (clusters false) and make_cluster_records (true).
+std::vector<GpuRecord> records_of(const Scene& scene, bool clusters) {
   std::vector<GpuRecord> records;
   std::uint32_t next_id = 1;
   for (std::uint32_t o = 0; o < scene.objects.size(); ++o) {
     const Object& object = scene.objects[o];
     for (std::uint32_t k = 0; k < object.primitive_count; ++k) {
       const Primitive& p = scene.primitives[object.first_primitive + k];
-      GpuRecord record{};
-      record.first_index = p.first_index;
-      record.triangle_count = p.index_count / 3;
-      record.object = o;
-      record.material = p.material;
-      record.first_id = next_id;
-      next_id += record.triangle_count;
-      if (record.triangle_count > 0) records.push_back(record);
+      const std::uint32_t triangles = p.index_count / 3;
+      const auto unit_normal = [&](std::uint32_t t) {
+        const std::uint32_t* i = &scene.indices[p.first_index + 3 * t];
+        const glm::vec3 n = glm::cross(scene.positions[i[1]] - scene.positions[i[0]],
+                                       scene.positions[i[2]] - scene.positions[i[0]]);
+        const float length = glm::length(n);
+        return length > 0 ? n / length : glm::vec3(0.0f);
+      };
+      // The length of the run from triangle `first`.
+      const auto run = [&](std::uint32_t first) {
+        if (!clusters) return triangles - first;
+        const glm::vec3 n0 = unit_normal(first);
+        std::uint32_t count = 1;
+        while (count < kClusterTriangles && first + count < triangles) {
+          if (count >= kClusterMinTriangles && glm::dot(unit_normal(first + count), n0) < 0.5f)
+            break;
+          ++count;
+        }
+        return count;
+      };
+      for (std::uint32_t first = 0; first < triangles;) {
+        GpuRecord record{};
+        record.first_index = p.first_index + 3 * first;
+        record.triangle_count = run(first);
+        record.object = o;
+        record.material = p.material;
+        record.first_id = next_id + first;
+        records.push_back(record);
+        first += record.triangle_count;
+      }
+      next_id += triangles;
     }
   }
   return records;
+}
+
+}  // namespace
+
+std::vector<GpuRecord> make_records(const Scene& scene) { return records_of(scene, false); }
+
+std::vector<GpuRecord> make_cluster_records(const Scene& scene) { return records_of(scene, true); }
+
+ClusterBounds cluster_bounds(const Scene& scene, const GpuRecord& record) {
+  FACET_ASSERT(record.triangle_count <= kClusterTriangles);
+  ClusterBounds bounds;
+  if (record.triangle_count == 0) return bounds;
+  std::array<glm::dvec3, 3 * kClusterTriangles> corners;
+  std::array<glm::dvec3, kClusterTriangles> normals;
+  glm::dvec3 lo(std::numeric_limits<double>::infinity()), hi(-lo), normal_sum(0.0);
+  bool every_normal = true;
+  for (std::uint32_t t = 0; t < record.triangle_count; ++t) {
+    glm::dvec3* p = &corners[3 * t];
+    for (int c = 0; c < 3; ++c) {
+      p[c] = glm::dvec3(scene.positions[scene.indices[record.first_index + 3 * t + c]]);
+      lo = glm::min(lo, p[c]);
+      hi = glm::max(hi, p[c]);
+    }
+    // A normal shorter than 1e-6 of its edges' squared lengths is a sliver's, which the float
+    // rounding of pass 1 may turn either way: then the cluster has no cone.
+    const glm::dvec3 e1 = p[1] - p[0], e2 = p[2] - p[0], n = glm::cross(e1, e2);
+    const double length = glm::length(n);
+    if (length > 1e-6 * (glm::dot(e1, e1) + glm::dot(e2, e2))) {
+      normals[t] = n / length;
+      normal_sum += normals[t];
+    } else {
+      every_normal = false;
+    }
+  }
+  bounds.centre = 0.5 * (lo + hi);
+  double radius2 = 0;
+  for (std::uint32_t k = 0; k < 3 * record.triangle_count; ++k) {
+    const glm::dvec3 d = corners[k] - bounds.centre;
+    radius2 = std::max(radius2, glm::dot(d, d));
+  }
+  bounds.radius = std::sqrt(radius2);
+  if (!every_normal || !(glm::length(normal_sum) > 0)) return bounds;
+  bounds.normal_axis = glm::normalize(normal_sum);
+  double min_cos = 1;
+  for (std::uint32_t t = 0; t < record.triangle_count; ++t)
+    min_cos = std::min(min_cos, glm::dot(normals[t], bounds.normal_axis));
+  if (min_cos > 0) bounds.normal_spread_sin = std::sqrt(std::max(0.0, 1 - min_cos * min_cos));
+  return bounds;
+}
+
+bool cluster_faces_away(const glm::dvec3& centre, double radius, const glm::dvec3& normal_axis,
+                        double normal_spread_sin) {
+  if (!(normal_spread_sin <= 1) || !(radius >= 0)) return false;
+  const double distance = glm::length(centre);
+  if (!(distance > radius)) return false;
+  // Every corner p lies within beta of the centre's direction and every normal n within alpha of
+  // the axis, so the angle between n and p is at most alpha + beta + gamma (gamma: between the
+  // axis and the centre); below a right angle, dot(n, p) > 0.
+  const double alpha = std::asin(normal_spread_sin);
+  const double beta = std::asin(radius / distance);
+  const double gamma = std::acos(std::clamp(glm::dot(normal_axis, centre) / distance, -1.0, 1.0));
+  return alpha + beta + gamma < 0.5 * std::numbers::pi - kFacingAwayMargin;
 }
 
 FacetSet FacetSet::build(const Warp& warp, const FacetBuildOptions& options, double z_near,

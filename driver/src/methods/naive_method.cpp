@@ -31,6 +31,7 @@ class NaiveMethod final : public FacetMethodBase {
 
   // Draws per piece the objects the CPU culled.
   bool lists_on_gpu_allowed() const override { return false; }
+  bool culls_clusters() const override { return false; }
 
   RenderStats render(const glm::dmat4& T_eye_world, std::span<OutputTarget> targets,
                      GpuTimer* timer) override {

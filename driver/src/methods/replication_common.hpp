@@ -133,7 +133,7 @@ class FacetMethodBase : public RenderMethod {
     std::uint32_t triangles_sole_piece = 0;
     // The list: list_entries() entries, the header texel, the block table (sized for every
     // triangle of the scene); its indirect arguments; the list build's object flags (GPU only).
-    Buffer list_buffer, ranges_buffer, list_args, object_visible_flags, list_offsets;
+    Buffer list_buffer, ranges_buffer, list_args, object_visible_flags, list_offsets, entry_states;
     Texture list_texels;  // list_buffer as a buffer texture
     // Replication results, reused while neither the view nor any object transform changes.
     // stats: visible triangles, pairs, overflow, staged pairs (std430 uints, count.comp), then
@@ -163,10 +163,15 @@ class FacetMethodBase : public RenderMethod {
   bool update_view(const glm::dmat4& T_eye_world, GpuTimer* timer = nullptr);
   // Whether this method may build its lists on the GPU (naive draws from the CPU's culling).
   virtual bool lists_on_gpu_allowed() const { return true; }
+  // Whether the records are clusters (make_cluster_records), culled one by one in the lists, or
+  // whole primitives (naive draws each object whole).
+  virtual bool culls_clusters() const { return true; }
   // Instances of the tessellator form's patch draws for output `out` (list_args).
   virtual std::uint32_t patch_instances(const OutputState&) const { return 1; }
   // Output i's list, culled and built on the CPU or queued on the GPU.
   void build_list_on_cpu(std::size_t i);
+  // eye_clusters_ for the view T_eye_world.
+  void update_eye_clusters(const glm::dmat4& T_eye_world);
   void build_list_on_gpu(std::size_t i);
   // Entries of every output's list: one per record.
   std::uint32_t list_entries() const { return std::uint32_t(entry_records_.size()); }
@@ -216,7 +221,7 @@ class FacetMethodBase : public RenderMethod {
   std::vector<std::uint32_t> entry_records_, material_first_entries_;
   std::uint32_t scene_list_triangles_ = 0;  // triangles of every record
   Buffer records_buffer_, object_frames_, entry_records_buffer_, material_first_entries_buffer_,
-      object_spheres_buffer_;
+      object_spheres_buffer_, cluster_spheres_buffer_;
   Program list_objects_, list_counts_, list_write_;
   PrefixScan list_scan_;
   Texture record_texels_,
@@ -230,6 +235,19 @@ class FacetMethodBase : public RenderMethod {
   bool have_view_ = false;
   std::vector<glm::mat4> last_T_world_object_;  // the transforms of the last update_view
   std::vector<BoundingSphere> eye_spheres_;     // the objects' spheres at the last update_view
+  // The clusters' bounds in the object frame (empty where records are whole primitives), and at
+  // the last update_view their spheres in the eye frame and how the lists cull them: as their
+  // object (a sphere of at least kOwnSphereRatio of the object's would cull little more, at a
+  // test per cluster and output), by their own sphere, or always (they face away, or hold no
+  // triangle).
+  std::vector<ClusterBounds> cluster_bounds_;
+  enum class ClusterCull : std::uint8_t { as_object, own_sphere, always };
+  static constexpr double kOwnSphereRatio = 0.75;
+  struct EyeCluster {
+    BoundingSphere sphere;
+    ClusterCull cull = ClusterCull::as_object;
+  };
+  std::vector<EyeCluster> eye_clusters_;
   // The outputs' facets and pair capacities while replace_scene prepares anew, taken by prepare
   // in output order (a rebuilt scene replicates about as much as the one it replaces, so its
   // first frame starts from the last frame's room rather than overflowing and replicating twice).

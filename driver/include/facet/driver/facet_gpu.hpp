@@ -57,6 +57,8 @@ inline constexpr GLuint indices = pulling::indices_binding, scan = 10, pairs = 1
 // arguments, and the static record of every entry and first entry of every material.
 inline constexpr GLuint list_out = 22, object_spheres = 23, object_visible = 24, list_args = 25,
                         entry_records = 26, material_first_entries = 27;
+// The clusters' eye-frame spheres, and each entry's state (culled, or its sole piece or none).
+inline constexpr GLuint cluster_spheres = 28, entry_states = 29;
 }  // namespace binding
 
 // What pass 3 draws: pieces. Piece f < F is facet f of the mesh (F facets); piece F + k, a quad,
@@ -170,6 +172,36 @@ constexpr std::uint64_t staged_words(std::uint64_t pairs) { return 2 * pairs + 1
 
 // Records of every object's primitives, in Scene::objects order, then primitive order.
 std::vector<GpuRecord> make_records(const Scene& scene);
+// The same triangles in clusters, which the facet pipelines cull one by one (ClusterBounds): each
+// primitive cut into runs of consecutive triangles that end at kClusterTriangles or, once they
+// hold kClusterMinTriangles, before a triangle whose normal turns more than 60 degrees from the
+// run's first (a mesh made wall by wall then has clusters that each face one way). The triangle
+// IDs stay first_id + k.
+std::vector<GpuRecord> make_cluster_records(const Scene& scene);
+inline constexpr std::uint32_t kClusterTriangles = 64, kClusterMinTriangles = 8;
+// The w of a cluster's sphere in the GPU list build (binding::cluster_spheres) where its own
+// sphere is not tested: culled always (it faces away, or holds no triangle), or as its object.
+inline constexpr float kClusterCulledAlways = -1.0f, kClusterAsObject = -2.0f;
+
+// What culls a record as a whole, in its object's frame (metres): a sphere holding its corners,
+// and the cone of its triangles' winding normals (cross(p1 - p0, p2 - p0)): a unit axis and the
+// sine of the half-angle, or a sine above 1 where there is no such cone below a right angle (a
+// spread of 90 degrees or more, or a triangle too thin for its normal to be trusted).
+struct ClusterBounds {
+  glm::dvec3 centre{0.0};
+  double radius = -1;  // < 0: no triangle
+  glm::dvec3 normal_axis{0.0};
+  double normal_spread_sin = 2;
+};
+ClusterBounds cluster_bounds(const Scene& scene, const GpuRecord& record);
+
+// True when every triangle inside the sphere (centre, radius) whose winding normal lies within
+// the cone (unit axis, sine of the half-angle) faces away from the eye at the origin, by at least
+// kFacingAwayMargin radians: each corner p then has dot(normal, p) > 0, so pass 1's back-face test
+// culls each triangle. Frame: any with the eye at its origin.
+inline constexpr double kFacingAwayMargin = 1e-4;
+bool cluster_faces_away(const glm::dvec3& centre, double radius, const glm::dvec3& normal_axis,
+                        double normal_spread_sin);
 
 // The facets of one output on the CPU (double) and on the GPU (float).
 struct FacetSet {

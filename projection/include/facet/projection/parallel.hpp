@@ -1,5 +1,6 @@
 #pragma once
-// Internal: a static-partition parallel loop over [0, count) on the hardware threads.
+// A static-partition parallel loop over [0, count) on the hardware threads, for the libraries'
+// own loops (facet::detail: not part of the API).
 #include <algorithm>
 #include <cstddef>
 #include <exception>
