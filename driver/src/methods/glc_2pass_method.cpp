@@ -330,7 +330,8 @@ class Glc2PassMethod final : public ObjectBaseline {
                      GpuTimer* timer) override {
     FACET_ASSERT(scene_ && targets.size() == outputs_.size());
     RenderStats stats;
-    stats.triangles_in = scene_->triangle_count();
+    stats.triangles_scene = scene_->triangle_count();
+    stats.triangles_in = stats.triangles_scene;
     stats.gpu_buffer_bytes = buffer_bytes_;
     const std::vector<BoundingSphere> spheres = object_spheres(*scene_, T_eye_world);
     std::vector<std::uint8_t> object_drawn(scene_->objects.size(), 0);

@@ -245,6 +245,7 @@ class GlcMethod final : public RenderMethod {
     FACET_ASSERT(targets.size() == outputs_.size());
     const Scene& scene = *scene_;
     RenderStats stats;
+    stats.triangles_scene = scene.triangle_count();
     // The triangles in the eye frame, in ID order, and per object its range and sphere.
     triangles_.clear();
     object_ranges_.assign(scene.objects.size() + 1, 0);

@@ -38,6 +38,7 @@ class NaiveMethod final : public FacetMethodBase {
     FACET_ASSERT(targets.size() == outputs_.size());
     update_view(T_eye_world);
     RenderStats stats;
+    stats.triangles_scene = scene_->triangle_count();
     // The record table and object frames, shared by the outputs.
     stats.gpu_buffer_bytes = records_buffer_.size() + object_frames_.size();
     TimedPass scope(timer, "draw");

@@ -29,7 +29,8 @@ void ObjectBaseline::begin_pulling(bool cull_back_faces) const {
 
 RenderStats ObjectBaseline::whole_scene_stats(std::uint64_t buffer_bytes) const {
   RenderStats stats;
-  stats.triangles_in = scene_->triangle_count();
+  stats.triangles_scene = scene_->triangle_count();
+  stats.triangles_in = stats.triangles_scene;
   stats.triangles_visible = stats.triangles_in;
   stats.gpu_buffer_bytes = buffer_bytes;
   return stats;

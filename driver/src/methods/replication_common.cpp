@@ -666,6 +666,7 @@ RenderStats PairPipelineBase::render(const glm::dmat4& T_eye_world, std::span<Ou
   FACET_ASSERT(targets.size() == outputs_.size());
   const bool changed = update_view(T_eye_world, timer);
   RenderStats stats;
+  stats.triangles_scene = scene_->triangle_count();
   stats.reused_replication = !outputs_.empty();
   std::vector<std::size_t> replicated;
   for (std::size_t i = 0; i < outputs_.size(); ++i) {

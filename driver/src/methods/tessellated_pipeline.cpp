@@ -56,6 +56,7 @@ class TessellatedPipeline final : public FacetMethodBase {
     FACET_ASSERT(targets.size() == outputs_.size());
     update_view(T_eye_world);
     RenderStats stats;
+    stats.triangles_scene = scene_->triangle_count();
     for (std::size_t i = 0; i < outputs_.size(); ++i) {
       OutputState& out = outputs_[i];
       targets[i].clear();

@@ -212,6 +212,7 @@ class VertexMethod final : public ObjectBaseline {
     FACET_ASSERT(scene_ && targets.size() == outputs_.size());
     const Scene& scene = *scene_;
     RenderStats stats;
+    stats.triangles_scene = scene.triangle_count();
     // Per output its warp's node texture and coverage mask, and the shared counters.
     stats.gpu_buffer_bytes = counters_.size();
     for (const OutputState& out : outputs_) stats.gpu_buffer_bytes += out.texture_bytes;

@@ -320,8 +320,10 @@ std::uint64_t FrameStats::replicas() const {
 }
 
 double FrameStats::replication_ratio() const {
-  const std::uint64_t in = triangles_in();
-  return in == 0 ? 0.0 : double(replicas()) / double(in);
+  std::uint64_t scene_triangles = 0;
+  for (const OutputFrameStats& output : outputs)
+    scene_triangles = std::max(scene_triangles, output.render.triangles_scene);
+  return scene_triangles == 0 ? 0.0 : double(replicas()) / double(scene_triangles);
 }
 
 nlohmann::json frame_stats_to_json(const FrameStats& stats) {

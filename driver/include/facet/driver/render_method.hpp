@@ -134,11 +134,14 @@ class OutputTarget {
 };
 
 struct RenderStats {
-  std::uint64_t triangles_in = 0;       // triangles of the objects that survived bounds culling
+  std::uint64_t triangles_scene = 0;  // Scene::triangle_count, whatever the method culls
+  // Triangles the method takes in after culling whole objects by their bounds (the facet
+  // pipelines cull clusters too, by their bounds and where they face away), summed over outputs.
+  std::uint64_t triangles_in = 0;
   std::uint64_t triangles_visible = 0;  // after per-triangle culling (back face, behind, coverage)
-  // Facet pipelines: of triangles_in, those whose object lies inside one piece's guarded pyramid
-  // and clear of every other piece's (sole_piece_of_sphere), which pass 1 gives that piece
-  // without the coverage grid.
+  // Facet pipelines: of triangles_in, those whose object or cluster lies inside one piece's
+  // guarded pyramid and clear of every other piece's (sole_piece_of_sphere), which pass 1 gives
+  // that piece without the coverage grid.
   std::uint64_t triangles_sole_piece = 0;
   // Facet pipelines: whether an output's triangle list was built on the GPU
   // (RenderSettings::triangle_list).
@@ -159,9 +162,11 @@ struct RenderStats {
   // Facet pipeline: outputs replicated a second time this frame because their pairs outgrew the
   // buffers sized from the frames before.
   std::uint64_t overflow_reruns = 0;
-  // replicas / triangles_in; the seed paper's replication ratio.
+  // replicas / triangles_scene: draws per scene triangle, over all outputs, the seed paper's
+  // replication ratio (its geometry shader took every scene triangle in), whatever a method
+  // culls before.
   double replication_ratio() const {
-    return triangles_in == 0 ? 0.0 : double(replicas) / double(triangles_in);
+    return triangles_scene == 0 ? 0.0 : double(replicas) / double(triangles_scene);
   }
 };
 
