@@ -87,8 +87,9 @@ void main() {
     if (sphere.w == kClusterCulledAlways) {
       state = kCulled;
     } else if (sphere.w >= 0.0 && state == kNoPiece) {
-      if (!sphere_may_meet_facets(sphere.xyz, sphere.w)) state = kCulled;
-      else if (sole_pieces != 0u) state = sole_piece_of_sphere(sphere.xyz, sphere.w);
+      // A sphere inside one piece meets a facet: the walk is needed only without one.
+      if (sole_pieces != 0u) state = sole_piece_of_sphere(sphere.xyz, sphere.w);
+      if (state == kNoPiece && !sphere_may_meet_facets(sphere.xyz, sphere.w)) state = kCulled;
     }
   }
   entry_state[k] = state;

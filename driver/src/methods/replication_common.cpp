@@ -354,21 +354,44 @@ void FacetMethodBase::update_eye_clusters(const glm::dmat4& T_eye_world) {
 void FacetMethodBase::build_list_on_cpu(std::size_t i) {
   const Scene& scene = *scene_;
   OutputState& out = outputs_[i];
-  out.object_visible.assign(scene.objects.size(), 0);
+  // Each object's and then each record's state in this output's list: culled, its sole piece
+  // (an object or cluster inside one piece and clear of the others, whose triangles pass 1 gives
+  // that piece without the grid; the walk, the reference, always walks), or kNoPiece. On one
+  // thread: with two, sharing the cores with llvmpipe's, the cylinder's lists at 160 strips took
+  // 1.3-2.2 ms against 1.6.
+  constexpr std::uint32_t kCulled = kNoPiece - 1;
+  const bool sole_pieces = settings_.coverage == FacetCoverage::grid;
+  std::vector<std::uint32_t> object_state(scene.objects.size(), kCulled);
   for (std::size_t o = 0; o < scene.objects.size(); ++o) {
     const BoundingSphere& sphere = eye_spheres_[o];
-    out.object_visible[o] = sphere.radius >= 0 && sphere_may_meet_facets(out.facets, sphere.centre,
-                                                                         sphere.radius * 1.0001);
+    const double radius = sphere.radius * 1.0001;
+    if (!(sphere.radius >= 0) || !sphere_may_meet_facets(out.facets, sphere.centre, radius))
+      continue;
+    object_state[o] =
+        sole_pieces ? sole_piece_of_sphere(out.facets, sphere.centre, radius) : kNoPiece;
   }
-  // Objects inside one piece and clear of the others: pass 1 gives their triangles that piece
-  // without the grid (the walk, the reference, always walks).
-  std::vector<std::uint32_t> sole_piece(scene.objects.size(), kNoPiece);
-  if (settings_.coverage == FacetCoverage::grid) {
-    for (std::size_t o = 0; o < scene.objects.size(); ++o) {
-      if (out.object_visible[o])
-        sole_piece[o] = sole_piece_of_sphere(out.facets, eye_spheres_[o].centre,
-                                             eye_spheres_[o].radius * 1.0001);
+  out.object_visible.assign(scene.objects.size(), 0);
+  for (std::size_t o = 0; o < scene.objects.size(); ++o)
+    out.object_visible[o] = object_state[o] != kCulled;
+  // A cluster of a seen object is culled when it faces away, or, where its object meets several
+  // pieces, when its own sphere meets none; else it may lie in one piece alone (then its sphere
+  // meets a facet).
+  std::vector<std::uint32_t> record_state(records_.size());
+  for (std::size_t r = 0; r < records_.size(); ++r) {
+    std::uint32_t state = object_state[records_[r].object];
+    if (state != kCulled && !eye_clusters_.empty()) {
+      const EyeCluster& cluster = eye_clusters_[r];
+      if (cluster.cull == ClusterCull::always) {
+        state = kCulled;
+      } else if (cluster.cull == ClusterCull::own_sphere && state == kNoPiece) {
+        const glm::dvec3& centre = cluster.sphere.centre;
+        const double radius = cluster.sphere.radius * 1.0001;
+        if (sole_pieces) state = sole_piece_of_sphere(out.facets, centre, radius);
+        if (state == kNoPiece && !sphere_may_meet_facets(out.facets, centre, radius))
+          state = kCulled;
+      }
     }
+    record_state[r] = state;
   }
   out.list.clear();
   out.material_ranges.clear();
@@ -378,23 +401,9 @@ void FacetMethodBase::build_list_on_cpu(std::size_t i) {
   for (std::uint32_t m = 0; m < material_count(); ++m) {
     out.material_ranges.push_back(triangles);
     for (std::uint32_t k = material_first_entries_[m]; k < material_first_entries_[m + 1]; ++k) {
-      const std::uint32_t r = entry_records_[k], object = records_[r].object;
-      bool seen = out.object_visible[object] != 0;
-      std::uint32_t sole = seen ? sole_piece[object] : kNoPiece;
-      if (seen && !eye_clusters_.empty()) {
-        // A cluster of a seen object: culled when it faces away, or, where its object meets
-        // several pieces, when its own sphere meets none; else it may lie in one piece alone.
-        const EyeCluster& cluster = eye_clusters_[r];
-        if (cluster.cull == ClusterCull::always) {
-          seen = false;
-        } else if (cluster.cull == ClusterCull::own_sphere && sole == kNoPiece) {
-          const double radius = cluster.sphere.radius * 1.0001;
-          seen = sphere_may_meet_facets(out.facets, cluster.sphere.centre, radius);
-          if (seen && settings_.coverage == FacetCoverage::grid)
-            sole = sole_piece_of_sphere(out.facets, cluster.sphere.centre, radius);
-        }
-        if (!seen) sole = kNoPiece;
-      }
+      const std::uint32_t r = entry_records_[k];
+      const bool seen = record_state[r] != kCulled;
+      const std::uint32_t sole = seen ? record_state[r] : kNoPiece;
       out.list.push_back({r, triangles, sole, 0});
       if (!seen) continue;
       triangles += records_[r].triangle_count;

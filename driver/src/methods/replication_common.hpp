@@ -237,12 +237,13 @@ class FacetMethodBase : public RenderMethod {
   std::vector<BoundingSphere> eye_spheres_;     // the objects' spheres at the last update_view
   // The clusters' bounds in the object frame (empty where records are whole primitives), and at
   // the last update_view their spheres in the eye frame and how the lists cull them: as their
-  // object (a sphere of at least kOwnSphereRatio of the object's would cull little more, at a
-  // test per cluster and output), by their own sphere, or always (they face away, or hold no
-  // triangle).
+  // object (a sphere of at least kOwnSphereRatio of the object's culls little more, at two tests
+  // per cluster and output: the city's lists on the cylinder at 160 strips took 1.46 ms a frame
+  // at 3/4, 1.04 at 1/2, 0.64 with no cluster tested), by their own sphere, or always (they face
+  // away, or hold no triangle).
   std::vector<ClusterBounds> cluster_bounds_;
   enum class ClusterCull : std::uint8_t { as_object, own_sphere, always };
-  static constexpr double kOwnSphereRatio = 0.75;
+  static constexpr double kOwnSphereRatio = 0.5;
   struct EyeCluster {
     BoundingSphere sphere;
     ClusterCull cull = ClusterCull::as_object;
