@@ -687,6 +687,41 @@ TEST(Pipeline, NaiveMatchesFacetsExceptOnDepthTies) {
   EXPECT_GE(naive.stats.replicas, modern.stats.replicas);
 }
 
+// Clusters of mirrored and unevenly scaled objects: a mirror turns the winding normals, which the
+// clusters' cones follow, and an uneven scale is not a similarity, so its clusters keep no cone.
+// facets (clusters) and naive (whole objects) then draw the same image, as for the city itself.
+TEST(Pipeline, ClusterCullingFollowsMirroredAndScaledObjects) {
+  test::shared_context();
+  Scene scene = small_city();
+  std::size_t mirrored = 0, scaled = 0;
+  for (std::size_t o = 0; o < scene.objects.size(); ++o) {
+    Object& object = scene.objects[o];
+    const glm::vec3 c = 0.5f * (object.bounds_world.p_min + object.bounds_world.p_max);
+    const glm::vec3 scale = o % 3 == 0   ? glm::vec3(-1, 1, 1)
+                            : o % 3 == 1 ? glm::vec3(1, 1.7f, 0.6f)
+                                         : glm::vec3(1);
+    mirrored += o % 3 == 0;
+    scaled += o % 3 == 1;
+    object.T_world_object = glm::translate(glm::mat4(1.0f), c) *
+                            glm::scale(glm::mat4(1.0f), scale) *
+                            glm::translate(glm::mat4(1.0f), -c);
+  }
+  scene.update_bounds();
+  ASSERT_GT(mirrored, 10u);
+  ASSERT_GT(scaled, 10u);
+  const auto outputs = cylinder();
+  const glm::dmat4 view = city_view(3.0);
+  const Rendered modern = render("facets", scene, outputs, strips(40), view);
+  const Rendered naive = render("naive", scene, outputs, strips(40), view);
+  std::size_t differing = 0;
+  for (std::size_t k = 0; k < modern.ids[0].size(); ++k)
+    differing += modern.ids[0][k] != naive.ids[0][k];
+  EXPECT_LE(differing, modern.ids[0].size() / 500) << differing;
+  EXPECT_GT(modern.ids[0].size() - count_value(modern.ids[0], 0), modern.ids[0].size() / 4);
+  // Clusters facing away left the facets list.
+  EXPECT_LT(modern.stats.triangles_in, naive.stats.triangles_in);
+}
+
 TEST(Pipeline, BackgroundSphereLeavesNoHoles) {
   test::shared_context();
   const Scene sphere = background_sphere(96, 48, 50.0f);
