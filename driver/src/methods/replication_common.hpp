@@ -132,7 +132,8 @@ class FacetMethodBase : public RenderMethod {
     std::uint32_t triangles = 0;
     std::uint32_t triangles_sole_piece = 0;
     // The list: list_entries() entries, the header texel, the block table (sized for every
-    // triangle of the scene); its indirect arguments; the list build's object flags (GPU only).
+    // triangle of the scene); its indirect arguments; the list build's object flags, offsets
+    // and entry states (GPU only).
     Buffer list_buffer, ranges_buffer, list_args, object_visible_flags, list_offsets, entry_states;
     Texture list_texels;  // list_buffer as a buffer texture
     // Replication results, reused while neither the view nor any object transform changes.
@@ -168,10 +169,10 @@ class FacetMethodBase : public RenderMethod {
   virtual bool culls_clusters() const { return true; }
   // Instances of the tessellator form's patch draws for output `out` (list_args).
   virtual std::uint32_t patch_instances(const OutputState&) const { return 1; }
-  // Output i's list, culled and built on the CPU or queued on the GPU.
-  void build_list_on_cpu(std::size_t i);
   // eye_clusters_ for the view T_eye_world.
   void update_eye_clusters(const glm::dmat4& T_eye_world);
+  // Output i's list, culled and built on the CPU or queued on the GPU.
+  void build_list_on_cpu(std::size_t i);
   void build_list_on_gpu(std::size_t i);
   // Entries of every output's list: one per record.
   std::uint32_t list_entries() const { return std::uint32_t(entry_records_.size()); }
