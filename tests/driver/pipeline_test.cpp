@@ -671,20 +671,29 @@ TEST(Pipeline, TessellatedFormGivesTheFacetsIds) {
   }
 }
 
-TEST(Pipeline, NaiveMatchesFacetsExceptOnDepthTies) {
-  test::shared_context();
-  const Scene scene = small_city();
+// `facets` and `naive` on the cylinder's 40 strips from city_view(3.0), and how many ID pixels
+// differ between them.
+struct FacetsAndNaive {
+  Rendered modern, naive;
+  std::size_t differing = 0;
+};
+FacetsAndNaive render_facets_and_naive(const Scene& scene) {
   const auto outputs = cylinder();
   const glm::dmat4 view = city_view(3.0);
-  const Rendered modern = render("facets", scene, outputs, strips(40), view);
-  const Rendered naive = render("naive", scene, outputs, strips(40), view);
-  std::size_t differing = 0;
-  for (std::size_t k = 0; k < modern.ids[0].size(); ++k)
-    differing += modern.ids[0][k] != naive.ids[0][k];
+  FacetsAndNaive result{render("facets", scene, outputs, strips(40), view),
+                        render("naive", scene, outputs, strips(40), view)};
+  for (std::size_t k = 0; k < result.modern.ids[0].size(); ++k)
+    result.differing += result.modern.ids[0][k] != result.naive.ids[0][k];
+  return result;
+}
+
+TEST(Pipeline, NaiveMatchesFacetsExceptOnDepthTies) {
+  test::shared_context();
+  const FacetsAndNaive both = render_facets_and_naive(small_city());
   // Both draw the same (triangle, facet) fragments with the same arithmetic, in another order,
   // so only exact depth ties can resolve differently: at most 0.2% of pixels.
-  EXPECT_LE(differing, modern.ids[0].size() / 500) << differing;
-  EXPECT_GE(naive.stats.replicas, modern.stats.replicas);
+  EXPECT_LE(both.differing, both.modern.ids[0].size() / 500) << both.differing;
+  EXPECT_GE(both.naive.stats.replicas, both.modern.stats.replicas);
 }
 
 // Clusters of mirrored and unevenly scaled objects: a mirror turns the winding normals, which the
@@ -709,17 +718,12 @@ TEST(Pipeline, ClusterCullingFollowsMirroredAndScaledObjects) {
   scene.update_bounds();
   ASSERT_GT(mirrored, 10u);
   ASSERT_GT(scaled, 10u);
-  const auto outputs = cylinder();
-  const glm::dmat4 view = city_view(3.0);
-  const Rendered modern = render("facets", scene, outputs, strips(40), view);
-  const Rendered naive = render("naive", scene, outputs, strips(40), view);
-  std::size_t differing = 0;
-  for (std::size_t k = 0; k < modern.ids[0].size(); ++k)
-    differing += modern.ids[0][k] != naive.ids[0][k];
-  EXPECT_LE(differing, modern.ids[0].size() / 500) << differing;
-  EXPECT_GT(modern.ids[0].size() - count_value(modern.ids[0], 0), modern.ids[0].size() / 4);
+  const FacetsAndNaive both = render_facets_and_naive(scene);
+  const std::vector<std::uint32_t>& ids = both.modern.ids[0];
+  EXPECT_LE(both.differing, ids.size() / 500) << both.differing;
+  EXPECT_GT(ids.size() - count_value(ids, 0), ids.size() / 4);
   // Clusters facing away left the facets list.
-  EXPECT_LT(modern.stats.triangles_in, naive.stats.triangles_in);
+  EXPECT_LT(both.modern.stats.triangles_in, both.naive.stats.triangles_in);
 }
 
 TEST(Pipeline, BackgroundSphereLeavesNoHoles) {
