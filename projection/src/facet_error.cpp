@@ -4,8 +4,8 @@
 #include <cmath>
 #include <mutex>
 
-#include "facets_internal.hpp"
 #include "facet/projection/parallel.hpp"
+#include "facets_internal.hpp"
 
 namespace facet {
 namespace detail {

@@ -10,9 +10,9 @@
 
 #include "facet/projection/errors.hpp"
 #include "facet/projection/facet_error.hpp"
+#include "facet/projection/parallel.hpp"
 #include "facet/projection/warp.hpp"
 #include "facets_internal.hpp"
-#include "facet/projection/parallel.hpp"
 
 namespace facet {
 

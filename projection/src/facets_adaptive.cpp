@@ -10,8 +10,8 @@
 #include <unordered_map>
 
 #include "facet/projection/errors.hpp"
-#include "facets_internal.hpp"
 #include "facet/projection/parallel.hpp"
+#include "facets_internal.hpp"
 
 namespace facet::detail {
 namespace {

@@ -4,7 +4,6 @@
 #include <array>
 #include <bit>
 #include <cmath>
-#include <limits>
 #include <numbers>
 #include <optional>
 
@@ -335,14 +334,15 @@ ClusterBounds cluster_bounds(const Scene& scene, const GpuRecord& record) {
   if (record.triangle_count == 0) return bounds;
   std::array<glm::dvec3, 3 * kClusterTriangles> corners;
   std::array<glm::dvec3, kClusterTriangles> normals;
-  glm::dvec3 lo(std::numeric_limits<double>::infinity()), hi(-lo), normal_sum(0.0);
+  Aabb box;
+  glm::dvec3 normal_sum(0.0);
   bool every_normal = true;
   for (std::uint32_t t = 0; t < record.triangle_count; ++t) {
     glm::dvec3* p = &corners[3 * t];
     for (int c = 0; c < 3; ++c) {
-      p[c] = glm::dvec3(scene.positions[scene.indices[record.first_index + 3 * t + c]]);
-      lo = glm::min(lo, p[c]);
-      hi = glm::max(hi, p[c]);
+      const glm::vec3& position = scene.positions[scene.indices[record.first_index + 3 * t + c]];
+      box.extend(position);
+      p[c] = glm::dvec3(position);
     }
     // A normal shorter than 1e-6 of its edges' squared lengths is a sliver's, which the float
     // rounding of pass 1 may turn either way: then the cluster has no cone.
@@ -355,7 +355,7 @@ ClusterBounds cluster_bounds(const Scene& scene, const GpuRecord& record) {
       every_normal = false;
     }
   }
-  bounds.centre = 0.5 * (lo + hi);
+  bounds.centre = 0.5 * (glm::dvec3(box.p_min) + glm::dvec3(box.p_max));
   double radius2 = 0;
   for (std::uint32_t k = 0; k < 3 * record.triangle_count; ++k) {
     const glm::dvec3 d = corners[k] - bounds.centre;

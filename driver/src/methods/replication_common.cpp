@@ -261,13 +261,13 @@ bool FacetMethodBase::update_view(const glm::dmat4& T_eye_world, GpuTimer* timer
                   [](const OutputState& out) { return out.list_on_gpu; })) {
     // In float, grown by 1e-6 of the distance: more than the centre's rounding (about 1e-7 of it)
     // and the plane tests' (a few ulps of the distance).
-    std::vector<glm::vec4> spheres(std::max<std::size_t>(eye_spheres_.size(), 1), glm::vec4(-1));
-    for (std::size_t o = 0; o < eye_spheres_.size(); ++o) {
-      const BoundingSphere& sphere = eye_spheres_[o];
-      if (sphere.radius < 0) continue;
+    const auto float_sphere = [](const BoundingSphere& sphere) {
       const double grown = sphere.radius * 1.0001 + 1e-6 * glm::length(sphere.centre);
-      spheres[o] = glm::vec4(glm::vec3(sphere.centre), float(grown));
-    }
+      return glm::vec4(glm::vec3(sphere.centre), float(grown));
+    };
+    std::vector<glm::vec4> spheres(std::max<std::size_t>(eye_spheres_.size(), 1), glm::vec4(-1));
+    for (std::size_t o = 0; o < eye_spheres_.size(); ++o)
+      if (eye_spheres_[o].radius >= 0) spheres[o] = float_sphere(eye_spheres_[o]);
     object_spheres_buffer_.sub_data(0, spheres.size() * sizeof(glm::vec4), spheres.data());
     // The clusters' likewise, with w = kClusterCulledAlways or kClusterAsObject where their own
     // spheres are not tested.
@@ -275,12 +275,9 @@ bool FacetMethodBase::update_view(const glm::dmat4& T_eye_world, GpuTimer* timer
       std::vector<glm::vec4> cluster_spheres(eye_clusters_.size());
       for (std::size_t r = 0; r < eye_clusters_.size(); ++r) {
         const EyeCluster& cluster = eye_clusters_[r];
-        const BoundingSphere& sphere = cluster.sphere;
-        const double grown = sphere.radius * 1.0001 + 1e-6 * glm::length(sphere.centre);
-        cluster_spheres[r] = glm::vec4(glm::vec3(sphere.centre),
-                                       cluster.cull == ClusterCull::always ? kClusterCulledAlways
-                                       : cluster.cull == ClusterCull::as_object ? kClusterAsObject
-                                                                                : float(grown));
+        cluster_spheres[r] = float_sphere(cluster.sphere);
+        if (cluster.cull == ClusterCull::always) cluster_spheres[r].w = kClusterCulledAlways;
+        if (cluster.cull == ClusterCull::as_object) cluster_spheres[r].w = kClusterAsObject;
       }
       cluster_spheres_buffer_.sub_data(0, cluster_spheres.size() * sizeof(glm::vec4),
                                        cluster_spheres.data());
